@@ -1,0 +1,152 @@
+//! Anisotropic sampling correction — meshtrim's extension of the paper.
+//!
+//! A laser line scanner samples much more densely along its lines than
+//! between them. The paper's β then follows the dense direction while the
+//! empty circles between lines reach half the line spacing, so plain BPD
+//! marks nearly every point. Here each projected neighbourhood gets a
+//! *sampling tensor*
+//!
+//! T = mean over members of (e1 e1ᵀ + e2 e2ᵀ),
+//!
+//! where e1 is a member's vector to its nearest other member and e2 the
+//! vector to its nearest member at least 60° away from the line of e1. The
+//! neighbourhood is then mapped by M = T^(-1/2), scaled to det M = 1, in
+//! which the scan lines look evenly spaced; β and both tests run on the
+//! mapped points. On isotropic samples T is nearly a multiple of the
+//! identity and M nearly the identity, so the paper's behaviour is kept.
+//! Because det M = 1, β stays a length: the geometric mean of the spacings
+//! along and across the lines.
+
+use crate::frame::Point2;
+use crate::resolution::dist2;
+
+/// A 2×2 linear map, row-major: `[[a, b], [c, d]]`.
+pub type Map2 = [[f64; 2]; 2];
+
+/// The identity map.
+pub const IDENTITY: Map2 = [[1.0, 0.0], [0.0, 1.0]];
+
+/// Applies `m` to `p`.
+#[inline]
+pub fn apply(m: &Map2, p: Point2) -> Point2 {
+    [
+        m[0][0] * p[0] + m[0][1] * p[1],
+        m[1][0] * p[0] + m[1][1] * p[1],
+    ]
+}
+
+/// cos²(60°): e2 must make at least this much of an angle with e1's line.
+const COS2_MIN_ANGLE: f64 = 0.25;
+
+/// The sampling tensor T of a projected neighbourhood (unnormalised sum).
+pub fn sampling_tensor(pts: &[Point2]) -> [f64; 3] {
+    let mut t = [0.0; 3]; // txx, txy, tyy
+    for j in 0..pts.len() {
+        let Some(e1) = nearest_vector(pts, j, None) else {
+            continue;
+        };
+        add_outer(&mut t, e1);
+        if let Some(e2) = nearest_vector(pts, j, Some(e1)) {
+            add_outer(&mut t, e2);
+        }
+    }
+    t
+}
+
+/// M = T^(-1/2) scaled to unit determinant; the identity if T is singular.
+pub fn whitening_map(t: [f64; 3]) -> Map2 {
+    let [a, b, c] = t;
+    let half_trace = 0.5 * (a + c);
+    let disc = (0.25 * (a - c) * (a - c) + b * b).sqrt();
+    let (l1, l2) = (half_trace + disc, half_trace - disc);
+    if !(l2 > l1 * 1e-12) {
+        return IDENTITY;
+    }
+    // Unit eigenvector of l1.
+    let (vx, vy) = if b.abs() > 1e-300 * (a.abs() + c.abs()) && b != 0.0 {
+        let (x, y) = (l1 - c, b);
+        let n = (x * x + y * y).sqrt();
+        (x / n, y / n)
+    } else if a >= c {
+        (1.0, 0.0)
+    } else {
+        (0.0, 1.0)
+    };
+    // M = s1 v vᵀ + s2 w wᵀ with s_i = l_i^(-1/2), scaled so s1 s2 = 1.
+    let scale = (l1 * l2).powf(0.25);
+    let (s1, s2) = (scale / l1.sqrt(), scale / l2.sqrt());
+    let (wx, wy) = (-vy, vx);
+    [
+        [s1 * vx * vx + s2 * wx * wx, s1 * vx * vy + s2 * wx * wy],
+        [s1 * vx * vy + s2 * wx * wy, s1 * vy * vy + s2 * wy * wy],
+    ]
+}
+
+/// Vector from `pts[j]` to its nearest other member; with `away_from`, only
+/// members whose direction is at least 60° from that vector's line count.
+fn nearest_vector(pts: &[Point2], j: usize, away_from: Option<Point2>) -> Option<Point2> {
+    let p = pts[j];
+    let mut best: Option<(f64, Point2)> = None;
+    for (m, &q) in pts.iter().enumerate() {
+        let d2 = dist2(p, q);
+        if m == j || d2 == 0.0 || best.is_some_and(|(b, _)| d2 >= b) {
+            continue;
+        }
+        let e = [q[0] - p[0], q[1] - p[1]];
+        if let Some(e1) = away_from {
+            let dot = e[0] * e1[0] + e[1] * e1[1];
+            if dot * dot > COS2_MIN_ANGLE * d2 * (e1[0] * e1[0] + e1[1] * e1[1]) {
+                continue;
+            }
+        }
+        best = Some((d2, e));
+    }
+    best.map(|(_, e)| e)
+}
+
+fn add_outer(t: &mut [f64; 3], e: Point2) {
+    t[0] += e[0] * e[0];
+    t[1] += e[0] * e[1];
+    t[2] += e[1] * e[1];
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn det(m: &Map2) -> f64 {
+        m[0][0] * m[1][1] - m[0][1] * m[1][0]
+    }
+
+    #[test]
+    fn line_scan_becomes_isotropic() {
+        // Lines 4 apart along y at 30°, points 1 apart along each line.
+        let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+        let pts: Vec<Point2> = (0..35)
+            .map(|i| {
+                let (a, b) = ((i % 7) as f64 - 3.0, ((i / 7) as f64 - 2.0) * 4.0);
+                [c * a - s * b, s * a + c * b]
+            })
+            .collect();
+        let m = whitening_map(sampling_tensor(&pts));
+        assert!((det(&m) - 1.0).abs() < 1e-12);
+        let along = apply(&m, [c, s]);
+        let across = apply(&m, [-s * 4.0, c * 4.0]);
+        let (la, lc) = (along[0].hypot(along[1]), across[0].hypot(across[1]));
+        assert!(
+            (la - 2.0).abs() < 1e-9 && (lc - 2.0).abs() < 1e-9,
+            "{la} {lc}"
+        );
+    }
+
+    #[test]
+    fn square_grid_maps_to_itself() {
+        let pts: Vec<Point2> = (0..36).map(|i| [(i % 6) as f64, (i / 6) as f64]).collect();
+        let m = whitening_map(sampling_tensor(&pts));
+        for (r, e) in m.iter().zip(IDENTITY.iter()) {
+            for (x, y) in r.iter().zip(e.iter()) {
+                assert!((x - y).abs() < 1e-12);
+            }
+        }
+    }
+}

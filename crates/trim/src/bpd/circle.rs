@@ -1,0 +1,190 @@
+//! The empty-circle test of BPD (section 2 of the paper, eq. 1).
+//!
+//! The paper: P_i is a boundary point "if there is at least one circle [through
+//! P_i and two neighbours] with radius equal or bigger than β_i and if the
+//! sphere ... whose centre coincide with the centre of the circle, does not
+//! contain any other point of the neighbourhood". meshtrim runs the test in
+//! the neighbourhood's best-fit plane (see `docs/bpd.md` for why: in 3D,
+//! nearly collinear triples span circles perpendicular to the surface whose
+//! spheres are empty, so out-of-plane noise turns interior points into
+//! boundary points). A collinear triple spans a circle of infinite radius, a
+//! half-plane through P_i: it counts when that half-plane holds no
+//! neighbour, i.e. when P_i lies on the convex hull of its neighbourhood.
+//!
+//! Two implementations give the same answer:
+//! - [`empty_circle_reference`] tries all (k-1)(k-2)/2 circles, as eq. 1
+//!   counts them, against every other neighbour: O(k³).
+//! - [`largest_empty_circle_exceeds`] uses the fact that the empty circles
+//!   through P_i and two neighbours are exactly the circumcircles of the
+//!   Delaunay triangles at P_i, whose centres are the vertices of P_i's
+//!   Voronoi cell. The cell is clipped from a box of half-size L ≥ β by the
+//!   bisectors with the neighbours, nearest first; it stops as soon as no
+//!   vertex is β away from P_i (clipping only shrinks the cell). A vertex on
+//!   the box means the cell is unbounded (P_i on the hull) or has a vertex
+//!   beyond L ≥ β: both are boundary cases of the reference, so the answer
+//!   is "some vertex at distance ≥ β". O(k · cell size), no allocation.
+
+use crate::frame::Point2;
+
+/// Reference circle test: `pts[0]` is P_i at the origin, `pts[1..]` its
+/// neighbours (distinct, non-zero). True if an empty circle through P_i and
+/// two neighbours has radius ≥ `beta`, or a half-plane through P_i is empty.
+pub fn empty_circle_reference(pts: &[Point2], beta: f64) -> bool {
+    let nb = &pts[1..];
+    if on_hull_reference(nb) {
+        return true;
+    }
+    for j in 0..nb.len() {
+        for k in j + 1..nb.len() {
+            let Some(c) = circumcentre_with_origin(nb[j], nb[k]) else {
+                continue; // collinear: the half-plane case above covers it
+            };
+            let r2 = c[0] * c[0] + c[1] * c[1];
+            if r2 < beta * beta {
+                continue;
+            }
+            let empty = nb.iter().enumerate().all(|(m, &q)| {
+                m == j || m == k || {
+                    let (dx, dy) = (q[0] - c[0], q[1] - c[1]);
+                    dx * dx + dy * dy >= r2 * (1.0 - 1e-12)
+                }
+            });
+            if empty {
+                return true;
+            }
+        }
+    }
+    false
+}
+
+/// True if all points lie in a closed half-plane whose border passes through
+/// the origin (the largest angular gap between them is at least π).
+pub fn on_hull_reference(nb: &[Point2]) -> bool {
+    let mut angles: Vec<f64> = nb.iter().map(|p| p[1].atan2(p[0])).collect();
+    angles.sort_by(f64::total_cmp);
+    let Some(&first) = angles.first() else {
+        return true;
+    };
+    let mut gap: f64 = first + std::f64::consts::TAU - angles[angles.len() - 1];
+    for w in angles.windows(2) {
+        gap = gap.max(w[1] - w[0]);
+    }
+    gap >= std::f64::consts::PI - 1e-12
+}
+
+/// Centre of the circle through the origin, `a` and `b`; None if collinear.
+fn circumcentre_with_origin(a: Point2, b: Point2) -> Option<Point2> {
+    let d = 2.0 * (a[0] * b[1] - a[1] * b[0]);
+    let (na, nb) = (a[0] * a[0] + a[1] * a[1], b[0] * b[0] + b[1] * b[1]);
+    let scale = na.max(nb);
+    if d.abs() <= 1e-12 * scale {
+        return None;
+    }
+    Some([(na * b[1] - nb * a[1]) / d, (nb * a[0] - na * b[0]) / d])
+}
+
+/// Reusable buffers for [`largest_empty_circle_exceeds`].
+#[derive(Default, Debug, Clone)]
+pub struct CellScratch {
+    poly: Vec<Point2>,
+    next: Vec<Point2>,
+}
+
+/// Fast circle test: is some vertex of P_i's Voronoi cell (clipped to a box
+/// of half-size `max(2·max|q|, 2β)`) at least `beta` from P_i?
+///
+/// `nb` are the neighbours relative to P_i, nearest first.
+pub fn largest_empty_circle_exceeds(nb: &[Point2], beta: f64, s: &mut CellScratch) -> bool {
+    let reach = nb
+        .iter()
+        .map(|q| q[0] * q[0] + q[1] * q[1])
+        .fold(0.0, f64::max)
+        .sqrt();
+    let l = (2.0 * reach).max(2.0 * beta);
+    s.poly.clear();
+    s.poly
+        .extend_from_slice(&[[-l, -l], [l, -l], [l, l], [-l, l]]);
+    let beta2 = beta * beta;
+    let mut far2 = 2.0 * l * l; // largest squared vertex distance so far
+    for &q in nb {
+        let q2 = q[0] * q[0] + q[1] * q[1];
+        // The bisector x·q = |q|²/2 cannot cut a cell within radius |q|/2.
+        if 0.25 * q2 >= far2 {
+            continue;
+        }
+        clip(&s.poly, q, 0.5 * q2, &mut s.next);
+        std::mem::swap(&mut s.poly, &mut s.next);
+        far2 = s
+            .poly
+            .iter()
+            .map(|v| v[0] * v[0] + v[1] * v[1])
+            .fold(0.0, f64::max);
+        if far2 < beta2 {
+            return false;
+        }
+    }
+    far2 >= beta2
+}
+
+/// Keeps the part of convex polygon `poly` where x·n <= h (Sutherland–Hodgman).
+fn clip(poly: &[Point2], n: Point2, h: f64, out: &mut Vec<Point2>) {
+    out.clear();
+    let side = |p: Point2| p[0] * n[0] + p[1] * n[1] - h;
+    for i in 0..poly.len() {
+        let a = poly[i];
+        let b = poly[(i + 1) % poly.len()];
+        let (sa, sb) = (side(a), side(b));
+        if sa <= 0.0 {
+            out.push(a);
+        }
+        if (sa < 0.0 && sb > 0.0) || (sa > 0.0 && sb < 0.0) {
+            let t = sa / (sa - sb);
+            out.push([a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grid_around(skip: impl Fn(f64, f64) -> bool) -> Vec<Point2> {
+        let mut pts = vec![[0.0, 0.0]];
+        for i in -3..=3 {
+            for j in -3..=3 {
+                let (x, y) = (i as f64, j as f64);
+                if (i, j) != (0, 0) && !skip(x, y) {
+                    pts.push([x, y]);
+                }
+            }
+        }
+        pts[1..].sort_by(|a, b| (a[0].hypot(a[1])).total_cmp(&b[0].hypot(b[1])));
+        pts
+    }
+
+    #[test]
+    fn interior_grid_point_has_no_big_empty_circle() {
+        let pts = grid_around(|_, _| false);
+        let mut s = CellScratch::default();
+        assert!(!empty_circle_reference(&pts, 1.0));
+        assert!(!largest_empty_circle_exceeds(&pts[1..], 1.0, &mut s));
+    }
+
+    #[test]
+    fn point_beside_a_hole_has_one() {
+        // Remove a 2×2 block next to the origin: a hole of radius ~1.
+        let pts = grid_around(|x, y| (1.0..=2.0).contains(&x) && (0.0..=1.0).contains(&y));
+        let mut s = CellScratch::default();
+        assert!(empty_circle_reference(&pts, 1.0));
+        assert!(largest_empty_circle_exceeds(&pts[1..], 1.0, &mut s));
+    }
+
+    #[test]
+    fn point_on_a_straight_border_is_on_the_hull() {
+        let pts = grid_around(|_, y| y > 0.0);
+        let mut s = CellScratch::default();
+        assert!(on_hull_reference(&pts[1..]));
+        assert!(empty_circle_reference(&pts, 1.0));
+        assert!(largest_empty_circle_exceeds(&pts[1..], 1.0, &mut s));
+    }
+}

@@ -1,0 +1,270 @@
+//! BPD — boundary point detection (section 2 of the paper).
+//!
+//! For every point P_i of an unorganised surface cloud, with no user
+//! threshold:
+//! 1. its k nearest neighbours, P_i included ([`crate::neighbours`]);
+//! 2. their best-fit plane and 2D projection ([`crate::frame`]), mapped by the
+//!    sampling tensor when `anisotropy` is on ([`crate::anisotropy`]);
+//! 3. the local resolution β_i = μ_i + 2σ_i ([`crate::resolution`]);
+//! 4. the empty-circle test ([`circle`]); if it does not find P_i on the
+//!    boundary,
+//! 5. the surrounding-path test ([`polar`]).
+//!
+//! [`detect_boundary`] is the fast, parallel version; [`detect_boundary_reference`]
+//! runs the same decisions with the plain O(k³) circle test, one point at a
+//! time, and exists to check the fast one.
+
+pub mod circle;
+pub mod polar;
+
+use rayon::prelude::*;
+
+use crate::anisotropy::{apply, sampling_tensor, whitening_map};
+use crate::cloud::{check_not_degenerate, merge_duplicates, Point3, Sites};
+use crate::error::CloudError;
+use crate::frame::{fit_plane, project, Point2};
+use crate::neighbours::NeighbourIndex;
+use crate::resolution::{beta_of, nearest_distances};
+
+/// Options of boundary point detection.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BpdOptions {
+    /// Neighbourhood size, the point itself included (the paper's k = 30,
+    /// so 29 neighbours). Must be at least [`BpdOptions::MIN_K`].
+    pub k: usize,
+    /// Map each projected neighbourhood by its sampling tensor before the
+    /// tests (meshtrim's extension for line scans; see [`crate::anisotropy`]).
+    /// Off gives the paper's isotropic behaviour.
+    pub anisotropy: bool,
+}
+
+impl BpdOptions {
+    /// Smallest accepted k: the point and three neighbours.
+    pub const MIN_K: usize = 4;
+}
+
+impl Default for BpdOptions {
+    fn default() -> Self {
+        Self {
+            k: 30,
+            anisotropy: true,
+        }
+    }
+}
+
+/// Which test labelled a point.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Decision {
+    /// An empty circle of radius ≥ β, or an empty half-plane, through P_i.
+    EmptyCircle,
+    /// No surrounding path through the neighbours.
+    OpenPath,
+    /// Both tests found P_i surrounded.
+    Interior,
+}
+
+/// Result of boundary point detection, one entry per input point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Detection {
+    /// True for boundary points, in input order.
+    pub boundary: Vec<bool>,
+    /// Local resolution β_i, in input order (in the cloud's units).
+    pub beta: Vec<f64>,
+    /// Which test decided each point, in input order.
+    pub decision: Vec<Decision>,
+    /// Number of input points that were exact copies of an earlier point
+    /// (they share the label of that point).
+    pub duplicates: usize,
+}
+
+impl Detection {
+    /// Number of boundary points.
+    pub fn boundary_count(&self) -> usize {
+        self.boundary.iter().filter(|&&b| b).count()
+    }
+}
+
+/// Fast, parallel BPD. The labels do not depend on the number of threads.
+pub fn detect_boundary(points: &[Point3], options: &BpdOptions) -> Result<Detection, CloudError> {
+    detect_boundary_with_progress(points, options, &|_| {})
+}
+
+/// [`detect_boundary`], calling `progress(done)` with the number of distinct
+/// points processed so far, a few hundred times over the run.
+pub fn detect_boundary_with_progress(
+    points: &[Point3],
+    options: &BpdOptions,
+    progress: &(dyn Fn(usize) + Sync),
+) -> Result<Detection, CloudError> {
+    let sites = prepare(points, options)?;
+    let index = NeighbourIndex::new(&sites.points);
+    let order = spatial_order(&sites.points);
+    let mut verdicts = vec![(Decision::Interior, 0.0); sites.points.len()];
+    let block = (order.len() / 256).clamp(4096, 65536);
+    for (b, chunk) in order.chunks(block).enumerate() {
+        let found: Vec<(Decision, f64)> = chunk
+            .par_iter()
+            .with_min_len(256)
+            .map_init(Scratch::default, |s, &i| {
+                analyse_point(&index, i as usize, options, s, TestImpl::Fast)
+            })
+            .collect();
+        for (&i, v) in chunk.iter().zip(found) {
+            verdicts[i as usize] = v;
+        }
+        progress((b * block + chunk.len()).min(order.len()));
+    }
+    Ok(spread_to_input(&sites, &verdicts))
+}
+
+/// Plain, sequential BPD with the O(k³) reference circle test.
+pub fn detect_boundary_reference(
+    points: &[Point3],
+    options: &BpdOptions,
+) -> Result<Detection, CloudError> {
+    let sites = prepare(points, options)?;
+    let index = NeighbourIndex::new(&sites.points);
+    let mut s = Scratch::default();
+    let verdicts: Vec<(Decision, f64)> = (0..sites.points.len())
+        .map(|i| analyse_point(&index, i, options, &mut s, TestImpl::Reference))
+        .collect();
+    Ok(spread_to_input(&sites, &verdicts))
+}
+
+fn prepare(points: &[Point3], options: &BpdOptions) -> Result<Sites, CloudError> {
+    if options.k < BpdOptions::MIN_K {
+        return Err(CloudError::KTooSmall {
+            k: options.k,
+            min: BpdOptions::MIN_K,
+        });
+    }
+    let sites = merge_duplicates(points)?;
+    check_not_degenerate(&sites.points)?;
+    if sites.points.len() < options.k {
+        return Err(CloudError::TooFewPoints {
+            distinct: sites.points.len(),
+            total: points.len(),
+            k: options.k,
+        });
+    }
+    Ok(sites)
+}
+
+fn spread_to_input(sites: &Sites, verdicts: &[(Decision, f64)]) -> Detection {
+    let at = |i: &u32| verdicts[*i as usize];
+    Detection {
+        boundary: sites
+            .site_of
+            .iter()
+            .map(|i| at(i).0 != Decision::Interior)
+            .collect(),
+        beta: sites.site_of.iter().map(|i| at(i).1).collect(),
+        decision: sites.site_of.iter().map(|i| at(i).0).collect(),
+        duplicates: sites.duplicates(),
+    }
+}
+
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum TestImpl {
+    Fast,
+    Reference,
+}
+
+/// Per-thread buffers: nothing is allocated per point once they have grown.
+#[derive(Default)]
+struct Scratch {
+    members: Vec<u32>,
+    projected: Vec<Point2>,
+    distances: Vec<f64>,
+    neighbours: Vec<Point2>,
+    cell: circle::CellScratch,
+    polar: polar::PolarScratch,
+}
+
+/// Runs steps 1–5 on point `i`; returns its decision and β_i.
+fn analyse_point(
+    index: &NeighbourIndex,
+    i: usize,
+    options: &BpdOptions,
+    s: &mut Scratch,
+    how: TestImpl,
+) -> (Decision, f64) {
+    let points = index.points();
+    index.nearest(i, options.k, &mut s.members);
+    let frame = fit_plane(points, &s.members);
+    project(points, &s.members, &frame, &mut s.projected);
+    if options.anisotropy {
+        let map = whitening_map(sampling_tensor(&s.projected));
+        for q in s.projected.iter_mut() {
+            *q = apply(&map, *q);
+        }
+    }
+    nearest_distances(&s.projected, &mut s.distances);
+    let beta = beta_of(&s.distances);
+    // Neighbours that project onto P_i itself carry no direction.
+    s.neighbours.clear();
+    s.neighbours.extend(
+        s.projected[1..]
+            .iter()
+            .copied()
+            .filter(|q| q[0] != 0.0 || q[1] != 0.0),
+    );
+    let by_circle = match how {
+        TestImpl::Fast => circle::largest_empty_circle_exceeds(&s.neighbours, beta, &mut s.cell),
+        TestImpl::Reference => {
+            s.projected.truncate(1);
+            s.projected.extend_from_slice(&s.neighbours);
+            circle::empty_circle_reference(&s.projected, beta)
+        }
+    };
+    let decision = if by_circle {
+        Decision::EmptyCircle
+    } else if polar::surrounding_path_is_open(&s.neighbours, &mut s.polar) {
+        Decision::OpenPath
+    } else {
+        Decision::Interior
+    };
+    (decision, beta)
+}
+
+/// Indices of `points` sorted along a Morton (Z-order) curve, so that
+/// consecutive queries touch the same part of the tree.
+fn spatial_order(points: &[Point3]) -> Vec<u32> {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in points {
+        for a in 0..3 {
+            lo[a] = lo[a].min(p[a]);
+            hi[a] = hi[a].max(p[a]);
+        }
+    }
+    let extent = (0..3)
+        .map(|a| hi[a] - lo[a])
+        .fold(0.0, f64::max)
+        .max(f64::MIN_POSITIVE);
+    let scale = ((1u64 << 21) - 1) as f64 / extent;
+    let mut keyed: Vec<(u64, u32)> = points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let cell = |a: usize| ((p[a] - lo[a]) * scale) as u64;
+            (
+                spread_bits(cell(0)) | spread_bits(cell(1)) << 1 | spread_bits(cell(2)) << 2,
+                i as u32,
+            )
+        })
+        .collect();
+    keyed.par_sort_unstable();
+    keyed.into_iter().map(|(_, i)| i).collect()
+}
+
+/// Spreads the low 21 bits of `x` so they occupy every third bit.
+fn spread_bits(x: u64) -> u64 {
+    let mut x = x & 0x1f_ffff;
+    x = (x | x << 32) & 0x001f_0000_0000_ffff;
+    x = (x | x << 16) & 0x001f_0000_ff00_00ff;
+    x = (x | x << 8) & 0x100f_00f0_0f00_f00f;
+    x = (x | x << 4) & 0x10c3_0c30_c30c_30c3;
+    x = (x | x << 2) & 0x1249_2492_4924_9249;
+    x
+}

@@ -1,0 +1,180 @@
+//! The surrounding-path test of BPD (section 2 of the paper, eqs. 2–5).
+//!
+//! "P_i is a boundary point if it is not possible to find a path that
+//! surrounds it and passes through the neighbour points." In the projected
+//! (and anisotropy-mapped) neighbourhood, with P_i at the pole:
+//!
+//! - polar coordinates (R_j, θ_j) of the neighbours;
+//! - the angular sector spanned by them runs from θ_min to θ_max, taken as
+//!   the complement of the largest empty angular gap (so the sector holds
+//!   every neighbour and θ_max − θ_min < 2π);
+//! - normalisation, eqs. 2–3: r_j = (R_j − R_min)/(R_max − R_min),
+//!   ϑ_j = (θ_j − θ_min)/(θ_max − θ_min) (r_j = 0 when all R_j are equal);
+//! - start point, eq. 4: the minimum of γ_j = r_j + |ϑ_j − ϑ_bis| with
+//!   ϑ_bis = ½, the bisector of the sector;
+//! - linking, eq. 5: γ_p = r_p + c·|Δϑ_p|, where Δϑ_p is the angle from the
+//!   last linked point to p taken the short way round (circularly, in
+//!   (−π, π], divided by the sector width) and c = −1 when p keeps the
+//!   direction of the previous step, +1 when it reverses it. As printed,
+//!   (ϑ_p − ϑ_last)·c, the factor c cancels (both directions get −|Δϑ|·sgn of
+//!   the previous step) and non-circular differences can never wind 2π; the
+//!   magnitude form is the reading that does what the text says c is for:
+//!   "any anti-clockwise rotation is penalised". The first step has no
+//!   direction to keep, so it takes γ_p = r_p + |Δϑ_p|, the nearest point in
+//!   angle and radius, like eq. 4;
+//! - α = Σ Δθ and τ = Σ |Δθ| over the steps; linking stops when no
+//!   neighbour is left or τ > 2π; P_i is a boundary point iff |α| < 2π.
+//!
+//! Ties in γ go to the lower neighbour index (neighbours are sorted by
+//! distance, then index), so the result is deterministic.
+
+use std::f64::consts::{PI, TAU};
+
+use crate::frame::Point2;
+
+/// Reusable buffers for [`surrounding_path_is_open`].
+#[derive(Default, Debug, Clone)]
+pub struct PolarScratch {
+    theta: Vec<f64>,
+    r: Vec<f64>,
+    sorted: Vec<f64>,
+    used: Vec<bool>,
+}
+
+/// Runs the surrounding-path test on neighbours `nb` (relative to P_i,
+/// non-zero). Returns true when no path surrounds P_i: a boundary point.
+pub fn surrounding_path_is_open(nb: &[Point2], s: &mut PolarScratch) -> bool {
+    if nb.len() < 2 {
+        return true;
+    }
+    s.theta.clear();
+    s.theta.extend(nb.iter().map(|p| p[1].atan2(p[0])));
+    let (theta_min, width) = occupied_sector(&s.theta, &mut s.sorted);
+    if width <= 0.0 {
+        return true;
+    }
+    let (r_min, r_max) = nb
+        .iter()
+        .map(|p| p[0].hypot(p[1]))
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), r| {
+            (lo.min(r), hi.max(r))
+        });
+    let r_span = r_max - r_min;
+    s.r.clear();
+    s.r.extend(nb.iter().map(|p| {
+        if r_span > 0.0 {
+            (p[0].hypot(p[1]) - r_min) / r_span
+        } else {
+            0.0
+        }
+    }));
+    // Eq. 4: start nearest the pole and the sector's bisector.
+    let normalised = |t: f64| (t - theta_min).rem_euclid(TAU) / width;
+    let start = argmin(nb.len(), |j| s.r[j] + (normalised(s.theta[j]) - 0.5).abs());
+    s.used.clear();
+    s.used.resize(nb.len(), false);
+    s.used[start] = true;
+    let (mut last, mut previous_turn) = (start, 0.0f64);
+    let (mut alpha, mut tau) = (0.0f64, 0.0f64);
+    for _ in 1..nb.len() {
+        let theta_last = s.theta[last];
+        let next = argmin(nb.len(), |p| {
+            if s.used[p] {
+                return f64::INFINITY;
+            }
+            let turn = circular_difference(s.theta[p], theta_last);
+            let c = if previous_turn == 0.0 || turn * previous_turn < 0.0 {
+                1.0
+            } else {
+                -1.0
+            };
+            s.r[p] + c * turn.abs() / width
+        });
+        let turn = circular_difference(s.theta[next], theta_last);
+        alpha += turn;
+        tau += turn.abs();
+        if turn != 0.0 {
+            previous_turn = turn;
+        }
+        s.used[next] = true;
+        last = next;
+        if tau > TAU {
+            break;
+        }
+    }
+    alpha.abs() < TAU
+}
+
+/// Start angle and width of the smallest sector holding all `theta`: the
+/// complement of the largest gap between consecutive angles.
+fn occupied_sector(theta: &[f64], sorted: &mut Vec<f64>) -> (f64, f64) {
+    sorted.clear();
+    sorted.extend_from_slice(theta);
+    sorted.sort_by(f64::total_cmp);
+    let n = sorted.len();
+    let mut gap = sorted[0] + TAU - sorted[n - 1];
+    let mut start = sorted[0];
+    for w in sorted.windows(2) {
+        if w[1] - w[0] > gap {
+            gap = w[1] - w[0];
+            start = w[1];
+        }
+    }
+    (start, TAU - gap)
+}
+
+/// `a − b` wrapped into (−π, π].
+fn circular_difference(a: f64, b: f64) -> f64 {
+    let d = (a - b).rem_euclid(TAU);
+    if d > PI {
+        d - TAU
+    } else {
+        d
+    }
+}
+
+fn argmin(n: usize, mut cost: impl FnMut(usize) -> f64) -> usize {
+    let mut best = (f64::INFINITY, 0);
+    for j in 0..n {
+        let c = cost(j);
+        if c < best.0 {
+            best = (c, j);
+        }
+    }
+    best.1
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ring(n: usize, radius: f64, from: f64, to: f64) -> Vec<Point2> {
+        (0..n)
+            .map(|i| {
+                let t = from + (to - from) * i as f64 / (n - 1) as f64;
+                [radius * t.cos(), radius * t.sin()]
+            })
+            .collect()
+    }
+
+    #[test]
+    fn point_inside_a_full_ring_is_surrounded() {
+        let mut nb = ring(12, 1.0, 0.0, TAU * 11.0 / 12.0);
+        nb.extend(ring(17, 2.0, 0.1, 0.1 + TAU * 16.0 / 17.0));
+        assert!(!surrounding_path_is_open(&nb, &mut PolarScratch::default()));
+    }
+
+    #[test]
+    fn point_on_the_hull_is_open() {
+        let mut nb = ring(10, 1.0, 0.0, 0.9 * PI);
+        nb.extend(ring(19, 2.0, 0.05, 0.9 * PI));
+        assert!(surrounding_path_is_open(&nb, &mut PolarScratch::default()));
+    }
+
+    #[test]
+    fn circular_difference_takes_the_short_way() {
+        assert!((circular_difference(3.0, -3.0) - (6.0 - TAU)).abs() < 1e-12);
+        assert!((circular_difference(-3.0, 3.0) - (TAU - 6.0)).abs() < 1e-12);
+        assert_eq!(circular_difference(PI, 0.0), PI);
+    }
+}

@@ -1,0 +1,195 @@
+//! A validated point cloud: finite coordinates, exact duplicates merged.
+//!
+//! Scanners and merged scan passes often repeat a point exactly. A repeated
+//! point adds no information about the surface but would put a zero into the
+//! nearest-neighbour distances of the local resolution (section 2 of the
+//! paper) and hide a real neighbour from the k-NN query. So exact duplicates
+//! are merged into one *site* before detection, and every copy gets the
+//! label and resolution of its site. Points that differ in any bit are kept
+//! as they are.
+
+use crate::error::CloudError;
+
+/// A point in 3D, in the cloud's own units.
+pub type Point3 = [f64; 3];
+
+/// The distinct points of a cloud and the map from input points to them.
+#[derive(Debug, Clone)]
+pub struct Sites {
+    /// Distinct points, in order of first appearance in the input.
+    pub points: Vec<Point3>,
+    /// For every input point, the index of its site in `points`.
+    pub site_of: Vec<u32>,
+}
+
+impl Sites {
+    /// Number of input points that were copies of an earlier point.
+    pub fn duplicates(&self) -> usize {
+        self.site_of.len() - self.points.len()
+    }
+}
+
+/// Checks that every coordinate is finite and merges exact duplicates.
+pub fn merge_duplicates(points: &[Point3]) -> Result<Sites, CloudError> {
+    if let Some((index, p)) = points
+        .iter()
+        .enumerate()
+        .find(|(_, p)| p.iter().any(|c| !c.is_finite()))
+    {
+        return Err(CloudError::NonFinite {
+            index,
+            x: p[0],
+            y: p[1],
+            z: p[2],
+        });
+    }
+    // Sort indices by coordinate bits (+0.0 and -0.0 are the same point).
+    let key = |p: &Point3| p.map(|c| (c + 0.0).to_bits());
+    let mut order: Vec<u32> = (0..points.len() as u32).collect();
+    order.sort_unstable_by_key(|&i| (key(&points[i as usize]), i));
+    let mut site_of = vec![u32::MAX; points.len()];
+    let mut first_of_run = vec![0u32; points.len()];
+    for w in 0..order.len() {
+        let i = order[w];
+        let same_as_prev = w > 0 && key(&points[order[w - 1] as usize]) == key(&points[i as usize]);
+        first_of_run[i as usize] = if same_as_prev {
+            first_of_run[order[w - 1] as usize]
+        } else {
+            i
+        };
+    }
+    let mut sites = Vec::new();
+    for i in 0..points.len() {
+        let first = first_of_run[i] as usize;
+        if first == i {
+            site_of[i] = sites.len() as u32;
+            sites.push(points[i]);
+        } else {
+            site_of[i] = site_of[first];
+        }
+    }
+    Ok(Sites {
+        points: sites,
+        site_of,
+    })
+}
+
+/// Rejects clouds whose distinct points all coincide or are collinear.
+///
+/// Collinearity is judged relative to the cloud's extent, so the verdict does
+/// not depend on units or position.
+pub fn check_not_degenerate(points: &[Point3]) -> Result<(), CloudError> {
+    let distinct = points.len();
+    let Some(&a) = points.first() else {
+        return Err(CloudError::Degenerate {
+            distinct,
+            what: "one point",
+        });
+    };
+    let far = |from: Point3| {
+        points
+            .iter()
+            .copied()
+            .max_by(|p, q| dist2(*p, from).total_cmp(&dist2(*q, from)))
+            .unwrap_or(from)
+    };
+    let b = far(a);
+    let extent2 = dist2(a, b);
+    if extent2 == 0.0 {
+        return Err(CloudError::Degenerate {
+            distinct,
+            what: "one point",
+        });
+    }
+    let ab = sub(b, a);
+    let off_line2 = points
+        .iter()
+        .map(|p| norm2(cross(ab, sub(*p, a))) / extent2)
+        .fold(0.0, f64::max);
+    // Farthest distance from the line a-b, relative to the extent.
+    if off_line2 <= extent2 * 1e-20 {
+        return Err(CloudError::Degenerate {
+            distinct,
+            what: "one line",
+        });
+    }
+    Ok(())
+}
+
+pub(crate) fn sub(a: Point3, b: Point3) -> Point3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+pub(crate) fn dot(a: Point3, b: Point3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+pub(crate) fn cross(a: Point3, b: Point3) -> Point3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+pub(crate) fn norm2(a: Point3) -> f64 {
+    dot(a, a)
+}
+
+pub(crate) fn dist2(a: Point3, b: Point3) -> f64 {
+    norm2(sub(a, b))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn duplicates_map_to_their_first_copy() {
+        let pts = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 0.0, 0.0],
+            [-0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+        ];
+        let s = merge_duplicates(&pts).unwrap();
+        assert_eq!(s.points, vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]);
+        assert_eq!(s.site_of, vec![0, 1, 0, 0, 1]);
+        assert_eq!(s.duplicates(), 3);
+    }
+
+    #[test]
+    fn non_finite_is_reported_with_its_index() {
+        let pts = [[0.0, 0.0, 0.0], [1.0, f64::NAN, 0.0]];
+        assert!(matches!(
+            merge_duplicates(&pts),
+            Err(CloudError::NonFinite { index: 1, .. })
+        ));
+    }
+
+    #[test]
+    fn collinear_and_coincident_clouds_are_degenerate() {
+        let line: Vec<Point3> = (0..50)
+            .map(|i| [i as f64, 2.0 * i as f64, -(i as f64)])
+            .collect();
+        assert!(matches!(
+            check_not_degenerate(&line),
+            Err(CloudError::Degenerate {
+                what: "one line",
+                ..
+            })
+        ));
+        assert!(matches!(
+            check_not_degenerate(&[[3.0; 3]]),
+            Err(CloudError::Degenerate {
+                what: "one point",
+                ..
+            })
+        ));
+        let plane: Vec<Point3> = (0..50)
+            .map(|i| [(i % 7) as f64, (i / 7) as f64, 0.0])
+            .collect();
+        assert!(check_not_degenerate(&plane).is_ok());
+    }
+}

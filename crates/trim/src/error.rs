@@ -1,0 +1,50 @@
+//! Error types of the algorithm library.
+//!
+//! Every variant says what was wrong with the input and, where it applies,
+//! which element. Internal invariants are `debug_assert!`s, never errors.
+
+use thiserror::Error;
+
+/// Why a point cloud was rejected before boundary detection.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum CloudError {
+    /// A coordinate is NaN or infinite. Readers drop or report such points
+    /// before they reach the library; this catches what they let through.
+    #[error("point {index} has a non-finite coordinate ({x}, {y}, {z})")]
+    NonFinite {
+        /// Index of the first offending point in the input slice.
+        index: usize,
+        /// Its coordinates.
+        x: f64,
+        /// Its coordinates.
+        y: f64,
+        /// Its coordinates.
+        z: f64,
+    },
+    /// The neighbourhood size is too small for the tests to mean anything.
+    #[error("k = {k} is too small: boundary detection needs k >= {min} (the point itself and at least {} neighbours)", min - 1)]
+    KTooSmall {
+        /// Requested neighbourhood size.
+        k: usize,
+        /// Smallest accepted value.
+        min: usize,
+    },
+    /// Fewer distinct points than one neighbourhood holds.
+    #[error("the cloud has {distinct} distinct points ({total} in all), fewer than the neighbourhood size k = {k}; lower --k or use a denser cloud")]
+    TooFewPoints {
+        /// Points after merging exact duplicates.
+        distinct: usize,
+        /// Points given.
+        total: usize,
+        /// Requested neighbourhood size.
+        k: usize,
+    },
+    /// All points coincide or lie on one line: there is no surface.
+    #[error("the cloud is degenerate: all {distinct} distinct points lie on {what}, so it has no surface and no boundary")]
+    Degenerate {
+        /// Number of distinct points.
+        distinct: usize,
+        /// "one point" or "one line".
+        what: &'static str,
+    },
+}
