@@ -59,7 +59,9 @@ pub fn whitening_map(t: [f64; 3]) -> Map2 {
     let half_trace = 0.5 * (a + c);
     let disc = (0.25 * (a - c) * (a - c) + b * b).sqrt();
     let (l1, l2) = (half_trace + disc, half_trace - disc);
-    if !(l2 > l1 * 1e-12) {
+    // Also catches NaN: a degenerate or non-finite tensor gives no usable map.
+    let well_conditioned = l2 > l1 * 1e-12;
+    if !well_conditioned {
         return IDENTITY;
     }
     // Unit eigenvector of l1.

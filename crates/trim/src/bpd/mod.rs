@@ -268,3 +268,100 @@ fn spread_bits(x: u64) -> u64 {
     x = (x | x << 2) & 0x1249_2492_4924_9249;
     x
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    /// A wavy jittered sheet with a hole and a notch, plus uniform noise.
+    fn random_sheet(seed: u64, n_side: usize, noise: f64, stretch: f64) -> Vec<Point3> {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let mut pts = Vec::new();
+        for i in 0..n_side {
+            for j in 0..n_side {
+                let x = i as f64 + rng.random_range(-0.35..0.35);
+                let y = (j as f64 + rng.random_range(-0.35..0.35)) * stretch;
+                let hole = (x - 0.3 * n_side as f64).hypot(y - 0.5 * n_side as f64 * stretch) < 3.0;
+                let notch = x > 0.7 * n_side as f64 && y < 0.3 * n_side as f64 * stretch;
+                if hole || notch {
+                    continue;
+                }
+                let z = 0.05 * (x * x + y * y).sqrt()
+                    + 2.0 * (0.1 * x).sin()
+                    + rng.random_range(-noise..=noise);
+                pts.push([x, y, z]);
+            }
+        }
+        pts
+    }
+
+    #[test]
+    fn fast_detection_matches_reference_on_random_clouds() {
+        for seed in 0..6 {
+            let noise = [0.0, 0.1, 0.4][seed as usize % 3];
+            let stretch = [1.0, 3.0][seed as usize % 2];
+            let pts = random_sheet(seed, 40, noise, stretch);
+            for anisotropy in [false, true] {
+                let opts = BpdOptions { k: 30, anisotropy };
+                let fast = detect_boundary(&pts, &opts).unwrap();
+                let slow = detect_boundary_reference(&pts, &opts).unwrap();
+                assert_eq!(fast.beta, slow.beta, "seed {seed}");
+                let differ: Vec<usize> = (0..pts.len())
+                    .filter(|&i| fast.boundary[i] != slow.boundary[i])
+                    .collect();
+                assert!(
+                    differ.is_empty(),
+                    "seed {seed} anisotropy {anisotropy}: labels differ at {differ:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn labels_do_not_depend_on_thread_count() {
+        let pts = random_sheet(11, 60, 0.2, 1.0);
+        let run = |threads| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| detect_boundary(&pts, &BpdOptions::default()).unwrap())
+        };
+        assert_eq!(run(1), run(2));
+        assert_eq!(run(1), run(3));
+    }
+
+    #[test]
+    fn duplicates_share_their_site_label_and_do_not_change_it() {
+        let pts = random_sheet(3, 30, 0.0, 1.0);
+        let mut doubled = pts.clone();
+        doubled.extend_from_slice(&pts);
+        let once = detect_boundary(&pts, &BpdOptions::default()).unwrap();
+        let twice = detect_boundary(&doubled, &BpdOptions::default()).unwrap();
+        assert_eq!(twice.duplicates, pts.len());
+        assert_eq!(&twice.boundary[..pts.len()], &once.boundary[..]);
+        assert_eq!(&twice.boundary[pts.len()..], &once.boundary[..]);
+    }
+
+    #[test]
+    fn bad_inputs_are_errors() {
+        let opts = BpdOptions::default();
+        let few: Vec<Point3> = (0..10).map(|i| [i as f64, (i * i) as f64, 0.0]).collect();
+        assert!(matches!(
+            detect_boundary(&few, &opts),
+            Err(CloudError::TooFewPoints { .. })
+        ));
+        let same = vec![[1.0, 2.0, 3.0]; 100];
+        assert!(matches!(
+            detect_boundary(&same, &opts),
+            Err(CloudError::Degenerate { .. })
+        ));
+        let k3 = BpdOptions { k: 3, ..opts };
+        assert!(matches!(
+            detect_boundary(&few, &k3),
+            Err(CloudError::KTooSmall { .. })
+        ));
+    }
+}
