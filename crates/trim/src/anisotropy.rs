@@ -19,6 +19,7 @@
 
 use crate::frame::Point2;
 use crate::resolution::dist2;
+use crate::rows::RowScratch;
 
 /// A 2×2 linear map, row-major: `[[a, b], [c, d]]`.
 pub type Map2 = [[f64; 2]; 2];
@@ -39,6 +40,7 @@ pub fn apply(m: &Map2, p: Point2) -> Point2 {
 const COS2_MIN_ANGLE: f64 = 0.25;
 
 /// The sampling tensor T of a projected neighbourhood (unnormalised sum).
+/// Plain reference of [`sampling_tensor_fast`].
 pub fn sampling_tensor(pts: &[Point2]) -> [f64; 3] {
     let mut t = [0.0; 3]; // txx, txy, tyy
     for j in 0..pts.len() {
@@ -97,13 +99,32 @@ fn nearest_vector(pts: &[Point2], j: usize, away_from: Option<Point2>) -> Option
         let e = [q[0] - p[0], q[1] - p[1]];
         if let Some(e1) = away_from {
             let dot = e[0] * e1[0] + e[1] * e1[1];
-            if dot * dot > COS2_MIN_ANGLE * d2 * (e1[0] * e1[0] + e1[1] * e1[1]) {
+            // Same operation order as `RowScratch::nearest_direction_away`.
+            if dot * dot > COS2_MIN_ANGLE * (e1[0] * e1[0] + e1[1] * e1[1]) * d2 {
                 continue;
             }
         }
         best = Some((d2, e));
     }
     best.map(|(_, e)| e)
+}
+
+/// [`sampling_tensor`] of the points loaded in `rows`, by vectorised row
+/// sweeps; bit-for-bit the same result.
+pub fn sampling_tensor_fast(rows: &mut RowScratch) -> [f64; 3] {
+    let mut t = [0.0; 3];
+    rows.fill_direction_matrix();
+    for j in 0..rows.len() {
+        let Some(m1) = rows.nearest_direction(j) else {
+            continue;
+        };
+        let e1 = rows.vector(j, m1);
+        add_outer(&mut t, e1);
+        if let Some(m2) = rows.nearest_direction_away(j, e1, COS2_MIN_ANGLE) {
+            add_outer(&mut t, rows.vector(j, m2));
+        }
+    }
+    t
 }
 
 fn add_outer(t: &mut [f64; 3], e: Point2) {
@@ -139,6 +160,30 @@ mod tests {
             (la - 2.0).abs() < 1e-9 && (lc - 2.0).abs() < 1e-9,
             "{la} {lc}"
         );
+    }
+
+    #[test]
+    fn fast_tensor_equals_reference() {
+        let mut state = 12345u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut rows = RowScratch::default();
+        for n in [1, 2, 3, 7, 30, 45] {
+            let mut pts: Vec<Point2> = (0..n).map(|_| [next(), 3.0 * next()]).collect();
+            if n > 3 {
+                pts[2] = pts[1]; // coincident projections must be skipped alike
+            }
+            rows.load(&pts);
+            assert_eq!(
+                sampling_tensor_fast(&mut rows),
+                sampling_tensor(&pts),
+                "n = {n}"
+            );
+        }
     }
 
     #[test]

@@ -19,12 +19,13 @@ pub mod polar;
 
 use rayon::prelude::*;
 
-use crate::anisotropy::{apply, sampling_tensor, whitening_map};
+use crate::anisotropy::{apply, sampling_tensor, sampling_tensor_fast, whitening_map};
 use crate::cloud::{check_not_degenerate, merge_duplicates, Point3, Sites};
 use crate::error::CloudError;
 use crate::frame::{fit_plane, project, Point2};
 use crate::neighbours::NeighbourIndex;
-use crate::resolution::{beta_of, nearest_distances};
+use crate::resolution::{beta_of, nearest_distances, nearest_distances_fast};
+use crate::rows::RowScratch;
 
 /// Options of boundary point detection.
 #[derive(Debug, Clone, PartialEq)]
@@ -177,6 +178,7 @@ struct Scratch {
     projected: Vec<Point2>,
     distances: Vec<f64>,
     neighbours: Vec<Point2>,
+    rows: RowScratch,
     cell: circle::CellScratch,
     polar: polar::PolarScratch,
 }
@@ -194,12 +196,25 @@ fn analyse_point(
     let frame = fit_plane(points, &s.members);
     project(points, &s.members, &frame, &mut s.projected);
     if options.anisotropy {
-        let map = whitening_map(sampling_tensor(&s.projected));
+        let tensor = match how {
+            TestImpl::Fast => {
+                s.rows.load(&s.projected);
+                sampling_tensor_fast(&mut s.rows)
+            }
+            TestImpl::Reference => sampling_tensor(&s.projected),
+        };
+        let map = whitening_map(tensor);
         for q in s.projected.iter_mut() {
             *q = apply(&map, *q);
         }
     }
-    nearest_distances(&s.projected, &mut s.distances);
+    match how {
+        TestImpl::Fast => {
+            s.rows.load(&s.projected);
+            nearest_distances_fast(&mut s.rows, &mut s.distances);
+        }
+        TestImpl::Reference => nearest_distances(&s.projected, &mut s.distances),
+    }
     let beta = beta_of(&s.distances);
     // Neighbours that project onto P_i itself carry no direction.
     s.neighbours.clear();

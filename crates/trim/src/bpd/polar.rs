@@ -53,23 +53,23 @@ pub fn surrounding_path_is_open(nb: &[Point2], s: &mut PolarScratch) -> bool {
     if width <= 0.0 {
         return true;
     }
-    let (r_min, r_max) = nb
-        .iter()
-        .map(|p| p[0].hypot(p[1]))
-        .fold((f64::INFINITY, 0.0f64), |(lo, hi), r| {
-            (lo.min(r), hi.max(r))
-        });
-    let r_span = r_max - r_min;
+    // Radii into `r` first, normalised in place below (eq. 2). Local
+    // coordinates are small and finite, so the plain formula cannot overflow.
     s.r.clear();
-    s.r.extend(nb.iter().map(|p| {
-        if r_span > 0.0 {
-            (p[0].hypot(p[1]) - r_min) / r_span
+    s.r.extend(nb.iter().map(|p| (p[0] * p[0] + p[1] * p[1]).sqrt()));
+    let (r_min, r_max) = s.r.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &r| {
+        (lo.min(r), hi.max(r))
+    });
+    let r_span = r_max - r_min;
+    for r in s.r.iter_mut() {
+        *r = if r_span > 0.0 {
+            (*r - r_min) / r_span
         } else {
             0.0
-        }
-    }));
+        };
+    }
     // Eq. 4: start nearest the pole and the sector's bisector.
-    let normalised = |t: f64| (t - theta_min).rem_euclid(TAU) / width;
+    let normalised = |t: f64| wrap_positive(t - theta_min) / width;
     let start = argmin(nb.len(), |j| s.r[j] + (normalised(s.theta[j]) - 0.5).abs());
     s.used.clear();
     s.used.resize(nb.len(), false);
@@ -123,10 +123,24 @@ fn occupied_sector(theta: &[f64], sorted: &mut Vec<f64>) -> (f64, f64) {
     (start, TAU - gap)
 }
 
-/// `a − b` wrapped into (−π, π].
+/// `a − b` wrapped into (−π, π], for angles from `atan2` (in [−π, π]), whose
+/// difference lies in [−2π, 2π]; avoids the slow floating-point remainder.
 fn circular_difference(a: f64, b: f64) -> f64 {
-    let d = (a - b).rem_euclid(TAU);
+    let d = a - b;
     if d > PI {
+        d - TAU
+    } else if d <= -PI {
+        d + TAU
+    } else {
+        d
+    }
+}
+
+/// An angle difference in [−2π, 2π] moved into [0, 2π).
+fn wrap_positive(d: f64) -> f64 {
+    if d < 0.0 {
+        d + TAU
+    } else if d >= TAU {
         d - TAU
     } else {
         d
