@@ -21,7 +21,6 @@ pub mod error;
 pub mod frame;
 pub mod neighbours;
 pub mod resolution;
-pub mod rows;
 
 pub use bpd::{detect_boundary, BpdOptions, Detection};
 pub use cloud::Point3;

@@ -9,38 +9,30 @@
 //! inflate β, and on line scans β is the spacing the tests see.
 
 use crate::frame::Point2;
-use crate::rows::RowScratch;
 
 /// Nearest-neighbour distance of every member, within the neighbourhood.
 ///
-/// `out[j]` is the distance from `pts[j]` to the closest other member.
-/// Plain reference of [`nearest_distances_fast`].
+/// `out[j]` is the distance from `pts[j]` to the closest other member. Each
+/// pair is measured once; the inner loop's minimum updates are branch-free
+/// and vectorise.
 pub fn nearest_distances(pts: &[Point2], out: &mut Vec<f64>) {
     out.clear();
     out.resize(pts.len(), f64::INFINITY);
     for j in 0..pts.len() {
-        for m in j + 1..pts.len() {
-            let d = dist2(pts[j], pts[m]);
-            if d < out[j] {
-                out[j] = d;
-            }
-            if d < out[m] {
-                out[m] = d;
-            }
+        let p = pts[j];
+        let (head, tail) = out.split_at_mut(j + 1);
+        let mut best = head[j];
+        for (d_m, &q) in tail.iter_mut().zip(&pts[j + 1..]) {
+            let d = dist2(p, q);
+            // `if` rather than `f64::min`, whose NaN handling blocks the
+            // plain min instruction (no NaN can occur here).
+            best = if d < best { d } else { best };
+            *d_m = if d < *d_m { d } else { *d_m };
         }
+        head[j] = best;
     }
     for d in out.iter_mut() {
         *d = d.sqrt();
-    }
-}
-
-/// [`nearest_distances`] of the points loaded in `rows`, by vectorised row
-/// sweeps; the same result.
-pub fn nearest_distances_fast(rows: &mut RowScratch, out: &mut Vec<f64>) {
-    out.clear();
-    for j in 0..rows.len() {
-        rows.fill_row(j);
-        out.push(rows.row_min().map_or(f64::INFINITY, |(d2, _)| d2.sqrt()));
     }
 }
 
@@ -77,19 +69,6 @@ mod tests {
         nearest_distances(&pts, &mut d);
         assert!(d.iter().all(|&x| (x - 2.0).abs() < 1e-12));
         assert!((beta_of(&d) - 2.0).abs() < 1e-12);
-    }
-
-    #[test]
-    fn fast_distances_equal_reference() {
-        let pts: Vec<Point2> = (0..37)
-            .map(|i| [((i * 17) % 23) as f64 * 0.37, ((i * 5) % 11) as f64 * 1.3])
-            .collect();
-        let (mut slow, mut fast) = (Vec::new(), Vec::new());
-        nearest_distances(&pts, &mut slow);
-        let mut rows = RowScratch::default();
-        rows.load(&pts);
-        nearest_distances_fast(&mut rows, &mut fast);
-        assert_eq!(slow, fast);
     }
 
     #[test]

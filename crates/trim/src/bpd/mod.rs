@@ -19,13 +19,14 @@ pub mod polar;
 
 use rayon::prelude::*;
 
-use crate::anisotropy::{apply, sampling_tensor, sampling_tensor_fast, whitening_map};
+use crate::anisotropy::{
+    apply, own_sampling_vectors, sampling_tensor, whitening_map, SamplingVectors,
+};
 use crate::cloud::{check_not_degenerate, merge_duplicates, Point3, Sites};
 use crate::error::CloudError;
 use crate::frame::{fit_plane, project, Point2};
-use crate::neighbours::NeighbourIndex;
-use crate::resolution::{beta_of, nearest_distances, nearest_distances_fast};
-use crate::rows::RowScratch;
+use crate::neighbours::{NeighbourIndex, QueryHint};
+use crate::resolution::{beta_of, nearest_distances};
 
 /// Options of boundary point detection.
 #[derive(Debug, Clone, PartialEq)]
@@ -91,45 +92,65 @@ pub fn detect_boundary(points: &[Point3], options: &BpdOptions) -> Result<Detect
 }
 
 /// [`detect_boundary`], calling `progress(done)` with the number of distinct
-/// points processed so far, a few hundred times over the run.
+/// points processed so far (all passes counted together, scaled to the
+/// number of distinct points), a few hundred times over the run.
 pub fn detect_boundary_with_progress(
     points: &[Point3],
     options: &BpdOptions,
     progress: &(dyn Fn(usize) + Sync),
 ) -> Result<Detection, CloudError> {
-    let sites = prepare(points, options)?;
-    let index = NeighbourIndex::new(&sites.points);
-    let order = spatial_order(&sites.points);
-    let mut verdicts = vec![(Decision::Interior, 0.0); sites.points.len()];
-    let block = (order.len() / 256).clamp(4096, 65536);
-    for (b, chunk) in order.chunks(block).enumerate() {
-        let found: Vec<(Decision, f64)> = chunk
-            .par_iter()
-            .with_min_len(256)
-            .map_init(Scratch::default, |s, &i| {
-                analyse_point(&index, i as usize, options, s, TestImpl::Fast)
-            })
-            .collect();
-        for (&i, v) in chunk.iter().zip(found) {
-            verdicts[i as usize] = v;
-        }
-        progress((b * block + chunk.len()).min(order.len()));
-    }
-    Ok(spread_to_input(&sites, &verdicts))
+    run(points, options, progress, TestImpl::Fast)
 }
 
-/// Plain, sequential BPD with the O(k³) reference circle test.
+/// Plain, sequential BPD with the O(k³) reference circle test; the same
+/// labels as [`detect_boundary`], for tests.
 pub fn detect_boundary_reference(
     points: &[Point3],
     options: &BpdOptions,
 ) -> Result<Detection, CloudError> {
+    run(points, options, &|_| {}, TestImpl::Reference)
+}
+
+/// The neighbourhoods of all points, `k` indices each. The points are
+/// copied in spatial order (see [`spatial_order`]), so that neighbours are
+/// close in memory too: position p is site `order[p]`, and the lists hold
+/// positions.
+struct Neighbourhoods {
+    points: Vec<Point3>,
+    order: Vec<u32>,
+    k: usize,
+    lists: Vec<u32>,
+}
+
+impl Neighbourhoods {
+    fn at(&self, position: usize) -> &[u32] {
+        &self.lists[position * self.k..(position + 1) * self.k]
+    }
+}
+
+fn run(
+    points: &[Point3],
+    options: &BpdOptions,
+    progress: &(dyn Fn(usize) + Sync),
+    how: TestImpl,
+) -> Result<Detection, CloudError> {
     let sites = prepare(points, options)?;
-    let index = NeighbourIndex::new(&sites.points);
-    let mut s = Scratch::default();
-    let verdicts: Vec<(Decision, f64)> = (0..sites.points.len())
-        .map(|i| analyse_point(&index, i, options, &mut s, TestImpl::Reference))
-        .collect();
-    Ok(spread_to_input(&sites, &verdicts))
+    let n = sites.points.len();
+    let passes = if options.anisotropy { 3 } else { 2 };
+    let report = |pass: usize| move |done: usize| progress((pass * n + done) / passes);
+    let hoods = neighbourhoods(&sites.points, options.k, how, &report(0));
+    let vectors = options.anisotropy.then(|| {
+        per_position(&hoods, how, &report(1), |s, p| {
+            let members = hoods.at(p);
+            let frame = fit_plane(&hoods.points, members);
+            project(&hoods.points, members, &frame, &mut s.projected);
+            own_sampling_vectors(&s.projected, &frame)
+        })
+    });
+    let verdicts = per_position(&hoods, how, &report(passes - 1), |s, p| {
+        analyse_point(&hoods, p, vectors.as_deref(), s, how)
+    });
+    Ok(spread_to_input(&sites, &to_sites(&hoods.order, verdicts)))
 }
 
 fn prepare(points: &[Point3], options: &BpdOptions) -> Result<Sites, CloudError> {
@@ -149,6 +170,94 @@ fn prepare(points: &[Point3], options: &BpdOptions) -> Result<Sites, CloudError>
         });
     }
     Ok(sites)
+}
+
+/// Finds every neighbourhood once (step 1), queried in spatial order so
+/// consecutive queries touch the same part of the tree.
+fn neighbourhoods(
+    sites: &[Point3],
+    k: usize,
+    how: TestImpl,
+    progress: &(dyn Fn(usize) + Sync),
+) -> Neighbourhoods {
+    let order = spatial_order(sites);
+    let points: Vec<Point3> = order.iter().map(|&i| sites[i as usize]).collect();
+    // Ties are broken by site index (input order), which, unlike the
+    // spatial order, does not change when the cloud is moved.
+    let index = NeighbourIndex::new(&points).with_ranks(&order);
+    let mut lists = vec![0u32; points.len() * k];
+    let block = block_len(points.len());
+    for (b, chunk) in lists.chunks_mut(block * k).enumerate() {
+        let fill = |(members, hint): &mut (Vec<u32>, QueryHint),
+                    (offset, out): (usize, &mut [u32])| {
+            index.nearest_near_last(b * block + offset, k, members, hint);
+            out.copy_from_slice(members);
+        };
+        match how {
+            TestImpl::Fast => chunk
+                .par_chunks_mut(k)
+                .with_min_len(256)
+                .enumerate()
+                .for_each_init(Default::default, fill),
+            TestImpl::Reference => {
+                // The reference asks every query afresh.
+                let mut scratch = Default::default();
+                chunk.chunks_mut(k).enumerate().for_each(|item| {
+                    fill(&mut scratch, item);
+                    scratch.1 = QueryHint::default();
+                });
+            }
+        }
+        progress((b * block + chunk.len() / k).min(points.len()));
+    }
+    drop(index);
+    Neighbourhoods {
+        points,
+        order,
+        k,
+        lists,
+    }
+}
+
+/// Runs `f` at every position of the spatial order, in blocks (parallel for
+/// the fast implementation), and returns the results in that order.
+fn per_position<T: Send>(
+    hoods: &Neighbourhoods,
+    how: TestImpl,
+    progress: &(dyn Fn(usize) + Sync),
+    f: impl Fn(&mut Scratch, usize) -> T + Sync,
+) -> Vec<T> {
+    let n = hoods.order.len();
+    let block = block_len(n);
+    let mut out = Vec::with_capacity(n);
+    let mut scratch = Scratch::default();
+    for start in (0..n).step_by(block) {
+        let range = start..(start + block).min(n);
+        match how {
+            TestImpl::Fast => out.par_extend(
+                range
+                    .into_par_iter()
+                    .with_min_len(256)
+                    .map_init(Scratch::default, |s, p| f(s, p)),
+            ),
+            TestImpl::Reference => out.extend(range.map(|p| f(&mut scratch, p))),
+        }
+        progress(out.len());
+    }
+    out
+}
+
+fn block_len(n: usize) -> usize {
+    (n / 256).clamp(4096, 65536)
+}
+
+/// Reorders per-position results to site order.
+fn to_sites<T: Copy>(order: &[u32], by_position: Vec<T>) -> Vec<T> {
+    let mut by_site = by_position.clone();
+    for (&site, v) in order.iter().zip(by_position) {
+        by_site[site as usize] = v;
+    }
+    by_site
 }
 
 fn spread_to_input(sites: &Sites, verdicts: &[(Decision, f64)]) -> Detection {
@@ -174,47 +283,33 @@ enum TestImpl {
 /// Per-thread buffers: nothing is allocated per point once they have grown.
 #[derive(Default)]
 struct Scratch {
-    members: Vec<u32>,
     projected: Vec<Point2>,
     distances: Vec<f64>,
     neighbours: Vec<Point2>,
-    rows: RowScratch,
     cell: circle::CellScratch,
     polar: polar::PolarScratch,
 }
 
-/// Runs steps 1–5 on point `i`; returns its decision and β_i.
+/// Runs steps 2–5 on the point at spatial position `p`; returns its
+/// decision and β_i.
 fn analyse_point(
-    index: &NeighbourIndex,
-    i: usize,
-    options: &BpdOptions,
+    hoods: &Neighbourhoods,
+    p: usize,
+    vectors: Option<&[SamplingVectors]>,
     s: &mut Scratch,
     how: TestImpl,
 ) -> (Decision, f64) {
-    let points = index.points();
-    index.nearest(i, options.k, &mut s.members);
-    let frame = fit_plane(points, &s.members);
-    project(points, &s.members, &frame, &mut s.projected);
-    if options.anisotropy {
-        let tensor = match how {
-            TestImpl::Fast => {
-                s.rows.load(&s.projected);
-                sampling_tensor_fast(&mut s.rows)
-            }
-            TestImpl::Reference => sampling_tensor(&s.projected),
-        };
+    let members = hoods.at(p);
+    let frame = fit_plane(&hoods.points, members);
+    project(&hoods.points, members, &frame, &mut s.projected);
+    if let Some(vectors) = vectors {
+        let tensor = sampling_tensor(&frame, members.iter().map(|&m| &vectors[m as usize]));
         let map = whitening_map(tensor);
         for q in s.projected.iter_mut() {
             *q = apply(&map, *q);
         }
     }
-    match how {
-        TestImpl::Fast => {
-            s.rows.load(&s.projected);
-            nearest_distances_fast(&mut s.rows, &mut s.distances);
-        }
-        TestImpl::Reference => nearest_distances(&s.projected, &mut s.distances),
-    }
+    nearest_distances(&s.projected, &mut s.distances);
     let beta = beta_of(&s.distances);
     // Neighbours that project onto P_i itself carry no direction.
     s.neighbours.clear();
