@@ -26,8 +26,14 @@ fn main() {
     let start = Instant::now();
     let found = detect_boundary(&cloud, &BpdOptions::default()).expect("detect");
     let ms = start.elapsed().as_secs_f64() * 1e3;
+    eprintln!("links: {}", found.links.len());
+    let by_path = found
+        .decision
+        .iter()
+        .filter(|&&d| d == trim::bpd::Decision::OpenPath)
+        .count();
     println!(
-        "{{\"kind\":\"{kind}\",\"points\":{},\"boundary\":{},\"detect_ms\":{ms:.1},\"peak_rss_mb\":{:.1}}}",
+        "{{\"kind\":\"{kind}\",\"points\":{},\"boundary\":{},\"by_path_test\":{by_path},\"detect_ms\":{ms:.1},\"peak_rss_mb\":{:.1}}}",
         cloud.len(),
         found.boundary_count(),
         peak_rss_mb()

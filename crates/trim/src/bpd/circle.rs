@@ -83,17 +83,24 @@ fn circumcentre_with_origin(a: Point2, b: Point2) -> Option<Point2> {
     Some([(na * b[1] - nb * a[1]) / d, (nb * a[0] - na * b[0]) / d])
 }
 
-/// Reusable buffers for [`largest_empty_circle_exceeds`].
+/// Label of a cell edge that lies on the initial box, not on a bisector.
+const BOX_EDGE: u32 = u32::MAX;
+
+/// Reusable buffers for [`largest_empty_circle_exceeds`]: the cell as a
+/// convex polygon, each vertex with the label of the edge that leaves it
+/// (the neighbour whose bisector it lies on, or [`BOX_EDGE`]).
 #[derive(Default, Debug, Clone)]
 pub struct CellScratch {
-    poly: Vec<Point2>,
-    next: Vec<Point2>,
+    poly: Vec<(Point2, u32)>,
+    next: Vec<(Point2, u32)>,
 }
 
 /// Fast circle test: is some vertex of P_i's Voronoi cell (clipped to a box
 /// of half-size `max(2·max|q|, 2β)`) at least `beta` from P_i?
 ///
-/// `nb` are the neighbours relative to P_i, nearest first.
+/// `nb` are the neighbours relative to P_i, nearest first. When the answer
+/// is true the cell in `s` is complete, and [`boundary_neighbours`] can read
+/// it.
 pub fn largest_empty_circle_exceeds(nb: &[Point2], beta: f64, s: &mut CellScratch) -> bool {
     let reach = nb
         .iter()
@@ -102,22 +109,26 @@ pub fn largest_empty_circle_exceeds(nb: &[Point2], beta: f64, s: &mut CellScratc
         .sqrt();
     let l = (2.0 * reach).max(2.0 * beta);
     s.poly.clear();
-    s.poly
-        .extend_from_slice(&[[-l, -l], [l, -l], [l, l], [-l, l]]);
+    s.poly.extend_from_slice(&[
+        ([-l, -l], BOX_EDGE),
+        ([l, -l], BOX_EDGE),
+        ([l, l], BOX_EDGE),
+        ([-l, l], BOX_EDGE),
+    ]);
     let beta2 = beta * beta;
     let mut far2 = 2.0 * l * l; // largest squared vertex distance so far
-    for &q in nb {
+    for (j, &q) in nb.iter().enumerate() {
         let q2 = q[0] * q[0] + q[1] * q[1];
         // The bisector x·q = |q|²/2 cannot cut a cell within radius |q|/2.
         if 0.25 * q2 >= far2 {
             continue;
         }
-        clip(&s.poly, q, 0.5 * q2, &mut s.next);
+        clip(&s.poly, q, 0.5 * q2, j as u32, &mut s.next);
         std::mem::swap(&mut s.poly, &mut s.next);
         far2 = s
             .poly
             .iter()
-            .map(|v| v[0] * v[0] + v[1] * v[1])
+            .map(|(v, _)| v[0] * v[0] + v[1] * v[1])
             .fold(0.0, f64::max);
         if far2 < beta2 {
             return false;
@@ -126,20 +137,46 @@ pub fn largest_empty_circle_exceeds(nb: &[Point2], beta: f64, s: &mut CellScratc
     far2 >= beta2
 }
 
-/// Keeps the part of convex polygon `poly` where x·n <= h (Sutherland–Hodgman).
-fn clip(poly: &[Point2], n: Point2, h: f64, out: &mut Vec<Point2>) {
+/// After [`largest_empty_circle_exceeds`] returned true: the neighbours
+/// (indices into its `nb`) joined to P_i by an empty circle of radius
+/// ≥ `beta` — those whose Voronoi edge with P_i reaches `beta` from P_i.
+/// They are P_i's neighbours *along the boundary* (the edges of the
+/// α-shape with α = β), which edge reconstruction uses to cluster and
+/// order boundary points. Sorted, without repeats.
+pub fn boundary_neighbours(s: &CellScratch, beta: f64, out: &mut Vec<u32>) {
+    out.clear();
+    let beta2 = beta * beta;
+    let norm2 = |v: Point2| v[0] * v[0] + v[1] * v[1];
+    for t in 0..s.poly.len() {
+        let (a, label) = s.poly[t];
+        let (b, _) = s.poly[(t + 1) % s.poly.len()];
+        // Distance to P_i along a segment is largest at an end.
+        if label != BOX_EDGE && norm2(a).max(norm2(b)) >= beta2 {
+            out.push(label);
+        }
+    }
+    out.sort_unstable();
+    out.dedup();
+}
+
+/// Keeps the part of convex polygon `poly` where x·n <= h
+/// (Sutherland–Hodgman); the new edge along x·n = h gets `label`.
+fn clip(poly: &[(Point2, u32)], n: Point2, h: f64, label: u32, out: &mut Vec<(Point2, u32)>) {
     out.clear();
     let side = |p: Point2| p[0] * n[0] + p[1] * n[1] - h;
     for i in 0..poly.len() {
-        let a = poly[i];
-        let b = poly[(i + 1) % poly.len()];
+        let (a, edge) = poly[i];
+        let (b, _) = poly[(i + 1) % poly.len()];
         let (sa, sb) = (side(a), side(b));
         if sa <= 0.0 {
-            out.push(a);
+            out.push((a, edge));
         }
         if (sa < 0.0 && sb > 0.0) || (sa > 0.0 && sb < 0.0) {
             let t = sa / (sa - sb);
-            out.push([a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]);
+            let cut = [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])];
+            // Leaving the half-plane, the cell continues along the new
+            // bisector; entering it, along the rest of the old edge.
+            out.push((cut, if sa < 0.0 { label } else { edge }));
         }
     }
 }
@@ -177,6 +214,20 @@ mod tests {
         let mut s = CellScratch::default();
         assert!(empty_circle_reference(&pts, 1.0));
         assert!(largest_empty_circle_exceeds(&pts[1..], 1.0, &mut s));
+    }
+
+    #[test]
+    fn boundary_neighbours_run_along_the_border() {
+        // Straight border y = 0 with the cloud below: P_i's neighbours along
+        // the border are (±1, 0).
+        let pts = grid_around(|_, y| y > 0.0);
+        let mut s = CellScratch::default();
+        assert!(largest_empty_circle_exceeds(&pts[1..], 1.0, &mut s));
+        let mut out = Vec::new();
+        boundary_neighbours(&s, 1.0, &mut out);
+        let found: Vec<Point2> = out.iter().map(|&j| pts[1 + j as usize]).collect();
+        assert_eq!(found.len(), 2, "{found:?}");
+        assert!(found.contains(&[1.0, 0.0]) && found.contains(&[-1.0, 0.0]));
     }
 
     #[test]

@@ -77,6 +77,12 @@ pub struct Detection {
     /// Number of input points that were exact copies of an earlier point
     /// (they share the label of that point).
     pub duplicates: usize,
+    /// Pairs of boundary points (input indices, smaller first, sorted)
+    /// joined by an empty circle of radius ≥ β: neighbours along the
+    /// boundary, the edges of the α-shape with α = β (see
+    /// [`circle::boundary_neighbours`]). A duplicate point is represented by
+    /// its first copy. Edge reconstruction clusters and orders with them.
+    pub links: Vec<[u32; 2]>,
 }
 
 impl Detection {
@@ -150,7 +156,14 @@ fn run(
     let verdicts = per_position(&hoods, how, &report(passes - 1), |s, p| {
         analyse_point(&hoods, p, vectors.as_deref(), s, how)
     });
-    Ok(spread_to_input(&sites, &to_sites(&hoods.order, verdicts)))
+    let links = links_in_input_order(&sites, &hoods.order, &verdicts);
+    let by_site = to_sites(
+        &hoods.order,
+        verdicts.iter().map(|v| (v.decision, v.beta)).collect(),
+    );
+    let mut detection = spread_to_input(&sites, &by_site);
+    detection.links = links;
+    Ok(detection)
 }
 
 fn prepare(points: &[Point3], options: &BpdOptions) -> Result<Sites, CloudError> {
@@ -260,6 +273,27 @@ fn to_sites<T: Copy>(order: &[u32], by_position: Vec<T>) -> Vec<T> {
     by_site
 }
 
+/// The links found at each position, as pairs of input indices.
+fn links_in_input_order(sites: &Sites, order: &[u32], verdicts: &[Verdict]) -> Vec<[u32; 2]> {
+    let mut first_input = vec![u32::MAX; sites.points.len()];
+    for (input, &site) in sites.site_of.iter().enumerate().rev() {
+        first_input[site as usize] = input as u32;
+    }
+    let input_of = |position: u32| first_input[order[position as usize] as usize];
+    let mut links: Vec<[u32; 2]> = verdicts
+        .iter()
+        .enumerate()
+        .flat_map(|(p, v)| {
+            let a = input_of(p as u32);
+            v.links.iter().map(move |&q| (a, input_of(q)))
+        })
+        .map(|(a, b)| [a.min(b), a.max(b)])
+        .collect();
+    links.par_sort_unstable();
+    links.dedup();
+    links
+}
+
 fn spread_to_input(sites: &Sites, verdicts: &[(Decision, f64)]) -> Detection {
     let at = |i: &u32| verdicts[*i as usize];
     Detection {
@@ -271,6 +305,7 @@ fn spread_to_input(sites: &Sites, verdicts: &[(Decision, f64)]) -> Detection {
         beta: sites.site_of.iter().map(|i| at(i).1).collect(),
         decision: sites.site_of.iter().map(|i| at(i).0).collect(),
         duplicates: sites.duplicates(),
+        links: Vec::new(),
     }
 }
 
@@ -280,25 +315,37 @@ enum TestImpl {
     Reference,
 }
 
-/// Per-thread buffers: nothing is allocated per point once they have grown.
+/// What the analysis finds at one point.
+struct Verdict {
+    decision: Decision,
+    beta: f64,
+    /// Positions of the neighbours along the boundary (empty unless the
+    /// circle test decided; allocated only then).
+    links: Vec<u32>,
+}
+
+/// Per-thread buffers: nothing is allocated per interior point once they
+/// have grown.
 #[derive(Default)]
 struct Scratch {
     projected: Vec<Point2>,
     distances: Vec<f64>,
     neighbours: Vec<Point2>,
+    /// Member slot of each entry of `neighbours`.
+    slots: Vec<u32>,
+    along: Vec<u32>,
     cell: circle::CellScratch,
     polar: polar::PolarScratch,
 }
 
-/// Runs steps 2–5 on the point at spatial position `p`; returns its
-/// decision and β_i.
+/// Runs steps 2–5 on the point at spatial position `p`.
 fn analyse_point(
     hoods: &Neighbourhoods,
     p: usize,
     vectors: Option<&[SamplingVectors]>,
     s: &mut Scratch,
     how: TestImpl,
-) -> (Decision, f64) {
+) -> Verdict {
     let members = hoods.at(p);
     let frame = fit_plane(&hoods.points, members);
     project(&hoods.points, members, &frame, &mut s.projected);
@@ -313,20 +360,33 @@ fn analyse_point(
     let beta = beta_of(&s.distances);
     // Neighbours that project onto P_i itself carry no direction.
     s.neighbours.clear();
-    s.neighbours.extend(
-        s.projected[1..]
-            .iter()
-            .copied()
-            .filter(|q| q[0] != 0.0 || q[1] != 0.0),
-    );
+    s.slots.clear();
+    for (slot, q) in s.projected.iter().enumerate().skip(1) {
+        if q[0] != 0.0 || q[1] != 0.0 {
+            s.neighbours.push(*q);
+            s.slots.push(slot as u32);
+        }
+    }
+    // The links always come from the fast cell, so both implementations
+    // report the same ones; the reference decides with its own test.
+    let cell_says = circle::largest_empty_circle_exceeds(&s.neighbours, beta, &mut s.cell);
     let by_circle = match how {
-        TestImpl::Fast => circle::largest_empty_circle_exceeds(&s.neighbours, beta, &mut s.cell),
+        TestImpl::Fast => cell_says,
         TestImpl::Reference => {
             s.projected.truncate(1);
             s.projected.extend_from_slice(&s.neighbours);
             circle::empty_circle_reference(&s.projected, beta)
         }
     };
+    let mut links = Vec::new();
+    if by_circle && cell_says {
+        circle::boundary_neighbours(&s.cell, beta, &mut s.along);
+        links.extend(
+            s.along
+                .iter()
+                .map(|&j| members[s.slots[j as usize] as usize]),
+        );
+    }
     let decision = if by_circle {
         Decision::EmptyCircle
     } else if polar::surrounding_path_is_open(&s.neighbours, &mut s.polar) {
@@ -334,7 +394,11 @@ fn analyse_point(
     } else {
         Decision::Interior
     };
-    (decision, beta)
+    Verdict {
+        decision,
+        beta,
+        links,
+    }
 }
 
 /// Indices of `points` sorted along a Morton (Z-order) curve, so that
