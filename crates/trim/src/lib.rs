@@ -18,9 +18,11 @@ pub mod anisotropy;
 pub mod bpd;
 pub mod cloud;
 pub mod error;
+pub mod evaluate;
 pub mod frame;
 pub mod neighbours;
 pub mod resolution;
+pub mod synthetic;
 
 pub use bpd::{detect_boundary, BpdOptions, Detection};
 pub use cloud::Point3;

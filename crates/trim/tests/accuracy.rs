@@ -1,0 +1,213 @@
+//! Accuracy of BPD on synthetic clouds with ground truth
+//! (`trim::synthetic`, scored by `trim::evaluate`). Run with `--nocapture`
+//! to see the measured numbers.
+
+use trim::evaluate::{ideal_first_layer, noise_robustness, percent_sweep, precision_recall};
+use trim::synthetic::{self, SyntheticCloud};
+use trim::{detect_boundary, BpdOptions};
+
+const TARGET: f64 = 0.98;
+
+/// Detects with the default options, prints the scores (and the ideal
+/// first layer's) and returns (precision, recall, f1).
+fn score(cloud: &SyntheticCloud) -> (f64, f64, f64) {
+    let det = detect_boundary(&cloud.points, &BpdOptions::default()).unwrap();
+    let a = precision_recall(&cloud.points, &det.boundary, cloud);
+    let ideal = precision_recall(&cloud.points, &ideal_first_layer(cloud), cloud);
+    let mean_beta = det.beta.iter().sum::<f64>() / det.beta.len() as f64;
+    let mean_h = cloud.spacing.iter().sum::<f64>() / cloud.len() as f64;
+    eprintln!(
+        "{:<36} n={:>6} detected={:>5} precision={:.4} recall={:.4} f1={:.4} | ideal layer: n={:>5} precision={:.4} recall={:.4} | mean β/h={:.3}",
+        cloud.name,
+        cloud.len(),
+        a.detected,
+        a.precision,
+        a.recall,
+        a.f1,
+        ideal.detected,
+        ideal.precision,
+        ideal.recall,
+        mean_beta / mean_h,
+    );
+    (a.precision, a.recall, a.f1)
+}
+
+fn assert_accurate(cloud: &SyntheticCloud) {
+    let (p, r, _) = score(cloud);
+    assert!(
+        p >= TARGET && r >= TARGET,
+        "{}: precision {p:.4}, recall {r:.4} (target {TARGET})",
+        cloud.name
+    );
+}
+
+#[test]
+fn plane_with_holes_of_2_4_8_beta() {
+    assert_accurate(&synthetic::plane_with_holes(1.0, 1));
+}
+
+#[test]
+fn notched_plate() {
+    assert_accurate(&synthetic::notched_plate(1.0, 2));
+}
+
+#[test]
+fn saddle_with_hole() {
+    assert_accurate(&synthetic::saddle_with_hole(1.5, 3));
+}
+
+#[test]
+fn cylinder_with_hole() {
+    assert_accurate(&synthetic::cylinder_with_hole(1.5, 4));
+}
+
+#[test]
+fn blade_at_4_8_16_34_mm() {
+    let mut failures = Vec::new();
+    for (i, h) in [4.0, 8.0, 16.0, 34.0].into_iter().enumerate() {
+        let cloud = synthetic::blade(h, 10 + i as u64);
+        let (p, r, _) = score(&cloud);
+        if p < TARGET || r < TARGET {
+            failures.push(format!("{}: precision {p:.4}, recall {r:.4}", cloud.name));
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+#[test]
+fn variable_density_x10() {
+    assert_accurate(&synthetic::variable_density(3.4, 5));
+}
+
+#[test]
+fn exactly_flat_perfect_grid() {
+    let cloud = synthetic::flat_grid(1.0);
+    assert!(cloud.points.iter().all(|p| p[2] == 0.0));
+    assert_accurate(&cloud);
+}
+
+#[test]
+fn line_scans_1_to_3_and_1_to_4_at_20_degrees() {
+    let mut failures = Vec::new();
+    for (i, ratio) in [3.0, 4.0].into_iter().enumerate() {
+        let cloud = synthetic::line_scan(ratio, 20f64.to_radians(), 1.0, 20 + i as u64);
+        let (p, r, f1) = score(&cloud);
+        if f1 < TARGET {
+            failures.push(format!(
+                "{}: precision {p:.4}, recall {r:.4}, F1 {f1:.4}",
+                cloud.name
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// Rotation about a generic axis, translation, uniform scale.
+fn transform(points: &[[f64; 3]], scale: f64, shift: [f64; 3], rotate: bool) -> Vec<[f64; 3]> {
+    let (axis, angle) = ([0.36f64, -0.48, 0.8], 0.7f64); // unit axis
+    let (s, c) = angle.sin_cos();
+    let [x, y, z] = axis;
+    let r = [
+        [
+            c + x * x * (1.0 - c),
+            x * y * (1.0 - c) - z * s,
+            x * z * (1.0 - c) + y * s,
+        ],
+        [
+            y * x * (1.0 - c) + z * s,
+            c + y * y * (1.0 - c),
+            y * z * (1.0 - c) - x * s,
+        ],
+        [
+            z * x * (1.0 - c) - y * s,
+            z * y * (1.0 - c) + x * s,
+            c + z * z * (1.0 - c),
+        ],
+    ];
+    points
+        .iter()
+        .map(|p| {
+            let q = if rotate {
+                [
+                    r[0][0] * p[0] + r[0][1] * p[1] + r[0][2] * p[2],
+                    r[1][0] * p[0] + r[1][1] * p[1] + r[1][2] * p[2],
+                    r[2][0] * p[0] + r[2][1] * p[1] + r[2][2] * p[2],
+                ]
+            } else {
+                *p
+            };
+            [
+                q[0] * scale + shift[0],
+                q[1] * scale + shift[1],
+                q[2] * scale + shift[2],
+            ]
+        })
+        .collect()
+}
+
+#[test]
+fn labels_are_invariant_under_rotation_translation_and_scale() {
+    let clouds = [
+        synthetic::blade(8.0, 30),
+        synthetic::plane_with_holes(1.0, 31),
+    ];
+    let cases: [(&str, f64, [f64; 3], bool); 3] = [
+        ("rotation", 1.0, [0.0; 3], true),
+        ("translation by 1e5", 1.0, [1e5, -1e5, 1e5], false),
+        ("scale ×0.001", 0.001, [0.0; 3], false),
+    ];
+    let mut report = Vec::new();
+    for cloud in &clouds {
+        let base = detect_boundary(&cloud.points, &BpdOptions::default())
+            .unwrap()
+            .boundary;
+        for (what, scale, shift, rotate) in cases {
+            let moved = transform(&cloud.points, scale, shift, rotate);
+            let labels = detect_boundary(&moved, &BpdOptions::default())
+                .unwrap()
+                .boundary;
+            let differ = base.iter().zip(&labels).filter(|(a, b)| a != b).count();
+            eprintln!(
+                "{} / {what}: {differ} of {} labels differ",
+                cloud.name,
+                cloud.len()
+            );
+            report.push((cloud.name.clone(), what, differ, labels == base));
+        }
+    }
+    for (name, what, differ, same) in report {
+        assert!(same, "{name} / {what}: {differ} labels differ");
+    }
+}
+
+#[test]
+fn blade_noise_20_percent_loses_nothing_75_percent_adds_nothing() {
+    // Ω and Ψ as in `trim::evaluate` (the paper's definitions, against the
+    // noise-free detection), swept in steps of 5 % up to 75 %.
+    let mut failures = Vec::new();
+    for (h, seed) in [(4.0, 40), (8.0, 41)] {
+        let cloud = synthetic::blade(h, seed);
+        let r =
+            noise_robustness(&cloud, &percent_sweep(5.0, 75.0), &BpdOptions::default(), 7).unwrap();
+        eprintln!(
+            "{}: Ω = {}{} %, Ψ = {}{} % (reference boundary {}); steps: {:?}",
+            cloud.name,
+            if r.omega_capped { "≥ " } else { "" },
+            r.omega,
+            if r.psi_capped { "≥ " } else { "" },
+            r.psi,
+            r.reference_boundary,
+            r.steps
+                .iter()
+                .map(|s| (s.percent, s.lost, s.false_boundary))
+                .collect::<Vec<_>>()
+        );
+        if r.omega < 20.0 || r.psi < 75.0 {
+            failures.push(format!(
+                "{}: Ω = {} %, Ψ = {} %",
+                cloud.name, r.omega, r.psi
+            ));
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
