@@ -1,1 +1,19 @@
-fn main() {}
+//! `meshtrim`: parse the command line, run, report errors as one line.
+
+use std::process::ExitCode;
+
+use clap::Parser;
+use meshtrim::cli::{run, Cli};
+
+fn main() -> ExitCode {
+    // Usage errors exit with 2 inside `parse`.
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            // `{:#}` joins the context chain: "error: FILE: what went wrong".
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

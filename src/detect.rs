@@ -1,0 +1,229 @@
+//! `meshtrim detect`: read a cloud, label its boundary points, report.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use anyhow::{bail, Context, Result};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use serde::Serialize;
+use trim::{BpdOptions, CloudError, Detection};
+
+use crate::cli::DetectArgs;
+use crate::io::atomic::write_atomic;
+use crate::io::labels::{LabelFormat, Labelled};
+use crate::io::{read_cloud, Point3};
+
+/// What `detect` prints: the counts and timings of the paper's Table 1.
+#[derive(Debug, Clone, Serialize)]
+pub struct Summary {
+    /// The input file, as given.
+    pub file: String,
+    /// Points read (after dropping non-finite PCD points).
+    pub points: usize,
+    /// Points left after merging exact duplicates.
+    pub distinct_points: usize,
+    /// Points that were exact copies of an earlier one.
+    pub duplicates: usize,
+    /// Points dropped by the reader for a NaN or infinite coordinate.
+    pub dropped_non_finite: usize,
+    /// Points labelled boundary (duplicates counted).
+    pub boundary_points: usize,
+    /// Smallest local resolution β over all points.
+    pub beta_min: f64,
+    /// Mean β.
+    pub beta_mean: f64,
+    /// Largest β.
+    pub beta_max: f64,
+    /// Standard deviation of β (population).
+    pub beta_std: f64,
+    /// Time to read the file, in milliseconds.
+    pub read_ms: f64,
+    /// Time of boundary detection, in milliseconds.
+    pub detect_ms: f64,
+    /// Neighbourhood size used.
+    pub k: usize,
+    /// Whether the anisotropy map was on.
+    pub anisotropy: bool,
+}
+
+/// Runs `meshtrim detect`.
+pub fn run(args: &DetectArgs) -> Result<()> {
+    // Check the output before the (possibly long) detection.
+    let output = args
+        .output
+        .as_deref()
+        .map(|out| check_output(out, &args.cloud))
+        .transpose()?;
+    let started = Instant::now();
+    let cloud = read_cloud(&args.cloud)?;
+    let read_time = started.elapsed();
+    let options = BpdOptions {
+        k: args.k,
+        anisotropy: !args.no_anisotropy,
+    };
+    let started = Instant::now();
+    let detection = detect_with_progress(&cloud.points, &options)
+        .with_context(|| args.cloud.display().to_string())?;
+    let detect_time = started.elapsed();
+    if let Some((path, format)) = &output {
+        write_labels(path, *format, &cloud.points, &detection)?;
+    }
+    let summary = Summary::new(args, &cloud, &detection, read_time, detect_time);
+    if args.json {
+        println!("{}", serde_json::to_string(&summary)?);
+    } else {
+        print!("{}", summary.table());
+        if let Some((path, _)) = &output {
+            println!("{:<20} {}", "output", path.display());
+        }
+    }
+    Ok(())
+}
+
+/// The output's format; refuses unknown extensions and the input itself.
+fn check_output(out: &Path, input: &Path) -> Result<(PathBuf, LabelFormat)> {
+    let Some(format) = LabelFormat::from_path(out) else {
+        bail!(
+            "{}: unsupported output format: use .ply or .csv",
+            out.display()
+        );
+    };
+    let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    };
+    if same(out, input) {
+        bail!("{}: the output would overwrite the input", out.display());
+    }
+    Ok((out.to_path_buf(), format))
+}
+
+fn write_labels(
+    path: &Path,
+    format: LabelFormat,
+    points: &[Point3],
+    detection: &Detection,
+) -> Result<()> {
+    let data = Labelled {
+        points,
+        boundary: &detection.boundary,
+        beta: &detection.beta,
+    };
+    write_atomic(path, |w| format.write(w, data))
+}
+
+/// BPD with a progress bar on stderr. The bar appears only once the run has
+/// taken a second, so quick runs print nothing, and indicatif hides it when
+/// stderr is not a terminal.
+fn detect_with_progress(points: &[Point3], options: &BpdOptions) -> Result<Detection, CloudError> {
+    let bar =
+        ProgressBar::with_draw_target(Some(points.len() as u64), ProgressDrawTarget::hidden());
+    bar.set_style(
+        ProgressStyle::with_template("detecting boundary {bar:40} {pos}/{len} points, {eta} left")
+            .expect("the template is valid"),
+    );
+    let started = Instant::now();
+    let shown = AtomicBool::new(false);
+    let progress = |done: usize| {
+        if started.elapsed() > Duration::from_secs(1) && !shown.swap(true, Ordering::Relaxed) {
+            bar.set_draw_target(ProgressDrawTarget::stderr());
+        }
+        bar.set_position(done as u64);
+    };
+    let result = trim::bpd::detect_boundary_with_progress(points, options, &progress);
+    bar.finish_and_clear();
+    result
+}
+
+impl Summary {
+    fn new(
+        args: &DetectArgs,
+        cloud: &crate::io::Cloud,
+        detection: &Detection,
+        read_time: Duration,
+        detect_time: Duration,
+    ) -> Self {
+        let (beta_min, beta_mean, beta_max, beta_std) = stats(&detection.beta);
+        Summary {
+            file: args.cloud.display().to_string(),
+            points: cloud.points.len(),
+            distinct_points: cloud.points.len() - detection.duplicates,
+            duplicates: detection.duplicates,
+            dropped_non_finite: cloud.dropped_non_finite,
+            boundary_points: detection.boundary_count(),
+            beta_min,
+            beta_mean,
+            beta_max,
+            beta_std,
+            read_ms: millis(read_time),
+            detect_ms: millis(detect_time),
+            k: args.k,
+            anisotropy: !args.no_anisotropy,
+        }
+    }
+
+    /// The summary as an aligned two-column table.
+    pub fn table(&self) -> String {
+        let share = 100.0 * self.boundary_points as f64 / self.points.max(1) as f64;
+        let on_off = if self.anisotropy { "on" } else { "off" };
+        let rows = [
+            ("file", self.file.clone()),
+            ("points", self.points.to_string()),
+            ("distinct points", self.distinct_points.to_string()),
+            ("duplicates", self.duplicates.to_string()),
+            ("dropped non-finite", self.dropped_non_finite.to_string()),
+            (
+                "boundary points",
+                format!("{} ({share:.1}%)", self.boundary_points),
+            ),
+            ("beta min", format!("{:.6}", self.beta_min)),
+            ("beta mean", format!("{:.6}", self.beta_mean)),
+            ("beta max", format!("{:.6}", self.beta_max)),
+            ("beta std", format!("{:.6}", self.beta_std)),
+            ("k", self.k.to_string()),
+            ("anisotropy", on_off.to_string()),
+            ("read time", format!("{:.1} ms", self.read_ms)),
+            ("detect time", format!("{:.1} ms", self.detect_ms)),
+        ];
+        rows.iter()
+            .map(|(label, value)| format!("{label:<20} {value}\n"))
+            .collect()
+    }
+}
+
+/// Minimum, mean, maximum and population standard deviation.
+fn stats(values: &[f64]) -> (f64, f64, f64, f64) {
+    let n = values.len().max(1) as f64;
+    let min = values.iter().copied().fold(f64::INFINITY, f64::min);
+    let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let mean = values.iter().sum::<f64>() / n;
+    let var = values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / n;
+    (min, mean, max, var.sqrt())
+}
+
+/// Milliseconds, rounded to 0.1 ms.
+fn millis(d: Duration) -> f64 {
+    (d.as_secs_f64() * 1e4).round() / 10.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stats_of_known_values() {
+        let (min, mean, max, std) = stats(&[1.0, 3.0, 5.0, 7.0]);
+        assert_eq!((min, mean, max), (1.0, 4.0, 7.0));
+        assert!((std - 5f64.sqrt()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn output_checks() {
+        let input = Path::new("Cargo.toml");
+        assert!(check_output(Path::new("x.txt"), input).is_err());
+        assert!(check_output(Path::new("Cargo.toml"), input).is_err());
+        let (_, f) = check_output(Path::new("out/x.CSV"), input).unwrap();
+        assert_eq!(f, LabelFormat::Csv);
+    }
+}

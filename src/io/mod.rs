@@ -1,0 +1,256 @@
+//! Reading point clouds and meshes, writing results.
+//!
+//! [`read_cloud`] picks the reader from the file's content when the content
+//! is unambiguous (a PLY or PCD header, OBJ `v` lines) and from its
+//! extension otherwise, so a PLY file named `.txt` still reads as PLY.
+//!
+//! Every error names the file, then where in it (a line for text, an
+//! element index for binary data) and what is wrong. Readers never panic on
+//! bad input.
+//!
+//! NaN policy: PCD readers drop points with a non-finite coordinate and count
+//! them, because organised PCD clouds mark empty pixels with NaN. In every
+//! other format a non-finite coordinate is an error.
+
+pub mod atomic;
+pub mod labels;
+pub mod obj;
+pub mod pcd;
+pub mod ply;
+pub mod text;
+
+use std::path::Path;
+
+use anyhow::{bail, Context, Result};
+
+/// A point in 3D, in the file's own units.
+pub type Point3 = [f64; 3];
+
+/// The file formats meshtrim reads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// Stanford PLY, ASCII or binary.
+    Ply,
+    /// Point Cloud Library PCD, ASCII, binary or binary_compressed.
+    Pcd,
+    /// Wavefront OBJ (`v` and `f` lines).
+    Obj,
+    /// One point per line, the first three columns being x, y and z.
+    Text,
+}
+
+impl Format {
+    /// Lower-case name, as used in messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            Format::Ply => "ply",
+            Format::Pcd => "pcd",
+            Format::Obj => "obj",
+            Format::Text => "text",
+        }
+    }
+
+    /// The format an extension names, if any.
+    fn from_extension(ext: &str) -> Option<Format> {
+        match ext.to_ascii_lowercase().as_str() {
+            "ply" => Some(Format::Ply),
+            "pcd" => Some(Format::Pcd),
+            "obj" => Some(Format::Obj),
+            "xyz" | "txt" | "csv" | "asc" | "pts" => Some(Format::Text),
+            _ => None,
+        }
+    }
+}
+
+/// A point cloud as read from a file, in file order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cloud {
+    /// The points, all finite.
+    pub points: Vec<Point3>,
+    /// Per-point normals, when the file has them (PLY nx/ny/nz, PCD
+    /// normal_x/normal_y/normal_z).
+    pub normals: Option<Vec<Point3>>,
+    /// Points dropped because a coordinate was NaN or infinite (PCD only).
+    pub dropped_non_finite: usize,
+    /// The format the file was read as.
+    pub format: Format,
+}
+
+/// A mesh as read from a file: vertices in file order, faces triangulated.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Mesh {
+    /// The vertices, all finite.
+    pub vertices: Vec<Point3>,
+    /// Per-vertex normals, when the file has them.
+    pub normals: Option<Vec<Point3>>,
+    /// Triangles as vertex indices, polygons split into fans; `None` when
+    /// the file has no face element or `f` lines at all.
+    pub faces: Option<Vec<[u32; 3]>>,
+}
+
+/// Reads a point cloud, choosing the reader by content and extension.
+///
+/// Fails, with the file name first in the message, on unreadable or
+/// malformed files and on files with no points.
+pub fn read_cloud(path: &Path) -> Result<Cloud> {
+    read_cloud_inner(path).with_context(|| path.display().to_string())
+}
+
+/// Reads a mesh (PLY or OBJ); the faces are `None` if the file has none.
+pub fn read_mesh(path: &Path) -> Result<Mesh> {
+    read_mesh_inner(path).with_context(|| path.display().to_string())
+}
+
+fn read_cloud_inner(path: &Path) -> Result<Cloud> {
+    let bytes = std::fs::read(path).context("cannot read")?;
+    let format = detect_format(path, &bytes)?;
+    let cloud = match format {
+        Format::Ply => from_mesh(ply::read_ply(&bytes)?, format),
+        Format::Obj => from_mesh(obj::read_obj(&bytes)?, format),
+        Format::Pcd => pcd::read_pcd(&bytes)?,
+        Format::Text => from_mesh(text::read_text(&bytes)?, format),
+    };
+    if cloud.points.is_empty() {
+        bail!("no points in the file ({} format)", format.name());
+    }
+    Ok(cloud)
+}
+
+fn read_mesh_inner(path: &Path) -> Result<Mesh> {
+    let bytes = std::fs::read(path).context("cannot read")?;
+    let mesh = match detect_format(path, &bytes)? {
+        Format::Ply => ply::read_ply(&bytes)?,
+        Format::Obj => obj::read_obj(&bytes)?,
+        other => bail!(
+            "a mesh must be PLY or OBJ, this is a {} point cloud",
+            other.name()
+        ),
+    };
+    if mesh.vertices.is_empty() {
+        bail!("no vertices in the file");
+    }
+    Ok(mesh)
+}
+
+fn from_mesh(mesh: Mesh, format: Format) -> Cloud {
+    Cloud {
+        points: mesh.vertices,
+        normals: mesh.normals,
+        dropped_non_finite: 0,
+        format,
+    }
+}
+
+/// Chooses the reader for a file.
+///
+/// The PLY and PCD headers and OBJ `v` lines are recognised whatever the
+/// extension says, because files get renamed. Otherwise the extension
+/// decides, and a file with an unknown extension is read as text if its
+/// first data line holds at least three numbers.
+pub fn detect_format(path: &Path, bytes: &[u8]) -> Result<Format> {
+    if let Some(format) = sniff(bytes) {
+        return Ok(format);
+    }
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+    if let Some(format) = Format::from_extension(ext) {
+        return Ok(format);
+    }
+    if text::looks_numeric(bytes) {
+        return Ok(Format::Text);
+    }
+    bail!(
+        "unknown format: the extension '{ext}' is not one of ply, pcd, obj, xyz, txt, csv, asc, pts, \
+         and the content is neither a PLY, PCD or OBJ header nor lines of numbers"
+    )
+}
+
+/// Recognises a format from the start of the file, if it is unambiguous.
+fn sniff(bytes: &[u8]) -> Option<Format> {
+    if bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n") {
+        return Some(Format::Ply);
+    }
+    // Only the start matters; a lossy view copes with binary data after it.
+    let head = String::from_utf8_lossy(&bytes[..bytes.len().min(4096)]);
+    let first = head
+        .lines()
+        .map(str::trim)
+        .find(|l| !l.is_empty() && !(l.starts_with('#') && !is_pcd_banner(l)))?;
+    if is_pcd_banner(first) || first.starts_with("VERSION") || first.starts_with("FIELDS") {
+        return Some(Format::Pcd);
+    }
+    let obj_line = |l: &str| l.starts_with("v ") || l.starts_with("v\t");
+    if head.lines().map(str::trim_start).any(obj_line) {
+        return Some(Format::Obj);
+    }
+    None
+}
+
+fn is_pcd_banner(line: &str) -> bool {
+    line.starts_with("# .PCD")
+}
+
+/// Describes a truncated element list: "expected 40256 vertices, file ends
+/// after 1234".
+pub(crate) fn truncated(expected: usize, what: &str, got: usize) -> anyhow::Error {
+    anyhow::anyhow!(
+        "expected {expected} {}, file ends after {got}",
+        plural(what)
+    )
+}
+
+/// Plural of an element name, for messages.
+pub(crate) fn plural(what: &str) -> String {
+    match what {
+        "vertex" => "vertices".to_string(),
+        w if w.ends_with('s') => w.to_string(),
+        w => format!("{w}s"),
+    }
+}
+
+/// Formats a point for messages, keeping NaN and inf readable.
+pub(crate) fn show(p: &Point3) -> String {
+    format!("({}, {}, {})", p[0], p[1], p[2])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn content_beats_extension() {
+        let p = Path::new("cloud.txt");
+        assert_eq!(
+            detect_format(p, b"ply\nformat ascii 1.0\n").unwrap(),
+            Format::Ply
+        );
+        let pcd = b"# .PCD v0.7 - Point Cloud Data\nVERSION 0.7\n";
+        assert_eq!(detect_format(p, pcd).unwrap(), Format::Pcd);
+        assert_eq!(
+            detect_format(p, b"VERSION 0.7\nFIELDS x y z\n").unwrap(),
+            Format::Pcd
+        );
+        let obj = b"# comment\nv 1 2 3\nv 4 5 6\n";
+        assert_eq!(detect_format(p, obj).unwrap(), Format::Obj);
+    }
+
+    #[test]
+    fn extension_then_numbers_then_error() {
+        assert_eq!(
+            detect_format(Path::new("a.CSV"), b"x,y,z\n").unwrap(),
+            Format::Text
+        );
+        assert_eq!(
+            detect_format(Path::new("a.dat"), b"1 2 3\n").unwrap(),
+            Format::Text
+        );
+        let err = detect_format(Path::new("a.dat"), b"hello world\n").unwrap_err();
+        assert!(err.to_string().contains("unknown format"), "{err}");
+    }
+
+    #[test]
+    fn plural_names() {
+        assert_eq!(plural("vertex"), "vertices");
+        assert_eq!(plural("face"), "faces");
+        assert_eq!(plural("points"), "points");
+    }
+}

@@ -1,0 +1,141 @@
+//! Wavefront OBJ: `v` and `f` lines.
+//!
+//! A few lines of our own rather than `tobj`: tobj only returns vertices
+//! that some face uses (re-indexed per object), so a face-less OBJ point
+//! cloud comes back empty, and its errors carry no line numbers. Here every
+//! `v` line is a vertex, in file order; `f` lines become triangle fans.
+//! Texture coordinates, normals (`vn`, indexed per face corner), groups and
+//! materials are ignored.
+
+use anyhow::{anyhow, bail, Result};
+
+use super::{show, Mesh, Point3};
+
+/// Reads the vertices and faces of an OBJ file.
+pub fn read_obj(bytes: &[u8]) -> Result<Mesh> {
+    let text = std::str::from_utf8(bytes).map_err(|e| {
+        anyhow!(
+            "not a text file (invalid UTF-8 at byte {})",
+            e.valid_up_to()
+        )
+    })?;
+    let mut mesh = Mesh::default();
+    for (i, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        let at = |e: anyhow::Error| anyhow!("line {}: {e}", i + 1);
+        match words.next() {
+            Some("v") => mesh.vertices.push(parse_vertex(words).map_err(at)?),
+            Some("f") => {
+                let faces = mesh.faces.get_or_insert_with(Vec::new);
+                parse_face(words, mesh.vertices.len(), faces).map_err(at)?;
+            }
+            _ => {}
+        }
+    }
+    check_indices(&mesh)?;
+    Ok(mesh)
+}
+
+/// Positive references may point forward, so they are checked at the end.
+fn check_indices(mesh: &Mesh) -> Result<()> {
+    let n = mesh.vertices.len();
+    for (t, face) in mesh.faces.as_deref().unwrap_or_default().iter().enumerate() {
+        if let Some(&v) = face.iter().find(|&&v| v as usize >= n) {
+            bail!(
+                "triangle {t} refers to vertex {}, but there are only {n} vertices",
+                v + 1
+            );
+        }
+    }
+    Ok(())
+}
+
+/// `v x y z [w | r g b]`: the first three numbers.
+fn parse_vertex<'a>(words: impl Iterator<Item = &'a str>) -> Result<Point3> {
+    let mut p: Point3 = [0.0; 3];
+    let mut words = words.take(3);
+    for (k, c) in p.iter_mut().enumerate() {
+        let word = words
+            .next()
+            .ok_or_else(|| anyhow!("a vertex needs x, y and z, found {k} value(s)"))?;
+        *c = word
+            .parse()
+            .map_err(|_| anyhow!("'{word}' is not a number"))?;
+    }
+    if p.iter().any(|c| !c.is_finite()) {
+        bail!("non-finite coordinate {}", show(&p));
+    }
+    Ok(p)
+}
+
+/// `f a b c ...`, each corner `v`, `v/vt`, `v//vn` or `v/vt/vn`, 1-based or
+/// negative (counted back from the latest vertex); 0-based on return.
+fn parse_face<'a>(
+    words: impl Iterator<Item = &'a str>,
+    defined: usize,
+    faces: &mut Vec<[u32; 3]>,
+) -> Result<()> {
+    let corners = words
+        .map(|w| corner_index(w, defined))
+        .collect::<Result<Vec<u32>>>()?;
+    for w in 1..corners.len().saturating_sub(1) {
+        faces.push([corners[0], corners[w], corners[w + 1]]);
+    }
+    Ok(())
+}
+
+fn corner_index(word: &str, defined: usize) -> Result<u32> {
+    let v = word.split('/').next().unwrap_or_default();
+    let n: i64 = v
+        .parse()
+        .map_err(|_| anyhow!("'{word}' is not a vertex reference"))?;
+    let index = if n < 0 { defined as i64 + n } else { n - 1 };
+    if n == 0 || index < 0 || index > i64::from(u32::MAX) {
+        bail!("face refers to vertex {n}, which does not exist");
+    }
+    Ok(index as u32)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn faceless_cloud_keeps_every_vertex() {
+        let mesh = read_obj(b"# cloud\nv 1 2 3\nv 4 5 6 1 0 0\nvn 0 0 1\nv 7 8 9\n").unwrap();
+        assert_eq!(
+            mesh.vertices,
+            vec![[1., 2., 3.], [4., 5., 6.], [7., 8., 9.]]
+        );
+        assert_eq!(mesh.faces, None);
+    }
+
+    #[test]
+    fn faces_all_corner_forms() {
+        let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1/1 2//3 3/4/5 -1\nf 1 2 3\n";
+        let mesh = read_obj(text.as_bytes()).unwrap();
+        assert_eq!(mesh.faces.unwrap(), vec![[0, 1, 2], [0, 2, 3], [0, 1, 2]]);
+    }
+
+    #[test]
+    fn errors_name_the_line() {
+        let e = |t: &str| read_obj(t.as_bytes()).unwrap_err().to_string();
+        assert_eq!(e("v 1 2 3\nv 1 x 3\n"), "line 2: 'x' is not a number");
+        assert_eq!(
+            e("v 1 2\n"),
+            "line 1: a vertex needs x, y and z, found 2 value(s)"
+        );
+        assert_eq!(
+            e("v 1 2 inf\n"),
+            "line 1: non-finite coordinate (1, 2, inf)"
+        );
+        assert_eq!(
+            e("v 1 2 3\nf 1 2 3\n"),
+            "triangle 0 refers to vertex 2, but there are only 1 vertices"
+        );
+        assert_eq!(
+            e("v 1 2 3\nf 1 -2 1\n"),
+            "line 2: face refers to vertex -2, which does not exist"
+        );
+    }
+}

@@ -1,0 +1,492 @@
+//! PCD (Point Cloud Library) reading: `DATA ascii`, `binary` and
+//! `binary_compressed`.
+//!
+//! The header lists the fields of a point (FIELDS, SIZE, TYPE, COUNT); x, y
+//! and z may have any numeric type and every other field (rgba, normals,
+//! curvature, padding `_`, COUNT > 1 descriptors) is skipped by its size.
+//! `binary` stores points one after the other; `binary_compressed` is a u32
+//! compressed size, a u32 uncompressed size and LZF data that holds the
+//! fields one after the other (all x, then all y, ...).
+//!
+//! Points with a NaN or infinite coordinate are dropped and counted:
+//! organised clouds from depth cameras mark empty pixels that way, so they
+//! are expected, not an error. Binary PCD is read as little-endian, the byte
+//! order of every machine PCL writes on in practice.
+
+use anyhow::{anyhow, bail, Result};
+
+use super::{truncated, Cloud, Format, Point3};
+
+/// One field of a PCD point.
+#[derive(Debug, Clone, PartialEq)]
+struct Field {
+    name: String,
+    size: usize,
+    ty: char,
+    count: usize,
+}
+
+impl Field {
+    /// Bytes the field takes in one point.
+    fn bytes(&self) -> usize {
+        self.size * self.count
+    }
+
+    /// Decodes the first element of the field from little-endian bytes.
+    fn decode(&self, b: &[u8]) -> f64 {
+        let mut raw = [0u8; 8];
+        raw[..self.size].copy_from_slice(&b[..self.size]);
+        match (self.ty, self.size) {
+            ('F', 4) => f64::from(f32::from_le_bytes([raw[0], raw[1], raw[2], raw[3]])),
+            ('F', _) => f64::from_le_bytes(raw),
+            ('U', _) => u64::from_le_bytes(raw) as f64,
+            // Sign-extend by shifting the value to the top and back.
+            (_, size) => {
+                let shift = 64 - 8 * size as u32;
+                ((i64::from_le_bytes(raw) << shift) >> shift) as f64
+            }
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Data {
+    Ascii,
+    Binary,
+    Compressed,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+struct Header {
+    fields: Vec<Field>,
+    points: usize,
+    data: Data,
+    body_start: usize,
+    lines: usize,
+}
+
+impl Header {
+    fn field(&self, name: &str) -> Option<usize> {
+        self.fields.iter().position(|f| f.name == name)
+    }
+
+    /// Bytes per point.
+    fn point_bytes(&self) -> usize {
+        self.fields.iter().map(Field::bytes).sum()
+    }
+}
+
+/// The fields the reader keeps: x, y, z and, if present, a normal.
+struct Wanted {
+    xyz: [usize; 3],
+    normal: Option<[usize; 3]>,
+}
+
+/// Reads a PCD file, dropping (and counting) non-finite points.
+pub fn read_pcd(bytes: &[u8]) -> Result<Cloud> {
+    let header = parse_header(bytes)?;
+    let wanted = wanted_fields(&header)?;
+    let body = &bytes[header.body_start..];
+    let raw = match header.data {
+        Data::Ascii => read_ascii(&header, &wanted, body)?,
+        Data::Binary => read_binary(&header, &wanted, body)?,
+        Data::Compressed => read_compressed(&header, &wanted, body)?,
+    };
+    Ok(keep_finite(raw))
+}
+
+fn wanted_fields(header: &Header) -> Result<Wanted> {
+    let f = |n| header.field(n);
+    let xyz = match (f("x"), f("y"), f("z")) {
+        (Some(x), Some(y), Some(z)) => [x, y, z],
+        _ => bail!("the PCD fields have no x, y and z"),
+    };
+    let normal = match (f("normal_x"), f("normal_y"), f("normal_z")) {
+        (Some(x), Some(y), Some(z)) => Some([x, y, z]),
+        _ => None,
+    };
+    Ok(Wanted { xyz, normal })
+}
+
+fn parse_header(bytes: &[u8]) -> Result<Header> {
+    let mut fields: Vec<Field> = Vec::new();
+    let (mut sizes, mut types, mut counts) = (None, None, None);
+    let (mut width, mut height, mut points) = (None, None, None);
+    let mut start = 0;
+    let mut line_no = 0;
+    while start < bytes.len() {
+        line_no += 1;
+        let len = bytes[start..].iter().position(|&b| b == b'\n');
+        let end = len.map_or(bytes.len(), |l| start + l);
+        let line = String::from_utf8_lossy(&bytes[start..end]);
+        start = (end + 1).min(bytes.len());
+        let at = |what: String| anyhow!("malformed PCD header: line {line_no}: {what}");
+        let words: Vec<&str> = line.split_whitespace().collect();
+        let Some((key, values)) = words.split_first() else {
+            continue;
+        };
+        match *key {
+            k if k.starts_with('#') => {}
+            "VERSION" | "VIEWPOINT" => {}
+            "FIELDS" | "COLUMNS" => fields = values.iter().map(|n| new_field(n)).collect(),
+            "SIZE" => sizes = Some(numbers(values).map_err(at)?),
+            "TYPE" => types = Some(values.iter().map(|t| t.to_string()).collect::<Vec<_>>()),
+            "COUNT" => counts = Some(numbers(values).map_err(at)?),
+            "WIDTH" => width = Some(number(values).map_err(at)?),
+            "HEIGHT" => height = Some(number(values).map_err(at)?),
+            "POINTS" => points = Some(number(values).map_err(at)?),
+            "DATA" => {
+                let data = parse_data(values).map_err(at)?;
+                let points = points.or(width.zip(height).map(|(w, h)| w * h));
+                let points = points.ok_or_else(|| at("no POINTS, WIDTH or HEIGHT".into()))?;
+                let fields = fill_fields(fields, sizes, types, counts).map_err(at)?;
+                return Ok(Header {
+                    fields,
+                    points,
+                    data,
+                    body_start: start,
+                    lines: line_no,
+                });
+            }
+            other => return Err(at(format!("unknown header line '{other}'"))),
+        }
+    }
+    bail!("malformed PCD header: no DATA line")
+}
+
+fn new_field(name: &str) -> Field {
+    Field {
+        name: name.to_string(),
+        size: 4,
+        ty: 'F',
+        count: 1,
+    }
+}
+
+fn number(values: &[&str]) -> Result<usize, String> {
+    match values {
+        [v] => v.parse().map_err(|_| format!("'{v}' is not a count")),
+        _ => Err(format!("expected one number, found '{}'", values.join(" "))),
+    }
+}
+
+fn numbers(values: &[&str]) -> Result<Vec<usize>, String> {
+    values.iter().map(|v| number(&[v])).collect()
+}
+
+fn parse_data(values: &[&str]) -> Result<Data, String> {
+    match values {
+        ["ascii"] => Ok(Data::Ascii),
+        ["binary"] => Ok(Data::Binary),
+        ["binary_compressed"] => Ok(Data::Compressed),
+        _ => Err(format!("unsupported DATA '{}'", values.join(" "))),
+    }
+}
+
+/// Puts SIZE, TYPE and COUNT into the fields and checks them.
+fn fill_fields(
+    mut fields: Vec<Field>,
+    sizes: Option<Vec<usize>>,
+    types: Option<Vec<String>>,
+    counts: Option<Vec<usize>>,
+) -> Result<Vec<Field>, String> {
+    let n = fields.len();
+    let check = |what: &str, len: Option<usize>| match len {
+        Some(len) if len != n => Err(format!("{what} has {len} entries for {n} fields")),
+        _ => Ok(()),
+    };
+    check("SIZE", sizes.as_ref().map(Vec::len))?;
+    check("TYPE", types.as_ref().map(Vec::len))?;
+    check("COUNT", counts.as_ref().map(Vec::len))?;
+    for (i, field) in fields.iter_mut().enumerate() {
+        field.size = sizes.as_ref().map_or(4, |s| s[i]);
+        field.count = counts.as_ref().map_or(1, |c| c[i]);
+        field.ty = types
+            .as_ref()
+            .map_or('F', |t| t[i].chars().next().unwrap_or('?'));
+        match (field.ty, field.size) {
+            ('F', 4 | 8) | ('I' | 'U', 1 | 2 | 4 | 8) => {}
+            (ty, size) => {
+                return Err(format!(
+                    "unsupported type {ty} of size {size} for field '{}'",
+                    field.name
+                ))
+            }
+        }
+    }
+    Ok(fields)
+}
+
+/// Points as read, non-finite ones included.
+struct Raw {
+    points: Vec<Point3>,
+    normals: Option<Vec<Point3>>,
+}
+
+impl Raw {
+    fn new(wanted: &Wanted, n: usize) -> Self {
+        Raw {
+            points: Vec::with_capacity(n),
+            normals: wanted.normal.map(|_| Vec::with_capacity(n)),
+        }
+    }
+
+    /// Appends one point, reading field `f` with `value(f)`.
+    fn push(&mut self, wanted: &Wanted, mut value: impl FnMut(usize) -> Result<f64>) -> Result<()> {
+        let [x, y, z] = wanted.xyz;
+        self.points.push([value(x)?, value(y)?, value(z)?]);
+        if let (Some([x, y, z]), Some(normals)) = (wanted.normal, self.normals.as_mut()) {
+            normals.push([value(x)?, value(y)?, value(z)?]);
+        }
+        Ok(())
+    }
+}
+
+fn read_ascii(header: &Header, wanted: &Wanted, body: &[u8]) -> Result<Raw> {
+    let text = std::str::from_utf8(body)
+        .map_err(|e| anyhow!("the ASCII data is not text (byte {})", e.valid_up_to()))?;
+    // Token index of each field's first element.
+    let mut first = Vec::with_capacity(header.fields.len());
+    let mut total = 0;
+    for f in &header.fields {
+        first.push(total);
+        total += f.count;
+    }
+    let mut raw = Raw::new(wanted, header.points);
+    let lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty());
+    for (i, line) in lines.take(header.points) {
+        let line_no = header.lines + i + 1;
+        let tokens: Vec<&str> = line.split_whitespace().collect();
+        if tokens.len() < total {
+            bail!(
+                "line {line_no}: expected {total} values, found {}",
+                tokens.len()
+            );
+        }
+        raw.push(wanted, |f| {
+            let token = tokens[first[f]];
+            token
+                .parse()
+                .map_err(|_| anyhow!("line {line_no}: '{token}' is not a number"))
+        })?;
+    }
+    if raw.points.len() < header.points {
+        return Err(truncated(header.points, "point", raw.points.len()));
+    }
+    Ok(raw)
+}
+
+fn read_binary(header: &Header, wanted: &Wanted, body: &[u8]) -> Result<Raw> {
+    let stride = header.point_bytes();
+    let available = body.len() / stride.max(1);
+    if available < header.points {
+        return Err(truncated(header.points, "point", available));
+    }
+    let offsets = offsets(header, |f| f.bytes());
+    let mut raw = Raw::new(wanted, header.points);
+    for record in body.chunks_exact(stride).take(header.points) {
+        raw.push(wanted, |f| {
+            Ok(header.fields[f].decode(&record[offsets[f]..]))
+        })?;
+    }
+    Ok(raw)
+}
+
+fn read_compressed(header: &Header, wanted: &Wanted, body: &[u8]) -> Result<Raw> {
+    if header.points == 0 {
+        return Ok(Raw::new(wanted, 0));
+    }
+    let size_at = |at: usize| {
+        body.get(at..at + 4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize)
+            .ok_or_else(|| anyhow!("the compressed data is truncated: no size header"))
+    };
+    let (compressed, uncompressed) = (size_at(0)?, size_at(4)?);
+    let expected = header.points * header.point_bytes();
+    if uncompressed != expected {
+        bail!(
+            "the compressed data holds {uncompressed} bytes, but {} points need {expected}",
+            header.points
+        );
+    }
+    let data = body.get(8..8 + compressed).ok_or_else(|| {
+        anyhow!(
+            "the compressed data is truncated: the header says {compressed} bytes, the file has {}",
+            body.len().saturating_sub(8)
+        )
+    })?;
+    let data = lzf::decompress(data, uncompressed)
+        .map_err(|e| anyhow!("the LZF-compressed data is corrupt ({e:?})"))?;
+    if data.len() != expected {
+        bail!(
+            "the compressed data decompresses to {} bytes, not {expected}",
+            data.len()
+        );
+    }
+    // Field f's block starts after all points of the earlier fields.
+    let starts = offsets(header, |f| f.bytes() * header.points);
+    let mut raw = Raw::new(wanted, header.points);
+    for i in 0..header.points {
+        raw.push(wanted, |f| {
+            let field = &header.fields[f];
+            Ok(field.decode(&data[starts[f] + i * field.bytes()..]))
+        })?;
+    }
+    Ok(raw)
+}
+
+/// Running sums of `len` over the fields: where each field starts.
+fn offsets(header: &Header, len: impl Fn(&Field) -> usize) -> Vec<usize> {
+    let mut at = 0;
+    header
+        .fields
+        .iter()
+        .map(|f| {
+            let start = at;
+            at += len(f);
+            start
+        })
+        .collect()
+}
+
+fn keep_finite(raw: Raw) -> Cloud {
+    let finite: Vec<bool> = raw
+        .points
+        .iter()
+        .map(|p| p.iter().all(|c| c.is_finite()))
+        .collect();
+    let keep = |v: Vec<Point3>| -> Vec<Point3> {
+        v.into_iter()
+            .zip(&finite)
+            .filter(|(_, &ok)| ok)
+            .map(|(p, _)| p)
+            .collect()
+    };
+    let dropped = finite.iter().filter(|&&ok| !ok).count();
+    Cloud {
+        points: keep(raw.points),
+        normals: raw.normals.map(keep),
+        dropped_non_finite: dropped,
+        format: Format::Pcd,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const HEAD: &str = "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z rgba normal_x normal_y normal_z\n\
+        SIZE 4 8 4 4 4 4 4\nTYPE F F F U F F F\nCOUNT 1 1 1 1 1 1 1\nWIDTH 3\nHEIGHT 1\n\
+        VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 3\n";
+
+    const POINTS: [[f64; 3]; 3] = [[1.5, 2.25, -3.0], [f64::NAN, 0.0, 0.0], [4.0, 5.0, 6.0]];
+
+    /// Field values of point i, in header order.
+    fn record(i: usize) -> (f32, f64, f32, u32, [f32; 3]) {
+        let p = POINTS[i];
+        (p[0] as f32, p[1], p[2] as f32, 0xff00ff, [0.0, 0.0, 1.0])
+    }
+
+    fn binary() -> Vec<u8> {
+        let mut out = format!("{HEAD}DATA binary\n").into_bytes();
+        for i in 0..3 {
+            let (x, y, z, rgba, n) = record(i);
+            out.extend(x.to_le_bytes());
+            out.extend(y.to_le_bytes());
+            out.extend(z.to_le_bytes());
+            out.extend(rgba.to_le_bytes());
+            n.iter().for_each(|c| out.extend(c.to_le_bytes()));
+        }
+        out
+    }
+
+    fn compressed() -> Vec<u8> {
+        let mut soa = Vec::new();
+        (0..3).for_each(|i| soa.extend(record(i).0.to_le_bytes()));
+        (0..3).for_each(|i| soa.extend(record(i).1.to_le_bytes()));
+        (0..3).for_each(|i| soa.extend(record(i).2.to_le_bytes()));
+        (0..3).for_each(|i| soa.extend(record(i).3.to_le_bytes()));
+        for k in 0..3 {
+            (0..3).for_each(|i| soa.extend(record(i).4[k].to_le_bytes()));
+        }
+        let packed = lzf::compress(&soa).unwrap_or_else(|_| soa.clone());
+        let mut out = format!("{HEAD}DATA binary_compressed\n").into_bytes();
+        out.extend((packed.len() as u32).to_le_bytes());
+        out.extend((soa.len() as u32).to_le_bytes());
+        out.extend(packed);
+        out
+    }
+
+    fn ascii() -> String {
+        let mut out = format!("{HEAD}DATA ascii\n");
+        for p in POINTS {
+            out += &format!("{} {} {} 16711935 0 0 1\n", p[0], p[1], p[2]);
+        }
+        out
+    }
+
+    fn check(cloud: Cloud) {
+        assert_eq!(cloud.points, vec![POINTS[0], POINTS[2]]);
+        assert_eq!(cloud.normals, Some(vec![[0.0, 0.0, 1.0]; 2]));
+        assert_eq!(cloud.dropped_non_finite, 1);
+    }
+
+    #[test]
+    fn all_three_encodings_drop_nan() {
+        check(read_pcd(ascii().as_bytes()).unwrap());
+        check(read_pcd(&binary()).unwrap());
+        check(read_pcd(&compressed()).unwrap());
+    }
+
+    #[test]
+    fn integer_fields_and_counts() {
+        let text =
+            "FIELDS j x y z\nSIZE 2 1 2 8\nTYPE I I U I\nCOUNT 2 1 1 1\nPOINTS 1\nDATA binary\n";
+        let mut bytes = text.as_bytes().to_vec();
+        bytes.extend([0, 0, 0, 0, 0xfe, 0x34, 0x12]);
+        bytes.extend((-5i64).to_le_bytes());
+        let cloud = read_pcd(&bytes).unwrap();
+        assert_eq!(cloud.points, vec![[-2.0, 4660.0, -5.0]]);
+    }
+
+    fn err(bytes: &[u8]) -> String {
+        format!("{:#}", read_pcd(bytes).unwrap_err())
+    }
+
+    #[test]
+    fn truncation_is_reported() {
+        let b = binary();
+        assert_eq!(
+            err(&b[..b.len() - 1]),
+            "expected 3 points, file ends after 2"
+        );
+        let c = compressed();
+        assert!(err(&c[..c.len() - 1]).contains("compressed data is truncated"));
+        let a = ascii();
+        let a = a.trim_end().rsplit_once('\n').unwrap().0;
+        assert_eq!(err(a.as_bytes()), "expected 3 points, file ends after 2");
+    }
+
+    #[test]
+    fn header_and_value_errors() {
+        assert!(err(b"FIELDS x y z\nPOINTS 1\n").contains("no DATA line"));
+        assert!(err(b"FIELDS x y z\nSIZE 2 2 2\nPOINTS 1\nDATA ascii\n")
+            .contains("line 4: unsupported type F of size 2"));
+        assert!(
+            err(b"FIELDS x y z\nSIZE 4 4\nPOINTS 1\nDATA ascii\n").contains("SIZE has 2 entries")
+        );
+        assert!(err(b"FIELDS a b c\nPOINTS 1\nDATA ascii\n1 2 3\n").contains("no x, y and z"));
+        assert!(err(b"FIELDS x y z\nPOINTS 1\nDATA lzma\n").contains("line 3: unsupported DATA"));
+        assert_eq!(
+            err(b"FIELDS x y z\nPOINTS 2\nDATA ascii\n1 2 3\n1 zz 3\n"),
+            "line 5: 'zz' is not a number"
+        );
+        assert_eq!(
+            err(b"FIELDS x y z\nPOINTS 1\nDATA ascii\n1 2\n"),
+            "line 4: expected 3 values, found 2"
+        );
+    }
+}

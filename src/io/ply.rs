@@ -1,0 +1,660 @@
+//! PLY (Stanford polygon file format) reading and writing.
+//!
+//! A small reader of its own, because the PLY crates are unmaintained. It
+//! reads the `ascii`, `binary_little_endian` and `binary_big_endian`
+//! encodings with every scalar type, and walks every element of the file in
+//! order, so elements before `vertex` (a scanner's `camera`, say) and list
+//! properties (faces, `range_grid`) are skipped by their real sizes. From the
+//! `vertex` element it keeps x, y, z and, when all three are present, the
+//! normal nx, ny, nz; from the `face` element the `vertex_indices` (or
+//! `vertex_index`) list, split into triangle fans.
+
+use std::io::Write;
+
+use anyhow::{anyhow, bail, Result};
+use byteorder::{BigEndian, ByteOrder, LittleEndian, WriteBytesExt};
+
+use super::{show, truncated, Mesh, Point3};
+
+/// A PLY scalar type.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Scalar {
+    /// `char` / `int8`.
+    I8,
+    /// `uchar` / `uint8`.
+    U8,
+    /// `short` / `int16`.
+    I16,
+    /// `ushort` / `uint16`.
+    U16,
+    /// `int` / `int32`.
+    I32,
+    /// `uint` / `uint32`.
+    U32,
+    /// `float` / `float32`.
+    F32,
+    /// `double` / `float64`.
+    F64,
+}
+
+impl Scalar {
+    /// The type a header names, with the sized aliases.
+    pub fn parse(name: &str) -> Option<Scalar> {
+        Some(match name {
+            "char" | "int8" => Scalar::I8,
+            "uchar" | "uint8" => Scalar::U8,
+            "short" | "int16" => Scalar::I16,
+            "ushort" | "uint16" => Scalar::U16,
+            "int" | "int32" => Scalar::I32,
+            "uint" | "uint32" => Scalar::U32,
+            "float" | "float32" => Scalar::F32,
+            "double" | "float64" => Scalar::F64,
+            _ => return None,
+        })
+    }
+
+    /// Size in bytes in the binary encodings.
+    pub fn size(self) -> usize {
+        match self {
+            Scalar::I8 | Scalar::U8 => 1,
+            Scalar::I16 | Scalar::U16 => 2,
+            Scalar::I32 | Scalar::U32 | Scalar::F32 => 4,
+            Scalar::F64 => 8,
+        }
+    }
+
+    /// Decodes one value from exactly `self.size()` bytes.
+    fn decode<B: ByteOrder>(self, b: &[u8]) -> f64 {
+        match self {
+            Scalar::I8 => f64::from(b[0] as i8),
+            Scalar::U8 => f64::from(b[0]),
+            Scalar::I16 => f64::from(B::read_i16(b)),
+            Scalar::U16 => f64::from(B::read_u16(b)),
+            Scalar::I32 => f64::from(B::read_i32(b)),
+            Scalar::U32 => f64::from(B::read_u32(b)),
+            Scalar::F32 => f64::from(B::read_f32(b)),
+            Scalar::F64 => B::read_f64(b),
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Encoding {
+    Ascii,
+    BinaryLe,
+    BinaryBe,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+enum Property {
+    Scalar {
+        name: String,
+        ty: Scalar,
+    },
+    List {
+        name: String,
+        count: Scalar,
+        item: Scalar,
+    },
+}
+
+impl Property {
+    fn name(&self) -> &str {
+        match self {
+            Property::Scalar { name, .. } | Property::List { name, .. } => name,
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq)]
+struct Element {
+    name: String,
+    count: usize,
+    properties: Vec<Property>,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+struct Header {
+    encoding: Encoding,
+    elements: Vec<Element>,
+    /// Byte offset of the first byte after `end_header`'s newline.
+    body_start: usize,
+    /// Number of header lines, so ASCII body lines can be numbered.
+    lines: usize,
+}
+
+/// Reads a PLY file: vertices, optional normals and optional faces.
+pub fn read_ply(bytes: &[u8]) -> Result<Mesh> {
+    let header = parse_header(bytes)?;
+    let body = &bytes[header.body_start..];
+    match header.encoding {
+        Encoding::Ascii => {
+            let text = std::str::from_utf8(body)
+                .map_err(|e| anyhow!("the ASCII body is not text (byte {})", e.valid_up_to()))?;
+            read_body(&header, &mut AsciiValues::new(text, header.lines))
+        }
+        Encoding::BinaryLe => read_body(&header, &mut BinaryValues::<LittleEndian>::new(body)),
+        Encoding::BinaryBe => read_body(&header, &mut BinaryValues::<BigEndian>::new(body)),
+    }
+}
+
+/// Splits off the header and parses it.
+fn parse_header(bytes: &[u8]) -> Result<Header> {
+    let end = find_end_header(bytes)
+        .ok_or_else(|| anyhow!("malformed PLY header: no 'end_header' line"))?;
+    let text = std::str::from_utf8(&bytes[..end.0])
+        .map_err(|_| anyhow!("malformed PLY header: it is not ASCII text"))?;
+    let mut encoding = None;
+    let mut elements: Vec<Element> = Vec::new();
+    let mut lines = 0;
+    for (i, line) in text.lines().enumerate() {
+        lines = i + 1;
+        let at = |what: String| anyhow!("malformed PLY header: line {}: {what}", i + 1);
+        let words: Vec<&str> = line.split_whitespace().collect();
+        match words.as_slice() {
+            ["ply"] if i == 0 => {}
+            _ if i == 0 => return Err(at("the file does not start with 'ply'".into())),
+            ["format", name, _version] => encoding = Some(parse_encoding(name).map_err(at)?),
+            ["comment", ..] | ["obj_info", ..] | [] => {}
+            ["element", name, count] => elements.push(Element {
+                name: name.to_string(),
+                count: count
+                    .parse()
+                    .map_err(|_| at(format!("'{count}' is not an element count")))?,
+                properties: Vec::new(),
+            }),
+            ["property", rest @ ..] => elements
+                .last_mut()
+                .ok_or_else(|| at("a property before any element".into()))?
+                .properties
+                .push(parse_property(rest).map_err(at)?),
+            ["end_header"] => break,
+            _ => return Err(at(format!("cannot understand '{line}'"))),
+        }
+    }
+    let encoding = encoding.ok_or_else(|| anyhow!("malformed PLY header: no 'format' line"))?;
+    Ok(Header {
+        encoding,
+        elements,
+        body_start: end.1,
+        lines,
+    })
+}
+
+/// Finds the `end_header` line: (end of its text, start of the body).
+fn find_end_header(bytes: &[u8]) -> Option<(usize, usize)> {
+    let mut start = 0;
+    while start < bytes.len() {
+        let len = bytes[start..].iter().position(|&b| b == b'\n')?;
+        let line = &bytes[start..start + len];
+        let line = line.strip_suffix(b"\r").unwrap_or(line);
+        if line.trim_ascii() == b"end_header" {
+            return Some((start + len, start + len + 1));
+        }
+        start += len + 1;
+    }
+    None
+}
+
+fn parse_encoding(name: &str) -> Result<Encoding, String> {
+    match name {
+        "ascii" => Ok(Encoding::Ascii),
+        "binary_little_endian" => Ok(Encoding::BinaryLe),
+        "binary_big_endian" => Ok(Encoding::BinaryBe),
+        _ => Err(format!("unknown format '{name}'")),
+    }
+}
+
+fn parse_property(words: &[&str]) -> Result<Property, String> {
+    let ty = |name: &str| {
+        Scalar::parse(name).ok_or_else(|| format!("unsupported property type '{name}'"))
+    };
+    match words {
+        ["list", count, item, name] => Ok(Property::List {
+            name: name.to_string(),
+            count: ty(count)?,
+            item: ty(item)?,
+        }),
+        [scalar, name] => Ok(Property::Scalar {
+            name: name.to_string(),
+            ty: ty(scalar)?,
+        }),
+        _ => Err(format!("cannot understand 'property {}'", words.join(" "))),
+    }
+}
+
+/// A source of values, ASCII tokens or binary data.
+trait Values {
+    /// The next value of type `ty`, or `None` when the data ends.
+    fn next(&mut self, ty: Scalar) -> Result<Option<f64>>;
+    /// "line N: " for ASCII data, empty for binary data.
+    fn line_prefix(&self) -> String;
+}
+
+/// Whitespace-separated values, numbered by line for messages.
+struct AsciiValues<'a> {
+    lines: std::str::Lines<'a>,
+    tokens: std::str::SplitAsciiWhitespace<'a>,
+    line: usize,
+}
+
+impl<'a> AsciiValues<'a> {
+    fn new(text: &'a str, header_lines: usize) -> Self {
+        Self {
+            lines: text.lines(),
+            tokens: "".split_ascii_whitespace(),
+            line: header_lines,
+        }
+    }
+}
+
+impl Values for AsciiValues<'_> {
+    fn next(&mut self, _ty: Scalar) -> Result<Option<f64>> {
+        loop {
+            if let Some(token) = self.tokens.next() {
+                let value = token
+                    .parse::<f64>()
+                    .map_err(|_| anyhow!("line {}: '{token}' is not a number", self.line))?;
+                return Ok(Some(value));
+            }
+            let Some(line) = self.lines.next() else {
+                return Ok(None);
+            };
+            self.line += 1;
+            self.tokens = line.split_ascii_whitespace();
+        }
+    }
+
+    fn line_prefix(&self) -> String {
+        format!("line {}: ", self.line)
+    }
+}
+
+/// Packed binary values in byte order `B`.
+struct BinaryValues<'a, B> {
+    data: &'a [u8],
+    order: std::marker::PhantomData<B>,
+}
+
+impl<'a, B> BinaryValues<'a, B> {
+    fn new(data: &'a [u8]) -> Self {
+        Self {
+            data,
+            order: std::marker::PhantomData,
+        }
+    }
+}
+
+impl<B: ByteOrder> Values for BinaryValues<'_, B> {
+    fn next(&mut self, ty: Scalar) -> Result<Option<f64>> {
+        let size = ty.size();
+        if self.data.len() < size {
+            return Ok(None);
+        }
+        let (value, rest) = self.data.split_at(size);
+        self.data = rest;
+        Ok(Some(ty.decode::<B>(value)))
+    }
+
+    fn line_prefix(&self) -> String {
+        String::new()
+    }
+}
+
+/// One record's values: scalars by property index (lists hold NaN there),
+/// and the items of the one list property the caller asked for.
+#[derive(Default)]
+struct Record {
+    scalars: Vec<f64>,
+    list: Vec<f64>,
+}
+
+/// What the body reader keeps from an element.
+enum Role {
+    /// x, y, z and optional nx, ny, nz property indices.
+    Vertex {
+        xyz: [usize; 3],
+        normal: Option<[usize; 3]>,
+    },
+    /// Index of the vertex index list property.
+    Face {
+        list: usize,
+    },
+    Skip,
+}
+
+fn read_body(header: &Header, values: &mut dyn Values) -> Result<Mesh> {
+    let mut mesh = Mesh::default();
+    let mut vertex_count = None;
+    for element in &header.elements {
+        match role_of(element)? {
+            Role::Vertex { xyz, normal } => {
+                if vertex_count.is_some() {
+                    bail!("the file has two vertex elements");
+                }
+                vertex_count = Some(element.count);
+                read_vertices(element, values, xyz, normal, &mut mesh)?;
+            }
+            Role::Face { list } => {
+                let faces = mesh.faces.get_or_insert_with(Vec::new);
+                read_faces(element, values, list, faces)?;
+            }
+            Role::Skip => read_element(element, values, None, |_, _| Ok(()))?,
+        }
+    }
+    let vertex_count = vertex_count.ok_or_else(|| anyhow!("the file has no vertex element"))?;
+    check_face_indices(mesh.faces.as_deref(), vertex_count)?;
+    Ok(mesh)
+}
+
+fn role_of(element: &Element) -> Result<Role> {
+    let find = |name: &str| {
+        element
+            .properties
+            .iter()
+            .position(|p| matches!(p, Property::Scalar { name: n, .. } if n == name))
+    };
+    match element.name.as_str() {
+        "vertex" => {
+            let xyz = match (find("x"), find("y"), find("z")) {
+                (Some(x), Some(y), Some(z)) => [x, y, z],
+                _ => bail!("the vertex element has no x, y and z properties"),
+            };
+            let normal = match (find("nx"), find("ny"), find("nz")) {
+                (Some(x), Some(y), Some(z)) => Some([x, y, z]),
+                _ => None,
+            };
+            Ok(Role::Vertex { xyz, normal })
+        }
+        "face" => {
+            let list = element.properties.iter().position(|p| {
+                matches!(p, Property::List { .. })
+                    && matches!(p.name(), "vertex_indices" | "vertex_index")
+            });
+            Ok(list.map_or(Role::Skip, |list| Role::Face { list }))
+        }
+        _ => Ok(Role::Skip),
+    }
+}
+
+fn read_vertices(
+    element: &Element,
+    values: &mut dyn Values,
+    xyz: [usize; 3],
+    normal: Option<[usize; 3]>,
+    mesh: &mut Mesh,
+) -> Result<()> {
+    mesh.vertices.reserve(element.count);
+    let mut normals = normal.map(|_| Vec::with_capacity(element.count));
+    read_element(element, values, None, |i, record| {
+        let p = xyz.map(|k| record.scalars[k]);
+        if p.iter().any(|c| !c.is_finite()) {
+            bail!("vertex {i} has a non-finite coordinate {}", show(&p));
+        }
+        mesh.vertices.push(p);
+        if let (Some(n), Some(out)) = (normal, normals.as_mut()) {
+            out.push(n.map(|k| record.scalars[k]));
+        }
+        Ok(())
+    })?;
+    mesh.normals = normals;
+    Ok(())
+}
+
+fn read_faces(
+    element: &Element,
+    values: &mut dyn Values,
+    list: usize,
+    faces: &mut Vec<[u32; 3]>,
+) -> Result<()> {
+    faces.reserve(element.count);
+    read_element(element, values, Some(list), |i, record| {
+        let index = |v: f64| {
+            if v.fract() == 0.0 && (0.0..=f64::from(u32::MAX)).contains(&v) {
+                Ok(v as u32)
+            } else {
+                Err(anyhow!("face {i} has a bad vertex index {v}"))
+            }
+        };
+        let corners = record.list.iter().map(|&v| index(v));
+        let corners: Vec<u32> = corners.collect::<Result<_>>()?;
+        // A fan from the first corner; faces with fewer than three corners
+        // enclose nothing and are dropped.
+        for w in 1..corners.len().saturating_sub(1) {
+            faces.push([corners[0], corners[w], corners[w + 1]]);
+        }
+        Ok(())
+    })
+}
+
+fn check_face_indices(faces: Option<&[[u32; 3]]>, vertices: usize) -> Result<()> {
+    for (t, face) in faces.unwrap_or_default().iter().enumerate() {
+        if let Some(&v) = face.iter().find(|&&v| v as usize >= vertices) {
+            bail!("triangle {t} refers to vertex {v}, but there are only {vertices} vertices");
+        }
+    }
+    Ok(())
+}
+
+/// Reads every record of `element`, handing each to `keep` with its index.
+fn read_element(
+    element: &Element,
+    values: &mut dyn Values,
+    wanted_list: Option<usize>,
+    mut keep: impl FnMut(usize, &Record) -> Result<()>,
+) -> Result<()> {
+    let mut record = Record::default();
+    for i in 0..element.count {
+        if !read_record(element, values, wanted_list, &mut record)? {
+            return Err(truncated(element.count, &element.name, i));
+        }
+        keep(i, &record).map_err(|e| anyhow!("{}{e}", values.line_prefix()))?;
+    }
+    Ok(())
+}
+
+/// Reads one record; false if the data ended before it was complete.
+fn read_record(
+    element: &Element,
+    values: &mut dyn Values,
+    wanted_list: Option<usize>,
+    record: &mut Record,
+) -> Result<bool> {
+    record.scalars.clear();
+    record.list.clear();
+    for (k, property) in element.properties.iter().enumerate() {
+        match *property {
+            Property::Scalar { ty, .. } => match values.next(ty)? {
+                Some(v) => record.scalars.push(v),
+                None => return Ok(false),
+            },
+            Property::List { count, item, .. } => {
+                record.scalars.push(f64::NAN);
+                let Some(n) = values.next(count)? else {
+                    return Ok(false);
+                };
+                let n = list_len(n, element, values)?;
+                for _ in 0..n {
+                    let Some(v) = values.next(item)? else {
+                        return Ok(false);
+                    };
+                    if wanted_list == Some(k) {
+                        record.list.push(v);
+                    }
+                }
+            }
+        }
+    }
+    Ok(true)
+}
+
+fn list_len(n: f64, element: &Element, values: &dyn Values) -> Result<usize> {
+    if n.fract() == 0.0 && (0.0..=f64::from(u32::MAX)).contains(&n) {
+        Ok(n as usize)
+    } else {
+        bail!(
+            "{}a {} has a bad list length {n}",
+            values.line_prefix(),
+            element.name
+        )
+    }
+}
+
+/// Writes points as a binary little-endian PLY with double x, y, z.
+pub fn write_points(w: &mut dyn Write, points: &[Point3], comment: &str) -> std::io::Result<()> {
+    writeln!(w, "ply\nformat binary_little_endian 1.0\ncomment {comment}")?;
+    writeln!(w, "element vertex {}", points.len())?;
+    writeln!(w, "property double x\nproperty double y\nproperty double z")?;
+    writeln!(w, "end_header")?;
+    for p in points {
+        for &c in p {
+            w.write_f64::<LittleEndian>(c)?;
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn err(bytes: &[u8]) -> String {
+        format!("{:#}", read_ply(bytes).unwrap_err())
+    }
+
+    const ASCII: &str = "ply\nformat ascii 1.0\ncomment test\nobj_info x 1\n\
+        element camera 1\nproperty float a\nproperty int b\n\
+        element face 2\nproperty list uchar int vertex_indices\n\
+        element vertex 4\nproperty float x\nproperty float y\nproperty float z\n\
+        property float nx\nproperty float ny\nproperty float nz\nproperty uchar red\n\
+        end_header\n\
+        0.5 7\n3 0 1 2\n4 0 1 2 3\n\
+        0 0 0 0 0 1 255\n1 0 0 0 0 1 0\n1 1 0 0 0 1 0\n0 1 0.25 0 0 1 0\n";
+
+    #[test]
+    fn ascii_with_faces_before_vertices() {
+        let mesh = read_ply(ASCII.as_bytes()).unwrap();
+        assert_eq!(
+            mesh.vertices,
+            vec![[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.25]]
+        );
+        assert_eq!(mesh.normals.unwrap()[3], [0., 0., 1.]);
+        assert_eq!(mesh.faces.unwrap(), vec![[0, 1, 2], [0, 1, 2], [0, 2, 3]]);
+    }
+
+    /// A binary file with every scalar type, a list element before the
+    /// vertices and an unused list property on the vertices.
+    fn binary<B: ByteOrder>(name: &str) -> Vec<u8> {
+        let mut out = format!(
+            "ply\nformat {name} 1.0\nelement range_grid 2\nproperty list uchar int vertex_indices\n\
+             element vertex 2\nproperty char a\nproperty uchar b\nproperty short c\n\
+             property ushort d\nproperty int32 e\nproperty uint f\nproperty float x\n\
+             property float64 y\nproperty list ushort double junk\nproperty double z\nend_header\n"
+        )
+        .into_bytes();
+        let mut grid = vec![1u8, 0, 0, 0, 0, 0];
+        B::write_i32(&mut grid[1..5], 1);
+        out.extend_from_slice(&grid);
+        for v in 0..2 {
+            let mut rec = vec![0u8; 1 + 1 + 2 + 2 + 4 + 4 + 4 + 8 + 2 + 8 + 8];
+            rec[0] = (-3i8) as u8;
+            rec[1] = 200;
+            B::write_i16(&mut rec[2..4], -300);
+            B::write_u16(&mut rec[4..6], 60000);
+            B::write_i32(&mut rec[6..10], -70000);
+            B::write_u32(&mut rec[10..14], 4_000_000_000);
+            B::write_f32(&mut rec[14..18], 1.5 + v as f32);
+            B::write_f64(&mut rec[18..26], -2.25);
+            B::write_u16(&mut rec[26..28], 1);
+            B::write_f64(&mut rec[28..36], 99.0);
+            B::write_f64(&mut rec[36..44], 0.1);
+            out.extend_from_slice(&rec);
+        }
+        out
+    }
+
+    #[test]
+    fn binary_both_byte_orders() {
+        for bytes in [
+            binary::<LittleEndian>("binary_little_endian"),
+            binary::<BigEndian>("binary_big_endian"),
+        ] {
+            let mesh = read_ply(&bytes).unwrap();
+            assert_eq!(mesh.vertices, vec![[1.5, -2.25, 0.1], [2.5, -2.25, 0.1]]);
+            assert_eq!(mesh.normals, None);
+            assert_eq!(mesh.faces, None);
+        }
+    }
+
+    #[test]
+    fn write_then_read() {
+        let points = vec![[0.1, -2.0, 3e-300], [f64::MAX, 0.0, -0.0]];
+        let mut bytes = Vec::new();
+        write_points(&mut bytes, &points, "round trip").unwrap();
+        assert_eq!(read_ply(&bytes).unwrap().vertices, points);
+    }
+
+    #[test]
+    fn truncated_binary_names_counts() {
+        let mut bytes = binary::<LittleEndian>("binary_little_endian");
+        bytes.truncate(bytes.len() - 5);
+        assert_eq!(err(&bytes), "expected 2 vertices, file ends after 1");
+    }
+
+    #[test]
+    fn truncated_ascii_names_counts() {
+        let text = ASCII.trim_end().rsplit_once('\n').unwrap().0;
+        assert_eq!(
+            err(text.as_bytes()),
+            "expected 4 vertices, file ends after 3"
+        );
+    }
+
+    #[test]
+    fn bad_number_names_line() {
+        let text = ASCII.replace("1 1 0 0 0 1 0", "1 abc 0 0 0 1 0");
+        assert_eq!(err(text.as_bytes()), "line 24: 'abc' is not a number");
+    }
+
+    #[test]
+    fn non_finite_names_line_and_vertex() {
+        let text = ASCII.replace("1 1 0 0 0 1 0", "1 nan 0 0 0 1 0");
+        assert_eq!(
+            err(text.as_bytes()),
+            "line 24: vertex 2 has a non-finite coordinate (1, NaN, 0)"
+        );
+    }
+
+    #[test]
+    fn header_errors() {
+        assert!(err(b"ply\nformat ascii 1.0\nelement vertex 1\n").contains("no 'end_header'"));
+        assert!(
+            err(b"ply\nformat ascii 1.0\nelement vertex 1\nproperty half x\nend_header\n")
+                .contains("line 4: unsupported property type 'half'")
+        );
+        assert!(err(b"ply\nformat weird 1.0\nend_header\n").contains("line 2: unknown format"));
+        assert!(err(b"ply\nproperty float x\nend_header\n").contains("line 2: a property before"));
+        assert!(
+            err(b"ply\nformat ascii 1.0\nelement vertex x\nend_header\n")
+                .contains("line 3: 'x' is not an element count")
+        );
+        assert!(err(b"ply\nformat ascii 1.0\nend_header\n").contains("no vertex element"));
+        let no_z = b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nend_header\n1 2\n";
+        assert!(err(no_z).contains("no x, y and z"));
+    }
+
+    #[test]
+    fn face_index_out_of_range() {
+        let text = ASCII.replace("4 0 1 2 3", "4 0 1 2 9");
+        assert_eq!(
+            err(text.as_bytes()),
+            "triangle 2 refers to vertex 9, but there are only 4 vertices"
+        );
+    }
+
+    #[test]
+    fn crlf_header() {
+        let text = ASCII.replace('\n', "\r\n");
+        assert_eq!(read_ply(text.as_bytes()).unwrap().vertices.len(), 4);
+    }
+}

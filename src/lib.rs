@@ -1,0 +1,13 @@
+//! # meshtrim, the command-line side
+//!
+//! Everything that touches files or the terminal lives here; the algorithms
+//! live in the `trim` library crate, which does no I/O.
+//!
+//! - [`io`] reads point clouds and meshes (PLY, PCD, OBJ, XYZ/CSV text) and
+//!   writes results atomically.
+//! - [`cli`] defines the command line and runs its subcommands.
+//! - [`detect`] is the `meshtrim detect` subcommand.
+
+pub mod cli;
+pub mod detect;
+pub mod io;

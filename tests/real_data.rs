@@ -1,0 +1,90 @@
+//! The readers on the real scans in the shared data directory
+//! (`../shared/data`, described in its SOURCES.md): every file must give
+//! exactly the documented point, face and dropped-NaN counts.
+//!
+//! The data is part of the project's test set, so a missing directory is a
+//! failure, not a skip.
+
+use std::path::PathBuf;
+
+use meshtrim::io::{read_cloud, read_mesh, Format};
+
+fn data(rel: &str) -> PathBuf {
+    let root = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data"));
+    assert!(
+        root.is_dir(),
+        "the real test data is missing: expected the directory {} (shared/ beside the repository)",
+        root.display()
+    );
+    root.join(rel)
+}
+
+/// Checks a cloud's point count, dropped count and format.
+fn cloud(rel: &str, format: Format, points: usize, dropped: usize) {
+    let cloud = read_cloud(&data(rel)).unwrap_or_else(|e| panic!("{e:#}"));
+    assert_eq!(cloud.format, format, "{rel}");
+    assert_eq!(cloud.points.len(), points, "{rel}");
+    assert_eq!(cloud.dropped_non_finite, dropped, "{rel}");
+}
+
+/// Checks a mesh's vertex and triangle counts.
+fn mesh(rel: &str, vertices: usize, triangles: usize) {
+    let mesh = read_mesh(&data(rel)).unwrap_or_else(|e| panic!("{e:#}"));
+    assert_eq!(mesh.vertices.len(), vertices, "{rel}");
+    assert_eq!(mesh.faces.map(|f| f.len()), Some(triangles), "{rel}");
+}
+
+#[test]
+fn stanford_bunny() {
+    cloud("stanford_bunny/bun_zipper.ply", Format::Ply, 35_947, 0);
+    mesh("stanford_bunny/bun_zipper.ply", 35_947, 69_451);
+    mesh("stanford_bunny/bun_zipper_res2.ply", 8_171, 16_301);
+    mesh("stanford_bunny/bun_zipper_res3.ply", 1_889, 3_851);
+    mesh("stanford_bunny/bun_zipper_res4.ply", 453, 948);
+    // Single range images: obj_info lines and a range_grid list element.
+    cloud("stanford_bunny/bun000.ply", Format::Ply, 40_256, 0);
+    cloud("stanford_bunny/bun045.ply", Format::Ply, 40_097, 0);
+    cloud("stanford_bunny/bun090.ply", Format::Ply, 30_379, 0);
+    cloud("stanford_bunny/chin.ply", Format::Ply, 37_738, 0);
+    let range = read_mesh(&data("stanford_bunny/bun000.ply")).unwrap();
+    assert_eq!(range.faces, None, "a range_grid is not a face element");
+}
+
+#[test]
+fn pcl_test() {
+    cloud("pcl_test/milk.pcd", Format::Pcd, 13_704, 0);
+    cloud("pcl_test/rops_cloud.pcd", Format::Pcd, 32_087, 0);
+    cloud("pcl_test/rs1.pcd", Format::Pcd, 289_541, 0);
+    // Organised 640 × 480 with NaN for empty pixels.
+    cloud(
+        "pcl_test/table_scene_mug_stereo_textured.pcd",
+        Format::Pcd,
+        209_280,
+        307_200 - 209_280,
+    );
+}
+
+#[test]
+fn blade_scan_kinect() {
+    cloud("blade_scan_kinect/BladeScan1.csv", Format::Text, 41_432, 0);
+    cloud("blade_scan_kinect/BladeScan2.csv", Format::Text, 45_660, 0);
+    let first = read_cloud(&data("blade_scan_kinect/BladeScan1.csv")).unwrap();
+    assert_eq!(first.points[0], [1471.2, -61.94, 141.39]);
+}
+
+#[test]
+fn meshlab_scans() {
+    // A `camera` element of 23 scalars comes before the vertices.
+    cloud("meshlab_scans/face000.ply", Format::Ply, 85_849, 0);
+    mesh("meshlab_scans/face000.ply", 85_849, 166_259);
+    mesh("meshlab_scans/lato000.ply", 44_461, 86_766);
+    mesh("meshlab_scans/Laurana50k.ply", 27_861, 49_954);
+}
+
+/// ASCII values are taken as written (parsed as f64), not rounded to the
+/// declared `float`.
+#[test]
+fn first_bunny_vertex_is_exact() {
+    let cloud = read_cloud(&data("stanford_bunny/bun000.ply")).unwrap();
+    assert_eq!(cloud.points[0], [-0.06325, 0.0359793, 0.0420873]);
+}
