@@ -169,7 +169,7 @@ fn greedy_tour(pts: &[Point3], candidates: &[Vec<u32>], links: &[[u32; 2]]) -> V
     let mut degree = vec![0u8; n];
     let mut parent: Vec<u32> = (0..n as u32).collect();
     let mut added = 0;
-    let mut add = |a: u32, b: u32, adjacency: &mut Vec<[u32; 2]>, degree: &mut Vec<u8>| {
+    let add = |a: u32, b: u32, adjacency: &mut [[u32; 2]], degree: &mut [u8]| {
         adjacency[a as usize][degree[a as usize] as usize] = b;
         adjacency[b as usize][degree[b as usize] as usize] = a;
         degree[a as usize] += 1;
