@@ -32,7 +32,7 @@ fn write_inner(
     };
     std::fs::create_dir_all(dir)
         .with_context(|| format!("cannot create directory {}", dir.display()))?;
-    let mut tmp = NamedTempFile::new_in(dir).context("cannot create a temporary file")?;
+    let mut tmp = temp_file(dir).context("cannot create a temporary file")?;
     {
         let mut out = BufWriter::new(tmp.as_file_mut());
         write(&mut out).context("cannot write")?;
@@ -45,6 +45,20 @@ fn write_inner(
         .map_err(|e| e.error)
         .context("cannot rename the temporary file")?;
     Ok(())
+}
+
+/// A temporary file in `dir` with the permissions a plain `File::create`
+/// would give (0o666 less the umask), not tempfile's private 0o600, since
+/// it becomes the output file.
+fn temp_file(dir: &Path) -> std::io::Result<NamedTempFile> {
+    #[cfg_attr(not(unix), allow(unused_mut))] // only unix sets a mode
+    let mut builder = tempfile::Builder::new();
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    builder.tempfile_in(dir)
 }
 
 #[cfg(test)]

@@ -1,0 +1,280 @@
+//! End-to-end tests of `meshtrim detect`, running the built binary.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use byteorder::{ByteOrder, LittleEndian};
+
+const FIXTURE: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/fixtures/meshes/blade_holes.ply"
+);
+
+/// Runs meshtrim with `args` and extra environment variables.
+fn meshtrim_env(args: &[&str], env: &[(&str, &str)]) -> Output {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_meshtrim"));
+    cmd.args(args);
+    for (k, v) in env {
+        cmd.env(k, v);
+    }
+    cmd.output().expect("the meshtrim binary runs")
+}
+
+fn meshtrim(args: &[&str]) -> Output {
+    meshtrim_env(args, &[])
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+fn path_str(p: &Path) -> &str {
+    p.to_str().expect("temp paths are UTF-8")
+}
+
+/// The records of a `detect` PLY output: (x, y, z, boundary, beta).
+fn read_labelled_ply(bytes: &[u8]) -> Vec<([f64; 3], u8, f64)> {
+    let end = bytes
+        .windows(11)
+        .position(|w| w == b"end_header\n")
+        .expect("a PLY header")
+        + 11;
+    let header = std::str::from_utf8(&bytes[..end]).unwrap();
+    assert!(header.contains(
+        "property double x\nproperty double y\nproperty double z\n\
+         property uchar boundary\nproperty double beta\n"
+    ));
+    let body = &bytes[end..];
+    assert_eq!(body.len() % 33, 0);
+    body.chunks_exact(33)
+        .map(|r| {
+            let p = [0, 8, 16].map(|o| LittleEndian::read_f64(&r[o..]));
+            (p, r[24], LittleEndian::read_f64(&r[25..]))
+        })
+        .collect()
+}
+
+/// The fixture's points, read the same simple way.
+fn fixture_points() -> Vec<[f64; 3]> {
+    let bytes = std::fs::read(FIXTURE).unwrap();
+    let end = bytes
+        .windows(11)
+        .position(|w| w == b"end_header\n")
+        .unwrap()
+        + 11;
+    bytes[end..]
+        .chunks_exact(24)
+        .map(|r| [0, 8, 16].map(|o| LittleEndian::read_f64(&r[o..])))
+        .collect()
+}
+
+#[test]
+fn ply_output_keeps_points_in_order() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("new/sub/labels.ply");
+    let run = meshtrim(&["detect", FIXTURE, "-o", path_str(&out)]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let records = read_labelled_ply(&std::fs::read(&out).unwrap());
+    let input = fixture_points();
+    assert_eq!(records.len(), input.len());
+    assert!(records.iter().zip(&input).all(|(r, p)| r.0 == *p));
+    let boundary = records.iter().filter(|r| r.1 == 1).count();
+    assert!(records.iter().all(|r| r.1 <= 1 && r.2 > 0.0));
+    assert!(
+        boundary > 0 && boundary * 10 < input.len() * 3,
+        "{boundary}"
+    );
+    let text = String::from_utf8(run.stdout).unwrap();
+    assert!(
+        text.contains(&format!("boundary points      {boundary} (")),
+        "{text}"
+    );
+}
+
+#[test]
+fn csv_output_header_and_rows() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("labels.csv");
+    let run = meshtrim(&["detect", FIXTURE, "-o", path_str(&out), "--k", "20"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let text = std::fs::read_to_string(&out).unwrap();
+    let mut lines = text.lines();
+    assert_eq!(lines.next(), Some("x,y,z,boundary,beta"));
+    let rows: Vec<&str> = lines.collect();
+    let input = fixture_points();
+    assert_eq!(rows.len(), input.len());
+    let first: Vec<f64> = rows[0].split(',').map(|f| f.parse().unwrap()).collect();
+    assert_eq!(&first[..3], &input[0]);
+}
+
+#[test]
+fn json_summary_is_consistent() {
+    let run = meshtrim(&["detect", FIXTURE, "--json", "--no-anisotropy"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let v: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+    let keys = [
+        "file",
+        "points",
+        "distinct_points",
+        "duplicates",
+        "dropped_non_finite",
+        "boundary_points",
+        "beta_min",
+        "beta_mean",
+        "beta_max",
+        "beta_std",
+        "read_ms",
+        "detect_ms",
+        "k",
+        "anisotropy",
+    ];
+    let object = v.as_object().unwrap();
+    assert_eq!(object.len(), keys.len());
+    assert!(keys.iter().all(|k| object.contains_key(*k)), "{v}");
+    let n = |k: &str| v[k].as_f64().unwrap();
+    assert_eq!(n("points") as usize, fixture_points().len());
+    assert_eq!(n("distinct_points") + n("duplicates"), n("points"));
+    assert_eq!(n("dropped_non_finite"), 0.0);
+    assert!(n("boundary_points") > 0.0 && n("boundary_points") < n("points"));
+    assert!(0.0 < n("beta_min") && n("beta_min") <= n("beta_mean"));
+    assert!(n("beta_mean") <= n("beta_max") && n("beta_std") >= 0.0);
+    assert_eq!(v["k"], 30);
+    assert_eq!(v["anisotropy"], false);
+    assert_eq!(v["file"], FIXTURE);
+}
+
+#[test]
+fn output_is_deterministic_across_runs_and_threads() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = |name: &str, threads: &str| {
+        let out = dir.path().join(name);
+        let r = meshtrim_env(
+            &["detect", FIXTURE, "-o", path_str(&out)],
+            &[("RAYON_NUM_THREADS", threads)],
+        );
+        assert!(r.status.success(), "{}", stderr(&r));
+        std::fs::read(out).unwrap()
+    };
+    let a = run("a.ply", "2");
+    assert_eq!(a, run("b.ply", "2"));
+    assert_eq!(a, run("c.ply", "1"));
+    let csv = run("a.csv", "1");
+    assert_eq!(csv, run("b.csv", "2"));
+}
+
+#[test]
+fn existing_output_is_replaced_atomically() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("labels.ply");
+    std::fs::write(&out, b"old content").unwrap();
+    let run = meshtrim(&["detect", FIXTURE, "-o", path_str(&out)]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    assert!(std::fs::read(&out).unwrap().starts_with(b"ply\n"));
+    let names: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(names, ["labels.ply"]);
+}
+
+/// Runs `detect` on `input` with an output in a fresh directory, and checks
+/// the failure: exit code 1, the file named, the expected words, no panic,
+/// no output and nothing else left in the output directory.
+fn fails(input: &Path, extra: &[&str], expected: &str) {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.ply");
+    let mut args = vec!["detect", path_str(input), "-o", path_str(&out)];
+    args.extend(extra);
+    let run = meshtrim(&args);
+    let err = stderr(&run);
+    assert_eq!(run.status.code(), Some(1), "{err}");
+    assert!(
+        err.starts_with(&format!("error: {}: ", input.display())),
+        "{err}"
+    );
+    assert!(err.contains(expected), "expected '{expected}' in: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0, "{err}");
+}
+
+/// Writes `bytes` to a file called `name` in a new temporary directory.
+fn input_file(name: &str, bytes: &[u8]) -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join(name);
+    std::fs::write(&path, bytes).unwrap();
+    (dir, path)
+}
+
+/// `n` points on a small grid, as text lines.
+fn grid_text(n: usize) -> String {
+    (0..n)
+        .map(|i| format!("{} {} 0\n", i % 10, i / 10))
+        .collect()
+}
+
+#[test]
+fn missing_file() {
+    let dir = tempfile::tempdir().unwrap();
+    fails(&dir.path().join("absent.ply"), &[], "cannot read");
+}
+
+#[test]
+fn unknown_extension_and_content() {
+    let (_d, path) = input_file("cloud.bin", b"\x00\x01 garbage that is not a cloud\n");
+    fails(&path, &[], "unknown format");
+}
+
+#[test]
+fn truncated_ply() {
+    let bytes = std::fs::read(FIXTURE).unwrap();
+    let (_d, path) = input_file("cut.ply", &bytes[..bytes.len() - 100]);
+    let n = fixture_points().len();
+    fails(
+        &path,
+        &[],
+        &format!("expected {n} vertices, file ends after {}", n - 5),
+    );
+}
+
+#[test]
+fn malformed_csv_names_the_line() {
+    let mut text = grid_text(40);
+    text.push_str("1,2,oops\n");
+    let (_d, path) = input_file("bad.csv", text.as_bytes());
+    fails(&path, &[], "line 41: 'oops' is not a number");
+}
+
+#[test]
+fn too_few_points() {
+    let (_d, path) = input_file("few.xyz", grid_text(12).as_bytes());
+    fails(&path, &[], "12 distinct points");
+}
+
+#[test]
+fn all_points_identical() {
+    let (_d, path) = input_file("same.xyz", "1 2 3\n".repeat(50).as_bytes());
+    fails(&path, &[], "degenerate");
+}
+
+#[test]
+fn k_too_small() {
+    fails(Path::new(FIXTURE), &["--k", "2"], "k = 2 is too small");
+}
+
+#[test]
+fn bad_output_extension_is_refused_before_reading() {
+    let run = meshtrim(&["detect", FIXTURE, "-o", "labels.txt"]);
+    assert_eq!(run.status.code(), Some(1));
+    assert!(stderr(&run).starts_with("error: labels.txt: unsupported output format"));
+    assert!(!Path::new("labels.txt").exists());
+}
+
+#[test]
+fn usage_errors_exit_2() {
+    assert_eq!(meshtrim(&["detect"]).status.code(), Some(2));
+    assert_eq!(
+        meshtrim(&["detect", FIXTURE, "--k", "x"]).status.code(),
+        Some(2)
+    );
+    assert_eq!(meshtrim(&["frobnicate"]).status.code(), Some(2));
+}
