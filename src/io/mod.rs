@@ -171,10 +171,9 @@ fn sniff(bytes: &[u8]) -> Option<Format> {
     }
     // Only the start matters; a lossy view copes with binary data after it.
     let head = String::from_utf8_lossy(&bytes[..bytes.len().min(4096)]);
-    let first = head
-        .lines()
-        .map(str::trim)
-        .find(|l| !l.is_empty() && !(l.starts_with('#') && !is_pcd_banner(l)))?;
+    // The PCD banner is a comment line, but a telling one.
+    let telling = |l: &&str| !l.is_empty() && (!l.starts_with('#') || is_pcd_banner(l));
+    let first = head.lines().map(str::trim).find(telling)?;
     if is_pcd_banner(first) || first.starts_with("VERSION") || first.starts_with("FIELDS") {
         return Some(Format::Pcd);
     }
