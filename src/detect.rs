@@ -117,6 +117,9 @@ fn write_labels(
 /// taken a second, so quick runs print nothing, and indicatif hides it when
 /// stderr is not a terminal.
 fn detect_with_progress(points: &[Point3], options: &BpdOptions) -> Result<Detection, CloudError> {
+    // The library counts distinct points, not known before it merges
+    // duplicates; the bar's length is all points, so with duplicates it stops
+    // short of full, and it is cleared at the end anyway.
     let bar =
         ProgressBar::with_draw_target(Some(points.len() as u64), ProgressDrawTarget::hidden());
     bar.set_style(

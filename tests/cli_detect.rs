@@ -278,3 +278,23 @@ fn usage_errors_exit_2() {
     );
     assert_eq!(meshtrim(&["frobnicate"]).status.code(), Some(2));
 }
+
+#[test]
+fn nan_in_text_is_an_error_with_its_line() {
+    let mut text = grid_text(40);
+    text.push_str("1 NaN 3\n");
+    let (_d, path) = input_file("nan.xyz", text.as_bytes());
+    fails(&path, &[], "line 41: non-finite coordinate (1, NaN, 3)");
+}
+
+#[test]
+fn nan_in_pcd_is_dropped_and_counted() {
+    let mut text = format!("FIELDS x y z\nPOINTS 42\nDATA ascii\n{}", grid_text(40));
+    text.push_str("nan nan nan\n1 inf 2\n");
+    let (_d, path) = input_file("organised.pcd", text.as_bytes());
+    let run = meshtrim(&["detect", path_str(&path), "--json", "--k", "10"]);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let v: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+    assert_eq!(v["points"], 40);
+    assert_eq!(v["dropped_non_finite"], 2);
+}

@@ -206,6 +206,13 @@ pub(crate) fn plural(what: &str) -> String {
     }
 }
 
+/// Capacity to reserve for `count` records announced by a header: a
+/// header can claim anything, so reserve at most a million and let the
+/// vector grow past that only as real data arrives.
+pub(crate) fn capacity(count: usize) -> usize {
+    count.min(1 << 20)
+}
+
 /// Formats a point for messages, keeping NaN and inf readable.
 pub(crate) fn show(p: &Point3) -> String {
     format!("({}, {}, {})", p[0], p[1], p[2])

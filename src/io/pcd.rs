@@ -15,7 +15,7 @@
 
 use anyhow::{anyhow, bail, Result};
 
-use super::{truncated, Cloud, Format, Point3};
+use super::{capacity, truncated, Cloud, Format, Point3};
 
 /// One field of a PCD point.
 #[derive(Debug, Clone, PartialEq)]
@@ -226,8 +226,8 @@ struct Raw {
 impl Raw {
     fn new(wanted: &Wanted, n: usize) -> Self {
         Raw {
-            points: Vec::with_capacity(n),
-            normals: wanted.normal.map(|_| Vec::with_capacity(n)),
+            points: Vec::with_capacity(capacity(n)),
+            normals: wanted.normal.map(|_| Vec::with_capacity(capacity(n))),
         }
     }
 
@@ -299,13 +299,22 @@ fn read_compressed(header: &Header, wanted: &Wanted, body: &[u8]) -> Result<Raw>
     if header.points == 0 {
         return Ok(Raw::new(wanted, 0));
     }
+    let expected = header
+        .points
+        .checked_mul(header.point_bytes())
+        .filter(|&e| e <= u32::MAX as usize)
+        .ok_or_else(|| {
+            anyhow!(
+                "{} points are too many for binary_compressed data",
+                header.points
+            )
+        })?;
     let size_at = |at: usize| {
         body.get(at..at + 4)
             .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize)
             .ok_or_else(|| anyhow!("the compressed data is truncated: no size header"))
     };
     let (compressed, uncompressed) = (size_at(0)?, size_at(4)?);
-    let expected = header.points * header.point_bytes();
     if uncompressed != expected {
         bail!(
             "the compressed data holds {uncompressed} bytes, but {} points need {expected}",
@@ -468,6 +477,14 @@ mod tests {
         let a = ascii();
         let a = a.trim_end().rsplit_once('\n').unwrap().0;
         assert_eq!(err(a.as_bytes()), "expected 3 points, file ends after 2");
+    }
+
+    #[test]
+    fn absurd_counts_are_errors_not_allocations() {
+        let huge = "FIELDS x y z\nPOINTS 18446744073709551615\nDATA";
+        assert!(err(format!("{huge} binary\n").as_bytes()).contains("file ends after 0"));
+        assert!(err(format!("{huge} ascii\n").as_bytes()).contains("file ends after 0"));
+        assert!(err(format!("{huge} binary_compressed\n").as_bytes()).contains("too many"));
     }
 
     #[test]

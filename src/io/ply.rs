@@ -14,7 +14,7 @@ use std::io::Write;
 use anyhow::{anyhow, bail, Result};
 use byteorder::{BigEndian, ByteOrder, LittleEndian, WriteBytesExt};
 
-use super::{show, truncated, Mesh, Point3};
+use super::{capacity, show, truncated, Mesh, Point3};
 
 /// A PLY scalar type.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -384,8 +384,8 @@ fn read_vertices(
     normal: Option<[usize; 3]>,
     mesh: &mut Mesh,
 ) -> Result<()> {
-    mesh.vertices.reserve(element.count);
-    let mut normals = normal.map(|_| Vec::with_capacity(element.count));
+    mesh.vertices.reserve(capacity(element.count));
+    let mut normals = normal.map(|_| Vec::with_capacity(capacity(element.count)));
     read_element(element, values, None, |i, record| {
         let p = xyz.map(|k| record.scalars[k]);
         if p.iter().any(|c| !c.is_finite()) {
@@ -407,7 +407,7 @@ fn read_faces(
     list: usize,
     faces: &mut Vec<[u32; 3]>,
 ) -> Result<()> {
-    faces.reserve(element.count);
+    faces.reserve(capacity(element.count));
     read_element(element, values, Some(list), |i, record| {
         let index = |v: f64| {
             if v.fract() == 0.0 && (0.0..=f64::from(u32::MAX)).contains(&v) {
@@ -649,6 +649,16 @@ mod tests {
         assert_eq!(
             err(text.as_bytes()),
             "triangle 2 refers to vertex 9, but there are only 4 vertices"
+        );
+    }
+
+    #[test]
+    fn absurd_counts_are_truncation_not_allocation() {
+        let text = "ply\nformat binary_little_endian 1.0\nelement vertex 18446744073709551615\n\
+            property float x\nproperty float y\nproperty float z\nend_header\n";
+        assert_eq!(
+            err(text.as_bytes()),
+            "expected 18446744073709551615 vertices, file ends after 0"
         );
     }
 
