@@ -9,14 +9,10 @@ use std::path::PathBuf;
 
 use meshtrim::io::{read_cloud, read_mesh, Format};
 
+mod common;
+
 fn data(rel: &str) -> PathBuf {
-    let root = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data"));
-    assert!(
-        root.is_dir(),
-        "the real test data is missing: expected the directory {} (shared/ beside the repository)",
-        root.display()
-    );
-    root.join(rel)
+    common::shared_data(rel)
 }
 
 /// Checks a cloud's point count, dropped count and format.

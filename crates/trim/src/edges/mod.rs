@@ -15,7 +15,6 @@ pub mod corners;
 pub mod offset;
 pub mod order;
 
-use crate::bpd::Detection;
 use crate::cloud::Point3;
 
 /// Options of edge reconstruction.
