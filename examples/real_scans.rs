@@ -1,0 +1,154 @@
+//! Runs BPD on the real scans in `../shared/data`, prints a markdown table
+//! and draws each detection to `docs/img/<name>.png`.
+//!
+//! `cargo run --release --example real_scans`
+
+use std::path::Path;
+use std::time::Instant;
+
+use trim::edges::cluster::cluster_boundary;
+use trim::{detect_boundary, BpdOptions, Point3};
+
+/// How to look at a scan: along its best-fit normal, or along an axis.
+#[derive(Clone, Copy)]
+enum View {
+    /// Orthographic, looking along the cloud's smallest principal axis.
+    Plane,
+    /// Orthographic, looking along +axis (0 = x, 1 = y, 2 = z) from the
+    /// negative side when `from_below`.
+    Axis(usize, bool),
+}
+
+const SCANS: &[(&str, &str, View)] = &[
+    (
+        "bunny_zipper",
+        "stanford_bunny/bun_zipper.ply",
+        View::Axis(1, true),
+    ),
+    (
+        "bunny_bun000",
+        "stanford_bunny/bun000.ply",
+        View::Axis(2, false),
+    ),
+    (
+        "blade_scan1",
+        "blade_scan_kinect/BladeScan1.csv",
+        View::Plane,
+    ),
+    (
+        "blade_scan2",
+        "blade_scan_kinect/BladeScan2.csv",
+        View::Plane,
+    ),
+    ("milk", "pcl_test/milk.pcd", View::Plane),
+    ("face000", "meshlab_scans/face000.ply", View::Axis(2, false)),
+];
+
+fn main() -> anyhow::Result<()> {
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data");
+    let out = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/img");
+    std::fs::create_dir_all(&out)?;
+    println!("| scan | points | boundary points | boundary loops (clusters) | dropped groups | β mean | detect ms | picture |");
+    println!("|---|---:|---:|---:|---:|---:|---:|---|");
+    for &(name, file, view) in SCANS {
+        let cloud = meshtrim::io::read_cloud(&data.join(file))?;
+        let start = Instant::now();
+        let found = detect_boundary(&cloud.points, &BpdOptions::default())?;
+        let ms = start.elapsed().as_secs_f64() * 1e3;
+        let clusters = cluster_boundary(&found.boundary, &found.links);
+        let beta = found.beta.iter().sum::<f64>() / found.beta.len() as f64;
+        let png = out.join(format!("{name}.png"));
+        draw(&cloud.points, &found.boundary, view, &png)?;
+        println!(
+            "| {file} | {} | {} | {} | {} | {beta:.4} | {ms:.0} | ![{name}](img/{name}.png) |",
+            cloud.points.len(),
+            found.boundary_count(),
+            clusters.clusters.len(),
+            clusters.dropped_clusters,
+        );
+    }
+    Ok(())
+}
+
+/// Draws interior points grey (shaded by depth) and boundary points red,
+/// far points first, to a PNG.
+fn draw(points: &[Point3], boundary: &[bool], view: View, path: &Path) -> anyhow::Result<()> {
+    let (axes, depth_axis) = view_axes(points, view);
+    let project = |p: &Point3| {
+        let d = |a: &Point3| a[0] * p[0] + a[1] * p[1] + a[2] * p[2];
+        (d(&axes[0]), d(&axes[1]), d(&depth_axis))
+    };
+    let projected: Vec<(f64, f64, f64)> = points.iter().map(project).collect();
+    let bounds = |f: fn(&(f64, f64, f64)) -> f64| {
+        projected
+            .iter()
+            .map(f)
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), v| {
+                (lo.min(v), hi.max(v))
+            })
+    };
+    let ((x0, x1), (y0, y1), (z0, z1)) = (bounds(|p| p.0), bounds(|p| p.1), bounds(|p| p.2));
+    let (width, height) = (1000usize, 800usize);
+    let scale = ((width - 40) as f64 / (x1 - x0)).min((height - 40) as f64 / (y1 - y0));
+    let mut order: Vec<usize> = (0..points.len()).collect();
+    // Far first, boundary after interior at equal depth; depth grows toward
+    // the viewer.
+    order.sort_by(|&a, &b| {
+        projected[a]
+            .2
+            .total_cmp(&projected[b].2)
+            .then(boundary[a].cmp(&boundary[b]))
+    });
+    let mut rgb = vec![255u8; width * height * 3];
+    for &i in &order {
+        let (x, y, z) = projected[i];
+        let px = 20.0 + (x - x0) * scale;
+        let py = height as f64 - 20.0 - (y - y0) * scale;
+        let shade = (200.0 - 120.0 * (z - z0) / (z1 - z0).max(f64::MIN_POSITIVE)) as u8;
+        let (colour, radius) = if boundary[i] {
+            ([220u8, 20, 20], 2i64)
+        } else {
+            ([shade, shade, shade], 1i64)
+        };
+        for dy in -radius + 1..radius {
+            for dx in -radius + 1..radius {
+                let (cx, cy) = (px as i64 + dx, py as i64 + dy);
+                if (0..width as i64).contains(&cx) && (0..height as i64).contains(&cy) {
+                    let at = (cy as usize * width + cx as usize) * 3;
+                    rgb[at..at + 3].copy_from_slice(&colour);
+                }
+            }
+        }
+    }
+    let file = std::io::BufWriter::new(std::fs::File::create(path)?);
+    let mut encoder = png::Encoder::new(file, width as u32, height as u32);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.write_header()?.write_image_data(&rgb)?;
+    Ok(())
+}
+
+/// Two screen axes and the depth axis (toward the viewer) for `view`.
+fn view_axes(points: &[Point3], view: View) -> ([Point3; 2], Point3) {
+    match view {
+        View::Axis(a, from_below) => {
+            let (s, t) = ((a + 1) % 3, (a + 2) % 3);
+            let unit = |i: usize| {
+                let mut v = [0.0; 3];
+                v[i] = 1.0;
+                v
+            };
+            let mut depth = unit(a);
+            if from_below {
+                depth[a] = -1.0;
+                ([unit(t), unit(s)], depth)
+            } else {
+                ([unit(s), unit(t)], depth)
+            }
+        }
+        View::Plane => {
+            let members: Vec<u32> = (0..points.len() as u32).collect();
+            let f = trim::frame::fit_plane(points, &members);
+            ([f.u, f.v], f.normal)
+        }
+    }
+}
