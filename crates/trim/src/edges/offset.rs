@@ -31,17 +31,27 @@ pub const WINDOW: usize = 5;
 /// Neighbourhood size for the area per sample (as in BPD).
 const K: usize = 30;
 
-/// Expected distance from each loop point to the physical edge: half the
-/// local row spacing. `loop_points` are indices into the cloud behind
-/// `index`, in loop order.
-pub fn edge_offsets(index: &NeighbourIndex, loop_points: &[u32]) -> Vec<f64> {
+/// The surface around one loop point, as the offset needs it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EdgeSide {
+    /// Expected distance to the physical edge: half the local row spacing.
+    pub offset: f64,
+    /// Unit normal of the surface (best-fit plane of the neighbourhood).
+    pub normal: Point3,
+    /// Centroid of the neighbourhood: a point on the inner side.
+    pub inside: Point3,
+}
+
+/// The [`EdgeSide`] of each loop point. `loop_points` are indices into the
+/// cloud behind `index`, in loop order.
+pub fn edge_sides(index: &NeighbourIndex, loop_points: &[u32]) -> Vec<EdgeSide> {
     let points = index.points();
     let n = loop_points.len();
     let mut members = Vec::new();
-    let mut area = Vec::with_capacity(n);
+    let mut local = Vec::with_capacity(n);
     for &p in loop_points {
         index.nearest(p as usize, K, &mut members);
-        area.push(area_per_sample(points, &members));
+        local.push(local_surface(points, &members));
     }
     let step: Vec<f64> = (0..n)
         .map(|i| {
@@ -55,19 +65,30 @@ pub fn edge_offsets(index: &NeighbourIndex, loop_points: &[u32]) -> Vec<f64> {
     (0..n)
         .map(|i| {
             let window = (0..=2 * WINDOW).map(|k| (i + n * (WINDOW + 1) + k - WINDOW) % n);
-            let (mut a, mut s, mut count) = (0.0, 0.0, 0.0);
+            let (mut a, mut s) = (0.0, 0.0);
             for j in window {
-                a += area[j];
+                a += local[j].0;
                 s += step[j];
-                count += 1.0;
             }
-            if s > 0.0 {
-                0.5 * (a / count) / (s / count)
-            } else {
-                0.0
+            EdgeSide {
+                offset: if s > 0.0 { 0.5 * a / s } else { 0.0 },
+                normal: local[i].1,
+                inside: local[i].2,
             }
         })
         .collect()
+}
+
+/// Area per sample, plane normal and centroid of a neighbourhood.
+fn local_surface(points: &[Point3], members: &[u32]) -> (f64, Point3, Point3) {
+    let mut centroid = [0.0; 3];
+    for &m in members {
+        for c in 0..3 {
+            centroid[c] += points[m as usize][c] / members.len() as f64;
+        }
+    }
+    let frame = fit_plane(points, members);
+    (area_per_sample(points, members), frame.normal, centroid)
 }
 
 /// Surface area per sample of a neighbourhood, by Pick's rule on its
@@ -145,18 +166,11 @@ fn polygon_area(poly: &[[f64; 2]]) -> f64 {
         .abs()
 }
 
-/// Moves each point of a closed or open smoothed polyline by `offsets[i]`
-/// along its outward normal in the surface's tangent plane. The normal is
-/// perpendicular to the polyline and to `surface_normal[i]`, on the side
-/// away from `inside[i]` (a point of the cloud behind the edge). Open
-/// polylines keep their end points (corners are not moved).
-pub fn move_outward(
-    polyline: &mut [Point3],
-    closed: bool,
-    offsets: &[f64],
-    surface_normal: &[Point3],
-    inside: &[Point3],
-) {
+/// Moves each point of a smoothed polyline outward by its side's offset,
+/// in the surface's tangent plane, perpendicular to the polyline, away from
+/// the side's inner point. `sides[i]` belongs to `polyline[i]`. An open
+/// polyline's end points (corners) are moved by [`corner_shift`] instead.
+pub fn move_outward(polyline: &mut [Point3], closed: bool, sides: &[EdgeSide]) {
     let n = polyline.len();
     if n < 2 {
         return;
@@ -164,19 +178,44 @@ pub fn move_outward(
     let original = polyline.to_vec();
     let range = if closed { 0..n } else { 1..n - 1 };
     for i in range {
-        let prev = original[(i + n - 1) % n];
-        let next = original[(i + 1) % n];
-        let tangent = sub(next, prev);
-        let mut out = cross(tangent, surface_normal[i]);
-        let len = norm2(out).sqrt();
-        if len == 0.0 {
-            continue;
+        let (prev, next) = if closed {
+            (original[(i + n - 1) % n], original[(i + 1) % n])
+        } else {
+            (original[i - 1], original[i + 1])
+        };
+        if let Some(out) = outward(sub(next, prev), original[i], &sides[i]) {
+            polyline[i] = [0, 1, 2].map(|c| original[i][c] + sides[i].offset * out[c]);
         }
-        if dot(out, sub(inside[i], original[i])) > 0.0 {
-            out = [-out[0], -out[1], -out[2]];
-        }
-        let k = offsets[i] / len;
-        polyline[i] = [0, 1, 2].map(|c| original[i][c] + k * out[c]);
+    }
+}
+
+/// Unit outward direction at `at` for a polyline running along `tangent`.
+pub fn outward(tangent: Point3, at: Point3, side: &EdgeSide) -> Option<Point3> {
+    let out = cross(tangent, side.normal);
+    let len = norm2(out).sqrt();
+    if len == 0.0 {
+        return None;
+    }
+    let sign = if dot(out, sub(side.inside, at)) > 0.0 {
+        -1.0
+    } else {
+        1.0
+    };
+    Some(out.map(|c| sign * c / len))
+}
+
+/// Displacement of a corner whose incoming and outgoing edges move out by
+/// `offset` along unit normals `n_in` and `n_out`: the offset lines meet
+/// at offset·(n_in + n_out)/(1 + n_in·n_out). Capped at 4·offset for very
+/// sharp corners.
+pub fn corner_shift(offset: f64, n_in: Point3, n_out: Point3) -> Point3 {
+    let denominator = (1.0 + dot(n_in, n_out)).max(0.125);
+    let shift = [0, 1, 2].map(|c| offset * (n_in[c] + n_out[c]) / denominator);
+    let len = norm2(shift).sqrt();
+    if len > 4.0 * offset {
+        shift.map(|c| c * 4.0 * offset / len)
+    } else {
+        shift
     }
 }
 
@@ -203,10 +242,12 @@ mod tests {
             .collect();
         let index = NeighbourIndex::new(&pts);
         let loop_points: Vec<u32> = (10..30).collect();
-        let offsets = edge_offsets(&index, &loop_points);
+        let sides = edge_sides(&index, &loop_points);
         // The first and last few average across the wrap of this open run.
-        for o in &offsets[WINDOW + 1..offsets.len() - WINDOW - 1] {
-            assert!((o - 0.5).abs() < 0.1, "{o}");
+        for side in &sides[WINDOW + 1..sides.len() - WINDOW - 1] {
+            assert!((side.offset - 0.5).abs() < 0.1, "{}", side.offset);
+            assert_eq!(side.normal, [0.0, 0.0, 1.0]);
+            assert!(side.inside[1] > 0.0);
         }
     }
 }
