@@ -10,6 +10,7 @@
 //! 5. optionally, each smoothed loop is moved out to where the surface
 //!    really ends.
 
+pub mod baseline;
 pub mod cluster;
 pub mod corners;
 pub mod offset;
