@@ -24,7 +24,7 @@ use crate::anisotropy::{
 };
 use crate::cloud::{check_not_degenerate, merge_duplicates, Point3, Sites};
 use crate::error::CloudError;
-use crate::frame::{fit_plane, project, Point2};
+use crate::frame::{fit_plane, project, Frame, Point2};
 use crate::neighbours::{NeighbourIndex, QueryHint};
 use crate::resolution::{beta_of, nearest_distances};
 
@@ -150,7 +150,7 @@ fn run(
             let members = hoods.at(p);
             let frame = fit_plane(&hoods.points, members);
             project(&hoods.points, members, &frame, &mut s.projected);
-            own_sampling_vectors(&s.projected, &frame)
+            (own_sampling_vectors(&s.projected, &frame), frame)
         })
     });
     let verdicts = per_position(&hoods, how, &report(passes - 1), |s, p| {
@@ -342,15 +342,16 @@ struct Scratch {
 fn analyse_point(
     hoods: &Neighbourhoods,
     p: usize,
-    vectors: Option<&[SamplingVectors]>,
+    vectors: Option<&[(SamplingVectors, Frame)]>,
     s: &mut Scratch,
     how: TestImpl,
 ) -> Verdict {
     let members = hoods.at(p);
-    let frame = fit_plane(&hoods.points, members);
+    // The first pass already fitted this neighbourhood's plane.
+    let frame = vectors.map_or_else(|| fit_plane(&hoods.points, members), |v| v[p].1);
     project(&hoods.points, members, &frame, &mut s.projected);
     if let Some(vectors) = vectors {
-        let tensor = sampling_tensor(&frame, members.iter().map(|&m| &vectors[m as usize]));
+        let tensor = sampling_tensor(&frame, members.iter().map(|&m| &vectors[m as usize].0));
         let map = whitening_map(tensor);
         for q in s.projected.iter_mut() {
             *q = apply(&map, *q);
