@@ -17,6 +17,7 @@
 pub mod anisotropy;
 pub mod bpd;
 pub mod cloud;
+pub mod edge_metrics;
 pub mod edges;
 pub mod error;
 pub mod evaluate;
