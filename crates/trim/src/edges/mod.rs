@@ -15,6 +15,7 @@ pub mod cluster;
 pub mod corners;
 pub mod offset;
 pub mod order;
+pub mod smooth;
 
 use crate::cloud::Point3;
 
