@@ -13,6 +13,7 @@
 //! other format a non-finite coordinate is an error.
 
 pub mod atomic;
+pub mod edges_out;
 pub mod labels;
 pub mod obj;
 pub mod pcd;

@@ -1,0 +1,549 @@
+//! Output of `meshtrim edges`: the reconstructed boundary loops and edges.
+//!
+//! Three formats, chosen by the output's extension, all deterministic byte
+//! for byte (no timestamps, floats in Rust's or serde_json's shortest
+//! round-trip form, or rounded the same way every time in SVG):
+//!
+//! - JSON: every loop with its ordered boundary point indices, its corners
+//!   and its smoothed edges;
+//! - OBJ: the smoothed edges as polylines (`l` lines), one `o` group per
+//!   loop;
+//! - SVG: a picture like the paper's Figure 4, the cloud seen along the
+//!   normal of its best-fit plane.
+
+use std::fmt::Write as _;
+use std::io::Write;
+
+use serde::Serialize;
+use trim::edges::Edges;
+use trim::frame::{fit_plane, Frame};
+
+use super::Point3;
+
+/// The input of the writers: the cloud, its boundary labels and its edges.
+#[derive(Debug, Clone, Copy)]
+pub struct EdgeData<'a> {
+    /// The input points, in input order (the loops index them).
+    pub points: &'a [Point3],
+    /// BPD's labels, one per point; true for boundary points. Only the SVG
+    /// picture uses them.
+    pub boundary: &'a [bool],
+    /// The reconstructed loops.
+    pub edges: &'a Edges,
+}
+
+/// Output formats of `edges`, chosen by the output's extension.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EdgesFormat {
+    /// Loops, corners and edges as one JSON object.
+    Json,
+    /// The smoothed edges as Wavefront OBJ polylines.
+    Obj,
+    /// A picture of the cloud, the raw loops and the smoothed edges.
+    Svg,
+}
+
+impl EdgesFormat {
+    /// The format an output path asks for, if supported.
+    pub fn from_path(path: &std::path::Path) -> Option<Self> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "json" => Some(EdgesFormat::Json),
+            "obj" => Some(EdgesFormat::Obj),
+            "svg" => Some(EdgesFormat::Svg),
+            _ => None,
+        }
+    }
+
+    /// Writes `data` in this format.
+    pub fn write(self, w: &mut dyn Write, data: EdgeData) -> std::io::Result<()> {
+        match self {
+            EdgesFormat::Json => write_json(w, data),
+            EdgesFormat::Obj => write_obj(w, data.edges),
+            EdgesFormat::Svg => write_svg(w, data),
+        }
+    }
+}
+
+#[derive(Serialize)]
+struct JsonEdges<'a> {
+    loops: Vec<JsonLoop<'a>>,
+}
+
+#[derive(Serialize)]
+struct JsonLoop<'a> {
+    closed: bool,
+    boundary_points: &'a [u32],
+    corners: Vec<Point3>,
+    edges: Vec<JsonEdge<'a>>,
+}
+
+#[derive(Serialize)]
+struct JsonEdge<'a> {
+    closed: bool,
+    points: &'a [Point3],
+}
+
+/// One compact JSON object and a newline:
+/// `{"loops":[{"closed":true,"boundary_points":[..],"corners":[[x,y,z],..],
+/// "edges":[{"closed":false,"points":[[x,y,z],..]},..]},..]}`.
+///
+/// `boundary_points` are indices into the input cloud in loop order;
+/// `corners` are the input coordinates of the corner points; a loop is
+/// always closed, an edge only when its loop has no corner.
+pub fn write_json(w: &mut dyn Write, data: EdgeData) -> std::io::Result<()> {
+    let loops = data
+        .edges
+        .loops
+        .iter()
+        .map(|l| JsonLoop {
+            closed: true,
+            boundary_points: &l.boundary_points,
+            corners: l.corner_points(data.points),
+            edges: l
+                .edges
+                .iter()
+                .map(|e| JsonEdge {
+                    closed: e.closed,
+                    points: &e.points,
+                })
+                .collect(),
+        })
+        .collect();
+    serde_json::to_writer(&mut *w, &JsonEdges { loops })?;
+    writeln!(w)
+}
+
+/// The smoothed edges as OBJ polylines: a header comment, then per loop an
+/// `o loop_N` group (N from 0, the loop's position in the JSON output), its
+/// `v` lines and one `l` line per edge (1-based indices). A closed edge
+/// repeats its first index at the end. Consecutive edges of a loop share
+/// their corner vertex when the coordinates are identical, as the library
+/// makes them, so each loop is one connected polyline.
+pub fn write_obj(w: &mut dyn Write, edges: &Edges) -> std::io::Result<()> {
+    let edge_count: usize = edges.loops.iter().map(|l| l.edges.len()).sum();
+    writeln!(w, "# meshtrim edges")?;
+    writeln!(
+        w,
+        "# {} loops, {edge_count} edges; one l line per edge",
+        edges.loops.len()
+    )?;
+    let mut next = 1usize; // the next vertex's OBJ index
+    for (n, l) in edges.loops.iter().enumerate() {
+        writeln!(w, "o loop_{n}")?;
+        // (coordinates, index) of the loop's first vertex and of the last one
+        // written, to share corners between consecutive edges.
+        let mut first: Option<(Point3, usize)> = None;
+        let mut last: Option<(Point3, usize)> = None;
+        let mut lines = Vec::with_capacity(l.edges.len());
+        for e in &l.edges {
+            let mut ids = Vec::with_capacity(e.points.len() + 1);
+            for (i, &p) in e.points.iter().enumerate() {
+                let shared = match (i, last, first) {
+                    (0, Some((q, id)), _) if q == p => Some(id),
+                    (i, _, Some((q, id))) if i + 1 == e.points.len() && q == p => Some(id),
+                    _ => None,
+                };
+                let id = shared.unwrap_or(next);
+                if shared.is_none() {
+                    writeln!(w, "v {} {} {}", p[0], p[1], p[2])?;
+                    next += 1;
+                }
+                first.get_or_insert((p, id));
+                last = Some((p, id));
+                ids.push(id);
+            }
+            if e.closed {
+                if let Some(&id) = ids.first() {
+                    ids.push(id);
+                }
+            }
+            lines.push(ids);
+        }
+        for ids in lines.iter().filter(|ids| ids.len() >= 2) {
+            write!(w, "l")?;
+            for id in ids {
+                write!(w, " {id}")?;
+            }
+            writeln!(w)?;
+        }
+    }
+    Ok(())
+}
+
+/// Interior points drawn at most, every n-th one, to keep the file small.
+pub const SVG_MAX_INTERIOR: usize = 20_000;
+
+/// Size of the picture's larger side, in SVG user units.
+const SVG_SIZE: f64 = 1000.0;
+/// Empty space around the data, in SVG user units.
+const SVG_MARGIN: f64 = 20.0;
+
+/// A picture like the paper's Figure 4: the cloud projected onto its
+/// best-fit plane and seen from the side its normal points to (first
+/// tangent axis to the right, second up), with the interior points as small
+/// grey dots (every n-th one, at most [`SVG_MAX_INTERIOR`]), all boundary
+/// points as red circles, the raw ordered loops as dashed grey-blue lines,
+/// the smoothed edges as solid dark lines and the corners as asterisks.
+///
+/// The data is scaled so the larger side is 1000 units plus a margin, and
+/// coordinates are rounded to 0.01 units.
+pub fn write_svg(w: &mut dyn Write, data: EdgeData) -> std::io::Result<()> {
+    let points = data.points;
+    let frame = if points.is_empty() {
+        Frame {
+            u: [1.0, 0.0, 0.0],
+            v: [0.0, 1.0, 0.0],
+            normal: [0.0, 0.0, 1.0],
+        }
+    } else {
+        let all: Vec<u32> = (0..points.len() as u32).collect();
+        fit_plane(points, &all)
+    };
+    let origin = points.first().copied().unwrap_or([0.0; 3]);
+    // Plane coordinates with the y axis pointing down, as SVG's does.
+    let plane = |p: &Point3| {
+        let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
+        let dot = |a: &Point3| d[0] * a[0] + d[1] * a[1] + d[2] * a[2];
+        [dot(&frame.u), -dot(&frame.v)]
+    };
+    let projected: Vec<[f64; 2]> = points.iter().map(plane).collect();
+    let edge_points = data
+        .edges
+        .loops
+        .iter()
+        .flat_map(|l| &l.edges)
+        .flat_map(|e| &e.points);
+    let mut lo = [f64::INFINITY; 2];
+    let mut hi = [f64::NEG_INFINITY; 2];
+    for q in projected.iter().copied().chain(edge_points.map(plane)) {
+        for a in 0..2 {
+            lo[a] = lo[a].min(q[a]);
+            hi[a] = hi[a].max(q[a]);
+        }
+    }
+    if lo[0] > hi[0] {
+        (lo, hi) = ([0.0; 2], [1.0; 2]);
+    }
+    let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]);
+    let scale = if extent > 0.0 { SVG_SIZE / extent } else { 1.0 };
+    let to_svg = |q: [f64; 2]| {
+        [
+            (q[0] - lo[0]) * scale + SVG_MARGIN,
+            (q[1] - lo[1]) * scale + SVG_MARGIN,
+        ]
+    };
+    let width = (hi[0] - lo[0]) * scale + 2.0 * SVG_MARGIN;
+    let height = (hi[1] - lo[1]) * scale + 2.0 * SVG_MARGIN;
+    let at = |i: u32| to_svg(projected[i as usize]);
+
+    let loops = &data.edges.loops;
+    let edge_count: usize = loops.iter().map(|l| l.edges.len()).sum();
+    let corner_count: usize = loops.iter().map(|l| l.corners.len()).sum();
+    let (w_, h_) = (num(width), num(height));
+    writeln!(
+        w,
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"0 0 {w_} {h_}\" \
+         width=\"{w_}\" height=\"{h_}\">"
+    )?;
+    writeln!(
+        w,
+        "<title>meshtrim edges: {} points, {} loops, {edge_count} edges, {corner_count} corners</title>",
+        points.len(),
+        loops.len()
+    )?;
+    writeln!(w, "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>")?;
+
+    // Interior points: zero-length round-capped segments, the most compact
+    // dots SVG has.
+    let interior: Vec<usize> = (0..points.len())
+        .filter(|&i| !data.boundary.get(i).copied().unwrap_or(false))
+        .collect();
+    let step = interior.len().div_ceil(SVG_MAX_INTERIOR).max(1);
+    writeln!(
+        w,
+        "<g id=\"interior\" fill=\"none\" stroke=\"#a8a8a8\" stroke-width=\"2\" stroke-linecap=\"round\">"
+    )?;
+    for chunk in interior
+        .iter()
+        .step_by(step)
+        .collect::<Vec<_>>()
+        .chunks(1000)
+    {
+        let mut d = String::new();
+        for (n, &&i) in chunk.iter().enumerate() {
+            let [x, y] = to_svg(projected[i]);
+            let sep = if n % 16 == 15 { "\n" } else { "" };
+            let _ = write!(d, "M{} {}h0{sep}", num(x), num(y));
+        }
+        writeln!(w, "<path d=\"{}\"/>", d.trim_end())?;
+    }
+    writeln!(w, "</g>")?;
+
+    writeln!(
+        w,
+        "<g id=\"boundary-points\" fill=\"none\" stroke=\"#d02020\" stroke-width=\"0.8\">"
+    )?;
+    for i in (0..points.len()).filter(|&i| data.boundary.get(i).copied().unwrap_or(false)) {
+        let [x, y] = to_svg(projected[i]);
+        writeln!(w, "<circle cx=\"{}\" cy=\"{}\" r=\"2.5\"/>", num(x), num(y))?;
+    }
+    writeln!(w, "</g>")?;
+
+    writeln!(
+        w,
+        "<g id=\"raw-loops\" fill=\"none\" stroke=\"#6f8fb0\" stroke-width=\"1\" stroke-dasharray=\"4 3\">"
+    )?;
+    for l in loops {
+        let ring = l.boundary_points.iter().chain(l.boundary_points.first());
+        polyline(w, ring.map(|&i| at(i)))?;
+    }
+    writeln!(w, "</g>")?;
+
+    writeln!(
+        w,
+        "<g id=\"edges\" fill=\"none\" stroke=\"#202020\" stroke-width=\"1.6\" stroke-linejoin=\"round\">"
+    )?;
+    for e in loops.iter().flat_map(|l| &l.edges) {
+        let closing = if e.closed { e.points.first() } else { None };
+        polyline(w, e.points.iter().chain(closing).map(|p| to_svg(plane(p))))?;
+    }
+    writeln!(w, "</g>")?;
+
+    writeln!(
+        w,
+        "<g id=\"corners\" fill=\"none\" stroke=\"black\" stroke-width=\"1.4\">"
+    )?;
+    for l in loops {
+        for &c in &l.corners {
+            let [x, y] = at(l.boundary_points[c]);
+            // A six-pointed asterisk of radius 6, as in the paper.
+            writeln!(
+                w,
+                "<path d=\"M{} {}h12M{} {}l6 10.39M{} {}l-6 10.39\"/>",
+                num(x - 6.0),
+                num(y),
+                num(x - 3.0),
+                num(y - 5.2),
+                num(x + 3.0),
+                num(y - 5.2)
+            )?;
+        }
+    }
+    writeln!(w, "</g>")?;
+    writeln!(w, "</svg>")
+}
+
+/// One `<polyline>` through `points`, 8 points a line.
+fn polyline(w: &mut dyn Write, points: impl Iterator<Item = [f64; 2]>) -> std::io::Result<()> {
+    let mut text = String::new();
+    for (n, [x, y]) in points.enumerate() {
+        let sep = match n {
+            0 => "",
+            n if n % 8 == 0 => "\n",
+            _ => " ",
+        };
+        let _ = write!(text, "{sep}{},{}", num(x), num(y));
+    }
+    writeln!(w, "<polyline points=\"{text}\"/>")
+}
+
+/// A picture coordinate, rounded to 0.01 (six significant digits at most on
+/// a 1000-unit picture), without trailing zeros.
+fn num(x: f64) -> String {
+    let s = format!("{x:.2}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" {
+        "0".to_string()
+    } else {
+        s.to_string()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use trim::edges::{Edge, Loop};
+
+    use super::*;
+
+    /// Six points: a square with corners 0, 1, 2, 3 (plus an interior point
+    /// 4 and a boundary point 5 that lies in no loop), and a second loop
+    /// without corners.
+    fn sample() -> (Vec<Point3>, Vec<bool>, Edges) {
+        let points = vec![
+            [0.0, 0.0, 0.0],
+            [2.0, 0.0, 0.0],
+            [2.0, 1.5, 0.0],
+            [0.0, 1.5, 0.0],
+            [1.0, 0.5, 0.0],
+            [0.5, 0.5, 0.25],
+        ];
+        let boundary = vec![true, true, true, true, false, true];
+        let square = Loop {
+            boundary_points: vec![0, 1, 2, 3],
+            corners: vec![0, 2],
+            edges: vec![
+                Edge {
+                    closed: false,
+                    points: vec![[0.0, 0.0, 0.0], [2.0, 0.1, 0.0], [2.0, 1.5, 0.0]],
+                },
+                Edge {
+                    closed: false,
+                    points: vec![[2.0, 1.5, 0.0], [0.1, 1.5, 0.0], [0.0, 0.0, 0.0]],
+                },
+            ],
+        };
+        let hole = Loop {
+            boundary_points: vec![5, 4, 1],
+            corners: vec![],
+            edges: vec![Edge {
+                closed: true,
+                points: vec![[0.5, 0.5, 0.25], [1.0, 0.5, -1e-7], [0.75, 1.0, 0.0]],
+            }],
+        };
+        let edges = Edges {
+            loops: vec![square, hole],
+            dropped_clusters: 1,
+            thinned_points: 2,
+        };
+        (points, boundary, edges)
+    }
+
+    fn render(format: EdgesFormat) -> String {
+        let (points, boundary, edges) = sample();
+        let data = EdgeData {
+            points: &points,
+            boundary: &boundary,
+            edges: &edges,
+        };
+        let mut out = Vec::new();
+        format.write(&mut out, data).unwrap();
+        String::from_utf8(out).unwrap()
+    }
+
+    #[test]
+    fn formats_from_extensions() {
+        let f = |p: &str| EdgesFormat::from_path(std::path::Path::new(p));
+        assert_eq!(f("a/b.json"), Some(EdgesFormat::Json));
+        assert_eq!(f("b.OBJ"), Some(EdgesFormat::Obj));
+        assert_eq!(f("b.svg"), Some(EdgesFormat::Svg));
+        assert_eq!(f("b.ply"), None);
+        assert_eq!(f("json"), None);
+    }
+
+    #[test]
+    fn json_has_the_documented_shape() {
+        let text = render(EdgesFormat::Json);
+        assert_eq!(
+            text,
+            "{\"loops\":[\
+             {\"closed\":true,\"boundary_points\":[0,1,2,3],\
+             \"corners\":[[0.0,0.0,0.0],[2.0,1.5,0.0]],\
+             \"edges\":[{\"closed\":false,\"points\":[[0.0,0.0,0.0],[2.0,0.1,0.0],[2.0,1.5,0.0]]},\
+             {\"closed\":false,\"points\":[[2.0,1.5,0.0],[0.1,1.5,0.0],[0.0,0.0,0.0]]}]},\
+             {\"closed\":true,\"boundary_points\":[5,4,1],\"corners\":[],\
+             \"edges\":[{\"closed\":true,\"points\":[[0.5,0.5,0.25],[1.0,0.5,-1e-7],[0.75,1.0,0.0]]}]}\
+             ]}\n"
+        );
+        let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        assert_eq!(v["loops"][1]["edges"][0]["points"][1][2], -1e-7);
+    }
+
+    #[test]
+    fn obj_shares_corners_and_closes_closed_edges() {
+        assert_eq!(
+            render(EdgesFormat::Obj),
+            "# meshtrim edges\n\
+             # 2 loops, 3 edges; one l line per edge\n\
+             o loop_0\n\
+             v 0 0 0\nv 2 0.1 0\nv 2 1.5 0\nv 0.1 1.5 0\n\
+             l 1 2 3\nl 3 4 1\n\
+             o loop_1\n\
+             v 0.5 0.5 0.25\nv 1 0.5 -0.0000001\nv 0.75 1 0\n\
+             l 5 6 7 5\n"
+        );
+    }
+
+    #[test]
+    fn obj_of_nothing_is_just_the_header() {
+        let mut out = Vec::new();
+        write_obj(&mut out, &Edges::default()).unwrap();
+        assert_eq!(
+            out,
+            b"# meshtrim edges\n# 0 loops, 0 edges; one l line per edge\n"
+        );
+    }
+
+    #[test]
+    fn svg_draws_every_layer() {
+        let text = render(EdgesFormat::Svg);
+        assert!(text.starts_with("<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"0 0 "));
+        assert!(text.ends_with("</svg>\n"));
+        // 5 boundary points as circles, 2 raw loops and 3 edges as
+        // polylines, 2 corners, 1 interior dot.
+        assert_eq!(text.matches("<circle ").count(), 5);
+        assert_eq!(text.matches("<polyline ").count(), 5);
+        assert_eq!(text.matches("l6 10.39").count(), 2);
+        assert_eq!(text.matches("h0").count(), 1);
+        // The larger side is 1000 units plus the margins.
+        let view = text.split("viewBox=\"0 0 ").nth(1).unwrap();
+        let size: Vec<f64> = view
+            .split('"')
+            .next()
+            .unwrap()
+            .split(' ')
+            .map(|s| s.parse().unwrap())
+            .collect();
+        assert_eq!(size[0].max(size[1]), 1040.0, "{text}");
+        // Seen from the side the normal (here about +z) points to, so not
+        // mirrored: 0 → 1 → 3 turns counter-clockwise, which with SVG's y
+        // axis pointing down is a negative cross product.
+        let circles: Vec<[f64; 2]> = text
+            .lines()
+            .filter(|l| l.starts_with("<circle "))
+            .map(|l| {
+                let attr = |name: &str| {
+                    let start = l.find(&format!("{name}=\"")).unwrap() + name.len() + 2;
+                    let end = start + l[start..].find('"').unwrap();
+                    l[start..end].parse::<f64>().unwrap()
+                };
+                [attr("cx"), attr("cy")]
+            })
+            .collect();
+        let (p0, p1, p3) = (circles[0], circles[1], circles[3]);
+        let cross = (p1[0] - p0[0]) * (p3[1] - p0[1]) - (p1[1] - p0[1]) * (p3[0] - p0[0]);
+        assert!(cross < 0.0, "{circles:?}");
+    }
+
+    #[test]
+    fn svg_subsamples_interior_points() {
+        let n = 2 * SVG_MAX_INTERIOR + 10;
+        let points: Vec<Point3> = (0..n)
+            .map(|i| [(i % 300) as f64, (i / 300) as f64, 0.0])
+            .collect();
+        let boundary = vec![false; n];
+        let edges = Edges::default();
+        let mut out = Vec::new();
+        let data = EdgeData {
+            points: &points,
+            boundary: &boundary,
+            edges: &edges,
+        };
+        write_svg(&mut out, data).unwrap();
+        let text = String::from_utf8(out).unwrap();
+        let dots = text.matches("h0").count();
+        assert!(
+            dots <= SVG_MAX_INTERIOR && dots > SVG_MAX_INTERIOR / 2,
+            "{dots}"
+        );
+    }
+
+    #[test]
+    fn numbers_are_rounded_without_trailing_zeros() {
+        assert_eq!(num(1.0), "1");
+        assert_eq!(num(12.345678), "12.35");
+        assert_eq!(num(0.1), "0.1");
+        assert_eq!(num(-0.001), "0");
+        assert_eq!(num(999.999), "1000");
+    }
+}
