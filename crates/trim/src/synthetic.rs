@@ -588,6 +588,32 @@ pub fn saddle_with_hole(spacing: f64, seed: u64) -> SyntheticCloud {
     )
 }
 
+/// A curved disc with a hole and no corner: the saddle z = 0.004·(x² − y²)
+/// over a disc of radius 50 (a 720-gon, as smooth as the sampling can tell),
+/// with a hole of radius 12 at (15, −10).
+pub fn curved_disc_with_hole(spacing: f64, seed: u64) -> SyntheticCloud {
+    let outer = (0..720)
+        .map(|i| {
+            let t = i as f64 / 720.0 * 2.0 * PI;
+            [50.0 * t.cos(), 50.0 * t.sin()]
+        })
+        .collect();
+    let region = Region {
+        outer,
+        holes: vec![Circle {
+            centre: [15.0, -10.0],
+            radius: 12.0,
+        }],
+    };
+    jittered(
+        format!("curved disc with hole, h={spacing}"),
+        Surface::Saddle { a: 0.004 },
+        region,
+        SpacingField::Uniform(spacing),
+        seed,
+    )
+}
+
 /// A cylinder patch of radius 50: arc length 0..150 (172°) by 0..100 along
 /// the axis, with a hole of radius 15 at (75, 50).
 pub fn cylinder_with_hole(spacing: f64, seed: u64) -> SyntheticCloud {

@@ -17,7 +17,11 @@ pub mod offset;
 pub mod order;
 pub mod smooth;
 
-use crate::cloud::Point3;
+use rayon::prelude::*;
+
+use crate::bpd::Detection;
+use crate::cloud::{sub, Point3};
+use crate::neighbours::NeighbourIndex;
 
 /// Options of edge reconstruction.
 #[derive(Debug, Clone, PartialEq)]
@@ -76,4 +80,115 @@ pub struct Edges {
     pub dropped_clusters: usize,
     /// Boundary points removed as spurs, strays or isolated points.
     pub thinned_points: usize,
+}
+
+/// Reconstructs the boundary edges of a cloud from its BPD result: loops,
+/// corners and smoothed edges (see the module doc for the steps).
+pub fn reconstruct_edges(points: &[Point3], detection: &Detection, options: &EdgeOptions) -> Edges {
+    let clusters = cluster::cluster_boundary(&detection.boundary, &detection.links);
+    let index = options.offset.then(|| NeighbourIndex::new(points));
+    let loops = clusters
+        .clusters
+        .par_iter()
+        .zip(&clusters.links)
+        .map(|(members, links)| build_loop(points, &detection.beta, members, links, index.as_ref()))
+        .collect();
+    Edges {
+        loops,
+        dropped_clusters: clusters.dropped_clusters,
+        thinned_points: clusters.thinned_points,
+    }
+}
+
+fn build_loop(
+    points: &[Point3],
+    beta: &[f64],
+    members: &[u32],
+    links: &[[u32; 2]],
+    index: Option<&NeighbourIndex>,
+) -> Loop {
+    let tour = order::closed_tour(points, members, links);
+    let loop_points: Vec<Point3> = tour.iter().map(|&i| points[i as usize]).collect();
+    let loop_beta: Vec<f64> = tour.iter().map(|&i| beta[i as usize]).collect();
+    let corners = corners::find_corners(&loop_points, &loop_beta);
+    let mut edges = smoothed_edges(&loop_points, &loop_beta, &corners);
+    if let Some(index) = index {
+        let sides = offset::edge_sides(index, &tour);
+        move_edges_outward(&mut edges, &corners, &sides);
+    }
+    Loop {
+        boundary_points: tour,
+        corners,
+        edges,
+    }
+}
+
+/// Splits a loop at its corners and smooths each piece (section 3.3).
+fn smoothed_edges(loop_points: &[Point3], beta: &[f64], corners: &[usize]) -> Vec<Edge> {
+    if corners.is_empty() {
+        return vec![Edge {
+            closed: true,
+            points: smooth::smooth_closed_edge(loop_points, beta),
+        }];
+    }
+    let n = loop_points.len();
+    (0..corners.len())
+        .map(|k| {
+            let (from, to) = (corners[k], corners[(k + 1) % corners.len()]);
+            // From one corner to the next, both included, wrapping round.
+            let len = (to + n - from) % n;
+            let len = if len == 0 { n } else { len };
+            let range: Vec<usize> = (0..=len).map(|j| (from + j) % n).collect();
+            let piece: Vec<Point3> = range.iter().map(|&j| loop_points[j]).collect();
+            let piece_beta: Vec<f64> = range.iter().map(|&j| beta[j]).collect();
+            Edge {
+                closed: false,
+                points: smooth::smooth_open_edge(&piece, &piece_beta),
+            }
+        })
+        .collect()
+}
+
+/// Moves every edge out to the estimated physical edge; corners move to
+/// where the moved edges meet, and stay shared by consecutive edges.
+fn move_edges_outward(edges: &mut [Edge], corners: &[usize], sides: &[offset::EdgeSide]) {
+    let n = sides.len();
+    if corners.is_empty() {
+        offset::move_outward(&mut edges[0].points, true, sides);
+        return;
+    }
+    // The sides of each edge's points, and the outward normals at its ends.
+    let mut end_normals = Vec::with_capacity(edges.len());
+    for (k, edge) in edges.iter_mut().enumerate() {
+        let from = corners[k];
+        let edge_sides: Vec<offset::EdgeSide> = (0..edge.points.len())
+            .map(|j| sides[(from + j) % n])
+            .collect();
+        let m = edge.points.len();
+        let first = offset::outward(
+            sub(edge.points[1], edge.points[0]),
+            edge.points[0],
+            &edge_sides[0],
+        );
+        let last = offset::outward(
+            sub(edge.points[m - 1], edge.points[m - 2]),
+            edge.points[m - 1],
+            &edge_sides[m - 1],
+        );
+        end_normals.push((first, last));
+        offset::move_outward(&mut edge.points, false, &edge_sides);
+    }
+    // Corner k ends edge k−1 and starts edge k.
+    for k in 0..edges.len() {
+        let previous = (k + edges.len() - 1) % edges.len();
+        let (Some(n_in), Some(n_out)) = (end_normals[previous].1, end_normals[k].0) else {
+            continue;
+        };
+        let shift = offset::corner_shift(sides[corners[k]].offset, n_in, n_out);
+        let corner = edges[k].points[0];
+        let moved = [0, 1, 2].map(|c| corner[c] + shift[c]);
+        edges[k].points[0] = moved;
+        let last = edges[previous].points.len() - 1;
+        edges[previous].points[last] = moved;
+    }
 }

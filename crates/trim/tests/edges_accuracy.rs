@@ -1,0 +1,161 @@
+//! Accuracy of edge reconstruction on synthetic clouds with ground truth.
+//! Run with `--nocapture` to see the measured numbers.
+
+use trim::edge_metrics::{match_corners, polyline_to_truth_in_spacings, true_corners};
+use trim::edges::{reconstruct_edges, EdgeOptions, Edges};
+use trim::synthetic::{self, SyntheticCloud};
+use trim::{detect_boundary, BpdOptions, Point3};
+
+/// Mean and largest distance of all smoothed edges to the true boundary,
+/// in local spacings.
+fn distance_to_truth(cloud: &SyntheticCloud, edges: &Edges) -> (f64, f64) {
+    let step = cloud.spacing.iter().copied().fold(f64::INFINITY, f64::min) / 4.0;
+    let (mut sum, mut count, mut max) = (0.0, 0usize, 0.0f64);
+    for edge in edges.loops.iter().flat_map(|l| &l.edges) {
+        let d = polyline_to_truth_in_spacings(&edge.points, edge.closed, step, cloud);
+        sum += d.mean * d.count as f64;
+        count += d.count;
+        max = max.max(d.max);
+    }
+    (sum / count as f64, max)
+}
+
+fn edges_of(cloud: &SyntheticCloud, offset: bool) -> Edges {
+    let detection = detect_boundary(&cloud.points, &BpdOptions::default()).unwrap();
+    reconstruct_edges(&cloud.points, &detection, &EdgeOptions { offset })
+}
+
+/// Checks loops, corners, distances and chaining; returns failures.
+fn check(cloud: &SyntheticCloud) -> Vec<String> {
+    let mut failures = Vec::new();
+    let edges = edges_of(cloud, true);
+    let raw = edges_of(cloud, false);
+    let name = &cloud.name;
+    if edges.loops.len() != cloud.boundary.len() {
+        failures.push(format!(
+            "{name}: {} loops, expected {}",
+            edges.loops.len(),
+            cloud.boundary.len()
+        ));
+    }
+    let found: Vec<Point3> = edges
+        .loops
+        .iter()
+        .flat_map(|l| l.corner_points(&cloud.points))
+        .collect();
+    let truth = true_corners(cloud);
+    let tolerance = 2.0 * cloud.spacing.iter().copied().fold(0.0, f64::max);
+    let (hit, missed, false_found) = match_corners(&found, &truth, tolerance);
+    if missed > 0 || false_found > 0 {
+        failures.push(format!(
+            "{name}: corners {hit} found, {missed} missed, {false_found} false"
+        ));
+    }
+    let (mean, max) = distance_to_truth(cloud, &edges);
+    let (raw_mean, raw_max) = distance_to_truth(cloud, &raw);
+    eprintln!(
+        "{name:<36} loops {} corners {}/{} (false {false_found}) | to truth in spacings: offset mean {mean:.3} max {max:.3}; no offset mean {raw_mean:.3} max {raw_max:.3}",
+        edges.loops.len(),
+        hit,
+        truth.len(),
+    );
+    if mean > 0.25 || max > 1.5 {
+        failures.push(format!(
+            "{name}: distance to truth mean {mean:.3}, max {max:.3} spacings"
+        ));
+    }
+    failures.extend(chain_breaks(&edges, name));
+    failures
+}
+
+/// Each loop's edges must chain end to start and close.
+fn chain_breaks(edges: &Edges, name: &str) -> Vec<String> {
+    let mut failures = Vec::new();
+    for (l, lp) in edges.loops.iter().enumerate() {
+        if lp.corners.is_empty() {
+            if lp.edges.len() != 1 || !lp.edges[0].closed {
+                failures.push(format!(
+                    "{name}: loop {l} has no corner but is not one closed edge"
+                ));
+            }
+            continue;
+        }
+        for k in 0..lp.edges.len() {
+            let next = &lp.edges[(k + 1) % lp.edges.len()];
+            let end = *lp.edges[k].points.last().unwrap();
+            if lp.edges[k].closed || end != next.points[0] {
+                failures.push(format!(
+                    "{name}: loop {l}: edge {k} does not end where edge {} starts",
+                    (k + 1) % lp.edges.len()
+                ));
+            }
+        }
+    }
+    failures
+}
+
+#[test]
+fn blade_at_4_8_16_mm() {
+    let failures: Vec<String> = [(4.0, 10), (8.0, 11), (16.0, 12)]
+        .into_iter()
+        .flat_map(|(h, seed)| check(&synthetic::blade(h, seed)))
+        .collect();
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+#[test]
+fn notched_plate_with_concave_and_convex_corners() {
+    let failures = check(&synthetic::notched_plate(1.0, 2));
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+#[test]
+fn curved_disc_with_a_hole_and_no_corner() {
+    let failures = check(&synthetic::curved_disc_with_hole(1.5, 3));
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+#[test]
+fn edges_follow_rigid_motions_and_units() {
+    let cloud = synthetic::notched_plate(1.0, 2);
+    let base = edges_of(&cloud, true);
+    let (c, s) = (0.6f64, 0.8f64);
+    for (what, scale, shift, rotate) in [
+        ("rotation", 1.0, [0.0; 3], true),
+        ("translation by 1e5", 1.0, [1e5, -1e5, 1e5], false),
+        ("scale ×0.001", 0.001, [0.0; 3], false),
+    ] {
+        let map = |p: Point3| {
+            let q = if rotate {
+                [c * p[0] - s * p[2], p[1], s * p[0] + c * p[2]]
+            } else {
+                p
+            };
+            [
+                q[0] * scale + shift[0],
+                q[1] * scale + shift[1],
+                q[2] * scale + shift[2],
+            ]
+        };
+        let moved: Vec<Point3> = cloud.points.iter().map(|&p| map(p)).collect();
+        let detection = detect_boundary(&moved, &BpdOptions::default()).unwrap();
+        let got = reconstruct_edges(&moved, &detection, &EdgeOptions::default());
+        assert_eq!(got.loops.len(), base.loops.len(), "{what}");
+        for (a, b) in base.loops.iter().zip(&got.loops) {
+            assert_eq!(a.boundary_points, b.boundary_points, "{what}");
+            assert_eq!(a.corners, b.corners, "{what}");
+            for (ea, eb) in a.edges.iter().zip(&b.edges) {
+                for (&pa, &pb) in ea.points.iter().zip(&eb.points) {
+                    let expect = map(pa);
+                    let err = (0..3)
+                        .map(|k| (expect[k] - pb[k]).abs())
+                        .fold(0.0, f64::max);
+                    assert!(
+                        err <= 1e-9 * (scale + 1e5 * f64::from(what.starts_with("translation"))),
+                        "{what}: {err}"
+                    );
+                }
+            }
+        }
+    }
+}
