@@ -116,7 +116,10 @@ fn write_labels(
 /// BPD with a progress bar on stderr. The bar appears only once the run has
 /// taken a second, so quick runs print nothing, and indicatif hides it when
 /// stderr is not a terminal.
-fn detect_with_progress(points: &[Point3], options: &BpdOptions) -> Result<Detection, CloudError> {
+pub(crate) fn detect_with_progress(
+    points: &[Point3],
+    options: &BpdOptions,
+) -> Result<Detection, CloudError> {
     // The library counts distinct points, not known before it merges
     // duplicates; the bar's length is all points, so with duplicates it stops
     // short of full, and it is cleared at the end anyway.
@@ -206,7 +209,7 @@ fn stats(values: &[f64]) -> (f64, f64, f64, f64) {
 }
 
 /// Milliseconds, rounded to 0.1 ms.
-fn millis(d: Duration) -> f64 {
+pub(crate) fn millis(d: Duration) -> f64 {
     (d.as_secs_f64() * 1e4).round() / 10.0
 }
 

@@ -7,7 +7,9 @@
 //!   writes results atomically.
 //! - [`cli`] defines the command line and runs its subcommands.
 //! - [`detect`] is the `meshtrim detect` subcommand.
+//! - [`edges`] is the `meshtrim edges` subcommand.
 
 pub mod cli;
 pub mod detect;
+pub mod edges;
 pub mod io;

@@ -1,0 +1,200 @@
+//! `meshtrim edges`: read a cloud, detect its boundary, reconstruct and
+//! smooth its edges, write them, report.
+
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use anyhow::{bail, Context, Result};
+use serde::Serialize;
+use trim::edges::{reconstruct_edges, EdgeOptions, Edges};
+use trim::{BpdOptions, Detection};
+
+use crate::cli::EdgesArgs;
+use crate::detect::{detect_with_progress, millis};
+use crate::io::atomic::write_atomic;
+use crate::io::edges_out::{EdgeData, EdgesFormat};
+use crate::io::{read_cloud, Cloud};
+
+/// What `edges` prints: the counts of each stage and the timings.
+#[derive(Debug, Clone, Serialize)]
+pub struct Summary {
+    /// The input file, as given.
+    pub file: String,
+    /// Points read (after dropping non-finite PCD points).
+    pub points: usize,
+    /// Points labelled boundary by BPD (duplicates counted).
+    pub boundary_points: usize,
+    /// Closed boundary loops reconstructed.
+    pub loops: usize,
+    /// Smoothed edges over all loops (one per loop without corners).
+    pub edges: usize,
+    /// Corners over all loops.
+    pub corners: usize,
+    /// Groups of boundary points too small or too thin to close a loop.
+    pub dropped_clusters: usize,
+    /// Boundary points removed as spurs, strays or isolated points.
+    pub thinned_points: usize,
+    /// Time to read the file, in milliseconds.
+    pub read_ms: f64,
+    /// Time of boundary detection, in milliseconds.
+    pub detect_ms: f64,
+    /// Time of edge reconstruction (clustering, ordering, corners,
+    /// smoothing, offset), in milliseconds.
+    pub edges_ms: f64,
+    /// Whether the edges were moved out to the surface's estimated edge.
+    pub offset: bool,
+}
+
+/// Runs `meshtrim edges`.
+pub fn run(args: &EdgesArgs) -> Result<()> {
+    // Check the output before the (possibly long) work.
+    let format = check_output(&args.output, &args.cloud)?;
+    let started = Instant::now();
+    let cloud = read_cloud(&args.cloud)?;
+    let read_time = started.elapsed();
+    let options = BpdOptions {
+        k: args.k,
+        anisotropy: !args.no_anisotropy,
+    };
+    let started = Instant::now();
+    let detection = detect_with_progress(&cloud.points, &options)
+        .with_context(|| args.cloud.display().to_string())?;
+    let detect_time = started.elapsed();
+    let started = Instant::now();
+    let edge_options = EdgeOptions {
+        offset: !args.no_offset,
+    };
+    let edges = reconstruct_edges(&cloud.points, &detection, &edge_options);
+    let edges_time = started.elapsed();
+    let data = EdgeData {
+        points: &cloud.points,
+        boundary: &detection.boundary,
+        edges: &edges,
+    };
+    write_atomic(&args.output, |w| format.write(w, data))?;
+    let times = [read_time, detect_time, edges_time];
+    let summary = Summary::new(args, &cloud, &detection, &edges, times);
+    if args.json {
+        println!("{}", serde_json::to_string(&summary)?);
+    } else {
+        print!("{}", summary.table());
+        println!("{:<20} {}", "output", args.output.display());
+    }
+    Ok(())
+}
+
+/// The output's format; refuses unknown extensions and the input itself.
+fn check_output(out: &Path, input: &Path) -> Result<EdgesFormat> {
+    let Some(format) = EdgesFormat::from_path(out) else {
+        bail!(
+            "{}: unsupported output format: use .json, .obj or .svg",
+            out.display()
+        );
+    };
+    let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    };
+    if same(out, input) {
+        bail!("{}: the output would overwrite the input", out.display());
+    }
+    Ok(format)
+}
+
+impl Summary {
+    fn new(
+        args: &EdgesArgs,
+        cloud: &Cloud,
+        detection: &Detection,
+        edges: &Edges,
+        [read, detect, reconstruct]: [Duration; 3],
+    ) -> Self {
+        Summary {
+            file: args.cloud.display().to_string(),
+            points: cloud.points.len(),
+            boundary_points: detection.boundary_count(),
+            loops: edges.loops.len(),
+            edges: edges.loops.iter().map(|l| l.edges.len()).sum(),
+            corners: edges.loops.iter().map(|l| l.corners.len()).sum(),
+            dropped_clusters: edges.dropped_clusters,
+            thinned_points: edges.thinned_points,
+            read_ms: millis(read),
+            detect_ms: millis(detect),
+            edges_ms: millis(reconstruct),
+            offset: !args.no_offset,
+        }
+    }
+
+    /// The summary as an aligned two-column table.
+    pub fn table(&self) -> String {
+        let share = 100.0 * self.boundary_points as f64 / self.points.max(1) as f64;
+        let on_off = if self.offset { "on" } else { "off" };
+        let rows = [
+            ("file", self.file.clone()),
+            ("points", self.points.to_string()),
+            (
+                "boundary points",
+                format!("{} ({share:.1}%)", self.boundary_points),
+            ),
+            ("loops", self.loops.to_string()),
+            ("edges", self.edges.to_string()),
+            ("corners", self.corners.to_string()),
+            ("dropped clusters", self.dropped_clusters.to_string()),
+            ("thinned points", self.thinned_points.to_string()),
+            ("offset", on_off.to_string()),
+            ("read time", format!("{:.1} ms", self.read_ms)),
+            ("detect time", format!("{:.1} ms", self.detect_ms)),
+            ("edges time", format!("{:.1} ms", self.edges_ms)),
+        ];
+        rows.iter()
+            .map(|(label, value)| format!("{label:<20} {value}\n"))
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn output_checks() {
+        let input = Path::new("Cargo.toml");
+        assert!(check_output(Path::new("x.ply"), input).is_err());
+        assert!(check_output(Path::new("x"), input).is_err());
+        let err = check_output(Path::new("x.txt"), input).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "x.txt: unsupported output format: use .json, .obj or .svg"
+        );
+        assert_eq!(
+            check_output(Path::new("out/e.SVG"), input).unwrap(),
+            EdgesFormat::Svg
+        );
+        assert_eq!(
+            check_output(Path::new("e.json"), input).unwrap(),
+            EdgesFormat::Json
+        );
+    }
+
+    #[test]
+    fn table_rows() {
+        let s = Summary {
+            file: "a.ply".into(),
+            points: 200,
+            boundary_points: 20,
+            loops: 2,
+            edges: 5,
+            corners: 4,
+            dropped_clusters: 1,
+            thinned_points: 3,
+            read_ms: 1.0,
+            detect_ms: 2.5,
+            edges_ms: 0.25,
+            offset: false,
+        };
+        let t = s.table();
+        assert!(t.contains("boundary points      20 (10.0%)\n"), "{t}");
+        assert!(t.contains("offset               off\n"), "{t}");
+        assert_eq!(t.lines().count(), 12);
+    }
+}
