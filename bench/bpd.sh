@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# BPD benchmark: meshtrim against Open3D on the same seeded clouds, in one run.
+# BPD benchmark: meshtrim against Open3D on the same seeded clouds, in one run
+# (plus meshtrim's edge reconstruction time on the same cloud).
 #
 #   bash bench/bpd.sh [SIZES...]     (default: 12309 100000 1000000 5000000)
 #
@@ -25,8 +26,8 @@ trap 'rm -rf "$work"' EXIT
 
 field() { python3 -c "import json,sys; print(json.loads(sys.argv[1])[sys.argv[2]])" "$1" "$2"; }
 
-echo "| cloud | points | meshtrim ms | meshtrim peak MB | boundary | Open3D normals+detect ms | Open3D boundary | Open3D / meshtrim |"
-echo "|---|---|---|---|---|---|---|---|"
+echo "| cloud | points | meshtrim detect ms | edges ms (loops) | meshtrim peak MB | boundary | Open3D normals+detect ms | Open3D boundary | Open3D / meshtrim detect |"
+echo "|---|---|---|---|---|---|---|---|---|"
 for kind in sheet linescan; do
     for n in "${sizes[@]}"; do
         [ "$kind" = linescan ] && [ "$n" -gt 1000000 ] && continue
@@ -36,7 +37,7 @@ for kind in sheet linescan; do
         ms=$(field "$ours" detect_ms)
         o3d=$(field "$theirs" total_ms)
         ratio=$(python3 -c "print(f'{$o3d / $ms:.2f}')")
-        echo "| $kind | $(field "$ours" points) | $ms | $(field "$ours" peak_rss_mb) | $(field "$ours" boundary) | $o3d | $(field "$theirs" boundary) | $ratio |"
+        echo "| $kind | $(field "$ours" points) | $ms | $(field "$ours" edges_ms) ($(field "$ours" loops)) | $(field "$ours" peak_rss_mb) | $(field "$ours" boundary) | $o3d | $(field "$theirs" boundary) | $ratio |"
         rm -f "$ply"
     done
 done

@@ -1,4 +1,5 @@
-//! Times BPD on one seeded synthetic cloud and prints one JSON line.
+//! Times BPD and edge reconstruction on one seeded synthetic cloud and
+//! prints one JSON line.
 //!
 //! `cargo run --release -p meshtrim-trim --example bench_bpd -- N [sheet|linescan] [OUT.ply]`
 //!
@@ -26,16 +27,20 @@ fn main() {
     let start = Instant::now();
     let found = detect_boundary(&cloud, &BpdOptions::default()).expect("detect");
     let ms = start.elapsed().as_secs_f64() * 1e3;
-    eprintln!("links: {}", found.links.len());
+    let start = Instant::now();
+    let edges =
+        trim::edges::reconstruct_edges(&cloud, &found, &trim::edges::EdgeOptions::default());
+    let edges_ms = start.elapsed().as_secs_f64() * 1e3;
     let by_path = found
         .decision
         .iter()
         .filter(|&&d| d == trim::bpd::Decision::OpenPath)
         .count();
     println!(
-        "{{\"kind\":\"{kind}\",\"points\":{},\"boundary\":{},\"by_path_test\":{by_path},\"detect_ms\":{ms:.1},\"peak_rss_mb\":{:.1}}}",
+        "{{\"kind\":\"{kind}\",\"points\":{},\"boundary\":{},\"by_path_test\":{by_path},\"detect_ms\":{ms:.1},\"loops\":{},\"edges_ms\":{edges_ms:.1},\"peak_rss_mb\":{:.1}}}",
         cloud.len(),
         found.boundary_count(),
+        edges.loops.len(),
         peak_rss_mb()
     );
 }

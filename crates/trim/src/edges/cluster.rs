@@ -15,7 +15,8 @@
 //! and isolated points cannot be part of a closed boundary, and a tour
 //! through them would zig-zag. Each cluster keeps the *2-core* of its link
 //! graph: points of degree < 2 are removed until none is left. Clusters with
-//! an empty 2-core (a chain, a lone point) are dropped and counted.
+//! an empty 2-core (a chain, a lone point) are dropped and counted, and so
+//! are 2-cores of three points: a loop needs four (see [`MIN_LOOP_POINTS`]).
 
 /// Boundaries found among the boundary points.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
@@ -53,15 +54,35 @@ pub fn cluster_boundary(boundary: &[bool], links: &[[u32; 2]]) -> Clusters {
         .into_iter()
         .filter(|&[a, b]| core[a as usize] && core[b as usize])
         .collect();
-    let (clusters, links) = components(boundary.len(), &core, &kept);
+    let (mut clusters, mut links) = components(boundary.len(), &core, &kept);
+    let triangles = keep_loops(&mut clusters, &mut links);
     let core_count: usize = clusters.iter().map(Vec::len).sum();
     let boundary_count = boundary.iter().filter(|&&b| b).count();
     Clusters {
-        dropped_clusters,
+        dropped_clusters: dropped_clusters + triangles,
         thinned_points: boundary_count - core_count,
         clusters,
         links,
     }
+}
+
+/// The smallest loop kept: the paper's smallest hole, of radius just
+/// above β, is found by four points.
+pub const MIN_LOOP_POINTS: usize = 4;
+
+/// Drops clusters of fewer than [`MIN_LOOP_POINTS`] points (three points
+/// around an empty circle of radius β: a gap of the sampling itself at the
+/// resolution limit, which jittered clouds of a million points show a few
+/// times); returns how many were dropped.
+fn keep_loops(clusters: &mut Vec<Vec<u32>>, links: &mut Vec<Vec<[u32; 2]>>) -> usize {
+    let keep: Vec<bool> = clusters
+        .iter()
+        .map(|c| c.len() >= MIN_LOOP_POINTS)
+        .collect();
+    let mut flags = keep.iter();
+    links.retain(|_| *flags.next().expect("one flag per cluster"));
+    clusters.retain(|c| c.len() >= MIN_LOOP_POINTS);
+    keep.iter().filter(|&&k| !k).count()
 }
 
 /// Marks the points of the 2-core: repeatedly removes points with fewer
@@ -180,6 +201,16 @@ mod tests {
         });
         assert_eq!(c.thinned_points, 6);
         assert_eq!(c.dropped_clusters, 2); // the chain and the lone point
+    }
+
+    #[test]
+    fn triangles_are_not_loops() {
+        let mut links = ring(0, 3);
+        links.extend(ring(3, 4));
+        let c = cluster_boundary(&[true; 7], &links);
+        assert_eq!(c.clusters, vec![vec![3, 4, 5, 6]]);
+        assert_eq!(c.dropped_clusters, 1);
+        assert_eq!(c.thinned_points, 3);
     }
 
     #[test]
