@@ -48,3 +48,30 @@ pub enum CloudError {
         what: &'static str,
     },
 }
+
+/// Why a mesh was rejected.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum MeshError {
+    /// A face refers to a vertex that does not exist.
+    #[error("face {face} refers to vertex {vertex}, but the mesh has {vertices} vertices")]
+    IndexOutOfRange {
+        /// Index of the face.
+        face: usize,
+        /// The bad vertex index.
+        vertex: u32,
+        /// Number of vertices.
+        vertices: usize,
+    },
+    /// A vertex coordinate is NaN or infinite.
+    #[error("vertex {index} has a non-finite coordinate")]
+    NonFinite {
+        /// Index of the vertex.
+        index: usize,
+    },
+    /// The mesh has no faces.
+    #[error("the mesh has no faces")]
+    NoFaces,
+    /// Nothing of the mesh lies where the cloud is.
+    #[error("no part of the mesh is supported by the cloud: is the cloud the one the mesh was reconstructed from, in the same units and pose?")]
+    Unsupported,
+}

@@ -22,10 +22,12 @@ pub mod edges;
 pub mod error;
 pub mod evaluate;
 pub mod frame;
+pub mod mesh;
 pub mod neighbours;
 pub mod resolution;
 pub mod synthetic;
+pub mod trimming;
 
 pub use bpd::{detect_boundary, BpdOptions, Detection};
 pub use cloud::Point3;
-pub use error::CloudError;
+pub use error::{CloudError, MeshError};

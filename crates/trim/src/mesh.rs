@@ -1,0 +1,190 @@
+//! Triangle meshes: validation, area, boundary loops and manifoldness, the
+//! checks the trimming stage and its tests need.
+
+use std::collections::HashMap;
+
+use crate::cloud::{cross, norm2, sub, Point3};
+use crate::error::MeshError;
+
+/// An indexed triangle mesh.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Mesh {
+    /// Vertex positions.
+    pub vertices: Vec<Point3>,
+    /// Triangles as vertex indices, counter-clockwise seen from outside
+    /// (for the meshes meshtrim writes: as oriented in the input).
+    pub faces: Vec<[u32; 3]>,
+}
+
+impl Mesh {
+    /// Checks indices and coordinates.
+    pub fn validate(&self) -> Result<(), MeshError> {
+        if self.faces.is_empty() {
+            return Err(MeshError::NoFaces);
+        }
+        if let Some(index) = self
+            .vertices
+            .iter()
+            .position(|v| v.iter().any(|c| !c.is_finite()))
+        {
+            return Err(MeshError::NonFinite { index });
+        }
+        for (face, f) in self.faces.iter().enumerate() {
+            if let Some(&vertex) = f.iter().find(|&&v| v as usize >= self.vertices.len()) {
+                return Err(MeshError::IndexOutOfRange {
+                    face,
+                    vertex,
+                    vertices: self.vertices.len(),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Area of face `f`.
+    pub fn face_area(&self, f: usize) -> f64 {
+        let [a, b, c] = self.faces[f].map(|i| self.vertices[i as usize]);
+        0.5 * norm2(cross(sub(b, a), sub(c, a))).sqrt()
+    }
+
+    /// Total area.
+    pub fn area(&self) -> f64 {
+        (0..self.faces.len()).map(|f| self.face_area(f)).sum()
+    }
+
+    /// How many faces use each undirected edge.
+    pub fn edge_uses(&self) -> HashMap<(u32, u32), u32> {
+        let mut uses = HashMap::new();
+        for f in &self.faces {
+            for k in 0..3 {
+                let (a, b) = (f[k], f[(k + 1) % 3]);
+                *uses.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+            }
+        }
+        uses
+    }
+
+    /// True if no edge is used by more than two faces.
+    pub fn is_edge_manifold(&self) -> bool {
+        self.edge_uses().values().all(|&n| n <= 2)
+    }
+
+    /// The border: directed edges (as the faces run) used by one face only,
+    /// chained into loops of vertex indices. At a vertex where several
+    /// border loops touch, the chaining takes the edges in index order.
+    pub fn boundary_loops(&self) -> Vec<Vec<u32>> {
+        let uses = self.edge_uses();
+        let mut next: HashMap<u32, Vec<u32>> = HashMap::new();
+        for f in &self.faces {
+            for k in 0..3 {
+                let (a, b) = (f[k], f[(k + 1) % 3]);
+                if uses[&(a.min(b), a.max(b))] == 1 {
+                    next.entry(a).or_default().push(b);
+                }
+            }
+        }
+        for v in next.values_mut() {
+            v.sort_unstable();
+        }
+        let mut starts: Vec<u32> = next.keys().copied().collect();
+        starts.sort_unstable();
+        let mut loops = Vec::new();
+        for start in starts {
+            while let Some(first) = next.get_mut(&start).and_then(|v| v.pop()) {
+                let mut chain = vec![start];
+                let mut at = first;
+                while at != start {
+                    chain.push(at);
+                    match next.get_mut(&at).and_then(|v| v.pop()) {
+                        Some(b) => at = b,
+                        None => break, // an open chain: non-manifold input
+                    }
+                }
+                loops.push(chain);
+            }
+        }
+        loops
+    }
+
+    /// Drops vertices no face uses, keeping the others in order.
+    pub fn remove_unused_vertices(&mut self) {
+        let mut new_index = vec![u32::MAX; self.vertices.len()];
+        for f in &self.faces {
+            for &v in f {
+                new_index[v as usize] = 0;
+            }
+        }
+        let mut kept = Vec::new();
+        for (i, slot) in new_index.iter_mut().enumerate() {
+            if *slot == 0 {
+                *slot = kept.len() as u32;
+                kept.push(self.vertices[i]);
+            }
+        }
+        for f in self.faces.iter_mut() {
+            *f = f.map(|v| new_index[v as usize]);
+        }
+        self.vertices = kept;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An n × n grid of unit squares, two triangles each, counter-clockwise.
+    pub(crate) fn grid(n: u32) -> Mesh {
+        let vertices = (0..=n)
+            .flat_map(|j| (0..=n).map(move |i| [i as f64, j as f64, 0.0]))
+            .collect();
+        let at = |i: u32, j: u32| j * (n + 1) + i;
+        let faces = (0..n)
+            .flat_map(|j| {
+                (0..n).flat_map(move |i| {
+                    [
+                        [at(i, j), at(i + 1, j), at(i + 1, j + 1)],
+                        [at(i, j), at(i + 1, j + 1), at(i, j + 1)],
+                    ]
+                })
+            })
+            .collect();
+        Mesh { vertices, faces }
+    }
+
+    #[test]
+    fn grid_has_one_border_loop_and_its_area() {
+        let m = grid(4);
+        assert!(m.validate().is_ok());
+        assert!((m.area() - 16.0).abs() < 1e-12);
+        assert!(m.is_edge_manifold());
+        let loops = m.boundary_loops();
+        assert_eq!(loops.len(), 1);
+        assert_eq!(loops[0].len(), 16);
+    }
+
+    #[test]
+    fn bad_indices_and_values_are_errors() {
+        let mut m = grid(1);
+        m.faces[1][2] = 9;
+        assert!(matches!(
+            m.validate(),
+            Err(MeshError::IndexOutOfRange {
+                face: 1,
+                vertex: 9,
+                ..
+            })
+        ));
+        let mut m = grid(1);
+        m.vertices[2][0] = f64::NAN;
+        assert_eq!(m.validate(), Err(MeshError::NonFinite { index: 2 }));
+    }
+
+    #[test]
+    fn unused_vertices_are_dropped() {
+        let mut m = grid(2);
+        m.faces.truncate(2);
+        m.remove_unused_vertices();
+        assert_eq!(m.vertices.len(), 4);
+        assert!(m.validate().is_ok());
+    }
+}

@@ -1,0 +1,459 @@
+//! Trimming a reconstructed mesh along the cloud's smoothed boundary —
+//! meshtrim's third stage (the paper's aim: meshes fit for CAM toolpaths).
+//!
+//! A screened-Poisson mesh wraps an open scan in a closed envelope that
+//! bulges past the borders and caps the holes; a Delaunay mesh has jagged
+//! borders. The smoothed loops of [`crate::edges`] say where the part ends.
+//! The mesh is cut along them and only what the cloud supports is kept:
+//!
+//! 1. **A signed field whose zero set is the boundary.** Each smoothed loop
+//!    is a wall standing on the surface: at every point q of a loop, the
+//!    outward direction o(q) lies in the surface's tangent plane (from the
+//!    cloud's local plane fit), perpendicular to the loop, away from the
+//!    cloud. A mesh vertex v gets f(v) = (v − q)·o(q) for its nearest loop
+//!    point q (at a loop vertex, o is the mean of the two segments'
+//!    directions). f < 0 inside the part, > 0 beyond the border and over
+//!    holes. Cutting along the zero level of a field, rather than tracing
+//!    the polyline across faces, cannot leave a crack or a dangling piece:
+//!    every mesh edge is cut at most once, by one rule, and the cut is as
+//!    smooth as the field, which is as smooth as the FFT edge.
+//! 2. **Snapping.** A vertex with |f| below [`SNAP`] local spacings is
+//!    moved onto the cut (f := 0): otherwise the cut would pass a hair's
+//!    breadth from it and leave a sliver triangle.
+//! 3. **The cut.** Faces with all f ≤ 0 are kept, faces with all f ≥ 0
+//!    dropped, and faces with both signs split: each crossed edge gets one
+//!    new vertex at the linear zero (shared by both faces of that edge, so
+//!    no crack opens), and the inside part (a triangle or a quadrilateral)
+//!    is triangulated in the face's own vertex order, which keeps the input
+//!    orientation.
+//! 4. **Keeping what the cloud supports.** The kept faces fall into
+//!    connected pieces: the part, and on a closed envelope also pieces of
+//!    its far side. Each cloud point is projected on the kept faces
+//!    (parry3d, f64); a piece is kept when at least half as many points
+//!    project onto it as its area holds at the cloud's local density
+//!    (area per point √3/2·β², a hexagonal packing at spacing β). The far
+//!    side of an envelope never receives the points (the near side is
+//!    closer), so it goes, however close it comes.
+//! 5. Unused vertices are removed.
+
+use std::collections::HashMap;
+
+use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use parry3d_f64::math::Vector;
+use parry3d_f64::query::PointQueryWithLocation;
+use parry3d_f64::shape::TriMesh;
+
+use crate::bpd::Detection;
+use crate::cloud::{dist2, dot, norm2, sub, Point3};
+use crate::edges::offset::{edge_sides, outward};
+use crate::edges::Edges;
+use crate::error::MeshError;
+use crate::mesh::Mesh;
+use crate::neighbours::NeighbourIndex;
+
+/// Vertices closer to the cut than this many local spacings are moved
+/// onto it.
+pub const SNAP: f64 = 0.1;
+
+/// A piece of the cut mesh is kept when the cloud points projecting onto
+/// it reach this share of what its area holds.
+pub const SUPPORT: f64 = 0.5;
+
+/// What trimming did.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct TrimReport {
+    /// Faces of the input mesh.
+    pub faces_in: usize,
+    /// Faces of the output.
+    pub faces_out: usize,
+    /// Input faces crossed by the boundary and split.
+    pub faces_split: usize,
+    /// Input faces dropped whole (beyond the border, over holes, or in
+    /// unsupported pieces).
+    pub faces_removed: usize,
+    /// Pieces of the cut mesh dropped for lack of cloud support.
+    pub pieces_dropped: usize,
+    /// Vertices snapped onto the cut.
+    pub vertices_snapped: usize,
+    /// Area of the input mesh.
+    pub area_in: f64,
+    /// Area of the output mesh.
+    pub area_out: f64,
+    /// For each smoothed loop: mean and largest distance from the output
+    /// border (its vertices) to the loop, and how many border vertices
+    /// were measured.
+    pub loops: Vec<LoopFit>,
+}
+
+/// How closely the output border follows one smoothed loop.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct LoopFit {
+    /// Mean distance from the border vertices nearest this loop to it.
+    pub mean: f64,
+    /// Largest such distance.
+    pub max: f64,
+    /// Border vertices measured.
+    pub count: usize,
+}
+
+/// Cuts `mesh` along the smoothed loops of `edges` (reconstructed from
+/// `cloud` with `detection`) and keeps what the cloud supports.
+pub fn trim_mesh(
+    mesh: &Mesh,
+    cloud: &[Point3],
+    detection: &Detection,
+    edges: &Edges,
+) -> Result<(Mesh, TrimReport), MeshError> {
+    mesh.validate()?;
+    let walls = Walls::new(cloud, detection, edges);
+    let mut field: Vec<f64> = mesh
+        .vertices
+        .iter()
+        .map(|&v| walls.signed_distance(v))
+        .collect();
+    let mut snapped = 0;
+    for (v, f) in mesh.vertices.iter().zip(field.iter_mut()) {
+        if *f != 0.0 && f.abs() < SNAP * walls.spacing_near(*v) {
+            *f = 0.0;
+            snapped += 1;
+        }
+    }
+    let (cut, origin, faces_split) = cut_inside(mesh, &field);
+    let (keep, pieces_dropped) = supported_faces(&cut, cloud, &detection.beta)?;
+    let mut survived = vec![false; mesh.faces.len()];
+    for (&o, &k) in origin.iter().zip(&keep) {
+        survived[o as usize] |= k;
+    }
+    let mut kept = Mesh {
+        vertices: cut.vertices,
+        faces: cut
+            .faces
+            .iter()
+            .zip(&keep)
+            .filter(|(_, &k)| k)
+            .map(|(f, _)| *f)
+            .collect(),
+    };
+    kept.remove_unused_vertices();
+    let report = TrimReport {
+        faces_in: mesh.faces.len(),
+        faces_out: kept.faces.len(),
+        faces_split,
+        faces_removed: survived.iter().filter(|&&s| !s).count(),
+        pieces_dropped,
+        vertices_snapped: snapped,
+        area_in: mesh.area(),
+        area_out: kept.area(),
+        loops: walls.border_fit(&kept),
+    };
+    Ok((kept, report))
+}
+
+/// The smoothed loops as walls: polyline vertices with outward directions
+/// and local spacing, indexed for nearest queries.
+struct Walls {
+    points: Vec<Point3>,
+    /// Outward unit direction of the segment from point i to its successor.
+    out: Vec<Point3>,
+    /// Successor and predecessor of each point in its closed loop.
+    next: Vec<u32>,
+    prev: Vec<u32>,
+    beta: Vec<f64>,
+    /// The loop each point belongs to.
+    loop_of: Vec<u32>,
+    loops: usize,
+    tree: Option<ImmutableKdTree<f64, 3>>,
+}
+
+impl Walls {
+    fn new(cloud: &[Point3], detection: &Detection, edges: &Edges) -> Self {
+        let index = NeighbourIndex::new(cloud);
+        let mut w = Walls {
+            points: Vec::new(),
+            out: Vec::new(),
+            next: Vec::new(),
+            prev: Vec::new(),
+            beta: Vec::new(),
+            loop_of: Vec::new(),
+            loops: edges.loops.len(),
+            tree: None,
+        };
+        for (l, lp) in edges.loops.iter().enumerate() {
+            let sides = edge_sides(&index, &lp.boundary_points);
+            let n = lp.boundary_points.len();
+            // The loop as one closed polyline: each open edge without its
+            // last point, which is the next edge's first (the corner), so
+            // that a corner has both of its segments.
+            let mut positions = Vec::new();
+            for (k, edge) in lp.edges.iter().enumerate() {
+                let from = lp.corners.get(k).copied().unwrap_or(0);
+                let take = if edge.closed {
+                    edge.points.len()
+                } else {
+                    edge.points.len() - 1
+                };
+                for (j, &p) in edge.points.iter().take(take).enumerate() {
+                    positions.push((from + j) % n);
+                    w.points.push(p);
+                }
+            }
+            let start = w.points.len() - positions.len();
+            let m = positions.len();
+            for (j, &position) in positions.iter().enumerate() {
+                w.next.push((start + (j + 1) % m) as u32);
+                w.prev.push((start + (j + m - 1) % m) as u32);
+                w.beta
+                    .push(detection.beta[lp.boundary_points[position] as usize]);
+                w.loop_of.push(l as u32);
+            }
+            for j in 0..m {
+                let i = start + j;
+                let (a, b) = (w.points[i], w.points[w.next[i] as usize]);
+                w.out
+                    .push(outward(sub(b, a), a, &sides[positions[j]]).unwrap_or([0.0; 3]));
+            }
+        }
+        if !w.points.is_empty() {
+            w.tree = ImmutableKdTree::new_from_slice(&w.points).ok();
+        }
+        w
+    }
+
+    fn nearest_point(&self, v: Point3) -> Option<usize> {
+        let tree = self.tree.as_ref()?;
+        Some(
+            tree.query(&v)
+                .nearest_one::<SquaredEuclidean<f64>>()
+                .execute()
+                .item as usize,
+        )
+    }
+
+    /// f(v): signed distance from v to the nearest wall (negative inside).
+    /// With no loop at all, everything is inside.
+    fn signed_distance(&self, v: Point3) -> f64 {
+        let Some(i) = self.nearest_point(v) else {
+            return -1.0;
+        };
+        // The nearest point on the two segments at the nearest vertex.
+        let mut best = (dist2(v, self.points[i]), self.points[i], self.vertex_out(i));
+        for (a, b) in [(self.prev[i] as usize, i), (i, self.next[i] as usize)] {
+            if a == b {
+                continue;
+            }
+            let (pa, pb) = (self.points[a], self.points[b]);
+            let ab = sub(pb, pa);
+            let len2 = norm2(ab);
+            if len2 == 0.0 {
+                continue;
+            }
+            let t = (dot(sub(v, pa), ab) / len2).clamp(0.0, 1.0);
+            let q = [0, 1, 2].map(|c| pa[c] + t * ab[c]);
+            let d = dist2(v, q);
+            if d < best.0 && t > 0.0 && t < 1.0 {
+                best = (d, q, self.out[a]);
+            }
+        }
+        dot(sub(v, best.1), best.2)
+    }
+
+    /// Outward direction at polyline vertex i: the mean of its segments'.
+    fn vertex_out(&self, i: usize) -> Point3 {
+        let (a, b) = (self.out[self.prev[i] as usize], self.out[i]);
+        let m = [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
+        let len = norm2(m).sqrt();
+        if len > 0.0 {
+            m.map(|c| c / len)
+        } else {
+            b
+        }
+    }
+
+    fn spacing_near(&self, v: Point3) -> f64 {
+        self.nearest_point(v).map_or(0.0, |i| self.beta[i])
+    }
+
+    /// Mean and largest distance from the border vertices of `mesh` to the
+    /// nearest loop, per loop.
+    fn border_fit(&self, mesh: &Mesh) -> Vec<LoopFit> {
+        let mut fits = vec![LoopFit::default(); self.loops];
+        for border in mesh.boundary_loops() {
+            for v in border {
+                let p = mesh.vertices[v as usize];
+                let Some(i) = self.nearest_point(p) else {
+                    continue;
+                };
+                let d = self.distance_to_polyline(p, i);
+                let fit = &mut fits[self.loop_of[i] as usize];
+                fit.mean += d;
+                fit.max = fit.max.max(d);
+                fit.count += 1;
+            }
+        }
+        for fit in fits.iter_mut() {
+            if fit.count > 0 {
+                fit.mean /= fit.count as f64;
+            }
+        }
+        fits
+    }
+
+    fn distance_to_polyline(&self, v: Point3, i: usize) -> f64 {
+        let mut best = dist2(v, self.points[i]);
+        for (a, b) in [(self.prev[i] as usize, i), (i, self.next[i] as usize)] {
+            let (pa, pb) = (self.points[a], self.points[b]);
+            let ab = sub(pb, pa);
+            let len2 = norm2(ab);
+            if len2 > 0.0 {
+                let t = (dot(sub(v, pa), ab) / len2).clamp(0.0, 1.0);
+                best = best.min(dist2(v, [0, 1, 2].map(|c| pa[c] + t * ab[c])));
+            }
+        }
+        best.sqrt()
+    }
+}
+
+/// Splits the faces crossed by the zero level of `field` and keeps the
+/// parts where it is ≤ 0. Returns the cut mesh (input vertices first, then
+/// one new vertex per crossed edge), the input face of each of its faces,
+/// and the number of split faces.
+fn cut_inside(mesh: &Mesh, field: &[f64]) -> (Mesh, Vec<u32>, usize) {
+    let mut out = Mesh {
+        vertices: mesh.vertices.clone(),
+        faces: Vec::with_capacity(mesh.faces.len()),
+    };
+    let mut origin = Vec::with_capacity(mesh.faces.len());
+    let mut crossing: HashMap<(u32, u32), u32> = HashMap::new();
+    let mut split = 0;
+    for (index, face) in mesh.faces.iter().enumerate() {
+        let f = face.map(|v| field[v as usize]);
+        if f.iter().all(|&x| x <= 0.0) {
+            out.faces.push(*face);
+            origin.push(index as u32);
+            continue;
+        }
+        if f.iter().all(|&x| x >= 0.0) {
+            continue;
+        }
+        split += 1;
+        let mut polygon: Vec<u32> = Vec::with_capacity(4);
+        for k in 0..3 {
+            let (a, b) = (face[k], face[(k + 1) % 3]);
+            let (fa, fb) = (f[k], f[(k + 1) % 3]);
+            if fa <= 0.0 {
+                polygon.push(a);
+            }
+            if (fa < 0.0 && fb > 0.0) || (fa > 0.0 && fb < 0.0) {
+                let key = (a.min(b), a.max(b));
+                let v = *crossing.entry(key).or_insert_with(|| {
+                    let (p, q, fp, fq) = if a < b {
+                        (a, b, fa, fb)
+                    } else {
+                        (b, a, fb, fa)
+                    };
+                    let t = fp / (fp - fq);
+                    let (pp, pq) = (mesh.vertices[p as usize], mesh.vertices[q as usize]);
+                    out.vertices
+                        .push([0, 1, 2].map(|c| pp[c] + t * (pq[c] - pp[c])));
+                    (out.vertices.len() - 1) as u32
+                });
+                polygon.push(v);
+            }
+        }
+        for k in 1..polygon.len().saturating_sub(1) {
+            out.faces.push([polygon[0], polygon[k], polygon[k + 1]]);
+            origin.push(index as u32);
+        }
+    }
+    (out, origin, split)
+}
+
+/// Which faces of `cut` lie in a piece the cloud supports (see the module
+/// doc), and how many pieces were dropped.
+fn supported_faces(
+    cut: &Mesh,
+    cloud: &[Point3],
+    beta: &[f64],
+) -> Result<(Vec<bool>, usize), MeshError> {
+    if cut.faces.is_empty() {
+        return Err(MeshError::Unsupported);
+    }
+    let piece = face_pieces(cut);
+    let pieces = piece.iter().map(|&p| p as usize + 1).max().unwrap_or(0);
+    let vertices: Vec<Vector> = cut
+        .vertices
+        .iter()
+        .map(|v| Vector::new(v[0], v[1], v[2]))
+        .collect();
+    let shape = TriMesh::new(vertices, cut.faces.clone()).map_err(|_| MeshError::NoFaces)?;
+    let mut hits = vec![0usize; pieces];
+    let mut cell_area = vec![0.0f64; pieces];
+    for (p, &b) in cloud.iter().zip(beta) {
+        let query = Vector::new(p[0], p[1], p[2]);
+        if let Some((_, (face, _))) =
+            shape.project_local_point_and_get_location_with_max_dist(query, false, 2.0 * b)
+        {
+            let k = piece[face as usize] as usize;
+            hits[k] += 1;
+            cell_area[k] += 0.75f64.sqrt() * b * b;
+        }
+    }
+    let mut area = vec![0.0f64; pieces];
+    for f in 0..cut.faces.len() {
+        area[piece[f] as usize] += cut.face_area(f);
+    }
+    // Points expected on a piece: its area over the mean cell area of the
+    // points that landed on it.
+    let keep: Vec<bool> = (0..pieces)
+        .map(|k| {
+            hits[k] > 0 && hits[k] as f64 >= SUPPORT * area[k] / (cell_area[k] / hits[k] as f64)
+        })
+        .collect();
+    if !keep.iter().any(|&k| k) {
+        return Err(MeshError::Unsupported);
+    }
+    let dropped = keep.iter().filter(|&&k| !k).count();
+    Ok((piece.iter().map(|&p| keep[p as usize]).collect(), dropped))
+}
+
+/// Connected pieces of faces sharing an edge; piece ids by first face.
+fn face_pieces(mesh: &Mesh) -> Vec<u32> {
+    let n = mesh.faces.len();
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    let mut first_on_edge: HashMap<(u32, u32), u32> = HashMap::new();
+    for (f, face) in mesh.faces.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (face[k], face[(k + 1) % 3]);
+            match first_on_edge.entry((a.min(b), a.max(b))) {
+                std::collections::hash_map::Entry::Occupied(e) => {
+                    let (ra, rb) = (find(&mut parent, *e.get()), find(&mut parent, f as u32));
+                    parent[ra.max(rb) as usize] = ra.min(rb);
+                }
+                std::collections::hash_map::Entry::Vacant(e) => {
+                    e.insert(f as u32);
+                }
+            }
+        }
+    }
+    let mut id = vec![u32::MAX; n];
+    let mut next = 0;
+    (0..n)
+        .map(|f| {
+            let r = find(&mut parent, f as u32) as usize;
+            if id[r] == u32::MAX {
+                id[r] = next;
+                next += 1;
+            }
+            id[r]
+        })
+        .collect()
+}
+
+fn find(parent: &mut [u32], mut i: u32) -> u32 {
+    while parent[i as usize] != i {
+        let grand = parent[parent[i as usize] as usize];
+        parent[i as usize] = grand;
+        i = grand;
+    }
+    i
+}
