@@ -14,11 +14,16 @@
 
 pub mod atomic;
 pub mod edges_out;
+pub mod gltf_io;
 pub mod labels;
+pub mod mesh_out;
 pub mod obj;
 pub mod pcd;
 pub mod ply;
+pub mod stl;
 pub mod text;
+
+pub use mesh_out::{write_mesh, MeshFormat};
 
 use std::path::Path;
 
@@ -97,7 +102,10 @@ pub fn read_cloud(path: &Path) -> Result<Cloud> {
     read_cloud_inner(path).with_context(|| path.display().to_string())
 }
 
-/// Reads a mesh (PLY or OBJ); the faces are `None` if the file has none.
+/// Reads a mesh: PLY, OBJ, STL (ASCII or binary), glTF or GLB.
+///
+/// The faces are `None` if a PLY or OBJ file has none; STL and glTF always
+/// give `Some`. See [`MeshInput`] for how the reader is chosen.
 pub fn read_mesh(path: &Path) -> Result<Mesh> {
     read_mesh_inner(path).with_context(|| path.display().to_string())
 }
@@ -119,18 +127,75 @@ fn read_cloud_inner(path: &Path) -> Result<Cloud> {
 
 fn read_mesh_inner(path: &Path) -> Result<Mesh> {
     let bytes = std::fs::read(path).context("cannot read")?;
-    let mesh = match detect_format(path, &bytes)? {
-        Format::Ply => ply::read_ply(&bytes)?,
-        Format::Obj => obj::read_obj(&bytes)?,
-        other => bail!(
-            "a mesh must be PLY or OBJ, this is a {} point cloud",
-            other.name()
-        ),
+    let mesh = match MeshInput::detect(path, &bytes)? {
+        MeshInput::Ply => ply::read_ply(&bytes)?,
+        MeshInput::Obj => obj::read_obj(&bytes)?,
+        MeshInput::Stl => stl::read_stl(&bytes)?,
+        MeshInput::Gltf => {
+            let dir = path.parent().unwrap_or(Path::new(""));
+            gltf_io::read_gltf(&bytes, dir)?
+        }
     };
     if mesh.vertices.is_empty() {
         bail!("no vertices in the file");
     }
     Ok(mesh)
+}
+
+/// The mesh readers, as [`read_mesh`] chooses them.
+///
+/// In order: the GLB magic `glTF` and a PLY header are recognised by
+/// content; then the extensions `.stl`, `.glb` and `.gltf` decide (ASCII
+/// or binary STL by content); then a binary STL whose size matches its
+/// triangle count, an ASCII STL (`solid` then `facet`) and glTF JSON (an
+/// object with `"asset"`) are recognised by content; then the point-cloud
+/// rules of [`detect_format`] give PLY or OBJ.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MeshInput {
+    /// Stanford PLY.
+    Ply,
+    /// Wavefront OBJ.
+    Obj,
+    /// STL, ASCII or binary.
+    Stl,
+    /// glTF 2.0, JSON or GLB.
+    Gltf,
+}
+
+impl MeshInput {
+    /// Chooses the mesh reader for a file, or fails naming the extension.
+    pub fn detect(path: &Path, bytes: &[u8]) -> Result<MeshInput> {
+        if gltf_io::is_glb(bytes) {
+            return Ok(MeshInput::Gltf);
+        }
+        if sniff(bytes) == Some(Format::Ply) {
+            return Ok(MeshInput::Ply);
+        }
+        let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+        match ext.to_ascii_lowercase().as_str() {
+            "stl" => return Ok(MeshInput::Stl),
+            "glb" | "gltf" => return Ok(MeshInput::Gltf),
+            _ => {}
+        }
+        if stl::is_exact_binary(bytes) || stl::looks_ascii(bytes) {
+            return Ok(MeshInput::Stl);
+        }
+        if gltf_io::looks_like_json(bytes) {
+            return Ok(MeshInput::Gltf);
+        }
+        match detect_format(path, bytes) {
+            Ok(Format::Ply) => Ok(MeshInput::Ply),
+            Ok(Format::Obj) => Ok(MeshInput::Obj),
+            Ok(other) => bail!(
+                "a mesh must be PLY, OBJ, STL, glTF or GLB, this is a {} point cloud",
+                other.name()
+            ),
+            Err(_) => bail!(
+                "unknown mesh format: the extension '{ext}' is not one of ply, obj, stl, gltf, \
+                 glb, and the content is not recognised as any of them"
+            ),
+        }
+    }
 }
 
 fn from_mesh(mesh: Mesh, format: Format) -> Cloud {

@@ -1,0 +1,587 @@
+//! glTF 2.0 meshes: `.gltf` (JSON) and `.glb` (binary container).
+//!
+//! The `gltf` crate parses and validates the document; the buffers and the
+//! accessors are read here, with every offset and length checked, so a
+//! malformed file gives an error naming the accessor instead of a panic.
+//!
+//! Reading: every node of the node hierarchy that has a mesh contributes all
+//! of that mesh's primitives, their `POSITION`s transformed by the node's
+//! world matrix (computed in `f64` from the `f32` matrices or translation,
+//! rotation and scale). Primitives must have mode `TRIANGLES` (any other
+//! mode is an error naming it); indices may be `u8`, `u16` or `u32`, or
+//! absent (consecutive triples). Under a world matrix with a negative
+//! determinant the triangles' winding is reversed, as the spec says, so
+//! the output keeps counter-clockwise front faces. Buffers may be the GLB
+//! binary chunk, `data:` URIs (base64) or files beside the `.gltf`.
+//! Sparse accessors, quantised positions and Draco compression are not read.
+//!
+//! Writing: one mesh with one primitive, `f32` positions with the `min` and
+//! `max` bounds the spec requires, and `u32` indices.
+
+use std::borrow::Cow;
+use std::io::Write;
+use std::path::Path;
+
+use anyhow::{anyhow, bail, Context, Result};
+use base64::Engine;
+use byteorder::{ByteOrder, LittleEndian};
+use gltf::accessor::{DataType, Dimensions};
+use gltf::mesh::Mode;
+
+use super::{show, Mesh, Point3};
+
+/// Whether the bytes are a GLB container (the `glTF` magic).
+pub fn is_glb(bytes: &[u8]) -> bool {
+    bytes.starts_with(b"glTF")
+}
+
+/// Whether the bytes look like a glTF JSON document: an object with an
+/// `"asset"` key near the start.
+pub fn looks_like_json(bytes: &[u8]) -> bool {
+    let head = String::from_utf8_lossy(&bytes[..bytes.len().min(4096)]);
+    head.trim_start().starts_with('{') && head.contains("\"asset\"")
+}
+
+/// Reads the triangles of every mesh instance in a glTF or GLB file.
+/// `dir` is where relative buffer URIs are resolved (the file's directory).
+pub fn read_gltf(bytes: &[u8], dir: &Path) -> Result<Mesh> {
+    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| anyhow!("malformed glTF: {e}"))?;
+    let buffers = load_buffers(&gltf, dir)?;
+    let document = &gltf.document;
+
+    // World matrices: walk down from the nodes that are nobody's child.
+    let nodes = document.nodes().len();
+    let mut has_parent = vec![false; nodes];
+    for node in document.nodes() {
+        for child in node.children() {
+            has_parent[child.index()] = true;
+        }
+    }
+    let mut visited = vec![false; nodes];
+    let mut stack: Vec<(gltf::Node, Matrix)> = document
+        .nodes()
+        .filter(|n| !has_parent[n.index()])
+        .map(|n| (n, IDENTITY))
+        .collect();
+    stack.reverse();
+    let mut mesh = Mesh {
+        faces: Some(Vec::new()),
+        ..Mesh::default()
+    };
+    while let Some((node, parent)) = stack.pop() {
+        if std::mem::replace(&mut visited[node.index()], true) {
+            bail!("node {} is reached twice: it has two parents", node.index());
+        }
+        let world = multiply(&parent, &local_matrix(&node));
+        if let Some(m) = node.mesh() {
+            for primitive in m.primitives() {
+                let at = || {
+                    format!(
+                        "node {}, mesh {}{}, primitive {}",
+                        node.index(),
+                        m.index(),
+                        m.name().map(|n| format!(" '{n}'")).unwrap_or_default(),
+                        primitive.index()
+                    )
+                };
+                add_primitive(&primitive, &buffers, &world, &mut mesh).with_context(at)?;
+            }
+        }
+        let children: Vec<_> = node.children().collect();
+        for child in children.into_iter().rev() {
+            stack.push((child, world));
+        }
+    }
+    if let Some(n) = visited.iter().position(|v| !v) {
+        bail!("node {n} is in a cycle of the node hierarchy");
+    }
+    Ok(mesh)
+}
+
+/// The bytes of every buffer, checked against its declared length.
+fn load_buffers<'a>(gltf: &'a gltf::Gltf, dir: &Path) -> Result<Vec<Cow<'a, [u8]>>> {
+    let mut out = Vec::new();
+    for buffer in gltf.document.buffers() {
+        let i = buffer.index();
+        let data: Cow<[u8]> = match buffer.source() {
+            gltf::buffer::Source::Bin => Cow::Borrowed(gltf.blob.as_deref().ok_or_else(|| {
+                anyhow!("buffer {i} refers to a GLB binary chunk, and there is none")
+            })?),
+            gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
+                Cow::Owned(decode_data_uri(uri).with_context(|| format!("buffer {i}"))?)
+            }
+            gltf::buffer::Source::Uri(uri) => {
+                if uri.contains("://") {
+                    bail!("buffer {i}: remote URI '{uri}' is not supported");
+                }
+                let path = dir.join(percent_decode(uri));
+                Cow::Owned(
+                    std::fs::read(&path)
+                        .with_context(|| format!("buffer {i}: cannot read '{}'", path.display()))?,
+                )
+            }
+        };
+        if data.len() < buffer.length() {
+            bail!(
+                "buffer {i} has {} bytes, its byteLength says {}",
+                data.len(),
+                buffer.length()
+            );
+        }
+        out.push(data);
+    }
+    Ok(out)
+}
+
+fn decode_data_uri(uri: &str) -> Result<Vec<u8>> {
+    let (_, data) = uri
+        .split_once(";base64,")
+        .ok_or_else(|| anyhow!("only base64 data URIs are supported"))?;
+    base64::engine::general_purpose::STANDARD
+        .decode(data.trim())
+        .map_err(|e| anyhow!("bad base64 in the data URI: {e}"))
+}
+
+/// Undoes `%XX` escapes in a relative URI; other bytes are kept.
+fn percent_decode(uri: &str) -> String {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        let hex = |b: u8| (b as char).to_digit(16);
+        if bytes[i] == b'%' && i + 2 < bytes.len() {
+            if let (Some(h), Some(l)) = (hex(bytes[i + 1]), hex(bytes[i + 2])) {
+                out.push((h * 16 + l) as u8);
+                i += 3;
+                continue;
+            }
+        }
+        out.push(bytes[i]);
+        i += 1;
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// A column-major 4×4 matrix, as glTF stores them.
+type Matrix = [[f64; 4]; 4];
+
+const IDENTITY: Matrix = [
+    [1.0, 0.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0, 0.0],
+    [0.0, 0.0, 1.0, 0.0],
+    [0.0, 0.0, 0.0, 1.0],
+];
+
+fn local_matrix(node: &gltf::Node) -> Matrix {
+    match node.transform() {
+        gltf::scene::Transform::Matrix { matrix } => matrix.map(|c| c.map(f64::from)),
+        gltf::scene::Transform::Decomposed {
+            translation,
+            rotation,
+            scale,
+        } => {
+            let [t, s] = [translation, scale].map(|v| v.map(f64::from));
+            let [x, y, z, w] = rotation.map(f64::from);
+            // The unit quaternion's rotation matrix, columns scaled by s.
+            let r = [
+                [
+                    1.0 - 2.0 * (y * y + z * z),
+                    2.0 * (x * y + z * w),
+                    2.0 * (x * z - y * w),
+                ],
+                [
+                    2.0 * (x * y - z * w),
+                    1.0 - 2.0 * (x * x + z * z),
+                    2.0 * (y * z + x * w),
+                ],
+                [
+                    2.0 * (x * z + y * w),
+                    2.0 * (y * z - x * w),
+                    1.0 - 2.0 * (x * x + y * y),
+                ],
+            ];
+            [
+                [r[0][0] * s[0], r[0][1] * s[0], r[0][2] * s[0], 0.0],
+                [r[1][0] * s[1], r[1][1] * s[1], r[1][2] * s[1], 0.0],
+                [r[2][0] * s[2], r[2][1] * s[2], r[2][2] * s[2], 0.0],
+                [t[0], t[1], t[2], 1.0],
+            ]
+        }
+    }
+}
+
+fn multiply(a: &Matrix, b: &Matrix) -> Matrix {
+    let mut out = [[0.0; 4]; 4];
+    for (col, out_col) in out.iter_mut().enumerate() {
+        for (row, value) in out_col.iter_mut().enumerate() {
+            *value = (0..4).map(|k| a[k][row] * b[col][k]).sum();
+        }
+    }
+    out
+}
+
+fn apply(m: &Matrix, p: [f64; 3]) -> Point3 {
+    let mut out = [0.0; 3];
+    for (row, value) in out.iter_mut().enumerate() {
+        *value = m[0][row] * p[0] + m[1][row] * p[1] + m[2][row] * p[2] + m[3][row];
+    }
+    out
+}
+
+fn determinant3(m: &Matrix) -> f64 {
+    m[0][0] * (m[1][1] * m[2][2] - m[2][1] * m[1][2])
+        - m[1][0] * (m[0][1] * m[2][2] - m[2][1] * m[0][2])
+        + m[2][0] * (m[0][1] * m[1][2] - m[1][1] * m[0][2])
+}
+
+fn mode_name(mode: Mode) -> &'static str {
+    match mode {
+        Mode::Points => "POINTS",
+        Mode::Lines => "LINES",
+        Mode::LineLoop => "LINE_LOOP",
+        Mode::LineStrip => "LINE_STRIP",
+        Mode::Triangles => "TRIANGLES",
+        Mode::TriangleStrip => "TRIANGLE_STRIP",
+        Mode::TriangleFan => "TRIANGLE_FAN",
+    }
+}
+
+fn add_primitive(
+    primitive: &gltf::Primitive,
+    buffers: &[Cow<[u8]>],
+    world: &Matrix,
+    mesh: &mut Mesh,
+) -> Result<()> {
+    if primitive.mode() != Mode::Triangles {
+        bail!(
+            "mode {} is not supported, only TRIANGLES",
+            mode_name(primitive.mode())
+        );
+    }
+    let positions = primitive
+        .get(&gltf::Semantic::Positions)
+        .ok_or_else(|| anyhow!("no POSITION attribute"))?;
+    if positions.data_type() != DataType::F32
+        || positions.dimensions() != Dimensions::Vec3
+        || positions.normalized()
+    {
+        bail!(
+            "accessor {} (POSITION) is {:?} {:?}, only float VEC3 positions are supported",
+            positions.index(),
+            positions.data_type(),
+            positions.dimensions()
+        );
+    }
+    let base = mesh.vertices.len();
+    let count = positions.count();
+    let new_total = base
+        .checked_add(count)
+        .filter(|&n| n <= u32::MAX as usize + 1)
+        .ok_or_else(|| anyhow!("more than {} vertices in all", u32::MAX))?;
+    let (data, stride) = accessor_data(&positions, buffers, 12, "POSITION")?;
+    mesh.vertices.reserve(count);
+    for i in 0..count {
+        let record = &data[i * stride..];
+        let local = [0, 4, 8].map(|o| f64::from(LittleEndian::read_f32(&record[o..])));
+        let p = apply(world, local);
+        if p.iter().any(|c| !c.is_finite()) {
+            bail!(
+                "POSITION {i} is non-finite in world coordinates: {}",
+                show(&p)
+            );
+        }
+        mesh.vertices.push(p);
+    }
+    debug_assert_eq!(mesh.vertices.len(), new_total);
+
+    let corners: Vec<u32> = match primitive.indices() {
+        Some(indices) => read_indices(&indices, buffers, count)?,
+        None => (0..count as u32).collect(),
+    };
+    if !corners.chunks_exact(3).remainder().is_empty() {
+        bail!(
+            "{} triangle corners, which is not a multiple of 3",
+            corners.len()
+        );
+    }
+    let flip = determinant3(world) < 0.0;
+    let faces = mesh.faces.get_or_insert_with(Vec::new);
+    faces.reserve(corners.len() / 3);
+    for t in corners.chunks_exact(3) {
+        let [a, b, c] = [t[0], t[1], t[2]].map(|v| v + base as u32);
+        faces.push(if flip { [a, c, b] } else { [a, b, c] });
+    }
+    Ok(())
+}
+
+fn read_indices(
+    indices: &gltf::Accessor,
+    buffers: &[Cow<[u8]>],
+    vertices: usize,
+) -> Result<Vec<u32>> {
+    let size = match (indices.data_type(), indices.dimensions()) {
+        (DataType::U8, Dimensions::Scalar) => 1,
+        (DataType::U16, Dimensions::Scalar) => 2,
+        (DataType::U32, Dimensions::Scalar) => 4,
+        (t, d) => bail!(
+            "accessor {} (indices) is {t:?} {d:?}, indices must be an unsigned scalar",
+            indices.index()
+        ),
+    };
+    let (data, stride) = accessor_data(indices, buffers, size, "indices")?;
+    let mut out = Vec::with_capacity(indices.count());
+    for i in 0..indices.count() {
+        let b = &data[i * stride..];
+        let v = match size {
+            1 => u32::from(b[0]),
+            2 => u32::from(LittleEndian::read_u16(b)),
+            _ => LittleEndian::read_u32(b),
+        };
+        if v as usize >= vertices {
+            bail!(
+                "index {i} (triangle {}) refers to vertex {v}, but the primitive has only {vertices} vertices",
+                i / 3
+            );
+        }
+        out.push(v);
+    }
+    Ok(out)
+}
+
+/// The bytes of an accessor from its first element on, and its stride,
+/// with every element (`size` bytes each) checked to lie inside the view.
+fn accessor_data<'b>(
+    accessor: &gltf::Accessor,
+    buffers: &'b [Cow<[u8]>],
+    size: usize,
+    what: &str,
+) -> Result<(&'b [u8], usize)> {
+    let a = accessor.index();
+    if accessor.sparse().is_some() {
+        bail!("accessor {a} ({what}) is sparse, which is not supported");
+    }
+    let view = accessor
+        .view()
+        .ok_or_else(|| anyhow!("accessor {a} ({what}) has no buffer view"))?;
+    let buffer = &buffers[view.buffer().index()];
+    let view_data = view
+        .offset()
+        .checked_add(view.length())
+        .and_then(|end| buffer.get(view.offset()..end))
+        .ok_or_else(|| {
+            anyhow!(
+                "buffer view {} (bytes {}..+{}) lies outside buffer {} ({} bytes)",
+                view.index(),
+                view.offset(),
+                view.length(),
+                view.buffer().index(),
+                buffer.len()
+            )
+        })?;
+    let stride = view.stride().unwrap_or(size);
+    if stride < size {
+        bail!(
+            "buffer view {} has a byteStride of {stride}, less than the {size}-byte elements of accessor {a}",
+            view.index()
+        );
+    }
+    let count = accessor.count();
+    let needed = match count {
+        0 => Some(accessor.offset()),
+        n => (n - 1)
+            .checked_mul(stride)
+            .and_then(|b| b.checked_add(size))
+            .and_then(|b| b.checked_add(accessor.offset())),
+    };
+    match needed {
+        Some(n) if n <= view_data.len() => Ok((&view_data[accessor.offset()..], stride)),
+        _ => bail!(
+            "accessor {a} ({what}): {count} elements from byte {} do not fit in buffer view {} ({} bytes)",
+            accessor.offset(),
+            view.index(),
+            view_data.len()
+        ),
+    }
+}
+
+/// The glTF JSON document and binary buffer of one mesh; `uri` is the
+/// buffer's URI (`None` for the GLB binary chunk).
+fn document(
+    vertices: &[Point3],
+    faces: &[[u32; 3]],
+    uri: Option<String>,
+) -> (serde_json::Value, Vec<u8>) {
+    let mut bin = Vec::with_capacity(12 * (vertices.len() + faces.len()));
+    let mut min = [f32::INFINITY; 3];
+    let mut max = [f32::NEG_INFINITY; 3];
+    for p in vertices {
+        for k in 0..3 {
+            let c = p[k] as f32;
+            min[k] = min[k].min(c);
+            max[k] = max[k].max(c);
+            bin.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    let positions_len = bin.len();
+    for v in faces.iter().flatten() {
+        bin.extend_from_slice(&v.to_le_bytes());
+    }
+    let mut buffer = serde_json::json!({ "byteLength": bin.len() });
+    if let Some(uri) = uri {
+        buffer["uri"] = uri.into();
+    }
+    let json = serde_json::json!({
+        "asset": { "version": "2.0", "generator": "meshtrim" },
+        "scene": 0,
+        "scenes": [{ "nodes": [0] }],
+        "nodes": [{ "mesh": 0 }],
+        "meshes": [{ "primitives": [{ "attributes": { "POSITION": 0 }, "indices": 1, "mode": 4 }] }],
+        "accessors": [
+            {
+                "bufferView": 0, "componentType": 5126, "count": vertices.len(), "type": "VEC3",
+                "min": min.map(f64::from), "max": max.map(f64::from)
+            },
+            { "bufferView": 1, "componentType": 5125, "count": 3 * faces.len(), "type": "SCALAR" }
+        ],
+        "bufferViews": [
+            { "buffer": 0, "byteOffset": 0, "byteLength": positions_len, "target": 34962 },
+            {
+                "buffer": 0, "byteOffset": positions_len,
+                "byteLength": bin.len() - positions_len, "target": 34963
+            }
+        ],
+        "buffers": [buffer]
+    });
+    (json, bin)
+}
+
+fn empty_error(vertices: &[Point3], faces: &[[u32; 3]]) -> std::io::Result<()> {
+    if vertices.is_empty() || faces.is_empty() {
+        return Err(std::io::Error::other(
+            "glTF needs at least one vertex and one triangle (accessors cannot be empty)",
+        ));
+    }
+    Ok(())
+}
+
+/// Writes a `.glb`: a JSON chunk (padded with spaces) and a binary chunk.
+///
+/// The caller checks the face indices and that coordinates fit in `f32`.
+pub fn write_glb(
+    w: &mut dyn Write,
+    vertices: &[Point3],
+    faces: &[[u32; 3]],
+) -> std::io::Result<()> {
+    empty_error(vertices, faces)?;
+    let (json, bin) = document(vertices, faces, None);
+    let mut json = serde_json::to_vec(&json).map_err(std::io::Error::other)?;
+    json.resize(json.len().next_multiple_of(4), b' ');
+    // The binary data is a multiple of 4 bytes already (f32 and u32).
+    let total = 12 + 8 + json.len() + 8 + bin.len();
+    let total = u32::try_from(total).map_err(|_| std::io::Error::other("GLB larger than 4 GiB"))?;
+    w.write_all(b"glTF")?;
+    w.write_all(&2u32.to_le_bytes())?;
+    w.write_all(&total.to_le_bytes())?;
+    w.write_all(&(json.len() as u32).to_le_bytes())?;
+    w.write_all(b"JSON")?;
+    w.write_all(&json)?;
+    w.write_all(&(bin.len() as u32).to_le_bytes())?;
+    w.write_all(b"BIN\0")?;
+    w.write_all(&bin)
+}
+
+/// Writes a `.gltf`: JSON with the buffer embedded as a base64 data URI.
+///
+/// The caller checks the face indices and that coordinates fit in `f32`.
+pub fn write_gltf(
+    w: &mut dyn Write,
+    vertices: &[Point3],
+    faces: &[[u32; 3]],
+) -> std::io::Result<()> {
+    empty_error(vertices, faces)?;
+    let (_, bin) = document(vertices, faces, None);
+    let uri = format!(
+        "data:application/octet-stream;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(&bin)
+    );
+    let (json, _) = document(vertices, faces, Some(uri));
+    serde_json::to_writer_pretty(&mut *w, &json).map_err(std::io::Error::other)?;
+    w.write_all(b"\n")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square() -> (Vec<Point3>, Vec<[u32; 3]>) {
+        (
+            vec![[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.5]],
+            vec![[0, 1, 2], [0, 2, 3]],
+        )
+    }
+
+    #[test]
+    fn glb_and_gltf_round_trip() {
+        let (v, f) = square();
+        for glb in [true, false] {
+            let mut bytes = Vec::new();
+            if glb {
+                write_glb(&mut bytes, &v, &f).unwrap();
+                assert!(is_glb(&bytes));
+                assert_eq!(bytes.len() % 4, 0);
+            } else {
+                write_gltf(&mut bytes, &v, &f).unwrap();
+                assert!(looks_like_json(&bytes));
+            }
+            let mesh = read_gltf(&bytes, Path::new(".")).unwrap();
+            assert_eq!(mesh.vertices, v);
+            assert_eq!(mesh.faces.unwrap(), f);
+        }
+    }
+
+    #[test]
+    fn matrices() {
+        let m = multiply(&IDENTITY, &IDENTITY);
+        assert_eq!(m, IDENTITY);
+        // A quarter turn about z takes x to y.
+        let s = std::f64::consts::FRAC_1_SQRT_2;
+        let (x, y, z, w) = (0.0, 0.0, s, s);
+        let r = [
+            [
+                1.0 - 2.0 * (y * y + z * z),
+                2.0 * (x * y + z * w),
+                2.0 * (x * z - y * w),
+                0.0,
+            ],
+            [
+                2.0 * (x * y - z * w),
+                1.0 - 2.0 * (x * x + z * z),
+                2.0 * (y * z + x * w),
+                0.0,
+            ],
+            [
+                2.0 * (x * z + y * w),
+                2.0 * (y * z - x * w),
+                1.0 - 2.0 * (x * x + y * y),
+                0.0,
+            ],
+            [0.0, 0.0, 0.0, 1.0],
+        ];
+        let p = apply(&r, [1.0, 0.0, 0.0]);
+        assert!((p[0]).abs() < 1e-12 && (p[1] - 1.0).abs() < 1e-12, "{p:?}");
+        assert!((determinant3(&r) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn percent_escapes() {
+        assert_eq!(percent_decode("my%20mesh.bin"), "my mesh.bin");
+        assert_eq!(percent_decode("a%2"), "a%2");
+        assert_eq!(percent_decode("100%"), "100%");
+    }
+
+    #[test]
+    fn empty_meshes_are_refused() {
+        let mut out = Vec::new();
+        assert!(write_glb(&mut out, &[], &[]).is_err());
+    }
+}

@@ -1,0 +1,260 @@
+//! Writing triangle meshes, the format chosen by the file extension.
+//!
+//! | extension | what is written |
+//! |---|---|
+//! | `.obj` | `v x y z` with the shortest decimals that read back to the same `f64`, `f a b c` 1-based |
+//! | `.ply` | binary little-endian, `double x y z`, faces as `list uchar int vertex_indices` |
+//! | `.stl` | binary, 80-byte header naming meshtrim, `f32` normals and corners |
+//! | `.glb` | binary glTF 2.0, one mesh, one primitive, `f32` positions, `u32` indices |
+//! | `.gltf` | glTF 2.0 JSON with the same data in an embedded base64 data URI |
+//!
+//! STL and glTF store coordinates as `f32`, so they lose precision beyond
+//! about 7 significant digits; OBJ and PLY keep `f64` exactly. Output is
+//! written atomically ([`super::atomic::write_atomic`]), and the bytes
+//! depend only on the mesh (no dates, no hash-map order).
+
+use std::io::Write;
+use std::path::Path;
+
+use anyhow::{anyhow, bail, Context, Result};
+use byteorder::{LittleEndian, WriteBytesExt};
+
+use super::atomic::write_atomic;
+use super::{gltf_io, show, stl, Point3};
+
+/// The mesh formats meshtrim writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MeshFormat {
+    /// Wavefront OBJ, text.
+    Obj,
+    /// Binary little-endian PLY with double coordinates.
+    Ply,
+    /// Binary STL.
+    Stl,
+    /// Binary glTF (GLB).
+    Glb,
+    /// glTF JSON with an embedded buffer.
+    Gltf,
+}
+
+impl MeshFormat {
+    /// The format a path's extension names (any case), if any.
+    pub fn from_path(path: &Path) -> Option<MeshFormat> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        Some(match ext.as_str() {
+            "obj" => MeshFormat::Obj,
+            "ply" => MeshFormat::Ply,
+            "stl" => MeshFormat::Stl,
+            "glb" => MeshFormat::Glb,
+            "gltf" => MeshFormat::Gltf,
+            _ => return None,
+        })
+    }
+
+    /// Whether the format stores coordinates as `f32`.
+    pub fn is_f32(self) -> bool {
+        matches!(self, MeshFormat::Stl | MeshFormat::Glb | MeshFormat::Gltf)
+    }
+
+    /// Writes the mesh in this format; the mesh must pass [`check_mesh`].
+    pub fn write(
+        self,
+        w: &mut dyn Write,
+        vertices: &[Point3],
+        faces: &[[u32; 3]],
+    ) -> std::io::Result<()> {
+        match self {
+            MeshFormat::Obj => write_obj(w, vertices, faces),
+            MeshFormat::Ply => write_ply(w, vertices, faces),
+            MeshFormat::Stl => stl::write_stl(w, vertices, faces),
+            MeshFormat::Glb => gltf_io::write_glb(w, vertices, faces),
+            MeshFormat::Gltf => gltf_io::write_gltf(w, vertices, faces),
+        }
+    }
+}
+
+/// Writes a triangle mesh to `path`, atomically, in the format its
+/// extension names: `.obj`, `.ply`, `.stl`, `.glb` or `.gltf`.
+///
+/// Fails, naming the file, before anything is written if the extension is
+/// unknown, a face refers to a missing vertex, a coordinate is not finite
+/// (or does not fit in `f32` for STL and glTF), or the format cannot hold
+/// the mesh (PLY's `int` indices, STL's `u32` triangle count, glTF's
+/// non-empty accessors).
+pub fn write_mesh(path: &Path, vertices: &[Point3], faces: &[[u32; 3]]) -> Result<()> {
+    let format = MeshFormat::from_path(path)
+        .ok_or_else(|| {
+            let ext = path.extension().map(|e| e.to_string_lossy().into_owned());
+            anyhow!(
+                "cannot write a mesh as '.{}': the extension must be one of obj, ply, stl, glb, gltf",
+                ext.unwrap_or_default()
+            )
+        })
+        .with_context(|| path.display().to_string())?;
+    check_mesh(format, vertices, faces).with_context(|| path.display().to_string())?;
+    write_atomic(path, |w| format.write(w, vertices, faces))
+}
+
+/// Checks that `format` can hold the mesh, with a message naming the
+/// vertex or face at fault.
+pub fn check_mesh(format: MeshFormat, vertices: &[Point3], faces: &[[u32; 3]]) -> Result<()> {
+    for (i, p) in vertices.iter().enumerate() {
+        if p.iter().any(|c| !c.is_finite()) {
+            bail!("vertex {i} has a non-finite coordinate {}", show(p));
+        }
+        if format.is_f32() && p.iter().any(|&c| !(c as f32).is_finite()) {
+            bail!(
+                "vertex {i} {} does not fit in the f32 coordinates of {}",
+                show(p),
+                format_name(format)
+            );
+        }
+    }
+    for (t, face) in faces.iter().enumerate() {
+        if let Some(&v) = face.iter().find(|&&v| v as usize >= vertices.len()) {
+            bail!(
+                "triangle {t} refers to vertex {v}, but there are only {} vertices",
+                vertices.len()
+            );
+        }
+    }
+    match format {
+        MeshFormat::Ply if vertices.len() > i32::MAX as usize + 1 => {
+            bail!("PLY int vertex indices hold at most 2^31 vertices")
+        }
+        MeshFormat::Stl if u32::try_from(faces.len()).is_err() => {
+            bail!("binary STL holds at most {} triangles", u32::MAX)
+        }
+        MeshFormat::Glb | MeshFormat::Gltf if vertices.is_empty() || faces.is_empty() => {
+            bail!("glTF needs at least one vertex and one triangle (accessors cannot be empty)")
+        }
+        _ => Ok(()),
+    }
+}
+
+fn format_name(format: MeshFormat) -> &'static str {
+    match format {
+        MeshFormat::Obj => "OBJ",
+        MeshFormat::Ply => "PLY",
+        MeshFormat::Stl => "STL",
+        MeshFormat::Glb | MeshFormat::Gltf => "glTF",
+    }
+}
+
+/// OBJ: a comment, `v` lines (Rust's shortest round-trip decimals, with an
+/// exponent for very large or small values), `f` lines 1-based.
+pub fn write_obj(
+    w: &mut dyn Write,
+    vertices: &[Point3],
+    faces: &[[u32; 3]],
+) -> std::io::Result<()> {
+    writeln!(
+        w,
+        "# meshtrim mesh: {} vertices, {} triangles",
+        vertices.len(),
+        faces.len()
+    )?;
+    for p in vertices {
+        writeln!(w, "v {:?} {:?} {:?}", p[0], p[1], p[2])?;
+    }
+    for f in faces {
+        let [a, b, c] = f.map(|v| u64::from(v) + 1);
+        writeln!(w, "f {a} {b} {c}")?;
+    }
+    Ok(())
+}
+
+/// PLY, binary little-endian: `double x y z`, then the faces as
+/// `list uchar int vertex_indices` (the list type most readers expect).
+pub fn write_ply(
+    w: &mut dyn Write,
+    vertices: &[Point3],
+    faces: &[[u32; 3]],
+) -> std::io::Result<()> {
+    write!(
+        w,
+        "ply\nformat binary_little_endian 1.0\ncomment written by meshtrim\n\
+         element vertex {}\nproperty double x\nproperty double y\nproperty double z\n\
+         element face {}\nproperty list uchar int vertex_indices\nend_header\n",
+        vertices.len(),
+        faces.len()
+    )?;
+    for p in vertices {
+        for &c in p {
+            w.write_f64::<LittleEndian>(c)?;
+        }
+    }
+    for f in faces {
+        w.write_u8(3)?;
+        for &v in f {
+            let v = i32::try_from(v).map_err(std::io::Error::other)?;
+            w.write_i32::<LittleEndian>(v)?;
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn extensions() {
+        let f = |p: &str| MeshFormat::from_path(Path::new(p));
+        assert_eq!(f("a/b.OBJ"), Some(MeshFormat::Obj));
+        assert_eq!(f("b.ply"), Some(MeshFormat::Ply));
+        assert_eq!(f("b.Stl"), Some(MeshFormat::Stl));
+        assert_eq!(f("b.glb"), Some(MeshFormat::Glb));
+        assert_eq!(f("b.gltf"), Some(MeshFormat::Gltf));
+        assert_eq!(f("b.xyz"), None);
+        assert_eq!(f("b"), None);
+    }
+
+    #[test]
+    fn obj_text_is_shortest_round_trip() {
+        let mut out = Vec::new();
+        let v = [[0.1, -2.0, 1e300], [1.0 / 3.0, -0.0, 5e-324]];
+        write_obj(&mut out, &v, &[[0, 1, 0]]).unwrap();
+        assert_eq!(
+            String::from_utf8(out).unwrap(),
+            "# meshtrim mesh: 2 vertices, 1 triangles\nv 0.1 -2.0 1e300\n\
+             v 0.3333333333333333 -0.0 5e-324\nf 1 2 1\n"
+        );
+    }
+
+    #[test]
+    fn ply_reads_back_exactly() {
+        let v = vec![[0.1, -2.0, 1e300], [1.0 / 3.0, -0.0, 5e-324], [1., 2., 3.]];
+        let f = vec![[0, 1, 2], [2, 1, 0]];
+        let mut out = Vec::new();
+        write_ply(&mut out, &v, &f).unwrap();
+        let mesh = super::super::ply::read_ply(&out).unwrap();
+        assert_eq!(mesh.vertices, v);
+        assert_eq!(mesh.faces.unwrap(), f);
+    }
+
+    #[test]
+    fn checks_name_the_fault() {
+        let e = |format, v: &[Point3], f: &[[u32; 3]]| {
+            check_mesh(format, v, f).unwrap_err().to_string()
+        };
+        let v = [[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 1e300]];
+        assert_eq!(
+            e(MeshFormat::Obj, &v, &[[0, 1, 3]]),
+            "triangle 0 refers to vertex 3, but there are only 3 vertices"
+        );
+        let stl = e(MeshFormat::Stl, &v, &[[0, 1, 2]]);
+        assert!(stl.starts_with("vertex 2 (0, 1, 1000"), "{stl}");
+        assert!(
+            stl.ends_with("does not fit in the f32 coordinates of STL"),
+            "{stl}"
+        );
+        assert!(check_mesh(MeshFormat::Ply, &v, &[[0, 1, 2]]).is_ok());
+        assert!(e(MeshFormat::Glb, &v[..2], &[]).contains("at least one"));
+        let nan = [[0.0, f64::NAN, 0.0]];
+        assert_eq!(
+            e(MeshFormat::Ply, &nan, &[]),
+            "vertex 0 has a non-finite coordinate (0, NaN, 0)"
+        );
+    }
+}

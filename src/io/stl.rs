@@ -1,0 +1,392 @@
+//! STL (stereolithography) meshes, ASCII and binary.
+//!
+//! STL stores every triangle with its own three corner positions and no
+//! vertex indices, so the reader merges corners with exactly equal
+//! positions (equal as `f64` after reading, so `-0` and `+0` are one
+//! vertex) into shared vertices, numbered in order of first appearance.
+//! Facet normals are ignored; positions are `f32` in binary files and read
+//! as written in ASCII files.
+//!
+//! ASCII or binary is decided by content: a file whose size is exactly
+//! `84 + 50 × n` for the triangle count `n` in its header is binary (even
+//! when its header starts with `solid`, as some exporters write), else a
+//! file starting with `solid` is ASCII, else it is binary and too short.
+
+use std::collections::HashMap;
+use std::io::Write;
+
+use anyhow::{anyhow, bail, Result};
+use byteorder::{ByteOrder, LittleEndian, WriteBytesExt};
+
+use super::{capacity, show, Mesh, Point3};
+
+/// Size of a binary STL's header: 80 bytes of text, a u32 triangle count.
+const HEADER: usize = 84;
+/// Size of one binary triangle: normal, three corners, u16 attribute.
+const RECORD: usize = 50;
+
+/// Whether the bytes are a binary STL whose size matches its declared
+/// triangle count exactly (a reliable sign, whatever the extension).
+pub fn is_exact_binary(bytes: &[u8]) -> bool {
+    bytes.len() >= HEADER && Some(bytes.len()) == binary_size(declared(bytes))
+}
+
+/// Whether the bytes start like an ASCII STL: `solid`, then a `facet` line
+/// or `endsolid` soon after.
+pub fn looks_ascii(bytes: &[u8]) -> bool {
+    let head = String::from_utf8_lossy(&bytes[..bytes.len().min(1024)]);
+    let mut words = head.split_whitespace();
+    words.next() == Some("solid")
+        && head
+            .lines()
+            .skip(1)
+            .map(str::trim_start)
+            .any(|l| l.starts_with("facet") || l.starts_with("endsolid"))
+}
+
+/// Reads an STL file, ASCII or binary, merging equal corner positions.
+pub fn read_stl(bytes: &[u8]) -> Result<Mesh> {
+    if is_exact_binary(bytes) {
+        return read_binary(bytes);
+    }
+    if bytes.trim_ascii_start().starts_with(b"solid") {
+        return read_ascii(bytes);
+    }
+    read_binary(bytes)
+}
+
+fn declared(bytes: &[u8]) -> u32 {
+    LittleEndian::read_u32(&bytes[80..84])
+}
+
+fn binary_size(triangles: u32) -> Option<usize> {
+    (triangles as usize)
+        .checked_mul(RECORD)
+        .and_then(|b| b.checked_add(HEADER))
+}
+
+/// Shares vertices between corners with equal positions.
+struct Merger {
+    mesh: Mesh,
+    index: HashMap<[u64; 3], u32>,
+}
+
+impl Merger {
+    fn new(triangles: usize) -> Self {
+        Self {
+            mesh: Mesh {
+                vertices: Vec::with_capacity(capacity(triangles / 2)),
+                normals: None,
+                faces: Some(Vec::with_capacity(capacity(triangles))),
+            },
+            index: HashMap::with_capacity(capacity(triangles / 2)),
+        }
+    }
+
+    fn vertex(&mut self, p: Point3) -> Result<u32> {
+        // Adding +0 turns -0 into +0, so the two (equal as f64) share a key.
+        let key = p.map(|c| (c + 0.0).to_bits());
+        if let Some(&i) = self.index.get(&key) {
+            return Ok(i);
+        }
+        let i = u32::try_from(self.mesh.vertices.len())
+            .map_err(|_| anyhow!("more than {} distinct vertices", u32::MAX))?;
+        self.mesh.vertices.push(p);
+        self.index.insert(key, i);
+        Ok(i)
+    }
+
+    fn triangle(&mut self, corners: [Point3; 3]) -> Result<()> {
+        let face = [
+            self.vertex(corners[0])?,
+            self.vertex(corners[1])?,
+            self.vertex(corners[2])?,
+        ];
+        if let Some(faces) = self.mesh.faces.as_mut() {
+            faces.push(face);
+        }
+        Ok(())
+    }
+}
+
+fn read_binary(bytes: &[u8]) -> Result<Mesh> {
+    if bytes.len() < HEADER {
+        bail!(
+            "not an STL file: it does not start with 'solid' (ASCII) and at {} bytes is \
+             shorter than a binary STL's {HEADER}-byte header",
+            bytes.len()
+        );
+    }
+    let n = declared(bytes);
+    let complete = (bytes.len() - HEADER) / RECORD;
+    if (complete as u64) < u64::from(n) {
+        bail!(
+            "binary STL truncated: the header declares {n} triangles ({} bytes), the file has {} \
+             bytes and ends in triangle {complete}",
+            binary_size(n).map_or_else(|| "too many".to_string(), |s| s.to_string()),
+            bytes.len()
+        );
+    }
+    // Bytes after the last triangle (padding some exporters add) are ignored.
+    let mut merger = Merger::new(n as usize);
+    for (t, record) in bytes[HEADER..]
+        .chunks_exact(RECORD)
+        .take(n as usize)
+        .enumerate()
+    {
+        let corner = |k: usize| -> Point3 {
+            let at = 12 + 12 * k;
+            [0, 4, 8].map(|o| f64::from(LittleEndian::read_f32(&record[at + o..])))
+        };
+        let corners = [corner(0), corner(1), corner(2)];
+        if let Some(p) = corners.iter().find(|p| p.iter().any(|c| !c.is_finite())) {
+            bail!("triangle {t} has a non-finite coordinate {}", show(p));
+        }
+        merger.triangle(corners)?;
+    }
+    Ok(merger.mesh)
+}
+
+/// Where the ASCII reader is in the `solid` grammar.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum State {
+    /// Before `solid` or after `endsolid`.
+    Outside,
+    /// Inside a solid, between facets.
+    Solid,
+    /// After `facet normal …`, before `outer loop`.
+    Facet,
+    /// After `outer loop`, reading `vertex` lines.
+    Loop,
+    /// After `endloop`, before `endfacet`.
+    EndLoop,
+}
+
+fn read_ascii(bytes: &[u8]) -> Result<Mesh> {
+    let text = std::str::from_utf8(bytes).map_err(|e| {
+        anyhow!(
+            "not an ASCII STL (invalid UTF-8 at byte {}) nor a binary one (its size does not \
+             match its triangle count)",
+            e.valid_up_to()
+        )
+    })?;
+    let mut merger = Merger::new(text.len() / 200);
+    let mut state = State::Outside;
+    let mut corners: Vec<Point3> = Vec::with_capacity(3);
+    let mut facets = 0usize;
+    let mut last = 0;
+    for (i, line) in text.lines().enumerate() {
+        last = i + 1;
+        let at = |e: String| anyhow!("line {}: {e}", i + 1);
+        let mut words = line.split_whitespace();
+        let Some(keyword) = words.next() else {
+            continue;
+        };
+        let expected = |what: &str| at(format!("expected {what}, found '{}'", line.trim()));
+        state = match (state, keyword) {
+            (State::Outside, "solid") => State::Solid,
+            (State::Outside, _) => return Err(expected("'solid'")),
+            (State::Solid, "facet") => {
+                if words.next() != Some("normal") {
+                    return Err(expected("'facet normal nx ny nz'"));
+                }
+                State::Facet
+            }
+            (State::Solid, "endsolid") => State::Outside,
+            (State::Solid, _) => return Err(expected("'facet normal' or 'endsolid'")),
+            (State::Facet, "outer") if words.next() == Some("loop") => State::Loop,
+            (State::Facet, _) => return Err(expected("'outer loop'")),
+            (State::Loop, "vertex") => {
+                corners.push(parse_xyz(words).map_err(at)?);
+                State::Loop
+            }
+            (State::Loop, "endloop") => {
+                if corners.len() != 3 {
+                    return Err(at(format!(
+                        "facet {facets} has {} vertices, a triangle needs 3",
+                        corners.len()
+                    )));
+                }
+                merger.triangle([corners[0], corners[1], corners[2]])?;
+                corners.clear();
+                facets += 1;
+                State::EndLoop
+            }
+            (State::Loop, _) => return Err(expected("'vertex x y z' or 'endloop'")),
+            (State::EndLoop, "endfacet") => State::Solid,
+            (State::EndLoop, _) => return Err(expected("'endfacet'")),
+        };
+    }
+    match state {
+        State::Outside => Ok(merger.mesh),
+        _ => bail!("line {last}: the file ends inside a solid (no 'endsolid' line)"),
+    }
+}
+
+fn parse_xyz<'a>(mut words: impl Iterator<Item = &'a str>) -> Result<Point3, String> {
+    let mut p: Point3 = [0.0; 3];
+    for (k, c) in p.iter_mut().enumerate() {
+        let word = words
+            .next()
+            .ok_or_else(|| format!("a vertex needs x, y and z, found {k} value(s)"))?;
+        *c = word
+            .parse()
+            .map_err(|_| format!("'{word}' is not a number"))?;
+    }
+    if let Some(extra) = words.next() {
+        return Err(format!(
+            "unexpected '{extra}' after the vertex's x, y and z"
+        ));
+    }
+    if p.iter().any(|c| !c.is_finite()) {
+        return Err(format!("non-finite coordinate {}", show(&p)));
+    }
+    Ok(p)
+}
+
+/// Writes a binary STL: an 80-byte header naming meshtrim, the triangle
+/// count, then per triangle its unit normal (from the corners, by the
+/// right-hand rule; zero for a degenerate triangle) and corners as `f32`.
+///
+/// The caller checks that the face indices are in range, that there are
+/// at most `u32::MAX` faces and that the coordinates fit in `f32`.
+pub fn write_stl(
+    w: &mut dyn Write,
+    vertices: &[Point3],
+    faces: &[[u32; 3]],
+) -> std::io::Result<()> {
+    let mut header = [b' '; 80];
+    let title = b"binary STL written by meshtrim";
+    header[..title.len()].copy_from_slice(title);
+    w.write_all(&header)?;
+    let count = u32::try_from(faces.len()).map_err(std::io::Error::other)?;
+    w.write_u32::<LittleEndian>(count)?;
+    for face in faces {
+        let [a, b, c] = face.map(|v| vertices[v as usize]);
+        for n in unit_normal(a, b, c) {
+            w.write_f32::<LittleEndian>(n as f32)?;
+        }
+        for p in [a, b, c] {
+            for coordinate in p {
+                w.write_f32::<LittleEndian>(coordinate as f32)?;
+            }
+        }
+        w.write_u16::<LittleEndian>(0)?;
+    }
+    Ok(())
+}
+
+fn unit_normal(a: Point3, b: Point3, c: Point3) -> Point3 {
+    let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+    let n = [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ];
+    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    if len > 0.0 && len.is_finite() {
+        n.map(|x| x / len)
+    } else {
+        [0.0; 3]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn err(bytes: &[u8]) -> String {
+        format!("{:#}", read_stl(bytes).unwrap_err())
+    }
+
+    const SQUARE: &str = "solid square\n  facet normal 0 0 1\n    outer loop\n\
+        \x20     vertex 0 0 0\n      vertex 1 0 0\n      vertex 1 1 0\n    endloop\n  endfacet\n\
+        \x20 facet normal 0 0 1\n    outer loop\n      vertex 0 0 0\n      vertex 1 1 0\n\
+        \x20     vertex 0 1 -0\n    endloop\n  endfacet\nendsolid square\n";
+
+    #[test]
+    fn ascii_merges_equal_corners() {
+        let mesh = read_stl(SQUARE.as_bytes()).unwrap();
+        assert_eq!(
+            mesh.vertices,
+            vec![[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., -0.]]
+        );
+        assert_eq!(mesh.faces.unwrap(), vec![[0, 1, 2], [0, 2, 3]]);
+        assert!(looks_ascii(SQUARE.as_bytes()));
+    }
+
+    #[test]
+    fn binary_round_trip_and_negative_zero() {
+        let vertices = vec![[0., 0., 0.], [1., 0., 0.], [1., 1., -0.], [0.1, 1., 0.]];
+        let faces = vec![[0, 1, 2], [0, 2, 3]];
+        let mut bytes = Vec::new();
+        write_stl(&mut bytes, &vertices, &faces).unwrap();
+        assert_eq!(bytes.len(), 84 + 2 * 50);
+        assert!(bytes.starts_with(b"binary STL written by meshtrim"));
+        assert!(is_exact_binary(&bytes));
+        let mesh = read_stl(&bytes).unwrap();
+        assert_eq!(mesh.vertices[3], [f64::from(0.1f32), 1., 0.]);
+        assert_eq!(mesh.faces.unwrap(), faces);
+        // The normal of the first triangle is +z.
+        assert_eq!(LittleEndian::read_f32(&bytes[84 + 8..]), 1.0);
+    }
+
+    #[test]
+    fn binary_with_solid_header_is_binary() {
+        let mut bytes = Vec::new();
+        write_stl(
+            &mut bytes,
+            &[[0.; 3], [1., 0., 0.], [0., 1., 0.]],
+            &[[0, 1, 2]],
+        )
+        .unwrap();
+        bytes[..6].copy_from_slice(b"solid ");
+        assert_eq!(read_stl(&bytes).unwrap().vertices.len(), 3);
+    }
+
+    #[test]
+    fn truncated_binary_names_the_triangle() {
+        let mut bytes = Vec::new();
+        let v = [[0.; 3], [1., 0., 0.], [0., 1., 0.]];
+        write_stl(&mut bytes, &v, &[[0, 1, 2]; 5]).unwrap();
+        bytes.truncate(84 + 3 * 50 + 20);
+        assert_eq!(
+            err(&bytes),
+            "binary STL truncated: the header declares 5 triangles (334 bytes), the file has \
+             254 bytes and ends in triangle 3"
+        );
+        assert!(err(b"tiny").contains("shorter than a binary STL's 84-byte header"));
+    }
+
+    #[test]
+    fn ascii_errors_name_the_line() {
+        let bad = SQUARE.replace("vertex 1 0 0", "vertex 1 x 0");
+        assert_eq!(err(bad.as_bytes()), "line 5: 'x' is not a number");
+        let bad = SQUARE.replace("    endloop\n  endfacet\nendsolid", "    endloop\nendsolid");
+        assert_eq!(
+            err(bad.as_bytes()),
+            "line 15: expected 'endfacet', found 'endsolid square'"
+        );
+        let bad = SQUARE.replacen("      vertex 1 1 0\n", "", 1);
+        assert_eq!(
+            err(bad.as_bytes()),
+            "line 6: facet 0 has 2 vertices, a triangle needs 3"
+        );
+        let cut = &SQUARE[..SQUARE.find("endsolid").unwrap()];
+        assert_eq!(
+            err(cut.as_bytes()),
+            "line 15: the file ends inside a solid (no 'endsolid' line)"
+        );
+        let bad = SQUARE.replace("vertex 0 1 -0", "vertex 0 1 nan");
+        assert_eq!(
+            err(bad.as_bytes()),
+            "line 13: non-finite coordinate (0, 1, NaN)"
+        );
+    }
+
+    #[test]
+    fn degenerate_normal_is_zero() {
+        assert_eq!(unit_normal([0.; 3], [1., 0., 0.], [2., 0., 0.]), [0.; 3]);
+    }
+}
