@@ -10,12 +10,25 @@ use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
 
 /// Boundary detection, edge smoothing and trimming of meshes from 3D scans.
+///
+/// The main job: `meshtrim MESH CLOUD OUT` cuts MESH (reconstructed from
+/// CLOUD, e.g. by screened Poisson) along CLOUD's smoothed boundary and
+/// writes what the cloud supports to OUT. The subcommands run the stages.
 #[derive(Debug, Parser)]
-#[command(name = "meshtrim", version, about)]
+#[command(
+    name = "meshtrim",
+    version,
+    about,
+    args_conflicts_with_subcommands = true,
+    subcommand_negates_reqs = true
+)]
 pub struct Cli {
-    /// What to do.
+    /// A stage on its own.
     #[command(subcommand)]
-    pub command: Command,
+    pub command: Option<Command>,
+    /// The main job (`meshtrim MESH CLOUD OUT`), when no subcommand is given.
+    #[command(flatten)]
+    pub trim: Option<TrimArgs>,
 }
 
 /// The subcommands.
@@ -26,6 +39,41 @@ pub enum Command {
     /// Detect the boundary, then group it into closed loops, find their
     /// corners and smooth their edges (the paper's RBS); write the edges.
     Edges(EdgesArgs),
+    /// Trim a mesh along its cloud's smoothed boundary (the same as
+    /// `meshtrim MESH CLOUD OUT`).
+    Trim(TrimArgs),
+}
+
+/// Arguments of the trimming (`meshtrim MESH CLOUD OUT`).
+#[derive(Debug, Clone, Args)]
+pub struct TrimArgs {
+    /// The mesh to trim: .obj, .ply, .stl, .gltf or .glb.
+    #[arg(required = true)]
+    pub mesh: PathBuf,
+    /// The point cloud the mesh was reconstructed from (any cloud format
+    /// `detect` reads).
+    #[arg(required = true)]
+    pub cloud: PathBuf,
+    /// The trimmed mesh: .obj, .ply (binary), .stl (binary), .gltf or .glb.
+    /// Missing parent directories are created.
+    #[arg(required = true)]
+    pub output: PathBuf,
+    /// Also write the report as JSON to this file.
+    #[arg(long, value_name = "FILE.json")]
+    pub report: Option<PathBuf>,
+    /// Neighbourhood size of boundary detection, the point itself included.
+    #[arg(long, default_value_t = 30)]
+    pub k: usize,
+    /// Use the paper's isotropic detection, without the sampling-tensor map.
+    #[arg(long)]
+    pub no_anisotropy: bool,
+    /// Cut along the smoothed boundary points themselves (the paper's
+    /// edges) instead of the estimated physical edge.
+    #[arg(long)]
+    pub no_offset: bool,
+    /// Print the report as one JSON object.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Arguments of `meshtrim detect`.
@@ -76,8 +124,12 @@ pub struct EdgesArgs {
 
 /// Runs the chosen subcommand.
 pub fn run(cli: Cli) -> Result<()> {
-    match cli.command {
-        Command::Detect(args) => crate::detect::run(&args),
-        Command::Edges(args) => crate::edges::run(&args),
+    match (cli.command, cli.trim) {
+        (Some(Command::Detect(args)), _) => crate::detect::run(&args),
+        (Some(Command::Edges(args)), _) => crate::edges::run(&args),
+        (Some(Command::Trim(args)), _) | (None, Some(args)) => crate::trim::run(&args),
+        (None, None) => {
+            anyhow::bail!("nothing to do: give MESH CLOUD OUT, or a subcommand (see --help)")
+        }
     }
 }

@@ -13,3 +13,4 @@ pub mod cli;
 pub mod detect;
 pub mod edges;
 pub mod io;
+pub mod trim;

@@ -1,0 +1,244 @@
+//! `meshtrim MESH CLOUD OUT` (also `meshtrim trim ...`): the main job. Read
+//! a mesh reconstructed from a scan and the scan's cloud, detect and smooth
+//! the cloud's boundary, cut the mesh along it, keep what the cloud
+//! supports, write the mesh, report.
+
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use anyhow::{bail, Context, Result};
+use serde::Serialize;
+use trim::edges::{reconstruct_edges, EdgeOptions};
+use trim::mesh::Mesh;
+use trim::trimming::{trim_mesh, LoopFit, TrimReport};
+use trim::BpdOptions;
+
+use crate::cli::TrimArgs;
+use crate::detect::{detect_with_progress, millis};
+use crate::io::atomic::write_atomic;
+use crate::io::mesh_out::{write_mesh, MeshFormat};
+use crate::io::{read_cloud, read_mesh};
+
+/// What the trimming prints and `--report` writes.
+#[derive(Debug, Clone, Serialize)]
+pub struct Report {
+    /// Input mesh, cloud and output, as given.
+    pub mesh: String,
+    /// The cloud.
+    pub cloud: String,
+    /// The output.
+    pub output: String,
+    /// Cloud points read.
+    pub points: usize,
+    /// Boundary points found by BPD.
+    pub boundary_points: usize,
+    /// Smoothed boundary loops the mesh was cut along.
+    pub loops: usize,
+    /// Input faces.
+    pub faces_in: usize,
+    /// Output faces.
+    pub faces_out: usize,
+    /// Input faces crossed by the boundary and split.
+    pub faces_split: usize,
+    /// Input faces removed whole.
+    pub faces_removed: usize,
+    /// Pieces of the cut mesh dropped for lack of cloud support (e.g. the
+    /// far side of a Poisson envelope).
+    pub pieces_dropped: usize,
+    /// Vertices snapped onto the cut to avoid slivers.
+    pub vertices_snapped: usize,
+    /// Area of the input mesh.
+    pub area_in: f64,
+    /// Area of the output mesh.
+    pub area_out: f64,
+    /// Per smoothed loop: mean and largest distance from the output border
+    /// to it, in the cloud's units.
+    pub border_to_edge: Vec<BorderFit>,
+    /// Time of each stage, in milliseconds.
+    pub read_ms: f64,
+    /// Boundary detection time.
+    pub detect_ms: f64,
+    /// Edge reconstruction time.
+    pub edges_ms: f64,
+    /// Cutting and classification time.
+    pub trim_ms: f64,
+    /// Writing time.
+    pub write_ms: f64,
+}
+
+/// How closely the output border follows one smoothed loop.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct BorderFit {
+    /// Mean distance.
+    pub mean: f64,
+    /// Largest distance.
+    pub max: f64,
+    /// Border vertices measured.
+    pub vertices: usize,
+}
+
+/// Runs the trimming.
+pub fn run(args: &TrimArgs) -> Result<()> {
+    check_paths(args)?;
+    let started = Instant::now();
+    let input = read_mesh(&args.mesh)?;
+    let Some(faces) = input.faces else {
+        bail!(
+            "{}: the file has no faces: give a mesh (the cloud goes second)",
+            args.mesh.display()
+        );
+    };
+    let mesh = Mesh {
+        vertices: input.vertices,
+        faces,
+    };
+    let cloud = read_cloud(&args.cloud)?;
+    let read_time = started.elapsed();
+    let options = BpdOptions {
+        k: args.k,
+        anisotropy: !args.no_anisotropy,
+    };
+    let started = Instant::now();
+    let detection = detect_with_progress(&cloud.points, &options)
+        .with_context(|| args.cloud.display().to_string())?;
+    let detect_time = started.elapsed();
+    let started = Instant::now();
+    let edges = reconstruct_edges(
+        &cloud.points,
+        &detection,
+        &EdgeOptions {
+            offset: !args.no_offset,
+        },
+    );
+    let edges_time = started.elapsed();
+    let started = Instant::now();
+    let (out, trimmed) = trim_mesh(&mesh, &cloud.points, &detection, &edges)
+        .with_context(|| format!("{} with {}", args.mesh.display(), args.cloud.display()))?;
+    let trim_time = started.elapsed();
+    let started = Instant::now();
+    write_mesh(&args.output, &out.vertices, &out.faces)?;
+    let write_time = started.elapsed();
+    let times = [read_time, detect_time, edges_time, trim_time, write_time];
+    let report = Report::new(
+        args,
+        cloud.points.len(),
+        detection.boundary_count(),
+        &trimmed,
+        times,
+    );
+    if let Some(path) = &args.report {
+        let json = serde_json::to_string_pretty(&report)?;
+        write_atomic(path, |w| w.write_all(json.as_bytes()))?;
+    }
+    if args.json {
+        println!("{}", serde_json::to_string(&report)?);
+    } else {
+        print!("{}", report.table());
+    }
+    Ok(())
+}
+
+/// Refuses unknown output formats and outputs that would overwrite an
+/// input, before any work.
+fn check_paths(args: &TrimArgs) -> Result<()> {
+    if MeshFormat::from_path(&args.output).is_none() {
+        bail!(
+            "{}: unsupported output format: use .obj, .ply, .stl, .gltf or .glb",
+            args.output.display()
+        );
+    }
+    if let Some(report) = &args.report {
+        if report.extension().and_then(|e| e.to_str()) != Some("json") {
+            bail!("{}: the report is JSON: name it .json", report.display());
+        }
+    }
+    let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    };
+    for input in [&args.mesh, &args.cloud] {
+        if same(&args.output, input) || args.report.as_deref().is_some_and(|r| same(r, input)) {
+            bail!("{}: an output would overwrite this input", input.display());
+        }
+    }
+    Ok(())
+}
+
+impl Report {
+    fn new(
+        args: &TrimArgs,
+        points: usize,
+        boundary_points: usize,
+        r: &TrimReport,
+        [read, detect, edges, trim, write]: [Duration; 5],
+    ) -> Self {
+        let fit = |l: &LoopFit| BorderFit {
+            mean: l.mean,
+            max: l.max,
+            vertices: l.count,
+        };
+        Report {
+            mesh: args.mesh.display().to_string(),
+            cloud: args.cloud.display().to_string(),
+            output: args.output.display().to_string(),
+            points,
+            boundary_points,
+            loops: r.loops.len(),
+            faces_in: r.faces_in,
+            faces_out: r.faces_out,
+            faces_split: r.faces_split,
+            faces_removed: r.faces_removed,
+            pieces_dropped: r.pieces_dropped,
+            vertices_snapped: r.vertices_snapped,
+            area_in: r.area_in,
+            area_out: r.area_out,
+            border_to_edge: r.loops.iter().map(fit).collect(),
+            read_ms: millis(read),
+            detect_ms: millis(detect),
+            edges_ms: millis(edges),
+            trim_ms: millis(trim),
+            write_ms: millis(write),
+        }
+    }
+
+    /// The report as an aligned two-column table.
+    pub fn table(&self) -> String {
+        let worst = self
+            .border_to_edge
+            .iter()
+            .map(|f| f.max)
+            .fold(0.0, f64::max);
+        let rows = [
+            ("mesh", self.mesh.clone()),
+            (
+                "cloud",
+                format!(
+                    "{} ({} points, {} boundary)",
+                    self.cloud, self.points, self.boundary_points
+                ),
+            ),
+            ("loops", self.loops.to_string()),
+            (
+                "faces in / out",
+                format!("{} / {}", self.faces_in, self.faces_out),
+            ),
+            ("faces split", self.faces_split.to_string()),
+            ("faces removed", self.faces_removed.to_string()),
+            ("pieces dropped", self.pieces_dropped.to_string()),
+            (
+                "area in / out",
+                format!("{:.6} / {:.6}", self.area_in, self.area_out),
+            ),
+            ("border to edge, max", format!("{worst:.3e}")),
+            ("read time", format!("{:.1} ms", self.read_ms)),
+            ("detect time", format!("{:.1} ms", self.detect_ms)),
+            ("edges time", format!("{:.1} ms", self.edges_ms)),
+            ("trim time", format!("{:.1} ms", self.trim_ms)),
+            ("write time", format!("{:.1} ms", self.write_ms)),
+            ("output", self.output.clone()),
+        ];
+        rows.iter()
+            .map(|(label, value)| format!("{label:<20} {value}\n"))
+            .collect()
+    }
+}

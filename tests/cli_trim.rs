@@ -1,0 +1,171 @@
+//! End-to-end tests of the main job, `meshtrim MESH CLOUD OUT`.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const MESH: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/fixtures/meshes/blade_small_poisson.ply"
+);
+const CLOUD: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/fixtures/meshes/blade_small.ply"
+);
+
+fn meshtrim(args: &[&str], threads: Option<&str>) -> Output {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_meshtrim"));
+    cmd.args(args);
+    if let Some(t) = threads {
+        cmd.env("RAYON_NUM_THREADS", t);
+    }
+    cmd.output().expect("run meshtrim")
+}
+
+fn temp_dir() -> tempfile::TempDir {
+    tempfile::tempdir().expect("temporary directory")
+}
+
+fn path(dir: &Path, name: &str) -> PathBuf {
+    dir.join(name)
+}
+
+fn assert_clean_failure(out: &Output, mentions: &str) {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.starts_with("error: "), "{stderr}");
+    assert!(stderr.contains(mentions), "{stderr} should name {mentions}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
+
+#[test]
+fn trims_the_fixture_and_reports() {
+    let dir = temp_dir();
+    let out = path(dir.path(), "sub/trimmed.ply");
+    let report = path(dir.path(), "report.json");
+    let run = meshtrim(
+        &[
+            MESH,
+            CLOUD,
+            out.to_str().unwrap(),
+            "--report",
+            report.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let text = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        text.contains("faces in / out") && text.contains("loops"),
+        "{text}"
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(json["loops"], 4, "outer border and three holes: {json}");
+    assert_eq!(json["border_to_edge"].as_array().unwrap().len(), 4);
+    let (faces_in, faces_out) = (
+        json["faces_in"].as_u64().unwrap(),
+        json["faces_out"].as_u64().unwrap(),
+    );
+    assert!(faces_out > 0 && faces_out < faces_in, "{json}");
+    assert!(
+        json["area_out"].as_f64().unwrap() < json["area_in"].as_f64().unwrap() / 2.0,
+        "the envelope's far side must go"
+    );
+    for key in [
+        "read_ms",
+        "detect_ms",
+        "edges_ms",
+        "trim_ms",
+        "write_ms",
+        "faces_split",
+        "pieces_dropped",
+    ] {
+        assert!(json.get(key).is_some(), "missing {key}");
+    }
+}
+
+#[test]
+fn the_trim_subcommand_is_the_same_job_and_output_is_deterministic() {
+    let dir = temp_dir();
+    let a = path(dir.path(), "a.obj");
+    let b = path(dir.path(), "b.obj");
+    assert!(meshtrim(&[MESH, CLOUD, a.to_str().unwrap()], Some("1"))
+        .status
+        .success());
+    assert!(
+        meshtrim(&["trim", MESH, CLOUD, b.to_str().unwrap()], Some("2"))
+            .status
+            .success()
+    );
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+}
+
+#[test]
+fn every_mesh_format_is_written() {
+    let dir = temp_dir();
+    for ext in ["obj", "ply", "stl", "glb", "gltf"] {
+        let out = path(dir.path(), &format!("t.{ext}"));
+        let run = meshtrim(&[MESH, CLOUD, out.to_str().unwrap()], None);
+        assert!(
+            run.status.success(),
+            "{ext}: {}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        assert!(std::fs::metadata(&out).unwrap().len() > 0, "{ext}");
+    }
+}
+
+#[test]
+fn bad_inputs_fail_cleanly_and_write_nothing() {
+    let dir = temp_dir();
+    let out = path(dir.path(), "out.ply");
+    let o = out.to_str().unwrap();
+    assert_clean_failure(
+        &meshtrim(
+            &[MESH, CLOUD, &path(dir.path(), "out.xyz").to_string_lossy()],
+            None,
+        ),
+        "out.xyz",
+    );
+    assert_clean_failure(&meshtrim(&["missing.ply", CLOUD, o], None), "missing.ply");
+    // A cloud given as the mesh: it has no faces.
+    assert_clean_failure(&meshtrim(&[CLOUD, CLOUD, o], None), "blade_small.ply");
+    // A cloud far away from the mesh supports none of it.
+    let moved = path(dir.path(), "moved.xyz");
+    let text: String = (0..200)
+        .map(|i| {
+            format!(
+                "{} {} {}\n",
+                1e6 + (i % 20) as f64,
+                1e6 + (i / 20) as f64,
+                1e6 + 0.01 * ((i * 7) % 5) as f64
+            )
+        })
+        .collect();
+    std::fs::write(&moved, text).unwrap();
+    assert_clean_failure(
+        &meshtrim(&[MESH, moved.to_str().unwrap(), o], None),
+        "supported",
+    );
+    assert!(!out.exists(), "no output on failure");
+}
+
+#[test]
+fn an_output_naming_an_input_is_refused() {
+    let dir = temp_dir();
+    let mesh = path(dir.path(), "mesh.ply");
+    std::fs::copy(MESH, &mesh).unwrap();
+    let before = std::fs::read(&mesh).unwrap();
+    assert_clean_failure(
+        &meshtrim(
+            &[mesh.to_str().unwrap(), CLOUD, mesh.to_str().unwrap()],
+            None,
+        ),
+        "mesh.ply",
+    );
+    assert_eq!(std::fs::read(&mesh).unwrap(), before);
+}
