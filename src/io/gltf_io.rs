@@ -540,36 +540,15 @@ mod tests {
     }
 
     #[test]
-    fn matrices() {
-        let m = multiply(&IDENTITY, &IDENTITY);
-        assert_eq!(m, IDENTITY);
-        // A quarter turn about z takes x to y.
-        let s = std::f64::consts::FRAC_1_SQRT_2;
-        let (x, y, z, w) = (0.0, 0.0, s, s);
-        let r = [
-            [
-                1.0 - 2.0 * (y * y + z * z),
-                2.0 * (x * y + z * w),
-                2.0 * (x * z - y * w),
-                0.0,
-            ],
-            [
-                2.0 * (x * y - z * w),
-                1.0 - 2.0 * (x * x + z * z),
-                2.0 * (y * z + x * w),
-                0.0,
-            ],
-            [
-                2.0 * (x * z + y * w),
-                2.0 * (y * z - x * w),
-                1.0 - 2.0 * (x * x + y * y),
-                0.0,
-            ],
-            [0.0, 0.0, 0.0, 1.0],
-        ];
-        let p = apply(&r, [1.0, 0.0, 0.0]);
-        assert!((p[0]).abs() < 1e-12 && (p[1] - 1.0).abs() < 1e-12, "{p:?}");
-        assert!((determinant3(&r) - 1.0).abs() < 1e-12);
+    fn matrix_product_is_column_major() {
+        let mut translate = IDENTITY;
+        translate[3] = [1.0, 2.0, 3.0, 1.0];
+        let mut scale = IDENTITY;
+        scale[0][0] = 2.0;
+        // Scale first, then translate.
+        let m = multiply(&translate, &scale);
+        assert_eq!(apply(&m, [1.0, 1.0, 1.0]), [3.0, 3.0, 4.0]);
+        assert_eq!(determinant3(&m), 2.0);
     }
 
     #[test]

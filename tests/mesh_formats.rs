@@ -1,0 +1,459 @@
+//! Mesh input and output in every format: round trips through each writer
+//! and reader, hand-written STL and glTF files, error messages, and the
+//! real meshes of `shared/data`.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use base64::Engine;
+use meshtrim::io::{read_mesh, write_mesh, Mesh, MeshInput, Point3};
+
+/// A 6 × 5 grid of vertices with one cell missing (a hole), coordinates
+/// that no short decimal or f32 holds exactly, and a little relief.
+fn grid_with_hole() -> (Vec<Point3>, Vec<[u32; 3]>) {
+    let (nx, ny) = (6u32, 5u32);
+    let mut vertices = Vec::new();
+    for j in 0..ny {
+        for i in 0..nx {
+            let (x, y) = (f64::from(i) / 3.0 + 0.1, f64::from(j) * 0.7 - 1e-3);
+            vertices.push([x, y, (x * 1.3).sin() * (y + 0.2).cos() / 7.0]);
+        }
+    }
+    let mut faces = Vec::new();
+    for j in 0..ny - 1 {
+        for i in 0..nx - 1 {
+            if (i, j) == (2, 2) {
+                continue;
+            }
+            let v = |i: u32, j: u32| j * nx + i;
+            faces.push([v(i, j), v(i + 1, j), v(i + 1, j + 1)]);
+            faces.push([v(i, j), v(i + 1, j + 1), v(i, j + 1)]);
+        }
+    }
+    (vertices, faces)
+}
+
+fn to_f32(p: &Point3) -> Point3 {
+    p.map(|c| f64::from(c as f32))
+}
+
+fn faces(mesh: &Mesh) -> &[[u32; 3]] {
+    mesh.faces.as_deref().expect("the mesh has faces")
+}
+
+fn error(path: &Path) -> String {
+    format!("{:#}", read_mesh(path).unwrap_err())
+}
+
+#[test]
+fn round_trip_through_every_format() {
+    let dir = tempfile::tempdir().unwrap();
+    let (vertices, triangles) = grid_with_hole();
+    for ext in ["obj", "ply", "stl", "glb", "gltf"] {
+        let path = dir.path().join(format!("grid.{ext}"));
+        write_mesh(&path, &vertices, &triangles).unwrap();
+        let first = std::fs::read(&path).unwrap();
+        write_mesh(&path, &vertices, &triangles).unwrap();
+        assert_eq!(
+            std::fs::read(&path).unwrap(),
+            first,
+            "{ext}: not deterministic"
+        );
+        let mesh = read_mesh(&path).unwrap_or_else(|e| panic!("{ext}: {e:#}"));
+        match ext {
+            "obj" | "ply" => {
+                assert_eq!(mesh.vertices, vertices, "{ext}");
+                assert_eq!(faces(&mesh), triangles, "{ext}");
+            }
+            "glb" | "gltf" => {
+                let expected: Vec<Point3> = vertices.iter().map(to_f32).collect();
+                assert_eq!(mesh.vertices, expected, "{ext}");
+                assert_eq!(faces(&mesh), triangles, "{ext}");
+            }
+            _ => {
+                // STL: the same triangles, corner by corner, at f32 precision;
+                // vertices shared again, numbered by first appearance.
+                assert_eq!(faces(&mesh).len(), triangles.len());
+                for (got, want) in faces(&mesh).iter().zip(&triangles) {
+                    for k in 0..3 {
+                        assert_eq!(
+                            mesh.vertices[got[k] as usize],
+                            to_f32(&vertices[want[k] as usize])
+                        );
+                    }
+                }
+                assert_eq!(mesh.vertices.len(), vertices.len());
+                assert_eq!(faces(&mesh)[0], [0, 1, 2]);
+            }
+        }
+    }
+}
+
+#[test]
+fn stl_and_gltf_are_recognised_by_content_under_other_names() {
+    let dir = tempfile::tempdir().unwrap();
+    let (vertices, triangles) = grid_with_hole();
+    for (ext, disguise) in [
+        ("stl", "mesh.dat"),
+        ("glb", "mesh.bin"),
+        ("gltf", "mesh.json"),
+    ] {
+        let path = dir.path().join(format!("grid.{ext}"));
+        write_mesh(&path, &vertices, &triangles).unwrap();
+        let other = dir.path().join(disguise);
+        std::fs::copy(&path, &other).unwrap();
+        let bytes = std::fs::read(&other).unwrap();
+        let want = if ext == "stl" {
+            MeshInput::Stl
+        } else {
+            MeshInput::Gltf
+        };
+        assert_eq!(MeshInput::detect(&other, &bytes).unwrap(), want);
+        assert_eq!(read_mesh(&other).unwrap(), read_mesh(&path).unwrap());
+    }
+}
+
+const ASCII_STL: &str = "solid tetra  \n\
+  facet normal 0 0 -1\n    outer loop\n      vertex 0 0 0\n      vertex 0 1 0\n      vertex 1 0 0\n    endloop\n  endfacet\n\
+  facet normal 0 -1 0\n    outer loop\n      vertex 0 0 0\n      vertex 1 0 0\n      vertex 0 0 1\n    endloop\n  endfacet\n\
+  facet normal -1 0 0\n    outer loop\n      vertex 0 0 0\n      vertex 0 0 1\n      vertex 0 1 0\n    endloop\n  endfacet\n\
+  facet normal 1 1 1\n    outer loop\n      vertex 1 0 0\n      vertex 0 1 0\n      vertex 0 0 1.5e-1\n    endloop\n  endfacet\n\
+endsolid tetra\n";
+
+#[test]
+fn hand_written_ascii_stl() {
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["tetra.stl", "tetra.txt"] {
+        let path = dir.path().join(name);
+        std::fs::write(&path, ASCII_STL).unwrap();
+        let mesh = read_mesh(&path).unwrap();
+        assert_eq!(
+            mesh.vertices,
+            vec![
+                [0., 0., 0.],
+                [0., 1., 0.],
+                [1., 0., 0.],
+                [0., 0., 1.],
+                [0., 0., 0.15]
+            ],
+            "{name}"
+        );
+        assert_eq!(
+            faces(&mesh),
+            [[0, 1, 2], [0, 2, 3], [0, 3, 1], [2, 1, 4]],
+            "{name}"
+        );
+        assert_eq!(mesh.normals, None);
+    }
+}
+
+#[test]
+fn stl_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let (vertices, triangles) = grid_with_hole();
+    let path = dir.path().join("cut.stl");
+    write_mesh(&path, &vertices, &triangles).unwrap();
+    let bytes = std::fs::read(&path).unwrap();
+    std::fs::write(&path, &bytes[..84 + 50 * 7 + 31]).unwrap();
+    let e = error(&path);
+    assert!(e.starts_with(&path.display().to_string()), "{e}");
+    assert!(
+        e.ends_with(&format!(
+            "binary STL truncated: the header declares {} triangles ({} bytes), the file has {} \
+             bytes and ends in triangle 7",
+            triangles.len(),
+            84 + 50 * triangles.len(),
+            84 + 50 * 7 + 31
+        )),
+        "{e}"
+    );
+
+    let bad = dir.path().join("bad.stl");
+    std::fs::write(
+        &bad,
+        ASCII_STL.replace("vertex 0 0 1\n    endloop", "vertex 0 0\n    endloop"),
+    )
+    .unwrap();
+    let e = error(&bad);
+    assert!(
+        e.ends_with("line 13: a vertex needs x, y and z, found 2 value(s)"),
+        "{e}"
+    );
+    std::fs::write(&bad, ASCII_STL.replace("outer loop", "outer")).unwrap();
+    assert!(error(&bad).ends_with("line 3: expected 'outer loop', found 'outer'"));
+}
+
+/// A glTF with an embedded buffer: a unit right triangle (u16 indices) as
+/// mesh 0, placed by a parent node (translation) and a child node (scale),
+/// and instanced again under a mirroring matrix.
+fn transformed_gltf(mode: u32) -> String {
+    let mut bin = Vec::new();
+    for p in [[0f32, 0., 0.], [1., 0., 0.], [0., 1., 0.]] {
+        for c in p {
+            bin.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    for i in [0u16, 1, 2, 0] {
+        bin.extend_from_slice(&i.to_le_bytes()); // the last one is padding
+    }
+    let data = base64::engine::general_purpose::STANDARD.encode(&bin);
+    format!(
+        r#"{{
+  "asset": {{"version": "2.0"}},
+  "scene": 0,
+  "scenes": [{{"nodes": [0, 2, 3]}}],
+  "nodes": [
+    {{"name": "parent", "translation": [10, 20, 30], "children": [1]}},
+    {{"name": "child", "scale": [2, 3, 4], "translation": [1, 0, 0], "mesh": 0}},
+    {{"name": "mirror", "matrix": [-1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1], "mesh": 0}},
+    {{"name": "turn", "rotation": [0, 0, 0.70710677, 0.70710677], "mesh": 0}}
+  ],
+  "meshes": [{{"name": "tri", "primitives": [{{"attributes": {{"POSITION": 0}}, "indices": 1, "mode": {mode}}}]}}],
+  "accessors": [
+    {{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0,0,0], "max": [1,1,0]}},
+    {{"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"}}
+  ],
+  "bufferViews": [
+    {{"buffer": 0, "byteOffset": 0, "byteLength": 36}},
+    {{"buffer": 0, "byteOffset": 36, "byteLength": 6}}
+  ],
+  "buffers": [{{"byteLength": {len}, "uri": "data:application/octet-stream;base64,{data}"}}]
+}}"#,
+        len = bin.len()
+    )
+}
+
+#[test]
+fn gltf_node_transforms_are_applied() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("placed.gltf");
+    std::fs::write(&path, transformed_gltf(4)).unwrap();
+    let mesh = read_mesh(&path).unwrap();
+    // Child: scale (2, 3, 4) then translation (1, 0, 0), then the parent's
+    // translation (10, 20, 30).
+    assert_eq!(
+        mesh.vertices[..3],
+        [[11., 20., 30.], [13., 20., 30.], [11., 23., 30.]]
+    );
+    // The mirror: x negated, and the winding reversed to keep the front.
+    assert_eq!(
+        mesh.vertices[3..6],
+        [[0., 0., 0.], [-1., 0., 0.], [0., 1., 0.]]
+    );
+    // The quarter turn about z takes x to y and y to -x.
+    let turned = [[0., 0., 0.], [0., 1., 0.], [-1., 0., 0.]];
+    for (got, want) in mesh.vertices[6..].iter().zip(turned) {
+        assert!((0..3).all(|k| (got[k] - want[k]).abs() < 1e-7), "{got:?}");
+    }
+    assert_eq!(faces(&mesh), [[0, 1, 2], [3, 5, 4], [6, 7, 8]]);
+}
+
+#[test]
+fn gltf_buffer_beside_the_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = transformed_gltf(4);
+    let uri_start = text.find("data:").unwrap();
+    let uri_end = uri_start + text[uri_start..].find('"').unwrap();
+    let data = text[uri_start..uri_end].split_once(',').unwrap().1;
+    let bin = base64::engine::general_purpose::STANDARD
+        .decode(data)
+        .unwrap();
+    std::fs::write(dir.path().join("tri angle.bin"), bin).unwrap();
+    let path = dir.path().join("beside.gltf");
+    std::fs::write(
+        &path,
+        format!("{}tri%20angle.bin{}", &text[..uri_start], &text[uri_end..]),
+    )
+    .unwrap();
+    let mesh = read_mesh(&path).unwrap();
+    assert_eq!(mesh.vertices.len(), 9);
+
+    std::fs::remove_file(dir.path().join("tri angle.bin")).unwrap();
+    let e = error(&path);
+    assert!(e.contains("buffer 0: cannot read"), "{e}");
+    assert!(e.contains("tri angle.bin"), "{e}");
+}
+
+#[test]
+fn gltf_errors() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("lines.gltf");
+    std::fs::write(&path, transformed_gltf(1)).unwrap();
+    let e = error(&path);
+    assert!(
+        e.ends_with(
+            "node 1, mesh 0 'tri', primitive 0: mode LINES is not supported, only TRIANGLES"
+        ),
+        "{e}"
+    );
+
+    let path = dir.path().join("short.gltf");
+    let text = transformed_gltf(4).replace(
+        r#""count": 3, "type": "SCALAR""#,
+        r#""count": 6, "type": "SCALAR""#,
+    );
+    std::fs::write(&path, text).unwrap();
+    let e = error(&path);
+    assert!(
+        e.ends_with(
+            "accessor 1 (indices): 6 elements from byte 0 do not fit in buffer view 1 (6 bytes)"
+        ),
+        "{e}"
+    );
+
+    let path = dir.path().join("broken.glb");
+    std::fs::write(&path, b"glTF\x02\0\0\0junk").unwrap();
+    assert!(error(&path).contains("malformed glTF"));
+}
+
+#[test]
+fn obj_and_ply_face_index_out_of_range() {
+    let dir = tempfile::tempdir().unwrap();
+    let obj = dir.path().join("bad.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 3 7\n").unwrap();
+    assert!(error(&obj).ends_with("triangle 1 refers to vertex 7, but there are only 3 vertices"));
+
+    let ply = dir.path().join("bad.ply");
+    std::fs::write(
+        &ply,
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+         property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n\
+         0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 2 5\n",
+    )
+    .unwrap();
+    assert!(error(&ply).ends_with("triangle 1 refers to vertex 5, but there are only 3 vertices"));
+}
+
+/// PLY files as Poisson reconstruction (`value`) and MeshLab (`quality`)
+/// write them: extra vertex properties are skipped.
+#[test]
+fn ply_extra_vertex_properties_are_ignored() {
+    let dir = tempfile::tempdir().unwrap();
+    let (vertices, triangles) = grid_with_hole();
+    let header = |format: &str| {
+        format!(
+            "ply\nformat {format} 1.0\ncomment generated like PoissonRecon / MeshLab\n\
+             element vertex {}\nproperty float x\nproperty float y\nproperty float z\n\
+             property float value\nproperty uchar red\nproperty float quality\n\
+             element face {}\nproperty list uchar int vertex_indices\nend_header\n",
+            vertices.len(),
+            triangles.len()
+        )
+    };
+    let mut ascii = header("ascii");
+    let mut binary = header("binary_little_endian").into_bytes();
+    for (i, p) in vertices.iter().enumerate() {
+        let p = p.map(|c| c as f32);
+        let q = p.map(f64::from); // the f32 values, written exactly
+        ascii += &format!(
+            "{} {} {} {} 200 {}\n",
+            q[0],
+            q[1],
+            q[2],
+            i as f32 * 0.5,
+            -1.25
+        );
+        for c in [p[0], p[1], p[2], i as f32 * 0.5] {
+            binary.extend_from_slice(&c.to_le_bytes());
+        }
+        binary.push(200);
+        binary.extend_from_slice(&(-1.25f32).to_le_bytes());
+    }
+    for f in &triangles {
+        ascii += &format!("3 {} {} {}\n", f[0], f[1], f[2]);
+        binary.push(3);
+        for v in f {
+            binary.extend_from_slice(&(*v as i32).to_le_bytes());
+        }
+    }
+    let expected: Vec<Point3> = vertices.iter().map(to_f32).collect();
+    for (name, bytes) in [("ascii.ply", ascii.into_bytes()), ("binary.ply", binary)] {
+        let path = dir.path().join(name);
+        std::fs::write(&path, bytes).unwrap();
+        let mesh = read_mesh(&path).unwrap();
+        assert_eq!(mesh.vertices, expected, "{name}");
+        assert_eq!(faces(&mesh), triangles, "{name}");
+    }
+}
+
+#[test]
+fn unknown_extensions() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("mesh.dat");
+    std::fs::write(&path, "hello\n").unwrap();
+    let e = error(&path);
+    assert!(
+        e.ends_with(
+            "unknown mesh format: the extension 'dat' is not one of ply, obj, stl, gltf, glb, \
+             and the content is not recognised as any of them"
+        ),
+        "{e}"
+    );
+
+    let (vertices, triangles) = grid_with_hole();
+    let out = dir.path().join("mesh.off");
+    let e = format!("{:#}", write_mesh(&out, &vertices, &triangles).unwrap_err());
+    assert!(
+        e.ends_with(
+            "cannot write a mesh as '.off': the extension must be one of obj, ply, stl, glb, gltf"
+        ),
+        "{e}"
+    );
+    // A bad mesh is refused before anything is written.
+    let out = dir.path().join("bad.ply");
+    let e = format!(
+        "{:#}",
+        write_mesh(&out, &vertices, &[[0, 1, 99]]).unwrap_err()
+    );
+    assert!(
+        e.ends_with("triangle 0 refers to vertex 99, but there are only 30 vertices"),
+        "{e}"
+    );
+    assert!(!out.exists());
+}
+
+fn real(rel: &str) -> PathBuf {
+    common::shared_data(rel)
+}
+
+#[test]
+fn real_bunny_reads_and_round_trips() {
+    let mesh = read_mesh(&real("stanford_bunny/bun_zipper.ply")).unwrap();
+    assert_eq!(mesh.vertices.len(), 35_947);
+    assert_eq!(faces(&mesh).len(), 69_451);
+    let dir = tempfile::tempdir().unwrap();
+    for ext in ["obj", "ply", "stl", "glb"] {
+        let path = dir.path().join(format!("bunny.{ext}"));
+        write_mesh(&path, &mesh.vertices, faces(&mesh)).unwrap();
+        let back = read_mesh(&path).unwrap();
+        assert_eq!(faces(&back).len(), 69_451, "{ext}");
+        if ext == "obj" || ext == "ply" {
+            let expected = Mesh {
+                normals: None,
+                ..mesh.clone()
+            };
+            assert!(back == expected, "{ext}: the mesh differs");
+        }
+        if ext == "glb" {
+            let expected: Vec<Point3> = mesh.vertices.iter().map(to_f32).collect();
+            assert!(back.vertices == expected, "glb: positions differ");
+        }
+        if ext == "stl" {
+            // Corner by corner at f32 precision (shared vertices renumbered).
+            let same = faces(&back).iter().zip(faces(&mesh)).all(|(g, w)| {
+                (0..3)
+                    .all(|k| back.vertices[g[k] as usize] == to_f32(&mesh.vertices[w[k] as usize]))
+            });
+            assert!(same, "stl: triangles differ");
+        }
+    }
+}
+
+#[test]
+fn real_meshlab_scan_reads() {
+    let mesh = read_mesh(&real("meshlab_scans/face000.ply")).unwrap();
+    assert_eq!(faces(&mesh).len(), 166_259);
+    let n = mesh.vertices.len();
+    assert!(faces(&mesh).iter().flatten().all(|&v| (v as usize) < n));
+}
