@@ -1,7 +1,8 @@
-"""Measures the density-trimming baseline that meshtrim must beat (a script,
-not a test): for each validation cloud, screened Poisson (PyMeshLab, normals
-from compute_normal_for_point_clouds) and density trimming at the 5 % and
-10 % quantiles of vertex quality; prints a markdown table.
+"""Measures meshtrim's trimming against the density-trimming baseline (a
+script, not a test): for each validation cloud, screened Poisson (PyMeshLab,
+normals from compute_normal_for_point_clouds), density trimming at the 5 %
+and 10 % quantiles of vertex quality, and `meshtrim MESH CLOUD OUT` (binary
+from $MESHTRIM, default target/release/meshtrim); prints a markdown table.
 
     .venv-test/bin/python tests/python/measure_baseline.py [--depth 8] [--seed 1]
 
@@ -15,8 +16,11 @@ from __future__ import annotations
 
 import argparse
 import os
+import subprocess
 import sys
+import tempfile
 import time
+from pathlib import Path
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
@@ -44,6 +48,7 @@ def main():
         for quant in (0.05, 0.10):
             tv, tf = poisson.density_trim(v, f, q, quant)
             rows.append((f"density < {quant:.0%} quantile", tv, tf))
+        rows.append(("meshtrim", *run_meshtrim(cloud, v, f, q)))
         for method, mv, mf in rows:
             m = poisson.border_metrics(mv, mf, cloud)
             print(
@@ -55,6 +60,21 @@ def main():
         if agree not in (0.0, 1.0):
             print(f"<!-- {cloud.name}: estimated normals agree with the truth on {agree:.1%} -->")
         sys.stdout.flush()
+
+
+def run_meshtrim(cloud, v, f, q):
+    """Trims the Poisson mesh with meshtrim; returns its vertices and faces."""
+    root = Path(__file__).resolve().parent.parent.parent
+    binary = os.environ.get("MESHTRIM", str(root / "target" / "release" / "meshtrim"))
+    with tempfile.TemporaryDirectory() as d:
+        d = Path(d)
+        synthetic.write_cloud_ply(d / "cloud.ply", cloud.points, cloud.normals)
+        synthetic.write_mesh_ply(d / "mesh.ply", v, f, quality=q)
+        subprocess.run([binary, d / "mesh.ply", d / "cloud.ply", d / "out.ply"], check=True,
+                       capture_output=True)
+        verts, faces = synthetic.read_ply(d / "out.ply")
+    import numpy as np
+    return np.stack([verts["x"], verts["y"], verts["z"]], axis=1), faces
 
 
 if __name__ == "__main__":
