@@ -74,4 +74,35 @@ pub enum MeshError {
     /// Nothing of the mesh lies where the cloud is.
     #[error("no part of the mesh is supported by the cloud: is the cloud the one the mesh was reconstructed from, in the same units and pose?")]
     Unsupported,
+    /// The cloud is not a height field over its best-fit plane: the
+    /// Delaunay path, which triangulates in that projection, cannot mesh it.
+    #[error("the surface folds over its best-fit plane ({percent:.1}% of the {what} stand on edge or face away from it, at most {limit}% allowed), so a mesh built in that projection would be broken; mesh it with screened Poisson and use `meshtrim MESH CLOUD OUT` instead")]
+    NotAHeightField {
+        /// Share of the offending elements, in percent.
+        percent: f64,
+        /// What was counted: "local normals" or "triangles".
+        what: &'static str,
+        /// Largest accepted share, in percent.
+        limit: f64,
+    },
+    /// A smoothed loop crosses itself in the projection onto the cloud's
+    /// best-fit plane, and removing the twisted stretch would take too much.
+    #[error("smoothed loop {index} crosses itself in the projection onto the best-fit plane (repairing it would drop {dropped} of its {vertices} vertices); the surface may fold over its plane there: mesh it with screened Poisson and use `meshtrim MESH CLOUD OUT` instead")]
+    LoopNotSimple {
+        /// Index of the loop in the edges.
+        index: usize,
+        /// Its vertices.
+        vertices: usize,
+        /// Vertices a repair would have dropped.
+        dropped: usize,
+    },
+    /// Two smoothed loops cross or touch in the projection onto the cloud's
+    /// best-fit plane.
+    #[error("smoothed loops {a} and {b} cross or touch in the projection onto the best-fit plane; the surface may fold over its plane there: mesh it with screened Poisson and use `meshtrim MESH CLOUD OUT` instead")]
+    LoopsCross {
+        /// Index of one loop in the edges.
+        a: usize,
+        /// Index of the other.
+        b: usize,
+    },
 }

@@ -17,6 +17,7 @@
 pub mod anisotropy;
 pub mod bpd;
 pub mod cloud;
+pub mod delaunay;
 pub mod edge_metrics;
 pub mod edges;
 pub mod error;

@@ -1,0 +1,846 @@
+//! The Delaunay path: a mesh built from the cloud itself, bounded by the
+//! smoothed loops (issue 4, "Delaunay path").
+//!
+//! 1. **Projection.** The whole cloud is projected onto its best-fit plane
+//!    (PCA of all points, [`fit_plane`]), in the frame's (u, v) axes
+//!    relative to the first point, which keeps precision for clouds far
+//!    from the origin. Since u × v = n, counter-clockwise in (u, v) is
+//!    counter-clockwise seen from the side the plane normal n points to.
+//! 2. **Height-field check, on the points.** Each point's local normal is
+//!    fitted to its [`NORMAL_K`] nearest neighbours. Where the surface
+//!    stands on edge or folds over its plane, local normals turn
+//!    perpendicular to n; if more than [`STEEP_SHARE`] of the points have
+//!    |nᵢ·n| < [`STEEP_COS`], the cloud is rejected with
+//!    [`MeshError::NotAHeightField`].
+//! 3. **Loops made valid.** Each smoothed loop becomes one closed polyline
+//!    (each open edge without its last point, the next edge's corner), with
+//!    its smoothed 3D positions. In the projection, consecutive vertices
+//!    closer than [`MERGE`]·β are merged, and the loops must be simple and
+//!    must not touch one another: a loop that crosses itself is repaired
+//!    by dropping the vertices of the shorter side of the crossing (a
+//!    twist, or a spike that turns straight back), as long as that takes at
+//!    most [`MAX_REPAIR`] of its vertices (and at least 4 may always go);
+//!    otherwise [`MeshError::LoopNotSimple`]. Two loops that cross or touch
+//!    give [`MeshError::LoopsCross`]. spade's exact predicates check every
+//!    constraint again before it is added (spade panics on crossing
+//!    constraints): what the floating-point repair missed is an error,
+//!    never a panic.
+//! 4. **Which points go in.** A cloud point is inserted when it lies inside
+//!    the loops by parity (inside the outer border, outside the holes; with
+//!    several outer loops, each patch) and farther than [`EXCLUDE`]·βᵢ from
+//!    every loop. Points closer to a loop are left out: the loop vertices
+//!    stand for the border there, and a point next to a constraint would
+//!    only make a sliver (or, on it, split the constraint and change the
+//!    border's vertex sequence). Points that coincide in 2D are merged by
+//!    spade (the first kept).
+//! 5. **Constrained Delaunay triangulation** (spade, exact predicates): the
+//!    points are bulk-loaded, then every loop's vertices are inserted and
+//!    its segments added as constraint edges.
+//! 6. **Kept faces.** The faces are classified exactly by a flood fill from
+//!    the outside that flips parity across every constraint edge: odd faces
+//!    (inside the outer border and outside the holes) are kept. They are
+//!    lifted back to 3D: cloud points keep their exact coordinates, loop
+//!    vertices take their smoothed 3D positions. Faces are
+//!    counter-clockwise seen from the plane normal's side; so the outer
+//!    border runs counter-clockwise and holes clockwise.
+//! 7. **Height-field check, on the triangles.** A lifted counter-clockwise
+//!    triangle can never be flipped relative to n (its normal's component
+//!    along n is its projected area), so folds show instead as triangles
+//!    joining the overlapping sheets, steep to the surface: a triangle is a
+//!    misfit when the mean |n_t·nᵥ| over its vertices' local normals is
+//!    below [`MISFIT_COS`]; more than [`MISFIT_SHARE`] of misfits gives
+//!    [`MeshError::NotAHeightField`].
+//!
+//! Degenerate faces: a projected Delaunay triangle has a positive area and
+//! its lift is never smaller, so no face has zero area. Slivers are
+//! prevented (points near loops left out, coincident loop vertices merged)
+//! rather than removed, since removing a face would open a hole; faces
+//! below [`DEGENERATE`]·β² (β the median resolution) are counted in the
+//! report, not removed.
+
+use rayon::prelude::*;
+use spade::handles::{FixedFaceHandle, FixedVertexHandle, InnerTag};
+use spade::{
+    ConstrainedDelaunayTriangulation, HasPosition, Intersection, LineIntersectionIterator, Point2,
+    PositionInTriangulation, Triangulation,
+};
+
+use crate::bpd::Detection;
+use crate::cloud::{cross, dot, norm2, sub, Point3};
+use crate::edges::Edges;
+use crate::error::MeshError;
+use crate::frame::fit_plane;
+use crate::mesh::Mesh;
+use crate::neighbours::NeighbourIndex;
+
+/// Neighbourhood size of the local normals of the height-field check.
+pub const NORMAL_K: usize = 30;
+/// A local normal with |nᵢ·n| below this stands on edge over the plane.
+pub const STEEP_COS: f64 = 0.1;
+/// Largest accepted share of such points.
+pub const STEEP_SHARE: f64 = 0.01;
+/// A triangle whose normal makes a mean |n_t·nᵥ| below this with its
+/// vertices' local normals does not follow the surface.
+pub const MISFIT_COS: f64 = 0.5;
+/// Largest accepted share of such triangles.
+pub const MISFIT_SHARE: f64 = 0.01;
+/// Cloud points closer to a loop than this many local resolutions β are
+/// left out.
+pub const EXCLUDE: f64 = 0.1;
+/// Consecutive loop vertices closer than this many β (in 2D) are merged.
+pub const MERGE: f64 = 1e-6;
+/// Largest share of a loop's vertices that untwisting it may drop.
+pub const MAX_REPAIR: f64 = 0.05;
+/// Faces smaller than this many β² are counted as degenerate.
+pub const DEGENERATE: f64 = 1e-12;
+
+/// What the Delaunay path did.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct DelaunayReport {
+    /// Cloud points given.
+    pub points_in: usize,
+    /// Cloud points that are vertices of the output.
+    pub points_used: usize,
+    /// Cloud points outside the loops (beyond the border or in holes).
+    pub points_outside: usize,
+    /// Cloud points left out for lying within [`EXCLUDE`]·β of a loop.
+    pub points_near_loop: usize,
+    /// Cloud points merged with another that projects to the same spot.
+    pub points_merged: usize,
+    /// Loop vertices merged with their predecessor (2D coincidence).
+    pub loop_vertices_merged: usize,
+    /// Loop vertices dropped to untwist self-crossing loops.
+    pub loop_vertices_dropped: usize,
+    /// Share of local normals standing on edge (|nᵢ·n| < [`STEEP_COS`]), %.
+    pub steep_normals_percent: f64,
+    /// Share of kept triangles not following the surface, %.
+    pub misfit_triangles_percent: f64,
+    /// Faces below [`DEGENERATE`]·β² (kept, counted).
+    pub degenerate_faces: usize,
+    /// For each smoothed loop, its vertices in the output, in loop order.
+    pub loops: Vec<Vec<u32>>,
+    /// Unit normal of the best-fit plane; faces are counter-clockwise seen
+    /// from its side.
+    pub plane_normal: Point3,
+    /// Area of the output.
+    pub area: f64,
+}
+
+/// Builds a mesh from the cloud itself, bounded by the smoothed loops.
+pub fn delaunay_mesh(
+    cloud: &[Point3],
+    detection: &Detection,
+    edges: &Edges,
+) -> Result<Mesh, MeshError> {
+    delaunay_mesh_with_report(cloud, detection, edges).map(|(mesh, _)| mesh)
+}
+
+/// [`delaunay_mesh`], with what it did.
+pub fn delaunay_mesh_with_report(
+    cloud: &[Point3],
+    detection: &Detection,
+    edges: &Edges,
+) -> Result<(Mesh, DelaunayReport), MeshError> {
+    let n = cloud.len();
+    if let Some(index) = cloud.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+        return Err(MeshError::NonFinite { index });
+    }
+    if n < 3 || detection.beta.len() != n {
+        return Err(MeshError::NoFaces);
+    }
+    let beta = &detection.beta;
+    let beta_median = median(beta);
+    let mut report = DelaunayReport {
+        points_in: n,
+        ..Default::default()
+    };
+
+    // 1. Projection.
+    let all: Vec<u32> = (0..n as u32).collect();
+    let frame = fit_plane(cloud, &all);
+    let plane_normal = frame.normal;
+    report.plane_normal = plane_normal;
+    let origin = cloud[0];
+    let to2 = |p: Point3| {
+        let d = sub(p, origin);
+        [dot(d, frame.u), dot(d, frame.v)]
+    };
+
+    // 2. Local normals, oriented to the plane normal's side.
+    let index = NeighbourIndex::new(cloud);
+    let normals: Vec<Point3> = (0..n)
+        .into_par_iter()
+        .map_init(Vec::new, |nb, i| {
+            index.nearest(i, NORMAL_K, nb);
+            let m = fit_plane(cloud, nb).normal;
+            if dot(m, plane_normal) < 0.0 {
+                m.map(|c| -c)
+            } else {
+                m
+            }
+        })
+        .collect();
+    let steep = normals
+        .iter()
+        .filter(|m| dot(**m, plane_normal) < STEEP_COS)
+        .count();
+    report.steep_normals_percent = 100.0 * steep as f64 / n as f64;
+    if steep as f64 > STEEP_SHARE * n as f64 {
+        return Err(MeshError::NotAHeightField {
+            percent: report.steep_normals_percent,
+            what: "local normals",
+            limit: 100.0 * STEEP_SHARE,
+        });
+    }
+
+    if edges.loops.is_empty() {
+        return Err(MeshError::NoFaces);
+    }
+
+    // 3. Loops as clean 2D rings.
+    let mut rings: Vec<Ring> = edges
+        .loops
+        .iter()
+        .map(|lp| Ring::from_loop(lp, beta))
+        .collect();
+    for ring in rings.iter_mut() {
+        ring.p2 = ring.p3.iter().map(|&p| to2(p)).collect();
+        report.loop_vertices_merged += ring.merge_coincident();
+    }
+    let grid = untwist(&mut rings, beta_median, &mut report)?;
+
+    // 4. Which cloud points go in.
+    let class: Vec<u8> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let p = to2(cloud[i]);
+            if grid.near(p, EXCLUDE * beta[i]) {
+                1
+            } else if grid.parity(p) {
+                0
+            } else {
+                2
+            }
+        })
+        .collect();
+    report.points_near_loop = class.iter().filter(|&&c| c == 1).count();
+    report.points_outside = class.iter().filter(|&&c| c == 2).count();
+    let nodes: Vec<Node> = (0..n)
+        .filter(|&i| class[i] == 0)
+        .map(|i| Node::new(to2(cloud[i]), i as u32))
+        .collect();
+    let inserted = nodes.len();
+
+    // 5. Constrained Delaunay triangulation.
+    let mut cdt: Cdt = if nodes.is_empty() {
+        Cdt::new()
+    } else {
+        Cdt::bulk_load(nodes).map_err(|_| MeshError::NoFaces)?
+    };
+    report.points_merged = inserted - cdt.num_vertices();
+    let mut loop_p3: Vec<Point3> = Vec::new();
+    let mut loop_ref: Vec<u32> = Vec::new();
+    let mut loop_of: Vec<u32> = Vec::new();
+    // The outer borders first: the largest loop by area.
+    let mut order: Vec<usize> = (0..rings.len()).collect();
+    order.sort_by(|&a, &b| rings[b].area().abs().total_cmp(&rings[a].area().abs()));
+    let mut ring_handles = vec![Vec::new(); rings.len()];
+    for &l in &order {
+        let ring = &rings[l];
+        let mut hs = Vec::with_capacity(ring.p2.len());
+        for j in 0..ring.p2.len() {
+            let id = (n + loop_p3.len()) as u32;
+            let position = point(ring.p2[j]);
+            match cdt.locate(position) {
+                PositionInTriangulation::OnVertex(h) => {
+                    return Err(crossing(&cdt, l, cdt.vertex(h).data().id, n, &loop_of));
+                }
+                PositionInTriangulation::OnEdge(e) if cdt.is_constraint_edge(e.as_undirected()) => {
+                    let other = cdt.directed_edge(e).from().data().id;
+                    return Err(crossing(&cdt, l, other, n, &loop_of));
+                }
+                _ => {}
+            }
+            let h = cdt
+                .insert(Node::new(ring.p2[j], id))
+                .map_err(|_| MeshError::NonFinite { index: 0 })?;
+            loop_p3.push(ring.p3[j]);
+            loop_ref.push(ring.reference[j]);
+            loop_of.push(l as u32);
+            hs.push(h);
+        }
+        let m = hs.len();
+        for j in 0..m {
+            let (a, b) = (hs[j], hs[(j + 1) % m]);
+            if let Some(other) = obstacle(&cdt, a, b) {
+                return Err(crossing(&cdt, l, other, n, &loop_of));
+            }
+            cdt.add_constraint(a, b);
+        }
+        ring_handles[l] = hs;
+    }
+
+    // 6. Kept faces, lifted.
+    let kept = inside_faces(&cdt);
+    let mut out_index = vec![u32::MAX; n + loop_p3.len()];
+    let mut faces_ids: Vec<[u32; 3]> = Vec::with_capacity(kept.len());
+    for f in kept {
+        let face = cdt.face(f);
+        let vs = face.vertices();
+        let mut ids = vs.map(|v| v.data().id);
+        let p = vs.map(|v| v.position());
+        let orient = (p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[1].y - p[0].y) * (p[2].x - p[0].x);
+        if orient < 0.0 {
+            ids.swap(1, 2);
+        }
+        faces_ids.push(ids);
+        for id in ids {
+            out_index[id as usize] = 0;
+        }
+    }
+    let mut vertices = Vec::new();
+    let mut reference = Vec::new();
+    for (id, slot) in out_index.iter_mut().enumerate() {
+        if *slot == 0 {
+            *slot = vertices.len() as u32;
+            if id < n {
+                vertices.push(cloud[id]);
+                reference.push(id as u32);
+            } else {
+                vertices.push(loop_p3[id - n]);
+                reference.push(loop_ref[id - n]);
+            }
+        }
+    }
+    report.points_used = out_index[..n].iter().filter(|&&s| s != u32::MAX).count();
+    let mesh = Mesh {
+        vertices,
+        faces: faces_ids
+            .iter()
+            .map(|f| f.map(|id| out_index[id as usize]))
+            .collect(),
+    };
+    report.loops = ring_handles
+        .iter()
+        .map(|hs| {
+            hs.iter()
+                .map(|&h| out_index[cdt.vertex(h).data().id as usize])
+                .collect()
+        })
+        .collect();
+    mesh.validate()?;
+
+    // 7. Triangles against the local normals; degenerate faces.
+    let mut misfits = 0;
+    for face in &mesh.faces {
+        let [a, b, c] = face.map(|v| mesh.vertices[v as usize]);
+        let nt = cross(sub(b, a), sub(c, a));
+        let len = norm2(nt).sqrt();
+        if 0.5 * len <= DEGENERATE * beta_median * beta_median {
+            report.degenerate_faces += 1;
+        }
+        if len == 0.0 {
+            misfits += 1;
+            continue;
+        }
+        let fit: f64 = face
+            .iter()
+            .map(|&v| dot(nt, normals[reference[v as usize] as usize]).abs() / len)
+            .sum::<f64>()
+            / 3.0;
+        if fit < MISFIT_COS {
+            misfits += 1;
+        }
+    }
+    report.misfit_triangles_percent = 100.0 * misfits as f64 / mesh.faces.len() as f64;
+    if misfits as f64 > MISFIT_SHARE * mesh.faces.len() as f64 {
+        return Err(MeshError::NotAHeightField {
+            percent: report.misfit_triangles_percent,
+            what: "triangles",
+            limit: 100.0 * MISFIT_SHARE,
+        });
+    }
+    report.area = mesh.area();
+    Ok((mesh, report))
+}
+
+type Cdt = ConstrainedDelaunayTriangulation<Node>;
+
+/// A triangulation vertex: a cloud point (id < n) or a loop vertex
+/// (id − n into the loop vertices).
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    position: Point2<f64>,
+    id: u32,
+}
+
+impl Node {
+    fn new(p: [f64; 2], id: u32) -> Self {
+        Node {
+            position: point(p),
+            id,
+        }
+    }
+}
+
+impl HasPosition for Node {
+    type Scalar = f64;
+    fn position(&self) -> Point2<f64> {
+        self.position
+    }
+}
+
+/// A spade point; coordinates too small for spade's predicates are zero.
+fn point(p: [f64; 2]) -> Point2<f64> {
+    let flush = |c: f64| {
+        if c.abs() < spade::MIN_ALLOWED_VALUE {
+            0.0
+        } else {
+            c
+        }
+    };
+    Point2::new(flush(p[0]), flush(p[1]))
+}
+
+fn median(values: &[f64]) -> f64 {
+    let mut v: Vec<f64> = values.iter().copied().filter(|b| b.is_finite()).collect();
+    if v.is_empty() {
+        return 1.0;
+    }
+    let mid = v.len() / 2;
+    *v.select_nth_unstable_by(mid, f64::total_cmp).1
+}
+
+/// The error for loop `l` meeting the vertex `other` (a vertex id).
+fn crossing(_cdt: &Cdt, l: usize, other: u32, n: usize, loop_of: &[u32]) -> MeshError {
+    let b = (other as usize)
+        .checked_sub(n)
+        .and_then(|j| loop_of.get(j))
+        .map_or(l, |&b| b as usize);
+    if b == l {
+        MeshError::LoopNotSimple {
+            index: l,
+            vertices: 0,
+            dropped: 0,
+        }
+    } else {
+        MeshError::LoopsCross {
+            a: b.min(l),
+            b: b.max(l),
+        }
+    }
+}
+
+/// What stands in the way of a constraint from `a` to `b`: a constraint
+/// edge it crosses or overlaps, or a vertex it passes through (its id).
+fn obstacle(cdt: &Cdt, a: FixedVertexHandle, b: FixedVertexHandle) -> Option<u32> {
+    if a == b {
+        return Some(cdt.vertex(a).data().id);
+    }
+    for intersection in LineIntersectionIterator::new_from_handles(cdt, a, b) {
+        match intersection {
+            Intersection::EdgeIntersection(e) if e.is_constraint_edge() => {
+                return Some(e.from().data().id)
+            }
+            Intersection::EdgeOverlap(e) if e.is_constraint_edge() => {
+                return Some(e.from().data().id)
+            }
+            Intersection::VertexIntersection(v) if v.fix() != a && v.fix() != b => {
+                return Some(v.data().id)
+            }
+            _ => {}
+        }
+    }
+    None
+}
+
+/// The inner faces with odd parity: a flood fill from the outside that
+/// flips parity across each constraint edge.
+fn inside_faces(cdt: &Cdt) -> Vec<FixedFaceHandle<InnerTag>> {
+    let mut parity: Vec<Option<bool>> = vec![None; cdt.num_all_faces()];
+    let mut stack = Vec::new();
+    for e in cdt.convex_hull() {
+        for side in [e, e.rev()] {
+            if let Some(inner) = side.face().as_inner() {
+                if parity[inner.fix().index()].is_none() {
+                    let odd = side.is_constraint_edge();
+                    parity[inner.fix().index()] = Some(odd);
+                    stack.push((inner.fix(), odd));
+                }
+            }
+        }
+    }
+    while let Some((f, odd)) = stack.pop() {
+        for e in cdt.face(f).adjacent_edges() {
+            if let Some(next) = e.rev().face().as_inner() {
+                if parity[next.fix().index()].is_none() {
+                    let p = odd ^ e.is_constraint_edge();
+                    parity[next.fix().index()] = Some(p);
+                    stack.push((next.fix(), p));
+                }
+            }
+        }
+    }
+    cdt.fixed_inner_faces()
+        .filter(|f| parity[f.index()] == Some(true))
+        .collect()
+}
+
+/// One smoothed loop as a closed polyline.
+struct Ring {
+    p3: Vec<Point3>,
+    p2: Vec<[f64; 2]>,
+    /// The boundary point each vertex was smoothed from.
+    reference: Vec<u32>,
+    beta: Vec<f64>,
+}
+
+impl Ring {
+    fn from_loop(lp: &crate::edges::Loop, beta: &[f64]) -> Self {
+        let n = lp.boundary_points.len().max(1);
+        let mut ring = Ring {
+            p3: Vec::new(),
+            p2: Vec::new(),
+            reference: Vec::new(),
+            beta: Vec::new(),
+        };
+        for (k, edge) in lp.edges.iter().enumerate() {
+            let from = lp.corners.get(k).copied().unwrap_or(0);
+            let take = if edge.closed {
+                edge.points.len()
+            } else {
+                edge.points.len().saturating_sub(1)
+            };
+            for (j, &p) in edge.points.iter().take(take).enumerate() {
+                let r = lp.boundary_points.get((from + j) % n).copied().unwrap_or(0);
+                ring.p3.push(p);
+                ring.reference.push(r);
+                ring.beta.push(beta.get(r as usize).copied().unwrap_or(0.0));
+            }
+        }
+        ring
+    }
+
+    fn len(&self) -> usize {
+        self.p2.len()
+    }
+
+    fn retain(&mut self, keep: &[bool]) {
+        let mut k = keep.iter();
+        self.p3.retain(|_| *k.next().unwrap_or(&true));
+        let mut k = keep.iter();
+        self.p2.retain(|_| *k.next().unwrap_or(&true));
+        let mut k = keep.iter();
+        self.reference.retain(|_| *k.next().unwrap_or(&true));
+        let mut k = keep.iter();
+        self.beta.retain(|_| *k.next().unwrap_or(&true));
+    }
+
+    /// Merges each vertex into its predecessor when they coincide in 2D
+    /// (within [`MERGE`]·β); returns how many went.
+    fn merge_coincident(&mut self) -> usize {
+        let m = self.len();
+        let mut keep = vec![true; m];
+        let mut last = 0;
+        for (j, k) in keep.iter_mut().enumerate().skip(1) {
+            if dist2d(self.p2[j], self.p2[last]) <= MERGE * self.beta[j] {
+                *k = false;
+            } else {
+                last = j;
+            }
+        }
+        // The closing segment.
+        while last > 0 && dist2d(self.p2[last], self.p2[0]) <= MERGE * self.beta[last] {
+            keep[last] = false;
+            last = (0..last).rev().find(|&j| keep[j]).unwrap_or(0);
+        }
+        let dropped = keep.iter().filter(|&&k| !k).count();
+        self.retain(&keep);
+        dropped
+    }
+
+    /// Signed area in 2D (positive counter-clockwise).
+    fn area(&self) -> f64 {
+        let m = self.len();
+        let o = self.p2.first().copied().unwrap_or([0.0; 2]);
+        (0..m)
+            .map(|j| {
+                let (a, b) = (self.p2[j], self.p2[(j + 1) % m]);
+                (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+            })
+            .sum::<f64>()
+            * 0.5
+    }
+}
+
+fn dist2d(a: [f64; 2], b: [f64; 2]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt()
+}
+
+fn orient(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
+    (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+}
+
+/// True if closed segments ab and cd share a point.
+fn segments_meet(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> bool {
+    let (d1, d2) = (orient(c, d, a), orient(c, d, b));
+    let (d3, d4) = (orient(a, b, c), orient(a, b, d));
+    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
+        && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
+    {
+        return true;
+    }
+    let within = |p: [f64; 2], q: [f64; 2], r: [f64; 2]| {
+        r[0] >= p[0].min(q[0])
+            && r[0] <= p[0].max(q[0])
+            && r[1] >= p[1].min(q[1])
+            && r[1] <= p[1].max(q[1])
+    };
+    (d1 == 0.0 && within(c, d, a))
+        || (d2 == 0.0 && within(c, d, b))
+        || (d3 == 0.0 && within(a, b, c))
+        || (d4 == 0.0 && within(a, b, d))
+}
+
+/// Repairs self-crossing loops (see the module doc) and checks that the
+/// loops do not meet; returns the segment grid of the valid loops.
+fn untwist(
+    rings: &mut [Ring],
+    beta_median: f64,
+    report: &mut DelaunayReport,
+) -> Result<SegmentGrid, MeshError> {
+    let original: Vec<usize> = rings.iter().map(Ring::len).collect();
+    let mut dropped = vec![0usize; rings.len()];
+    loop {
+        for (l, ring) in rings.iter().enumerate() {
+            if ring.len() < 3 {
+                return Err(MeshError::LoopNotSimple {
+                    index: l,
+                    vertices: original[l],
+                    dropped: original[l] - ring.len(),
+                });
+            }
+        }
+        let grid = SegmentGrid::new(rings, EXCLUDE * beta_median);
+        let Some((s, t)) = grid.first_crossing() else {
+            report.loop_vertices_dropped += dropped.iter().sum::<usize>();
+            return Ok(grid);
+        };
+        let ((l, i), (k, j)) = (grid.owner[s as usize], grid.owner[t as usize]);
+        if l != k {
+            return Err(MeshError::LoopsCross {
+                a: l.min(k) as usize,
+                b: l.max(k) as usize,
+            });
+        }
+        let l = l as usize;
+        let m = rings[l].len();
+        let (i, j) = (i.min(j) as usize, i.max(j) as usize);
+        // Drop vertices i+1..=j, or j+1..=i round the end: the fewer.
+        let mut keep = vec![true; m];
+        if j - i <= m - (j - i) {
+            keep[i + 1..=j].iter_mut().for_each(|k| *k = false);
+        } else {
+            keep[j + 1..].iter_mut().for_each(|k| *k = false);
+            keep[..=i].iter_mut().for_each(|k| *k = false);
+        }
+        let gone = keep.iter().filter(|&&k| !k).count();
+        dropped[l] += gone;
+        let limit = ((MAX_REPAIR * original[l] as f64) as usize).max(4);
+        if dropped[l] > limit {
+            return Err(MeshError::LoopNotSimple {
+                index: l,
+                vertices: original[l],
+                dropped: dropped[l],
+            });
+        }
+        rings[l].retain(&keep);
+    }
+}
+
+/// The loops' segments in a uniform grid, for parity, proximity and
+/// crossing queries in 2D.
+struct SegmentGrid {
+    a: Vec<[f64; 2]>,
+    b: Vec<[f64; 2]>,
+    /// (loop, index of the segment's first vertex in it).
+    owner: Vec<(u32, u32)>,
+    sizes: Vec<u32>,
+    x0: f64,
+    y0: f64,
+    cell: f64,
+    nx: usize,
+    ny: usize,
+    cells: Vec<Vec<u32>>,
+}
+
+impl SegmentGrid {
+    fn new(rings: &[Ring], min_cell: f64) -> Self {
+        let mut g = SegmentGrid {
+            a: Vec::new(),
+            b: Vec::new(),
+            owner: Vec::new(),
+            sizes: rings.iter().map(|r| r.len() as u32).collect(),
+            x0: 0.0,
+            y0: 0.0,
+            cell: 1.0,
+            nx: 1,
+            ny: 1,
+            cells: Vec::new(),
+        };
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        let mut length = 0.0;
+        for (l, ring) in rings.iter().enumerate() {
+            let m = ring.len();
+            for i in 0..m {
+                let (a, b) = (ring.p2[i], ring.p2[(i + 1) % m]);
+                for c in 0..2 {
+                    lo[c] = lo[c].min(a[c]);
+                    hi[c] = hi[c].max(a[c]);
+                }
+                length += dist2d(a, b);
+                g.a.push(a);
+                g.b.push(b);
+                g.owner.push((l as u32, i as u32));
+            }
+        }
+        let segments = g.a.len();
+        if segments == 0 {
+            g.cells = vec![Vec::new()];
+            return g;
+        }
+        let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]).max(f64::MIN_POSITIVE);
+        let mut cell = (2.0 * length / segments as f64)
+            .max(min_cell)
+            .max(extent * 1e-9);
+        let dims = |cell: f64| {
+            (
+                ((hi[0] - lo[0]) / cell).floor() as usize + 1,
+                ((hi[1] - lo[1]) / cell).floor() as usize + 1,
+            )
+        };
+        while {
+            let (nx, ny) = dims(cell);
+            nx.saturating_mul(ny) > 4 * segments + 16
+        } {
+            cell *= 1.5;
+        }
+        (g.nx, g.ny) = dims(cell);
+        g.x0 = lo[0];
+        g.y0 = lo[1];
+        g.cell = cell;
+        g.cells = vec![Vec::new(); g.nx * g.ny];
+        for s in 0..segments {
+            let (a, b) = (g.a[s], g.b[s]);
+            let (c0, c1) = (g.col(a[0].min(b[0])), g.col(a[0].max(b[0])));
+            let (r0, r1) = (g.row(a[1].min(b[1])), g.row(a[1].max(b[1])));
+            for r in r0..=r1 {
+                for c in c0..=c1 {
+                    g.cells[r * g.nx + c].push(s as u32);
+                }
+            }
+        }
+        g
+    }
+
+    fn col(&self, x: f64) -> usize {
+        (((x - self.x0) / self.cell).floor().max(0.0) as usize).min(self.nx - 1)
+    }
+
+    fn row(&self, y: f64) -> usize {
+        (((y - self.y0) / self.cell).floor().max(0.0) as usize).min(self.ny - 1)
+    }
+
+    /// True if `p` is inside an odd number of loops (ray to +x).
+    fn parity(&self, p: [f64; 2]) -> bool {
+        if self.a.is_empty()
+            || p[1] < self.y0
+            || p[1] > self.y0 + self.cell * self.ny as f64
+            || p[0] > self.x0 + self.cell * self.nx as f64
+        {
+            return false;
+        }
+        let r = self.row(p[1]);
+        let mut odd = false;
+        for c in self.col(p[0])..self.nx {
+            for &s in &self.cells[r * self.nx + c] {
+                let (a, b) = (self.a[s as usize], self.b[s as usize]);
+                if (a[1] > p[1]) != (b[1] > p[1]) {
+                    let t = (p[1] - a[1]) / (b[1] - a[1]);
+                    let x = (a[0] + t * (b[0] - a[0])).clamp(a[0].min(b[0]), a[0].max(b[0]));
+                    if x > p[0] && self.col(x) == c {
+                        odd = !odd;
+                    }
+                }
+            }
+        }
+        odd
+    }
+
+    /// True if a segment passes within `radius` of `p`.
+    fn near(&self, p: [f64; 2], radius: f64) -> bool {
+        if self.a.is_empty() {
+            return false;
+        }
+        let (c0, c1) = (self.col(p[0] - radius), self.col(p[0] + radius));
+        let (r0, r1) = (self.row(p[1] - radius), self.row(p[1] + radius));
+        for r in r0..=r1 {
+            for c in c0..=c1 {
+                for &s in &self.cells[r * self.nx + c] {
+                    let (a, b) = (self.a[s as usize], self.b[s as usize]);
+                    let ab = [b[0] - a[0], b[1] - a[1]];
+                    let len2 = ab[0] * ab[0] + ab[1] * ab[1];
+                    let t = if len2 > 0.0 {
+                        (((p[0] - a[0]) * ab[0] + (p[1] - a[1]) * ab[1]) / len2).clamp(0.0, 1.0)
+                    } else {
+                        0.0
+                    };
+                    let q = [a[0] + t * ab[0], a[1] + t * ab[1]];
+                    if dist2d(p, q) < radius {
+                        return true;
+                    }
+                }
+            }
+        }
+        false
+    }
+
+    /// Some pair of segments that meet other than at their shared vertex
+    /// (or that share one and turn straight back).
+    fn first_crossing(&self) -> Option<(u32, u32)> {
+        for cell in &self.cells {
+            for (x, &s) in cell.iter().enumerate() {
+                for &t in &cell[x + 1..] {
+                    let (ls, is) = self.owner[s as usize];
+                    let (lt, it) = self.owner[t as usize];
+                    let (sa, sb) = (self.a[s as usize], self.b[s as usize]);
+                    let (ta, tb) = (self.a[t as usize], self.b[t as usize]);
+                    if ls == lt {
+                        let m = self.sizes[ls as usize];
+                        let (first, second) = if (is + 1) % m == it {
+                            ((sa, sb), (ta, tb))
+                        } else if (it + 1) % m == is {
+                            ((ta, tb), (sa, sb))
+                        } else {
+                            if segments_meet(sa, sb, ta, tb) {
+                                return Some((s, t));
+                            }
+                            continue;
+                        };
+                        // Adjacent: a spike turns straight back.
+                        let (p, q, r) = (first.0, first.1, second.1);
+                        let back = (q[0] - p[0]) * (r[0] - q[0]) + (q[1] - p[1]) * (r[1] - q[1]);
+                        if m > 3 && orient(p, q, r) == 0.0 && back < 0.0 {
+                            return Some((s, t));
+                        }
+                        continue;
+                    }
+                    if segments_meet(sa, sb, ta, tb) {
+                        return Some((s, t));
+                    }
+                }
+            }
+        }
+        None
+    }
+}

@@ -1,0 +1,228 @@
+//! The Delaunay path on synthetic clouds with ground truth: a mesh built
+//! from the cloud itself, bounded by the smoothed loops. Run with
+//! `--nocapture` for the numbers.
+
+use std::collections::HashSet;
+
+use trim::delaunay::{delaunay_mesh, delaunay_mesh_with_report, DelaunayReport};
+use trim::edges::{reconstruct_edges, EdgeOptions};
+use trim::evaluate::BoundaryIndex;
+use trim::mesh::Mesh;
+use trim::synthetic::{self, SyntheticCloud};
+use trim::{detect_boundary, BpdOptions, MeshError, Point3};
+
+fn meshed(points: &[Point3]) -> Result<(Mesh, DelaunayReport), MeshError> {
+    let detection = detect_boundary(points, &BpdOptions::default()).unwrap();
+    let edges = reconstruct_edges(points, &detection, &EdgeOptions::default());
+    delaunay_mesh_with_report(points, &detection, &edges)
+}
+
+/// Area of the true surface: the midpoint rule over a fine grid of the
+/// parameter domain, |S_u × S_v| du dv on the cells whose centre is inside.
+fn true_area(cloud: &SyntheticCloud, step: f64) -> f64 {
+    let (lo, hi) = cloud.region.bounds();
+    let mut area = 0.0;
+    let mut u = lo[0] + step / 2.0;
+    while u < hi[0] {
+        let mut v = lo[1] + step / 2.0;
+        while v < hi[1] {
+            if cloud.region.contains([u, v]) {
+                let (a, b) = cloud.surface.tangents([u, v]);
+                let n = [
+                    a[1] * b[2] - a[2] * b[1],
+                    a[2] * b[0] - a[0] * b[2],
+                    a[0] * b[1] - a[1] * b[0],
+                ];
+                area += (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt() * step * step;
+            }
+            v += step;
+        }
+        u += step;
+    }
+    area
+}
+
+/// True if `a` is `b` rotated, in either direction.
+fn same_cycle(a: &[u32], b: &[u32]) -> bool {
+    if a.len() != b.len() || a.is_empty() {
+        return a.len() == b.len();
+    }
+    let Some(start) = b.iter().position(|&x| x == a[0]) else {
+        return false;
+    };
+    let m = a.len();
+    let forward = (0..m).all(|j| a[j] == b[(start + j) % m]);
+    let backward = (0..m).all(|j| a[j] == b[(start + m - j) % m]);
+    forward || backward
+}
+
+/// Checks one case; returns the failures.
+fn check(cloud: &SyntheticCloud, truth_area: f64) -> Vec<String> {
+    let name = &cloud.name;
+    let (mesh, report) = match meshed(&cloud.points) {
+        Ok(r) => r,
+        Err(e) => return vec![format!("{name}: {e}")],
+    };
+    let mut failures = Vec::new();
+    let h = cloud.spacing.iter().sum::<f64>() / cloud.len() as f64;
+    let truth = BoundaryIndex::new(cloud);
+    let loops = mesh.boundary_loops();
+    let border: Vec<f64> = loops
+        .iter()
+        .flatten()
+        .map(|&v| truth.distance(mesh.vertices[v as usize]) / h)
+        .collect();
+    let mean = border.iter().sum::<f64>() / border.len().max(1) as f64;
+    let max = border.iter().copied().fold(0.0, f64::max);
+    let area_error = mesh.area() / truth_area - 1.0;
+    let n = report.plane_normal;
+    let mut flipped = 0;
+    let mut min_area = f64::INFINITY;
+    for f in 0..mesh.faces.len() {
+        min_area = min_area.min(mesh.face_area(f));
+        let [a, b, c] = mesh.faces[f].map(|i| mesh.vertices[i as usize]);
+        let (e1, e2) = (
+            [0, 1, 2].map(|k| b[k] - a[k]),
+            [0, 1, 2].map(|k| c[k] - a[k]),
+        );
+        let normal = [
+            e1[1] * e2[2] - e1[2] * e2[1],
+            e1[2] * e2[0] - e1[0] * e2[2],
+            e1[0] * e2[1] - e1[1] * e2[0],
+        ];
+        if normal[0] * n[0] + normal[1] * n[1] + normal[2] * n[2] <= 0.0 {
+            flipped += 1;
+        }
+    }
+    let distinct: HashSet<[u64; 3]> = mesh.vertices.iter().map(|p| p.map(f64::to_bits)).collect();
+    eprintln!(
+        "{name}: {} points, {} faces, {} loops (truth {}), border→truth mean {mean:.3} max {max:.3} spacings, \
+         area {:.1} vs {truth_area:.1} ({:+.2} %), smallest face {:.2e} h², \
+         steep normals {:.2} %, misfit triangles {:.2} %, points used {} / outside {} / near loops {} / merged {}, \
+         loop vertices merged {} dropped {}",
+        cloud.len(),
+        mesh.faces.len(),
+        loops.len(),
+        cloud.boundary.len(),
+        mesh.area(),
+        100.0 * area_error,
+        min_area / (h * h),
+        report.steep_normals_percent,
+        report.misfit_triangles_percent,
+        report.points_used,
+        report.points_outside,
+        report.points_near_loop,
+        report.points_merged,
+        report.loop_vertices_merged,
+        report.loop_vertices_dropped,
+    );
+    if mesh.validate().is_err() {
+        failures.push(format!("{name}: invalid mesh"));
+    }
+    if loops.len() != cloud.boundary.len() {
+        failures.push(format!(
+            "{name}: {} border loops, expected {}",
+            loops.len(),
+            cloud.boundary.len()
+        ));
+    }
+    let unmatched = report
+        .loops
+        .iter()
+        .filter(|l| !loops.iter().any(|b| same_cycle(l, b)))
+        .count();
+    if unmatched > 0 || report.loops.len() != loops.len() {
+        failures.push(format!(
+            "{name}: {unmatched} smoothed loops are not border loops of the mesh"
+        ));
+    }
+    if mean > 0.3 || max > 2.0 {
+        failures.push(format!("{name}: border mean {mean:.3}, max {max:.3}"));
+    }
+    if area_error.abs() > 0.03 {
+        failures.push(format!("{name}: area off by {:.2} %", 100.0 * area_error));
+    }
+    if !mesh.is_edge_manifold() {
+        failures.push(format!("{name}: not edge-manifold"));
+    }
+    if min_area <= 1e-12 * h * h || report.degenerate_faces > 0 {
+        failures.push(format!("{name}: degenerate faces"));
+    }
+    if flipped > 0 {
+        failures.push(format!("{name}: {flipped} faces flipped"));
+    }
+    if distinct.len() != mesh.vertices.len() {
+        failures.push(format!("{name}: duplicate vertices"));
+    }
+    failures
+}
+
+#[test]
+fn notched_plate_is_meshed_within_its_smoothed_loops() {
+    let cloud = synthetic::notched_plate(1.0, 2);
+    let h = 1.0;
+    let area = (60.0 * 40.0 - 15.0 * 15.0 - std::f64::consts::PI * 25.0) * h * h;
+    let failures = check(&cloud, area);
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+#[test]
+fn curved_disc_with_hole_is_meshed_within_its_smoothed_loops() {
+    let cloud = synthetic::curved_disc_with_hole(1.5, 3);
+    let area = true_area(&cloud, 0.1);
+    let failures = check(&cloud, area);
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+#[test]
+fn blade_is_meshed_within_its_smoothed_loops() {
+    let cloud = synthetic::blade(8.0, 11);
+    let area = true_area(&cloud, 0.5);
+    let failures = check(&cloud, area);
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+#[test]
+fn far_from_the_origin_gives_the_same_mesh() {
+    let cloud = synthetic::notched_plate(1.0, 2);
+    let shifted: Vec<Point3> = cloud
+        .points
+        .iter()
+        .map(|p| [p[0] + 1e5, p[1] - 2e5, p[2] + 3e5])
+        .collect();
+    let (a, _) = meshed(&cloud.points).unwrap();
+    let (b, _) = meshed(&shifted).unwrap();
+    assert_eq!(a.faces.len(), b.faces.len());
+    assert!((a.area() - b.area()).abs() < 1e-6 * a.area());
+}
+
+/// A cylinder patch over 300° of arc folds over any plane.
+#[test]
+fn a_folded_surface_is_not_a_height_field() {
+    let (radius, length, h) = (20.0, 60.0, 1.0);
+    let arc = 300f64.to_radians();
+    let (na, nz) = ((radius * arc / h) as usize, (length / h) as usize);
+    let mut points = Vec::new();
+    for i in 0..=na {
+        for j in 0..=nz {
+            // A small deterministic jitter, so the grid is not degenerate.
+            let wobble = ((i * 7 + j * 13) % 11) as f64 / 11.0 - 0.5;
+            let t = (i as f64 + 0.2 * wobble) * h / radius;
+            let z = (j as f64 + 0.2 * wobble) * h;
+            if t <= arc {
+                points.push([radius * t.cos(), radius * t.sin(), z]);
+            }
+        }
+    }
+    let detection = detect_boundary(&points, &BpdOptions::default()).unwrap();
+    let edges = reconstruct_edges(&points, &detection, &EdgeOptions::default());
+    let result = delaunay_mesh(&points, &detection, &edges);
+    eprintln!("folded cylinder: {result:?}");
+    match result {
+        Err(e @ MeshError::NotAHeightField { .. }) => {
+            let message = e.to_string();
+            assert!(message.contains("screened Poisson"), "{message}");
+        }
+        other => panic!("expected NotAHeightField, got {other:?}"),
+    }
+}
