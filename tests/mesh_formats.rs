@@ -457,3 +457,25 @@ fn real_meshlab_scan_reads() {
     let n = mesh.vertices.len();
     assert!(faces(&mesh).iter().flatten().all(|&v| (v as usize) < n));
 }
+
+/// Every prefix of a valid file (and a few corrupted bytes) gives a result
+/// or an error, never a panic.
+#[test]
+fn damaged_files_never_panic() {
+    let dir = tempfile::tempdir().unwrap();
+    let (vertices, triangles) = grid_with_hole();
+    for ext in ["stl", "glb", "gltf", "ply", "obj"] {
+        let path = dir.path().join(format!("whole.{ext}"));
+        write_mesh(&path, &vertices, &triangles).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        let cut = dir.path().join(format!("cut.{ext}"));
+        for len in (0..bytes.len()).step_by(11) {
+            std::fs::write(&cut, &bytes[..len]).unwrap();
+            let _ = read_mesh(&cut);
+            let mut flipped = bytes.clone();
+            flipped[len] ^= 0x5a;
+            std::fs::write(&cut, &flipped).unwrap();
+            let _ = read_mesh(&cut);
+        }
+    }
+}

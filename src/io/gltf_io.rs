@@ -45,7 +45,7 @@ pub fn looks_like_json(bytes: &[u8]) -> bool {
 /// Reads the triangles of every mesh instance in a glTF or GLB file.
 /// `dir` is where relative buffer URIs are resolved (the file's directory).
 pub fn read_gltf(bytes: &[u8], dir: &Path) -> Result<Mesh> {
-    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| anyhow!("malformed glTF: {e}"))?;
+    let gltf = parse(bytes)?;
     let buffers = load_buffers(&gltf, dir)?;
     let document = &gltf.document;
 
@@ -96,6 +96,30 @@ pub fn read_gltf(bytes: &[u8], dir: &Path) -> Result<Mesh> {
         bail!("node {n} is in a cycle of the node hierarchy");
     }
     Ok(mesh)
+}
+
+/// Parses and validates the document. The accessor indices of mesh
+/// attributes are checked first, because gltf-json 1.4.1's validation
+/// indexes the `POSITION` accessor without a bounds check (and panics).
+fn parse(bytes: &[u8]) -> Result<gltf::Gltf> {
+    let malformed = |e: gltf::Error| anyhow!("malformed glTF: {e}");
+    let raw = gltf::Gltf::from_slice_without_validation(bytes).map_err(malformed)?;
+    let blob = raw.blob;
+    let json = raw.document.into_json();
+    let accessors = json.accessors.len();
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            let used = primitive.attributes.values().chain(&primitive.indices);
+            if let Some(bad) = used.map(|a| a.value()).find(|&a| a >= accessors) {
+                bail!(
+                    "malformed glTF: mesh {m}, primitive {p} refers to accessor {bad}, \
+                     but there are only {accessors}"
+                );
+            }
+        }
+    }
+    let document = gltf::Document::from_json(json).map_err(malformed)?;
+    Ok(gltf::Gltf { document, blob })
 }
 
 /// The bytes of every buffer, checked against its declared length.
