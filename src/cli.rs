@@ -42,6 +42,35 @@ pub enum Command {
     /// Trim a mesh along its cloud's smoothed boundary (the same as
     /// `meshtrim MESH CLOUD OUT`).
     Trim(TrimArgs),
+    /// Mesh the cloud itself: constrained Delaunay triangulation in its
+    /// best-fit plane, bounded by the smoothed loops (spade).
+    Mesh(MeshArgs),
+}
+
+/// Arguments of `meshtrim mesh`.
+#[derive(Debug, Clone, Args)]
+pub struct MeshArgs {
+    /// Input point cloud (any format `detect` reads).
+    pub cloud: PathBuf,
+    /// The mesh: .obj, .ply (binary), .stl (binary), .gltf or .glb.
+    /// Missing parent directories are created.
+    pub output: PathBuf,
+    /// Also write the report as JSON to this file.
+    #[arg(long, value_name = "FILE.json")]
+    pub report: Option<PathBuf>,
+    /// Neighbourhood size of boundary detection, the point itself included.
+    #[arg(long, default_value_t = 30)]
+    pub k: usize,
+    /// Use the paper's isotropic detection, without the sampling-tensor map.
+    #[arg(long)]
+    pub no_anisotropy: bool,
+    /// Bound the mesh by the smoothed boundary points themselves (the
+    /// paper's edges) instead of the estimated physical edge.
+    #[arg(long)]
+    pub no_offset: bool,
+    /// Print the report as one JSON object.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Arguments of the trimming (`meshtrim MESH CLOUD OUT`).
@@ -128,6 +157,7 @@ pub fn run(cli: Cli) -> Result<()> {
         (Some(Command::Detect(args)), _) => crate::detect::run(&args),
         (Some(Command::Edges(args)), _) => crate::edges::run(&args),
         (Some(Command::Trim(args)), _) | (None, Some(args)) => crate::trim::run(&args),
+        (Some(Command::Mesh(args)), _) => crate::mesh_cmd::run(&args),
         (None, None) => {
             anyhow::bail!("nothing to do: give MESH CLOUD OUT, or a subcommand (see --help)")
         }

@@ -13,4 +13,5 @@ pub mod cli;
 pub mod detect;
 pub mod edges;
 pub mod io;
+pub mod mesh_cmd;
 pub mod trim;

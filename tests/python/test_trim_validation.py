@@ -170,3 +170,30 @@ def test_bunny_base_holes(tmp_path):
     spacing = float(np.median(poisson.cKDTree(pts).query(pts, k=2)[0][:, 1]))
     assert poisson.max_distance_to_cloud(out_v, pts) <= 2.0 * spacing
     assert poisson.is_edge_manifold(of)
+
+
+@pytest.fixture(scope="session", params=sorted(CASES))
+def delaunay_case(request, tmp_path_factory):
+    """One synthetic case meshed by the Delaunay path, `meshtrim mesh`."""
+    cloud = CASES[request.param]()
+    d = tmp_path_factory.mktemp(f"delaunay_{request.param}")
+    cloud_path = d / "cloud.ply"
+    out_path = d / "delaunay.ply"
+    synthetic.write_cloud_ply(cloud_path, cloud.points, cloud.normals)
+    run_meshtrim("mesh", cloud_path, out_path)
+    verts, faces = synthetic.read_ply(out_path)
+    out_v = np.stack([verts["x"], verts["y"], verts["z"]], axis=1)
+    return {"cloud": cloud, "out": (out_v, faces), "metrics": poisson.border_metrics(out_v, faces, cloud)}
+
+
+def test_delaunay_path(delaunay_case):
+    m = delaunay_case["metrics"]
+    v, f = delaunay_case["out"]
+    assert m["loops"] == m["true_loops"], m
+    assert m["border_mean"] <= 0.3 and m["border_max"] <= 2.0, m
+    assert m["truth_to_border_max"] <= 2.0, m
+    assert abs(m["area_ratio"] - 1.0) <= 0.03, m
+    assert m["max_vertex_to_cloud"] <= max(1.0, truth_to_cloud_max(delaunay_case["cloud"])), m
+    assert m["edge_manifold"] and m["degenerate"] == 0, m
+    assert poisson.orientation_consistent(f)
+    assert len(np.unique(v, axis=0)) == len(v)

@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# End-to-end benchmark of the main job: a seeded ~1M-point blade cloud, its
+# screened-Poisson mesh (PyMeshLab, depth 10), then `meshtrim MESH CLOUD OUT`
+# with the time of each stage (from --report) and the peak memory
+# (/usr/bin/time). Uses the test venv (created by scripts/python_env.sh).
+#
+#   bash bench/trim.sh [SPACING_MM]     (default 0.38: about 1.1M points)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+spacing=${1:-0.38}
+bash scripts/python_env.sh >/dev/null
+cargo build --release -q --bin meshtrim
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+.venv-test/bin/python - "$work" "$spacing" <<'PY'
+import sys, time
+sys.path.insert(0, "tests/python")
+import poisson, synthetic
+work, h = sys.argv[1], float(sys.argv[2])
+c = synthetic.blade(h, 1)
+synthetic.write_cloud_ply(f"{work}/cloud.ply", c.points, c.normals)
+t = time.time()
+v, f, q = poisson.reconstruct(c.points, c.normals, depth=10)
+synthetic.write_mesh_ply(f"{work}/mesh.ply", v, f, quality=q)
+print(f"cloud: {len(c.points)} points; Poisson depth 10: {len(f)} triangles in {time.time() - t:.0f} s", flush=True)
+PY
+/usr/bin/time -v ./target/release/meshtrim "$work/mesh.ply" "$work/cloud.ply" "$work/out.ply" \
+    --report "$work/report.json" > "$work/stdout" 2> "$work/time"
+python3 - "$work" <<'PY'
+import json, re, sys
+work = sys.argv[1]
+r = json.load(open(f"{work}/report.json"))
+t = open(f"{work}/time").read()
+peak = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", t).group(1)) / 1024
+wall = re.search(r"Elapsed \(wall clock\) time.*: (.*)", t).group(1)
+print("| faces in | faces out | loops | read ms | detect ms | edges ms | trim ms | write ms | wall | peak MB |")
+print("|---:|---:|---:|---:|---:|---:|---:|---:|---|---:|")
+print(f"| {r['faces_in']} | {r['faces_out']} | {r['loops']} | {r['read_ms']:.0f} | {r['detect_ms']:.0f} "
+      f"| {r['edges_ms']:.0f} | {r['trim_ms']:.0f} | {r['write_ms']:.0f} | {wall} | {peak:.0f} |")
+PY

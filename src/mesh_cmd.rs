@@ -1,0 +1,148 @@
+//! `meshtrim mesh CLOUD OUT`: the Delaunay path. Detect and smooth the
+//! cloud's boundary, triangulate the cloud in its best-fit plane with the
+//! smoothed loops as constraints (spade), lift back, write, report.
+
+use std::time::{Duration, Instant};
+
+use anyhow::{bail, Context, Result};
+use serde::Serialize;
+use trim::delaunay::{delaunay_mesh_with_report, DelaunayReport};
+use trim::edges::{reconstruct_edges, EdgeOptions};
+use trim::BpdOptions;
+
+use crate::cli::MeshArgs;
+use crate::detect::{detect_with_progress, millis};
+use crate::io::atomic::write_atomic;
+use crate::io::mesh_out::{write_mesh, MeshFormat};
+use crate::io::read_cloud;
+
+/// What `mesh` prints and `--report` writes.
+#[derive(Debug, Clone, Serialize)]
+pub struct Report {
+    /// The cloud, as given.
+    pub cloud: String,
+    /// The output, as given.
+    pub output: String,
+    /// Cloud points read.
+    pub points: usize,
+    /// Cloud points that are vertices of the output.
+    pub points_used: usize,
+    /// Cloud points outside the loops (beyond the border or in holes).
+    pub points_outside: usize,
+    /// Cloud points left out for lying right on a loop.
+    pub points_near_loop: usize,
+    /// Smoothed loops used as constraints.
+    pub loops: usize,
+    /// Loop vertices dropped to untwist self-crossing loops.
+    pub loop_vertices_dropped: usize,
+    /// Output faces.
+    pub faces: usize,
+    /// Output area.
+    pub area: f64,
+    /// Time of each stage, in milliseconds.
+    pub read_ms: f64,
+    /// Boundary detection time.
+    pub detect_ms: f64,
+    /// Edge reconstruction time.
+    pub edges_ms: f64,
+    /// Triangulation time.
+    pub mesh_ms: f64,
+    /// Writing time.
+    pub write_ms: f64,
+}
+
+/// Runs `meshtrim mesh`.
+pub fn run(args: &MeshArgs) -> Result<()> {
+    if MeshFormat::from_path(&args.output).is_none() {
+        bail!(
+            "{}: unsupported output format: use .obj, .ply, .stl, .gltf or .glb",
+            args.output.display()
+        );
+    }
+    let started = Instant::now();
+    let cloud = read_cloud(&args.cloud)?;
+    let read_time = started.elapsed();
+    let options = BpdOptions {
+        k: args.k,
+        anisotropy: !args.no_anisotropy,
+    };
+    let started = Instant::now();
+    let detection = detect_with_progress(&cloud.points, &options)
+        .with_context(|| args.cloud.display().to_string())?;
+    let detect_time = started.elapsed();
+    let started = Instant::now();
+    let edge_options = EdgeOptions {
+        offset: !args.no_offset,
+    };
+    let edges = reconstruct_edges(&cloud.points, &detection, &edge_options);
+    let edges_time = started.elapsed();
+    let started = Instant::now();
+    let (mesh, made) = delaunay_mesh_with_report(&cloud.points, &detection, &edges)
+        .with_context(|| args.cloud.display().to_string())?;
+    let mesh_time = started.elapsed();
+    let started = Instant::now();
+    write_mesh(&args.output, &mesh.vertices, &mesh.faces)?;
+    let write_time = started.elapsed();
+    let times = [read_time, detect_time, edges_time, mesh_time, write_time];
+    let report = Report::new(args, cloud.points.len(), mesh.faces.len(), &made, times);
+    if let Some(path) = &args.report {
+        let json = serde_json::to_string_pretty(&report)?;
+        write_atomic(path, |w| w.write_all(json.as_bytes()))?;
+    }
+    if args.json {
+        println!("{}", serde_json::to_string(&report)?);
+    } else {
+        print!("{}", report.table());
+    }
+    Ok(())
+}
+
+impl Report {
+    fn new(
+        args: &MeshArgs,
+        points: usize,
+        faces: usize,
+        made: &DelaunayReport,
+        [read, detect, edges, mesh, write]: [Duration; 5],
+    ) -> Self {
+        Report {
+            cloud: args.cloud.display().to_string(),
+            output: args.output.display().to_string(),
+            points,
+            points_used: made.points_used,
+            points_outside: made.points_outside,
+            points_near_loop: made.points_near_loop,
+            loops: made.loops.len(),
+            loop_vertices_dropped: made.loop_vertices_dropped,
+            faces,
+            area: made.area,
+            read_ms: millis(read),
+            detect_ms: millis(detect),
+            edges_ms: millis(edges),
+            mesh_ms: millis(mesh),
+            write_ms: millis(write),
+        }
+    }
+
+    /// The report as an aligned two-column table.
+    pub fn table(&self) -> String {
+        let rows = [
+            ("cloud", format!("{} ({} points)", self.cloud, self.points)),
+            ("points used", self.points_used.to_string()),
+            ("points outside", self.points_outside.to_string()),
+            ("points on a loop", self.points_near_loop.to_string()),
+            ("loops", self.loops.to_string()),
+            ("faces", self.faces.to_string()),
+            ("area", format!("{:.6}", self.area)),
+            ("read time", format!("{:.1} ms", self.read_ms)),
+            ("detect time", format!("{:.1} ms", self.detect_ms)),
+            ("edges time", format!("{:.1} ms", self.edges_ms)),
+            ("mesh time", format!("{:.1} ms", self.mesh_ms)),
+            ("write time", format!("{:.1} ms", self.write_ms)),
+            ("output", self.output.clone()),
+        ];
+        rows.iter()
+            .map(|(label, value)| format!("{label:<20} {value}\n"))
+            .collect()
+    }
+}
