@@ -253,11 +253,17 @@ pub fn delaunay_mesh_with_report(
             let position = point(ring.p2[j]);
             match cdt.locate(position) {
                 PositionInTriangulation::OnVertex(h) => {
-                    return Err(crossing(&cdt, l, cdt.vertex(h).data().id, n, &loop_of));
+                    return Err(crossing(
+                        l,
+                        ring.len(),
+                        cdt.vertex(h).data().id,
+                        n,
+                        &loop_of,
+                    ));
                 }
                 PositionInTriangulation::OnEdge(e) if cdt.is_constraint_edge(e.as_undirected()) => {
                     let other = cdt.directed_edge(e).from().data().id;
-                    return Err(crossing(&cdt, l, other, n, &loop_of));
+                    return Err(crossing(l, ring.len(), other, n, &loop_of));
                 }
                 _ => {}
             }
@@ -273,7 +279,7 @@ pub fn delaunay_mesh_with_report(
         for j in 0..m {
             let (a, b) = (hs[j], hs[(j + 1) % m]);
             if let Some(other) = obstacle(&cdt, a, b) {
-                return Err(crossing(&cdt, l, other, n, &loop_of));
+                return Err(crossing(l, ring.len(), other, n, &loop_of));
             }
             cdt.add_constraint(a, b);
         }
@@ -412,7 +418,7 @@ fn median(values: &[f64]) -> f64 {
 }
 
 /// The error for loop `l` meeting the vertex `other` (a vertex id).
-fn crossing(_cdt: &Cdt, l: usize, other: u32, n: usize, loop_of: &[u32]) -> MeshError {
+fn crossing(l: usize, vertices: usize, other: u32, n: usize, loop_of: &[u32]) -> MeshError {
     let b = (other as usize)
         .checked_sub(n)
         .and_then(|j| loop_of.get(j))
@@ -420,7 +426,7 @@ fn crossing(_cdt: &Cdt, l: usize, other: u32, n: usize, loop_of: &[u32]) -> Mesh
     if b == l {
         MeshError::LoopNotSimple {
             index: l,
-            vertices: 0,
+            vertices,
             dropped: 0,
         }
     } else {
@@ -842,5 +848,90 @@ impl SegmentGrid {
             }
         }
         None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ring(p2: Vec<[f64; 2]>) -> Ring {
+        Ring {
+            p3: p2.iter().map(|p| [p[0], p[1], 0.0]).collect(),
+            reference: vec![0; p2.len()],
+            beta: vec![1.0; p2.len()],
+            p2,
+        }
+    }
+
+    /// A square of side `s` at `o`, 4·k vertices counter-clockwise.
+    fn square(o: [f64; 2], s: f64, k: usize) -> Vec<[f64; 2]> {
+        let t = |i: usize| s * i as f64 / k as f64;
+        let mut p = Vec::new();
+        p.extend((0..k).map(|i| [o[0] + t(i), o[1]]));
+        p.extend((0..k).map(|i| [o[0] + s, o[1] + t(i)]));
+        p.extend((0..k).map(|i| [o[0] + s - t(i), o[1] + s]));
+        p.extend((0..k).map(|i| [o[0], o[1] + s - t(i)]));
+        p
+    }
+
+    #[test]
+    fn a_small_twist_is_untwisted() {
+        let mut p = square([0.0, 0.0], 10.0, 20);
+        // A bow tie: segments 4→5 and 6→7 cross.
+        p[5] = [3.0, 0.5];
+        p[6] = [2.0, 0.5];
+        let mut rings = vec![ring(p)];
+        let mut report = DelaunayReport::default();
+        let grid = untwist(&mut rings, 1.0, &mut report).unwrap();
+        assert!(grid.first_crossing().is_none());
+        assert_eq!(report.loop_vertices_dropped, 2);
+        assert!(grid.parity([5.0, 5.0]) && !grid.parity([11.0, 5.0]));
+    }
+
+    #[test]
+    fn a_figure_eight_is_not_repaired() {
+        let mut p = square([0.0, 0.0], 10.0, 20);
+        // Swap the top side's x: the loop crosses itself in the middle.
+        for q in p.iter_mut().skip(40).take(20) {
+            q[0] = 10.0 - q[0];
+        }
+        let mut rings = vec![ring(p)];
+        let mut report = DelaunayReport::default();
+        assert!(matches!(
+            untwist(&mut rings, 1.0, &mut report),
+            Err(MeshError::LoopNotSimple { index: 0, .. })
+        ));
+    }
+
+    #[test]
+    fn crossing_loops_are_reported() {
+        let mut rings = vec![
+            ring(square([0.0, 0.0], 10.0, 10)),
+            ring(square([8.0, 8.0], 5.0, 5)),
+        ];
+        let mut report = DelaunayReport::default();
+        assert!(matches!(
+            untwist(&mut rings, 1.0, &mut report),
+            Err(MeshError::LoopsCross { a: 0, b: 1 })
+        ));
+        assert!(MeshError::LoopsCross { a: 0, b: 1 }
+            .to_string()
+            .contains("loops 0 and 1"));
+    }
+
+    #[test]
+    fn parity_sees_holes_and_patches() {
+        let rings = vec![
+            ring(square([0.0, 0.0], 10.0, 10)),
+            ring(square([3.0, 3.0], 4.0, 4)),
+            ring(square([20.0, 0.0], 5.0, 5)),
+        ];
+        let grid = SegmentGrid::new(&rings, 0.1);
+        assert!(grid.parity([1.0, 1.0]));
+        assert!(!grid.parity([5.0, 5.0]));
+        assert!(!grid.parity([15.0, 1.0]));
+        assert!(grid.parity([22.0, 2.0]));
+        assert!(grid.near([10.05, 5.0], 0.1) && !grid.near([10.2, 5.0], 0.1));
     }
 }
