@@ -169,3 +169,39 @@ fn an_output_naming_an_input_is_refused() {
     );
     assert_eq!(std::fs::read(&mesh).unwrap(), before);
 }
+
+#[test]
+fn the_delaunay_path_meshes_the_cloud_and_refuses_a_folded_surface() {
+    let dir = temp_dir();
+    let out = path(dir.path(), "delaunay.ply");
+    let run = meshtrim(&["mesh", CLOUD, out.to_str().unwrap(), "--json"], None);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+    assert_eq!(json["loops"], 4, "{json}");
+    assert!(json["faces"].as_u64().unwrap() > 1000, "{json}");
+    // A cylinder patch covering 300° of arc folds over any plane.
+    let folded = path(dir.path(), "folded.xyz");
+    let text: String = (0..120 * 30)
+        .map(|i| {
+            let (a, z) = (
+                (i % 120) as f64 / 120.0 * 300f64.to_radians(),
+                (i / 120) as f64 * 0.26,
+            );
+            format!("{} {} {}\n", 10.0 * a.cos(), 10.0 * a.sin(), z)
+        })
+        .collect();
+    std::fs::write(&folded, text).unwrap();
+    let out = path(dir.path(), "folded.ply");
+    assert_clean_failure(
+        &meshtrim(
+            &["mesh", folded.to_str().unwrap(), out.to_str().unwrap()],
+            None,
+        ),
+        "folded.xyz",
+    );
+    assert!(!out.exists());
+}
