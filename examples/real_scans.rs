@@ -6,7 +6,7 @@
 use std::path::Path;
 use std::time::Instant;
 
-use trim::edges::cluster::cluster_boundary;
+use trim::edges::{reconstruct_edges, EdgeOptions, Edges};
 use trim::{detect_boundary, BpdOptions, Point3};
 
 /// How to look at a scan: along its best-fit normal, or along an axis.
@@ -48,31 +48,40 @@ fn main() -> anyhow::Result<()> {
     let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data");
     let out = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/img");
     std::fs::create_dir_all(&out)?;
-    println!("| scan | points | boundary points | boundary loops (clusters) | dropped groups | β mean | detect ms | picture |");
-    println!("|---|---:|---:|---:|---:|---:|---:|---|");
+    println!("| scan | points | boundary points | loops | corners | dropped groups | β mean | detect ms | edges ms | picture |");
+    println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---|");
     for &(name, file, view) in SCANS {
         let cloud = meshtrim::io::read_cloud(&data.join(file))?;
         let start = Instant::now();
         let found = detect_boundary(&cloud.points, &BpdOptions::default())?;
         let ms = start.elapsed().as_secs_f64() * 1e3;
-        let clusters = cluster_boundary(&found.boundary, &found.links);
+        let start = Instant::now();
+        let edges = reconstruct_edges(&cloud.points, &found, &EdgeOptions::default());
+        let edges_ms = start.elapsed().as_secs_f64() * 1e3;
+        let corners: usize = edges.loops.iter().map(|l| l.corners.len()).sum();
         let beta = found.beta.iter().sum::<f64>() / found.beta.len() as f64;
         let png = out.join(format!("{name}.png"));
-        draw(&cloud.points, &found.boundary, view, &png)?;
+        draw(&cloud.points, &found.boundary, &edges, view, &png)?;
         println!(
-            "| {file} | {} | {} | {} | {} | {beta:.4} | {ms:.0} | ![{name}](img/{name}.png) |",
+            "| {file} | {} | {} | {} | {corners} | {} | {beta:.4} | {ms:.0} | {edges_ms:.0} | ![{name}](img/{name}.png) |",
             cloud.points.len(),
             found.boundary_count(),
-            clusters.clusters.len(),
-            clusters.dropped_clusters,
+            edges.loops.len(),
+            edges.dropped_clusters,
         );
     }
     Ok(())
 }
 
 /// Draws interior points grey (shaded by depth) and boundary points red,
-/// far points first, to a PNG.
-fn draw(points: &[Point3], boundary: &[bool], view: View, path: &Path) -> anyhow::Result<()> {
+/// far points first, then the smoothed edges as dark blue lines, to a PNG.
+fn draw(
+    points: &[Point3],
+    boundary: &[bool],
+    edges: &Edges,
+    view: View,
+    path: &Path,
+) -> anyhow::Result<()> {
     let (axes, depth_axis) = view_axes(points, view);
     let project = |p: &Point3| {
         let d = |a: &Point3| a[0] * p[0] + a[1] * p[1] + a[2] * p[2];
@@ -116,6 +125,35 @@ fn draw(points: &[Point3], boundary: &[bool], view: View, path: &Path) -> anyhow
                 if (0..width as i64).contains(&cx) && (0..height as i64).contains(&cy) {
                     let at = (cy as usize * width + cx as usize) * 3;
                     rgb[at..at + 3].copy_from_slice(&colour);
+                }
+            }
+        }
+    }
+    let to_pixel = |p: &Point3| {
+        let (x, y, _) = project(p);
+        (
+            20.0 + (x - x0) * scale,
+            height as f64 - 20.0 - (y - y0) * scale,
+        )
+    };
+    for edge in edges.loops.iter().flat_map(|l| &l.edges) {
+        let n = edge.points.len();
+        let segments = if edge.closed { n } else { n.saturating_sub(1) };
+        for i in 0..segments {
+            let (a, b) = (
+                to_pixel(&edge.points[i]),
+                to_pixel(&edge.points[(i + 1) % n]),
+            );
+            let steps = ((b.0 - a.0).abs().max((b.1 - a.1).abs()).ceil() as usize).max(1);
+            for s in 0..=steps {
+                let t = s as f64 / steps as f64;
+                let (x, y) = (
+                    (a.0 + t * (b.0 - a.0)) as i64,
+                    (a.1 + t * (b.1 - a.1)) as i64,
+                );
+                if (0..width as i64).contains(&x) && (0..height as i64).contains(&y) {
+                    let at = (y as usize * width + x as usize) * 3;
+                    rgb[at..at + 3].copy_from_slice(&[20, 40, 140]);
                 }
             }
         }
