@@ -13,8 +13,10 @@
 //!
 //! Thinning: spurs (chains hanging off a boundary), stray boundary points
 //! and isolated points cannot be part of a closed boundary, and a tour
-//! through them would zig-zag. Each cluster keeps the *2-core* of its link
-//! graph: points of degree < 2 are removed until none is left. Clusters with
+//! through them would zig-zag. Links on no cycle of the link graph
+//! (bridges: a chain of stray points joining two boundaries) are removed,
+//! then each cluster keeps the *2-core* of its link graph: points of
+//! degree < 2 are removed until none is left. Clusters with
 //! an empty 2-core (a chain, a lone point) are dropped and counted, and so
 //! are 2-cores of three points: a loop needs four (see [`MIN_LOOP_POINTS`]).
 
@@ -44,8 +46,17 @@ pub fn cluster_boundary(boundary: &[bool], links: &[[u32; 2]]) -> Clusters {
         .copied()
         .filter(|&[a, b]| a != b && boundary[a as usize] && boundary[b as usize])
         .collect();
-    let core = two_core(boundary, &valid);
     let (groups, _) = components(boundary.len(), boundary, &valid);
+    // Links on no cycle (bridges) join separate boundaries through a chain
+    // of stray points; without them the 2-core splits into the loops.
+    let mut valid = valid;
+    let bridges = bridges(boundary.len(), &valid);
+    valid.retain(|l| {
+        bridges
+            .binary_search(&[l[0].min(l[1]), l[0].max(l[1])])
+            .is_err()
+    });
+    let core = two_core(boundary, &valid);
     let dropped_clusters = groups
         .iter()
         .filter(|g| !g.iter().any(|&i| core[i as usize]))
@@ -83,6 +94,58 @@ fn keep_loops(clusters: &mut Vec<Vec<u32>>, links: &mut Vec<Vec<[u32; 2]>>) -> u
     links.retain(|_| *flags.next().expect("one flag per cluster"));
     clusters.retain(|c| c.len() >= MIN_LOOP_POINTS);
     keep.iter().filter(|&&k| !k).count()
+}
+
+/// The bridges of the link graph (links on no cycle), as sorted pairs
+/// (smaller index first). Iterative Tarjan: discovery order and low-links.
+fn bridges(n: usize, links: &[[u32; 2]]) -> Vec<[u32; 2]> {
+    let mut adjacency: Vec<Vec<(u32, usize)>> = vec![Vec::new(); n];
+    for (e, &[a, b]) in links.iter().enumerate() {
+        adjacency[a as usize].push((b, e));
+        adjacency[b as usize].push((a, e));
+    }
+    let mut order = vec![u32::MAX; n];
+    let mut low = vec![0u32; n];
+    let mut counter = 0u32;
+    let mut found = Vec::new();
+    for root in 0..n {
+        if order[root] != u32::MAX || adjacency[root].is_empty() {
+            continue;
+        }
+        // Stack of (vertex, link it was entered by, next neighbour slot).
+        let mut stack: Vec<(usize, usize, usize)> = vec![(root, usize::MAX, 0)];
+        order[root] = counter;
+        low[root] = counter;
+        counter += 1;
+        while let Some(&mut (v, via, ref mut slot)) = stack.last_mut() {
+            if let Some(&(w, e)) = adjacency[v].get(*slot) {
+                *slot += 1;
+                let w = w as usize;
+                if e == via {
+                    continue;
+                }
+                if order[w] == u32::MAX {
+                    order[w] = counter;
+                    low[w] = counter;
+                    counter += 1;
+                    stack.push((w, e, 0));
+                } else {
+                    low[v] = low[v].min(order[w]);
+                }
+            } else {
+                stack.pop();
+                if let Some(&(parent, _, _)) = stack.last() {
+                    low[parent] = low[parent].min(low[v]);
+                    if low[v] > order[parent] {
+                        let (a, b) = (parent as u32, v as u32);
+                        found.push([a.min(b), a.max(b)]);
+                    }
+                }
+            }
+        }
+    }
+    found.sort_unstable();
+    found
 }
 
 /// Marks the points of the 2-core: repeatedly removes points with fewer
@@ -201,6 +264,19 @@ mod tests {
         });
         assert_eq!(c.thinned_points, 6);
         assert_eq!(c.dropped_clusters, 2); // the chain and the lone point
+    }
+
+    #[test]
+    fn two_loops_joined_by_a_chain_are_separated() {
+        let mut links = ring(0, 5);
+        links.extend(ring(5, 6));
+        links.extend([[2, 11], [11, 12], [12, 7]]); // a chain between them
+        let c = cluster_boundary(&[true; 13], &links);
+        assert_eq!(
+            c.clusters,
+            vec![(0..5).collect::<Vec<u32>>(), (5..11).collect()]
+        );
+        assert_eq!(c.thinned_points, 2);
     }
 
     #[test]
