@@ -42,6 +42,7 @@ use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use parry3d_f64::math::Vector;
 use parry3d_f64::query::PointQueryWithLocation;
 use parry3d_f64::shape::TriMesh;
+use rayon::prelude::*;
 
 use crate::bpd::Detection;
 use crate::cloud::{dist2, dot, norm2, sub, Point3};
@@ -108,7 +109,7 @@ pub fn trim_mesh(
     let walls = Walls::new(cloud, detection, edges);
     let mut field: Vec<f64> = mesh
         .vertices
-        .iter()
+        .par_iter()
         .map(|&v| walls.signed_distance(v))
         .collect();
     let mut snapped = 0;
@@ -388,12 +389,21 @@ fn supported_faces(
     let shape = TriMesh::new(vertices, cut.faces.clone()).map_err(|_| MeshError::NoFaces)?;
     let mut hits = vec![0usize; pieces];
     let mut cell_area = vec![0.0f64; pieces];
-    for (p, &b) in cloud.iter().zip(beta) {
-        let query = Vector::new(p[0], p[1], p[2]);
-        if let Some((_, (face, _))) =
-            shape.project_local_point_and_get_location_with_max_dist(query, false, 2.0 * b)
-        {
-            let k = piece[face as usize] as usize;
+    // Each projection is independent: parallel, then summed in cloud order
+    // so the sums do not depend on the thread count.
+    let landed: Vec<Option<u32>> = cloud
+        .par_iter()
+        .zip(beta)
+        .map(|(p, &b)| {
+            let query = Vector::new(p[0], p[1], p[2]);
+            shape
+                .project_local_point_and_get_location_with_max_dist(query, false, 2.0 * b)
+                .map(|(_, (face, _))| face)
+        })
+        .collect();
+    for (face, &b) in landed.iter().zip(beta) {
+        if let Some(face) = face {
+            let k = piece[*face as usize] as usize;
             hits[k] += 1;
             cell_area[k] += 0.75f64.sqrt() * b * b;
         }
