@@ -12,7 +12,7 @@ use trim::{BpdOptions, CloudError, Detection};
 use crate::cli::DetectArgs;
 use crate::io::atomic::write_atomic;
 use crate::io::labels::{LabelFormat, Labelled};
-use crate::io::{read_cloud, Point3};
+use crate::io::{read_cloud, Cloud, Point3};
 
 /// What `detect` prints: the counts and timings of the paper's Table 1.
 #[derive(Debug, Clone, Serialize)]
@@ -55,17 +55,12 @@ pub fn run(args: &DetectArgs) -> Result<()> {
         .as_deref()
         .map(|out| check_output(out, &args.cloud))
         .transpose()?;
-    let started = Instant::now();
-    let cloud = read_cloud(&args.cloud)?;
-    let read_time = started.elapsed();
-    let options = BpdOptions {
-        k: args.k,
-        anisotropy: !args.no_anisotropy,
-    };
-    let started = Instant::now();
-    let detection = detect_with_progress(&cloud.points, &options)
-        .with_context(|| args.cloud.display().to_string())?;
-    let detect_time = started.elapsed();
+    let Detected {
+        cloud,
+        detection,
+        read_time,
+        detect_time,
+    } = read_and_detect(&args.cloud, args.k, args.no_anisotropy)?;
     if let Some((path, format)) = &output {
         write_labels(path, *format, &cloud.points, &detection)?;
     }
@@ -89,11 +84,7 @@ fn check_output(out: &Path, input: &Path) -> Result<(PathBuf, LabelFormat)> {
             out.display()
         );
     };
-    let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
-        (Ok(a), Ok(b)) => a == b,
-        _ => false,
-    };
-    if same(out, input) {
+    if same_file(out, input) {
         bail!("{}: the output would overwrite the input", out.display());
     }
     Ok((out.to_path_buf(), format))
@@ -209,6 +200,45 @@ fn stats(values: &[f64]) -> (f64, f64, f64, f64) {
 }
 
 /// Milliseconds, rounded to 0.1 ms.
+/// A cloud read from a file and its boundary points, with the time of each
+/// step: the start of every command that works from a cloud.
+pub(crate) struct Detected {
+    pub cloud: Cloud,
+    pub detection: Detection,
+    pub read_time: Duration,
+    pub detect_time: Duration,
+}
+
+/// Reads the cloud at `path` and runs BPD on it (with the progress bar),
+/// errors naming the file.
+pub(crate) fn read_and_detect(path: &Path, k: usize, no_anisotropy: bool) -> Result<Detected> {
+    let started = Instant::now();
+    let cloud = read_cloud(path)?;
+    let read_time = started.elapsed();
+    let options = BpdOptions {
+        k,
+        anisotropy: !no_anisotropy,
+    };
+    let started = Instant::now();
+    let detection = detect_with_progress(&cloud.points, &options)
+        .with_context(|| path.display().to_string())?;
+    Ok(Detected {
+        cloud,
+        detection,
+        read_time,
+        detect_time: started.elapsed(),
+    })
+}
+
+/// True when `a` and `b` name the same existing file (an output must never
+/// overwrite an input).
+pub(crate) fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
+}
+
 pub(crate) fn millis(d: Duration) -> f64 {
     (d.as_secs_f64() * 1e4).round() / 10.0
 }

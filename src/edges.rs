@@ -4,16 +4,16 @@
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use serde::Serialize;
 use trim::edges::{reconstruct_edges, EdgeOptions, Edges};
-use trim::{BpdOptions, Detection};
+use trim::Detection;
 
 use crate::cli::EdgesArgs;
-use crate::detect::{detect_with_progress, millis};
+use crate::detect::{millis, read_and_detect, same_file, Detected};
 use crate::io::atomic::write_atomic;
 use crate::io::edges_out::{EdgeData, EdgesFormat};
-use crate::io::{read_cloud, Cloud};
+use crate::io::Cloud;
 
 /// What `edges` prints: the counts of each stage and the timings.
 #[derive(Debug, Clone, Serialize)]
@@ -49,17 +49,12 @@ pub struct Summary {
 pub fn run(args: &EdgesArgs) -> Result<()> {
     // Check the output before the (possibly long) work.
     let format = check_output(&args.output, &args.cloud)?;
-    let started = Instant::now();
-    let cloud = read_cloud(&args.cloud)?;
-    let read_time = started.elapsed();
-    let options = BpdOptions {
-        k: args.k,
-        anisotropy: !args.no_anisotropy,
-    };
-    let started = Instant::now();
-    let detection = detect_with_progress(&cloud.points, &options)
-        .with_context(|| args.cloud.display().to_string())?;
-    let detect_time = started.elapsed();
+    let Detected {
+        cloud,
+        detection,
+        read_time,
+        detect_time,
+    } = read_and_detect(&args.cloud, args.k, args.no_anisotropy)?;
     let started = Instant::now();
     let edge_options = EdgeOptions {
         offset: !args.no_offset,
@@ -91,11 +86,7 @@ fn check_output(out: &Path, input: &Path) -> Result<EdgesFormat> {
             out.display()
         );
     };
-    let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
-        (Ok(a), Ok(b)) => a == b,
-        _ => false,
-    };
-    if same(out, input) {
+    if same_file(out, input) {
         bail!("{}: the output would overwrite the input", out.display());
     }
     Ok(format)

@@ -8,13 +8,11 @@ use anyhow::{bail, Context, Result};
 use serde::Serialize;
 use trim::delaunay::{delaunay_mesh_with_report, DelaunayReport};
 use trim::edges::{reconstruct_edges, EdgeOptions};
-use trim::BpdOptions;
 
 use crate::cli::MeshArgs;
-use crate::detect::{detect_with_progress, millis};
+use crate::detect::{millis, read_and_detect, Detected};
 use crate::io::atomic::write_atomic;
 use crate::io::mesh_out::{write_mesh, MeshFormat};
-use crate::io::read_cloud;
 
 /// What `mesh` prints and `--report` writes.
 #[derive(Debug, Clone, Serialize)]
@@ -59,17 +57,12 @@ pub fn run(args: &MeshArgs) -> Result<()> {
             args.output.display()
         );
     }
-    let started = Instant::now();
-    let cloud = read_cloud(&args.cloud)?;
-    let read_time = started.elapsed();
-    let options = BpdOptions {
-        k: args.k,
-        anisotropy: !args.no_anisotropy,
-    };
-    let started = Instant::now();
-    let detection = detect_with_progress(&cloud.points, &options)
-        .with_context(|| args.cloud.display().to_string())?;
-    let detect_time = started.elapsed();
+    let Detected {
+        cloud,
+        detection,
+        read_time,
+        detect_time,
+    } = read_and_detect(&args.cloud, args.k, args.no_anisotropy)?;
     let started = Instant::now();
     let edge_options = EdgeOptions {
         offset: !args.no_offset,

@@ -11,13 +11,12 @@ use serde::Serialize;
 use trim::edges::{reconstruct_edges, EdgeOptions};
 use trim::mesh::Mesh;
 use trim::trimming::{trim_mesh, LoopFit, TrimReport};
-use trim::BpdOptions;
 
 use crate::cli::TrimArgs;
-use crate::detect::{detect_with_progress, millis};
+use crate::detect::{millis, read_and_detect, same_file, Detected};
 use crate::io::atomic::write_atomic;
 use crate::io::mesh_out::{write_mesh, MeshFormat};
-use crate::io::{read_cloud, read_mesh};
+use crate::io::read_mesh;
 
 /// What the trimming prints and `--report` writes.
 #[derive(Debug, Clone, Serialize)]
@@ -92,16 +91,14 @@ pub fn run(args: &TrimArgs) -> Result<()> {
         vertices: input.vertices,
         faces,
     };
-    let cloud = read_cloud(&args.cloud)?;
-    let read_time = started.elapsed();
-    let options = BpdOptions {
-        k: args.k,
-        anisotropy: !args.no_anisotropy,
-    };
-    let started = Instant::now();
-    let detection = detect_with_progress(&cloud.points, &options)
-        .with_context(|| args.cloud.display().to_string())?;
-    let detect_time = started.elapsed();
+    let mesh_read_time = started.elapsed();
+    let Detected {
+        cloud,
+        detection,
+        read_time,
+        detect_time,
+    } = read_and_detect(&args.cloud, args.k, args.no_anisotropy)?;
+    let read_time = mesh_read_time + read_time;
     let started = Instant::now();
     let edges = reconstruct_edges(
         &cloud.points,
@@ -152,12 +149,9 @@ fn check_paths(args: &TrimArgs) -> Result<()> {
             bail!("{}: the report is JSON: name it .json", report.display());
         }
     }
-    let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
-        (Ok(a), Ok(b)) => a == b,
-        _ => false,
-    };
     for input in [&args.mesh, &args.cloud] {
-        if same(&args.output, input) || args.report.as_deref().is_some_and(|r| same(r, input)) {
+        let overwrites = |out: &Path| same_file(out, input);
+        if overwrites(&args.output) || args.report.as_deref().is_some_and(overwrites) {
             bail!("{}: an output would overwrite this input", input.display());
         }
     }

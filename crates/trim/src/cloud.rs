@@ -31,6 +31,14 @@ impl Sites {
 
 /// Checks that every coordinate is finite and merges exact duplicates.
 pub fn merge_duplicates(points: &[Point3]) -> Result<Sites, CloudError> {
+    // Sites, neighbour lists and k-d tree items are u32 indices.
+    let max = u32::MAX as usize;
+    if points.len() > max {
+        return Err(CloudError::TooManyPoints {
+            count: points.len(),
+            max,
+        });
+    }
     if let Some((index, p)) = points
         .iter()
         .enumerate()

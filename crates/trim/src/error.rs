@@ -21,6 +21,14 @@ pub enum CloudError {
         /// Its coordinates.
         z: f64,
     },
+    /// More points than 32-bit indices address.
+    #[error("the cloud has {count} points; meshtrim indexes points with 32 bits and handles at most {max}")]
+    TooManyPoints {
+        /// Points given.
+        count: usize,
+        /// Largest supported count.
+        max: usize,
+    },
     /// The neighbourhood size is too small for the tests to mean anything.
     #[error("k = {k} is too small: boundary detection needs k >= {min} (the point itself and at least {} neighbours)", min - 1)]
     KTooSmall {
