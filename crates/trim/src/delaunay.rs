@@ -370,18 +370,18 @@ pub fn delaunay_mesh_with_report(
     Ok((mesh, report))
 }
 
-type Cdt = ConstrainedDelaunayTriangulation<Node>;
+pub(crate) type Cdt = ConstrainedDelaunayTriangulation<Node>;
 
 /// A triangulation vertex: a cloud point (id < n) or a loop vertex
 /// (id − n into the loop vertices).
 #[derive(Debug, Clone, Copy)]
-struct Node {
-    position: Point2<f64>,
-    id: u32,
+pub(crate) struct Node {
+    pub(crate) position: Point2<f64>,
+    pub(crate) id: u32,
 }
 
 impl Node {
-    fn new(p: [f64; 2], id: u32) -> Self {
+    pub(crate) fn new(p: [f64; 2], id: u32) -> Self {
         Node {
             position: point(p),
             id,
@@ -397,7 +397,7 @@ impl HasPosition for Node {
 }
 
 /// A spade point; coordinates too small for spade's predicates are zero.
-fn point(p: [f64; 2]) -> Point2<f64> {
+pub(crate) fn point(p: [f64; 2]) -> Point2<f64> {
     let flush = |c: f64| {
         if c.abs() < spade::MIN_ALLOWED_VALUE {
             0.0
@@ -408,7 +408,7 @@ fn point(p: [f64; 2]) -> Point2<f64> {
     Point2::new(flush(p[0]), flush(p[1]))
 }
 
-fn median(values: &[f64]) -> f64 {
+pub(crate) fn median(values: &[f64]) -> f64 {
     let mut v: Vec<f64> = values.iter().copied().filter(|b| b.is_finite()).collect();
     if v.is_empty() {
         return 1.0;
@@ -439,7 +439,7 @@ fn crossing(l: usize, vertices: usize, other: u32, n: usize, loop_of: &[u32]) ->
 
 /// What stands in the way of a constraint from `a` to `b`: a constraint
 /// edge it crosses or overlaps, or a vertex it passes through (its id).
-fn obstacle(cdt: &Cdt, a: FixedVertexHandle, b: FixedVertexHandle) -> Option<u32> {
+pub(crate) fn obstacle(cdt: &Cdt, a: FixedVertexHandle, b: FixedVertexHandle) -> Option<u32> {
     if a == b {
         return Some(cdt.vertex(a).data().id);
     }
@@ -462,7 +462,7 @@ fn obstacle(cdt: &Cdt, a: FixedVertexHandle, b: FixedVertexHandle) -> Option<u32
 
 /// The inner faces with odd parity: a flood fill from the outside that
 /// flips parity across each constraint edge.
-fn inside_faces(cdt: &Cdt) -> Vec<FixedFaceHandle<InnerTag>> {
+pub(crate) fn inside_faces(cdt: &Cdt) -> Vec<FixedFaceHandle<InnerTag>> {
     let mut parity: Vec<Option<bool>> = vec![None; cdt.num_all_faces()];
     let mut stack = Vec::new();
     for e in cdt.convex_hull() {
@@ -493,16 +493,17 @@ fn inside_faces(cdt: &Cdt) -> Vec<FixedFaceHandle<InnerTag>> {
 }
 
 /// One smoothed loop as a closed polyline.
-struct Ring {
-    p3: Vec<Point3>,
-    p2: Vec<[f64; 2]>,
+#[derive(Debug, Clone)]
+pub(crate) struct Ring {
+    pub(crate) p3: Vec<Point3>,
+    pub(crate) p2: Vec<[f64; 2]>,
     /// The boundary point each vertex was smoothed from.
-    reference: Vec<u32>,
-    beta: Vec<f64>,
+    pub(crate) reference: Vec<u32>,
+    pub(crate) beta: Vec<f64>,
 }
 
 impl Ring {
-    fn from_loop(lp: &crate::edges::Loop, beta: &[f64]) -> Self {
+    pub(crate) fn from_loop(lp: &crate::edges::Loop, beta: &[f64]) -> Self {
         let n = lp.boundary_points.len().max(1);
         let mut ring = Ring {
             p3: Vec::new(),
@@ -527,7 +528,7 @@ impl Ring {
         ring
     }
 
-    fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.p2.len()
     }
 
@@ -544,7 +545,7 @@ impl Ring {
 
     /// Merges each vertex into its predecessor when they coincide in 2D
     /// (within [`MERGE`]·β); returns how many went.
-    fn merge_coincident(&mut self) -> usize {
+    pub(crate) fn merge_coincident(&mut self) -> usize {
         let m = self.len();
         let mut keep = vec![true; m];
         let mut last = 0;
@@ -566,7 +567,7 @@ impl Ring {
     }
 
     /// Signed area in 2D (positive counter-clockwise).
-    fn area(&self) -> f64 {
+    pub(crate) fn area(&self) -> f64 {
         let m = self.len();
         let o = self.p2.first().copied().unwrap_or([0.0; 2]);
         (0..m)
@@ -583,12 +584,12 @@ fn dist2d(a: [f64; 2], b: [f64; 2]) -> f64 {
     ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt()
 }
 
-fn orient(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
+pub(crate) fn orient(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
     (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
 }
 
 /// True if closed segments ab and cd share a point.
-fn segments_meet(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> bool {
+pub(crate) fn segments_meet(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> bool {
     let (d1, d2) = (orient(c, d, a), orient(c, d, b));
     let (d3, d4) = (orient(a, b, c), orient(a, b, d));
     if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
@@ -610,7 +611,7 @@ fn segments_meet(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> bool {
 
 /// Repairs self-crossing loops (see the module doc) and checks that the
 /// loops do not meet; returns the segment grid of the valid loops.
-fn untwist(
+pub(crate) fn untwist(
     rings: &mut [Ring],
     beta_median: f64,
     report: &mut DelaunayReport,
@@ -666,7 +667,7 @@ fn untwist(
 
 /// The loops' segments in a uniform grid, for parity, proximity and
 /// crossing queries in 2D.
-struct SegmentGrid {
+pub(crate) struct SegmentGrid {
     a: Vec<[f64; 2]>,
     b: Vec<[f64; 2]>,
     /// (loop, index of the segment's first vertex in it).
@@ -758,7 +759,7 @@ impl SegmentGrid {
     }
 
     /// True if `p` is inside an odd number of loops (ray to +x).
-    fn parity(&self, p: [f64; 2]) -> bool {
+    pub(crate) fn parity(&self, p: [f64; 2]) -> bool {
         if self.a.is_empty()
             || p[1] < self.y0
             || p[1] > self.y0 + self.cell * self.ny as f64
@@ -784,7 +785,7 @@ impl SegmentGrid {
     }
 
     /// True if a segment passes within `radius` of `p`.
-    fn near(&self, p: [f64; 2], radius: f64) -> bool {
+    pub(crate) fn near(&self, p: [f64; 2], radius: f64) -> bool {
         if self.a.is_empty() {
             return false;
         }
@@ -809,6 +810,22 @@ impl SegmentGrid {
             }
         }
         false
+    }
+
+    /// True if a loop segment meets the segment from `p` to `q`.
+    pub(crate) fn crosses(&self, p: [f64; 2], q: [f64; 2]) -> bool {
+        if self.a.is_empty() {
+            return false;
+        }
+        let (c0, c1) = (self.col(p[0].min(q[0])), self.col(p[0].max(q[0])));
+        let (r0, r1) = (self.row(p[1].min(q[1])), self.row(p[1].max(q[1])));
+        (r0..=r1).any(|r| {
+            (c0..=c1).any(|c| {
+                self.cells[r * self.nx + c]
+                    .iter()
+                    .any(|&s| segments_meet(self.a[s as usize], self.b[s as usize], p, q))
+            })
+        })
     }
 
     /// Some pair of segments that meet other than at their shared vertex

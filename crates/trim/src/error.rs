@@ -104,6 +104,18 @@ pub enum MeshError {
         /// Vertices a repair would have dropped.
         dropped: usize,
     },
+    /// Some edges are shared by more than two faces.
+    #[error("{edges} edges are shared by more than two faces; the mesh must be edge-manifold (repair it first, e.g. MeshLab's \"Repair non Manifold Edges\")")]
+    NonManifold {
+        /// How many such edges.
+        edges: usize,
+    },
+    /// Neighbouring faces run their shared edge the same way.
+    #[error("{edges} edges are run the same way by both their faces; the faces must be consistently oriented (re-orient them first, e.g. MeshLab's \"Re-Orient all faces coherently\")")]
+    Misoriented {
+        /// How many such edges.
+        edges: usize,
+    },
     /// Two smoothed loops cross or touch in the projection onto the cloud's
     /// best-fit plane.
     #[error("smoothed loops {a} and {b} cross or touch in the projection onto the best-fit plane; the surface may fold over its plane there: mesh it with screened Poisson and use `meshtrim MESH CLOUD OUT` instead")]

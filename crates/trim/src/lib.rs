@@ -16,6 +16,7 @@
 
 pub mod anisotropy;
 pub mod bpd;
+pub mod clean;
 pub mod cloud;
 pub mod delaunay;
 pub mod edge_metrics;

@@ -108,6 +108,19 @@ fn build_loop(
     index: Option<&NeighbourIndex>,
 ) -> Loop {
     let tour = order::closed_tour(points, members, links);
+    loop_from_tour(points, beta, tour, index)
+}
+
+/// Corners, smoothed edges and (with `index`, the cloud's neighbour index)
+/// the outward offset of one closed tour of boundary points (indices into
+/// `points`, in loop order). Used on BPD's tours and on the border loops of
+/// a mesh, whose order the mesh itself gives.
+pub fn loop_from_tour(
+    points: &[Point3],
+    beta: &[f64],
+    tour: Vec<u32>,
+    index: Option<&NeighbourIndex>,
+) -> Loop {
     let loop_points: Vec<Point3> = tour.iter().map(|&i| points[i as usize]).collect();
     let loop_beta: Vec<f64> = tour.iter().map(|&i| beta[i as usize]).collect();
     let corners = corners::find_corners(&loop_points, &loop_beta);

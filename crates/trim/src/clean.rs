@@ -1,0 +1,777 @@
+//! Border cleanup of triangulated scans — `meshtrim clean` (meshtrim's
+//! extension of the paper to meshes whose own vertices are the cloud).
+//!
+//! Scanner software triangulates the raw samples, so a scan's border runs
+//! through the outermost samples and zig-zags between them. The paper's
+//! edge reconstruction (section 3) gives the smooth edge those samples
+//! stand for; cleaning replaces the jagged border by it:
+//!
+//! 1. **Border loops.** The mesh's own border (edges used by one face),
+//!    chained in face order, gives each boundary already ordered: the
+//!    mesh's connectivity replaces BPD's clustering and the travelling-
+//!    salesman tour, which can only guess the order the mesh knows. Loops
+//!    of fewer than [`MIN_LOOP_POINTS`] vertices (a missing triangle) are
+//!    too small to smooth and stay as they are.
+//! 2. **Smoothed loops.** Each loop gets its corners (section 3.1), its
+//!    FFT-smoothed edges (section 3.3, cut-off following the local β of the
+//!    vertices) and, unless switched off, the outward offset to the
+//!    physical edge ([`crate::edges::offset`]): the smoothed loop passes
+//!    outside the jagged border at its notches and inside it at its spikes.
+//! 3. **The band.** Around each loop, the faces within a few rings of its
+//!    border (starting at [`FIRST_DEPTH`] rings, grown to [`MAX_DEPTH`]
+//!    while the cut reaches the band's rim) are projected onto their
+//!    best-fit plane, oriented with the faces. A band whose faces do not
+//!    all keep their orientation in the projection folds over it, and its
+//!    loop is left unchanged (reported). Loops whose bands share a face are
+//!    handled together.
+//! 4. **What goes.** Within the band, a vertex stays when it lies on the
+//!    surface's side of the smoothed loops and farther than [`MARGIN`]·βᵢ
+//!    from them (closer, it would only make a sliver against the new
+//!    border), and is not a vertex of the old border. Faces with a vertex
+//!    that goes, or crossed by a smoothed loop, are removed.
+//! 5. **The gap is filled.** The removed region and the gap between the
+//!    old border and the smoothed loops are triangulated again, in the
+//!    projection, by a constrained Delaunay triangulation (spade, exact
+//!    predicates) of the smoothed loops' vertices, the kept vertices of the
+//!    removed faces, and, as constraints, the smoothed loops and the edges
+//!    where removed faces met kept ones (and the borders of small loops
+//!    the band takes in). The faces between these curves — by a parity
+//!    flood fill across the constraints — are the new ones. Every vertex
+//!    of them is a point of the surface already (a mesh vertex, or a
+//!    smoothed loop vertex), so the new faces follow the surface without
+//!    any lifting; Delaunay maximises their smallest angles.
+//! 6. Unused vertices are removed. Vertices outside the bands keep their
+//!    exact coordinates and the faces there are untouched.
+//!
+//! A constraint that would cross another, or two vertices that coincide in
+//! the projection, leave the loops of that band unchanged (reported) rather
+//! than produce a broken mesh.
+
+use std::collections::{BTreeSet, HashMap};
+
+use rayon::prelude::*;
+use spade::{PositionInTriangulation, Triangulation};
+
+use crate::cloud::{cross, dot, norm2, sub, Point3};
+use crate::delaunay::{
+    inside_faces, median, obstacle, orient, untwist, Cdt, DelaunayReport, Node, Ring,
+};
+use crate::edges::cluster::MIN_LOOP_POINTS;
+use crate::edges::loop_from_tour;
+use crate::error::MeshError;
+use crate::frame::fit_plane;
+use crate::mesh::Mesh;
+use crate::neighbours::NeighbourIndex;
+
+/// Vertices closer than this many β to a smoothed loop are replaced.
+pub const MARGIN: f64 = 0.5;
+/// Rings of faces around a border the band starts with …
+pub const FIRST_DEPTH: u32 = 3;
+/// … and the most it grows to.
+pub const MAX_DEPTH: u32 = 12;
+
+/// Options of the cleanup.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CleanOptions {
+    /// Move the smoothed border out to the estimated physical edge (off
+    /// gives the paper's edges, through the border vertices).
+    pub offset: bool,
+}
+
+impl Default for CleanOptions {
+    fn default() -> Self {
+        Self { offset: true }
+    }
+}
+
+/// Loops left as they were, and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LeftLoops {
+    /// Indices of the loops (in the input's border order).
+    pub loops: Vec<usize>,
+    /// Why they could not be replaced.
+    pub reason: String,
+}
+
+/// What the cleanup did.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct CleanReport {
+    /// Border loops of the input.
+    pub loops_in: usize,
+    /// Loops replaced by their smoothed edge.
+    pub loops_smoothed: usize,
+    /// Loops too small to smooth (kept as they are).
+    pub loops_too_small: usize,
+    /// Loops that could not be replaced, with the reason.
+    pub loops_left: Vec<LeftLoops>,
+    /// Input faces.
+    pub faces_in: usize,
+    /// Input faces removed (in the bands).
+    pub faces_removed: usize,
+    /// New faces (the bands triangulated again).
+    pub faces_added: usize,
+    /// Output faces.
+    pub faces_out: usize,
+    /// New vertices (on the smoothed loops).
+    pub vertices_added: usize,
+    /// Area of the input.
+    pub area_in: f64,
+    /// Area of the output.
+    pub area_out: f64,
+    /// Smallest angle of the new faces, in degrees.
+    pub min_angle_new: f64,
+}
+
+/// Replaces the jagged border of `mesh` by its smoothed boundary (see the
+/// module doc). `beta` is the local resolution of each vertex (from BPD on
+/// the vertices).
+pub fn clean_mesh(
+    mesh: &Mesh,
+    beta: &[f64],
+    options: &CleanOptions,
+) -> Result<(Mesh, CleanReport), MeshError> {
+    mesh.validate()?;
+    if mesh.faces.is_empty() {
+        return Err(MeshError::NoFaces);
+    }
+    check_manifold(mesh)?;
+    let borders = mesh.boundary_loops();
+    let mut report = CleanReport {
+        loops_in: borders.len(),
+        faces_in: mesh.faces.len(),
+        area_in: mesh.area(),
+        ..Default::default()
+    };
+    let index = options.offset.then(|| NeighbourIndex::new(&mesh.vertices));
+    let smoothable: Vec<bool> = borders.iter().map(|b| b.len() >= MIN_LOOP_POINTS).collect();
+    report.loops_too_small = smoothable.iter().filter(|&&s| !s).count();
+    let rings: Vec<Option<Ring>> = borders
+        .par_iter()
+        .zip(&smoothable)
+        .map(|(border, &smooth)| {
+            smooth.then(|| {
+                let lp = loop_from_tour(&mesh.vertices, beta, border.clone(), index.as_ref());
+                Ring::from_loop(&lp, beta)
+            })
+        })
+        .collect();
+    let topology = Topology::new(mesh);
+    let context = Context {
+        mesh,
+        beta,
+        borders: &borders,
+        rings: &rings,
+        topology: &topology,
+        beta_median: median(beta),
+    };
+    let patches = replace_all(&context);
+    let mut out = assemble(mesh, &patches, &mut report);
+    out.remove_unused_vertices();
+    check_manifold(&out)?;
+    report.faces_out = out.faces.len();
+    report.area_out = out.area();
+    Ok((out, report))
+}
+
+/// Everything the band replacement reads.
+struct Context<'a> {
+    mesh: &'a Mesh,
+    beta: &'a [f64],
+    borders: &'a [Vec<u32>],
+    rings: &'a [Option<Ring>],
+    topology: &'a Topology,
+    beta_median: f64,
+}
+
+/// The new faces of one band.
+#[derive(Debug, Default)]
+struct Patch {
+    /// Loops it replaces.
+    loops: Vec<usize>,
+    /// Input faces it removes.
+    removed: Vec<u32>,
+    /// New vertices (smoothed loop vertices).
+    vertices: Vec<Point3>,
+    /// New faces: ids below the mesh's vertex count are input vertices,
+    /// the others `vertex count + index into vertices`.
+    faces: Vec<[u32; 3]>,
+}
+
+/// One band's outcome: its faces (to detect bands that overlap) and the
+/// patch, or why its loops stay.
+struct Outcome {
+    loops: Vec<usize>,
+    band: Vec<u32>,
+    patch: Result<Patch, String>,
+}
+
+/// Replaces every smoothable loop, merging loops whose bands overlap until
+/// no two bands share a face.
+fn replace_all(cx: &Context) -> Vec<Outcome> {
+    let seeds: Vec<usize> = (0..cx.rings.len())
+        .filter(|&l| cx.rings[l].is_some())
+        .collect();
+    let mut groups: Vec<Vec<usize>> = seeds.iter().map(|&l| vec![l]).collect();
+    loop {
+        let outcomes: Vec<Outcome> = groups.par_iter().map(|g| replace_group(cx, g)).collect();
+        match first_overlap(&outcomes) {
+            None => return outcomes,
+            Some((a, b)) => {
+                let taken = groups.remove(b);
+                groups[a].extend(taken);
+                groups[a].sort_unstable();
+            }
+        }
+    }
+}
+
+/// Two outcomes whose bands share a face (indices, a < b).
+fn first_overlap(outcomes: &[Outcome]) -> Option<(usize, usize)> {
+    let mut owner: HashMap<u32, usize> = HashMap::new();
+    for (g, outcome) in outcomes.iter().enumerate() {
+        for &f in &outcome.band {
+            if let Some(&other) = owner.get(&f) {
+                return Some((other, g));
+            }
+            owner.insert(f, g);
+        }
+    }
+    None
+}
+
+/// Tries growing bands around one group of loops.
+fn replace_group(cx: &Context, group: &[usize]) -> Outcome {
+    let sources: Vec<u32> = group
+        .iter()
+        .flat_map(|&l| cx.borders[l].iter().copied())
+        .collect();
+    let mut depth = FIRST_DEPTH;
+    loop {
+        let band = Band::around(cx, &sources, depth);
+        let result = band.replace(cx, group);
+        let outcome = |patch| Outcome {
+            loops: group.to_vec(),
+            band: band.faces.clone(),
+            patch,
+        };
+        match result {
+            Err(Retry::Grow) if depth < MAX_DEPTH => depth = (depth * 3 / 2).min(MAX_DEPTH),
+            Err(Retry::Grow) => {
+                return outcome(Err(format!(
+                    "the smoothed border runs more than {MAX_DEPTH} rings of faces from the mesh border"
+                )))
+            }
+            Err(Retry::Leave(reason)) => return outcome(Err(reason)),
+            Ok(patch) => return outcome(Ok(patch)),
+        }
+    }
+}
+
+/// Why a band could not be replaced as it is.
+enum Retry {
+    /// The cut reaches the band's rim: take more rings.
+    Grow,
+    /// The loops stay, for this reason.
+    Leave(String),
+}
+
+/// The faces within some rings of a group's border, projected.
+struct Band {
+    depth: u32,
+    /// Ring distance of each band vertex from the border.
+    rings_from_border: HashMap<u32, u32>,
+    /// Band faces, ascending.
+    faces: Vec<u32>,
+}
+
+impl Band {
+    /// Faces with a vertex less than `depth` rings from `sources`.
+    fn around(cx: &Context, sources: &[u32], depth: u32) -> Band {
+        let mut distance: HashMap<u32, u32> = sources.iter().map(|&v| (v, 0)).collect();
+        let mut frontier: Vec<u32> = distance.keys().copied().collect();
+        frontier.sort_unstable();
+        for d in 1..=depth {
+            let mut next = Vec::new();
+            for &v in &frontier {
+                for &f in cx.topology.faces_of(v) {
+                    for w in cx.mesh.faces[f as usize] {
+                        distance.entry(w).or_insert_with(|| {
+                            next.push(w);
+                            d
+                        });
+                    }
+                }
+            }
+            next.sort_unstable();
+            frontier = next;
+        }
+        let faces: BTreeSet<u32> = distance
+            .iter()
+            .filter(|&(_, &d)| d < depth)
+            .flat_map(|(&v, _)| cx.topology.faces_of(v).iter().copied())
+            .collect();
+        Band {
+            depth,
+            rings_from_border: distance,
+            faces: faces.into_iter().collect(),
+        }
+    }
+
+    /// The patch replacing the group's loops, or why not.
+    fn replace(&self, cx: &Context, group: &[usize]) -> Result<Patch, Retry> {
+        let mesh = cx.mesh;
+        let projection = Projection::of(cx, &self.faces)?;
+        let mut rings: Vec<Ring> = group
+            .iter()
+            .filter_map(|&l| cx.rings[l].as_ref())
+            .map(|r| {
+                let mut ring = r.clone();
+                ring.p2 = ring.p3.iter().map(|&p| projection.to2(p)).collect();
+                ring.merge_coincident();
+                ring
+            })
+            .collect();
+        let grid = untwist(&mut rings, cx.beta_median, &mut DelaunayReport::default())
+            .map_err(|e| Retry::Leave(e.to_string()))?;
+        let has_outer = rings.iter().any(|r| r.area() > 0.0);
+        let old_border: BTreeSet<u32> = group
+            .iter()
+            .flat_map(|&l| cx.borders[l].iter().copied())
+            .collect();
+        let p2 = |v: u32| projection.to2(mesh.vertices[v as usize]);
+        let stays = |v: u32| {
+            let p = p2(v);
+            !old_border.contains(&v)
+                && grid.parity(p) == has_outer
+                && !grid.near(p, MARGIN * cx.beta[v as usize])
+        };
+        let mut stay: HashMap<u32, bool> = HashMap::new();
+        let mut removed = Vec::new();
+        for &f in &self.faces {
+            let face = mesh.faces[f as usize];
+            let all_stay = face
+                .iter()
+                .all(|&v| *stay.entry(v).or_insert_with(|| stays(v)));
+            let crossed =
+                all_stay && (0..3).any(|k| grid.crosses(p2(face[k]), p2(face[(k + 1) % 3])));
+            if !all_stay || crossed {
+                removed.push(f);
+            }
+        }
+        let reaches_rim = removed.iter().any(|&f| {
+            mesh.faces[f as usize]
+                .iter()
+                .any(|v| self.rings_from_border[v] + 1 >= self.depth)
+        });
+        if reaches_rim {
+            return Err(Retry::Grow);
+        }
+        let border_edges: BTreeSet<(u32, u32)> = group
+            .iter()
+            .flat_map(|&l| {
+                let b = &cx.borders[l];
+                (0..b.len()).map(move |i| (b[i], b[(i + 1) % b.len()]))
+            })
+            .collect();
+        let walls = walls(mesh, &self.faces, &removed, &border_edges);
+        let free: BTreeSet<u32> = removed
+            .iter()
+            .flat_map(|&f| mesh.faces[f as usize])
+            .filter(|v| stay[v])
+            .collect();
+        let mut patch = triangulate(mesh, &projection, &rings, &walls, &free)?;
+        patch.loops = group.to_vec();
+        patch.removed = removed;
+        Ok(patch)
+    }
+}
+
+/// The edges (directed as the removed faces run them) that bound the removed region against what stays: shared with a kept
+/// face, or on the border of a loop outside the group.
+fn walls(
+    mesh: &Mesh,
+    band: &[u32],
+    removed: &[u32],
+    group_border: &BTreeSet<(u32, u32)>,
+) -> Vec<[u32; 2]> {
+    let removed_set: BTreeSet<u32> = removed.iter().copied().collect();
+    let mut uses: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
+    for &f in band {
+        let face = mesh.faces[f as usize];
+        for k in 0..3 {
+            let (a, b) = (face[k], face[(k + 1) % 3]);
+            uses.entry((a.min(b), a.max(b))).or_default().push(f);
+        }
+    }
+    let mut walls = Vec::new();
+    for &f in removed {
+        let face = mesh.faces[f as usize];
+        for k in 0..3 {
+            let (a, b) = (face[k], face[(k + 1) % 3]);
+            let others: Vec<u32> = uses[&(a.min(b), a.max(b))]
+                .iter()
+                .copied()
+                .filter(|&g| g != f)
+                .collect();
+            let wall = match others.first() {
+                Some(g) => !removed_set.contains(g),
+                None => !group_border.contains(&(a, b)),
+            };
+            if wall {
+                walls.push([a, b]);
+            }
+        }
+    }
+    walls
+}
+
+/// The constrained Delaunay triangulation of the band's gap (step 5).
+fn triangulate(
+    mesh: &Mesh,
+    projection: &Projection,
+    rings: &[Ring],
+    walls: &[[u32; 2]],
+    free: &BTreeSet<u32>,
+) -> Result<Patch, Retry> {
+    let n = mesh.vertices.len() as u32;
+    let mut cdt = Cdt::new();
+    let mut patch = Patch::default();
+    let mut handle_of: HashMap<u32, spade::handles::FixedVertexHandle> = HashMap::new();
+    let coincide = || Retry::Leave("two vertices coincide in the projection of the band".into());
+    let mut insert = |cdt: &mut Cdt, p: [f64; 2], id: u32| -> Result<_, Retry> {
+        if let Some(&h) = handle_of.get(&id) {
+            return Ok(h);
+        }
+        if let PositionInTriangulation::OnVertex(_) = cdt.locate(crate::delaunay::point(p)) {
+            return Err(coincide());
+        }
+        let h = cdt.insert(Node::new(p, id)).map_err(|_| coincide())?;
+        handle_of.insert(id, h);
+        Ok(h)
+    };
+    let mut ring_handles = Vec::new();
+    for ring in rings {
+        let mut hs = Vec::with_capacity(ring.len());
+        for (j, &p) in ring.p2.iter().enumerate() {
+            let id = n + patch.vertices.len() as u32;
+            patch.vertices.push(ring.p3[j]);
+            hs.push(insert(&mut cdt, p, id)?);
+        }
+        ring_handles.push(hs);
+    }
+    let wall_vertices: BTreeSet<u32> = walls.iter().flatten().copied().collect();
+    for &v in wall_vertices.iter().chain(free) {
+        insert(&mut cdt, projection.to2(mesh.vertices[v as usize]), v)?;
+    }
+    let crossing = || Retry::Leave("the smoothed border crosses the kept mesh".into());
+    let constrain = |cdt: &mut Cdt, a, b| {
+        if obstacle(cdt, a, b).is_some() {
+            return Err(crossing());
+        }
+        cdt.add_constraint(a, b);
+        Ok(())
+    };
+    for hs in &ring_handles {
+        for j in 0..hs.len() {
+            constrain(&mut cdt, hs[j], hs[(j + 1) % hs.len()])?;
+        }
+    }
+    for w in walls {
+        constrain(&mut cdt, handle_of[&w[0]], handle_of[&w[1]])?;
+    }
+    for f in inside_faces(&cdt) {
+        let vs = cdt.face(f).vertices();
+        let mut ids = vs.map(|v| v.data().id);
+        let p = vs.map(|v| {
+            let q = v.position();
+            [q.x, q.y]
+        });
+        if orient(p[0], p[1], p[2]) < 0.0 {
+            ids.swap(1, 2);
+        }
+        patch.faces.push(ids);
+    }
+    Ok(patch)
+}
+
+/// The best-fit plane of a band, oriented with its faces.
+struct Projection {
+    origin: Point3,
+    u: Point3,
+    v: Point3,
+}
+
+impl Projection {
+    /// Fits the band's plane; a band face that turns over in it means the
+    /// surface folds there.
+    fn of(cx: &Context, faces: &[u32]) -> Result<Projection, Retry> {
+        let mesh = cx.mesh;
+        let members: Vec<u32> = faces
+            .iter()
+            .flat_map(|&f| mesh.faces[f as usize])
+            .collect::<BTreeSet<u32>>()
+            .into_iter()
+            .collect();
+        let frame = fit_plane(&mesh.vertices, &members);
+        let facing: f64 = faces
+            .iter()
+            .map(|&f| dot(face_normal(mesh, f), frame.normal))
+            .sum();
+        let v = if facing < 0.0 {
+            frame.v.map(|c| -c)
+        } else {
+            frame.v
+        };
+        let projection = Projection {
+            origin: mesh.vertices[members[0] as usize],
+            u: frame.u,
+            v,
+        };
+        let turned = faces.iter().filter(|&&f| {
+            let [a, b, c] =
+                mesh.faces[f as usize].map(|i| projection.to2(mesh.vertices[i as usize]));
+            orient(a, b, c) <= 0.0
+        });
+        let turned = turned.count();
+        if turned > 0 {
+            return Err(Retry::Leave(format!(
+                "the surface folds over its plane near this border ({turned} of {} faces turn over in the projection)",
+                faces.len()
+            )));
+        }
+        Ok(projection)
+    }
+
+    fn to2(&self, p: Point3) -> [f64; 2] {
+        let d = sub(p, self.origin);
+        [dot(d, self.u), dot(d, self.v)]
+    }
+}
+
+fn face_normal(mesh: &Mesh, f: u32) -> Point3 {
+    let [a, b, c] = mesh.faces[f as usize].map(|i| mesh.vertices[i as usize]);
+    cross(sub(b, a), sub(c, a))
+}
+
+/// The input with every successful patch applied; failures go to the
+/// report.
+fn assemble(mesh: &Mesh, outcomes: &[Outcome], report: &mut CleanReport) -> Mesh {
+    let n = mesh.vertices.len() as u32;
+    let mut removed = vec![false; mesh.faces.len()];
+    let mut vertices = mesh.vertices.clone();
+    let mut new_faces = Vec::new();
+    let mut min_angle = f64::INFINITY;
+    for outcome in outcomes {
+        let patch = match &outcome.patch {
+            Ok(patch) => patch,
+            Err(reason) => {
+                report.loops_left.push(LeftLoops {
+                    loops: outcome.loops.clone(),
+                    reason: reason.clone(),
+                });
+                continue;
+            }
+        };
+        report.loops_smoothed += patch.loops.len();
+        report.faces_removed += patch.removed.len();
+        for &f in &patch.removed {
+            removed[f as usize] = true;
+        }
+        let base = vertices.len() as u32;
+        vertices.extend_from_slice(&patch.vertices);
+        report.vertices_added += patch.vertices.len();
+        for face in &patch.faces {
+            let face = face.map(|id| if id < n { id } else { base + id - n });
+            min_angle = min_angle.min(smallest_angle(&vertices, face));
+            new_faces.push(face);
+        }
+    }
+    report.faces_added = new_faces.len();
+    report.min_angle_new = if min_angle.is_finite() {
+        min_angle
+    } else {
+        0.0
+    };
+    let mut faces: Vec<[u32; 3]> = mesh
+        .faces
+        .iter()
+        .zip(&removed)
+        .filter(|(_, &r)| !r)
+        .map(|(f, _)| *f)
+        .collect();
+    faces.extend(new_faces);
+    Mesh { vertices, faces }
+}
+
+/// Smallest angle of a triangle, in degrees.
+fn smallest_angle(vertices: &[Point3], face: [u32; 3]) -> f64 {
+    let p = face.map(|i| vertices[i as usize]);
+    (0..3)
+        .map(|k| {
+            let (a, b) = (sub(p[(k + 1) % 3], p[k]), sub(p[(k + 2) % 3], p[k]));
+            let c = dot(a, b) / (norm2(a) * norm2(b)).sqrt();
+            c.clamp(-1.0, 1.0).acos().to_degrees()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Edge-manifold with consistent orientation: every undirected edge used
+/// at most twice, every directed edge at most once.
+fn check_manifold(mesh: &Mesh) -> Result<(), MeshError> {
+    let mut directed: HashMap<(u32, u32), u32> = HashMap::new();
+    for f in &mesh.faces {
+        for k in 0..3 {
+            *directed.entry((f[k], f[(k + 1) % 3])).or_insert(0) += 1;
+        }
+    }
+    let misoriented = directed.values().filter(|&&c| c > 1).count();
+    let over = mesh.edge_uses().values().filter(|&&c| c > 2).count();
+    if over > 0 {
+        return Err(MeshError::NonManifold { edges: over });
+    }
+    if misoriented > 0 {
+        return Err(MeshError::Misoriented { edges: misoriented });
+    }
+    Ok(())
+}
+
+/// The faces around each vertex (compressed rows).
+struct Topology {
+    start: Vec<u32>,
+    faces: Vec<u32>,
+}
+
+impl Topology {
+    fn new(mesh: &Mesh) -> Self {
+        let mut count = vec![0u32; mesh.vertices.len() + 1];
+        for f in &mesh.faces {
+            for &v in f {
+                count[v as usize + 1] += 1;
+            }
+        }
+        for i in 1..count.len() {
+            count[i] += count[i - 1];
+        }
+        let mut fill = count.clone();
+        let mut faces = vec![0; count[mesh.vertices.len()] as usize];
+        for (i, f) in mesh.faces.iter().enumerate() {
+            for &v in f {
+                faces[fill[v as usize] as usize] = i as u32;
+                fill[v as usize] += 1;
+            }
+        }
+        Topology {
+            start: count,
+            faces,
+        }
+    }
+
+    fn faces_of(&self, v: u32) -> &[u32] {
+        &self.faces[self.start[v as usize] as usize..self.start[v as usize + 1] as usize]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bpd::{detect_boundary, BpdOptions};
+    use crate::synthetic::SplitMix64;
+    use spade::{DelaunayTriangulation, Point2 as SpadePoint};
+
+    /// A jittered grid of pitch 1 over a disc of radius `r` with a hole of
+    /// radius `hole` at the centre, triangulated by Delaunay, keeping the
+    /// triangles whose centroid lies in the annulus: a jagged scan border.
+    fn jagged_annulus(r: f64, hole: f64, seed: u64) -> Mesh {
+        let mut rng = SplitMix64::new(seed);
+        let mut points = Vec::new();
+        let m = r.ceil() as i64 + 1;
+        for j in -m..=m {
+            for i in -m..=m {
+                let p = [
+                    i as f64 + rng.range(-0.3, 0.3),
+                    j as f64 + rng.range(-0.3, 0.3),
+                ];
+                let d = (p[0] * p[0] + p[1] * p[1]).sqrt();
+                if d <= r && d >= hole {
+                    points.push(p);
+                }
+            }
+        }
+        let mut dt: DelaunayTriangulation<SpadePoint<f64>> = DelaunayTriangulation::new();
+        for p in &points {
+            dt.insert(SpadePoint::new(p[0], p[1])).unwrap();
+        }
+        let vertices: Vec<Point3> = dt
+            .vertices()
+            .map(|v| [v.position().x, v.position().y, 0.1 * v.position().x])
+            .collect();
+        let faces = dt
+            .inner_faces()
+            .map(|f| f.vertices().map(|v| v.fix().index() as u32))
+            .filter(|f| {
+                let c = f.iter().fold([0.0, 0.0], |c, &v| {
+                    [
+                        c[0] + vertices[v as usize][0] / 3.0,
+                        c[1] + vertices[v as usize][1] / 3.0,
+                    ]
+                });
+                let d = (c[0] * c[0] + c[1] * c[1]).sqrt();
+                d < r && d > hole
+            })
+            .collect();
+        let mut mesh = Mesh { vertices, faces };
+        mesh.remove_unused_vertices();
+        mesh
+    }
+
+    /// Mean and largest distance of the border vertices to the true
+    /// circles (radii `r` and `hole`, in the x-y projection; the surface
+    /// z = 0.1·x stretches x by under 0.5 %).
+    fn border_error(mesh: &Mesh, r: f64, hole: f64) -> (f64, f64) {
+        let loops = mesh.boundary_loops();
+        let d: Vec<f64> = loops
+            .iter()
+            .flatten()
+            .map(|&v| {
+                let p = mesh.vertices[v as usize];
+                let rho = (p[0] * p[0] + p[1] * p[1]).sqrt();
+                (rho - r).abs().min((rho - hole).abs())
+            })
+            .collect();
+        let mean = d.iter().sum::<f64>() / d.len() as f64;
+        (mean, d.iter().copied().fold(0.0, f64::max))
+    }
+
+    fn clean(mesh: &Mesh) -> (Mesh, CleanReport) {
+        let detection = detect_boundary(&mesh.vertices, &BpdOptions::default()).unwrap();
+        clean_mesh(mesh, &detection.beta, &CleanOptions::default()).unwrap()
+    }
+
+    #[test]
+    fn a_jagged_annulus_gets_its_circles_back() {
+        let mesh = jagged_annulus(20.0, 6.0, 7);
+        let (before_mean, _) = border_error(&mesh, 20.0, 6.0);
+        let (out, report) = clean(&mesh);
+        let (after_mean, after_max) = border_error(&out, 20.0, 6.0);
+        assert_eq!(report.loops_in, 2, "{report:?}");
+        assert_eq!(report.loops_smoothed, 2, "{report:?}");
+        assert_eq!(out.boundary_loops().len(), 2);
+        // Measured: 0.20 pitch before, 0.15 after (the jagged border's
+        // vertices are on the true circle's side of the samples; its
+        // straight edges cut the corners, which vertices alone do not see).
+        assert!(
+            after_mean < 0.8 * before_mean,
+            "before {before_mean}, after {after_mean}"
+        );
+        assert!(after_mean < 0.2, "after {after_mean}");
+        let truth = std::f64::consts::PI * (20.0f64.powi(2) - 6.0f64.powi(2));
+        let error = |a: f64| (a - truth).abs() / truth;
+        assert!(
+            error(report.area_out) < 0.5 * error(report.area_in),
+            "{report:?}"
+        );
+        assert!(after_max < 1.0, "{after_max}");
+        assert!(report.min_angle_new > 5.0, "{report:?}");
+        check_manifold(&out).unwrap();
+    }
+}
