@@ -45,6 +45,36 @@ pub enum Command {
     /// Mesh the cloud itself: constrained Delaunay triangulation in its
     /// best-fit plane, bounded by the smoothed loops (spade).
     Mesh(MeshArgs),
+    /// Smooth the jagged border of a triangulated scan (its own vertices
+    /// are the cloud): the border is replaced by the smoothed boundary,
+    /// the gap filled with new faces on the surface.
+    Clean(CleanArgs),
+}
+
+/// Arguments of `meshtrim clean`.
+#[derive(Debug, Clone, Args)]
+pub struct CleanArgs {
+    /// The mesh: .obj, .ply, .stl, .gltf or .glb.
+    pub input: PathBuf,
+    /// The cleaned mesh: .obj, .ply (binary), .stl (binary), .gltf or
+    /// .glb. Missing parent directories are created.
+    pub output: PathBuf,
+    /// Also write the report as JSON to this file.
+    #[arg(long, value_name = "FILE.json")]
+    pub report: Option<PathBuf>,
+    /// Neighbourhood size of boundary detection, the point itself included.
+    #[arg(long, default_value_t = 30)]
+    pub k: usize,
+    /// Use the paper's isotropic detection, without the sampling-tensor map.
+    #[arg(long)]
+    pub no_anisotropy: bool,
+    /// Put the new border through the smoothed border vertices (the
+    /// paper's edges) instead of the estimated physical edge.
+    #[arg(long)]
+    pub no_offset: bool,
+    /// Print the report as one JSON object.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// Arguments of `meshtrim mesh`.
@@ -158,6 +188,7 @@ pub fn run(cli: Cli) -> Result<()> {
         (Some(Command::Edges(args)), _) => crate::edges::run(&args),
         (Some(Command::Trim(args)), _) | (None, Some(args)) => crate::trim::run(&args),
         (Some(Command::Mesh(args)), _) => crate::mesh_cmd::run(&args),
+        (Some(Command::Clean(args)), _) => crate::clean_cmd::run(&args),
         (None, None) => {
             anyhow::bail!("nothing to do: give MESH CLOUD OUT, or a subcommand (see --help)")
         }

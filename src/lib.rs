@@ -8,7 +8,9 @@
 //! - [`cli`] defines the command line and runs its subcommands.
 //! - [`detect`] is the `meshtrim detect` subcommand.
 //! - [`edges`] is the `meshtrim edges` subcommand.
+//! - [`clean_cmd`] is `meshtrim clean`.
 
+pub mod clean_cmd;
 pub mod cli;
 pub mod detect;
 pub mod edges;

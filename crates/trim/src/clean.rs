@@ -320,7 +320,7 @@ impl Band {
     /// The patch replacing the group's loops, or why not.
     fn replace(&self, cx: &Context, group: &[usize]) -> Result<Patch, Retry> {
         let mesh = cx.mesh;
-        let projection = Projection::of(cx, &self.faces)?;
+        let projection = Projection::of(cx, &self.faces);
         let mut rings: Vec<Ring> = group
             .iter()
             .filter_map(|&l| cx.rings[l].as_ref())
@@ -345,13 +345,16 @@ impl Band {
                 && grid.parity(p) == has_outer
                 && !grid.near(p, MARGIN * cx.beta[v as usize])
         };
-        let mut stay: HashMap<u32, bool> = HashMap::new();
+        let stay: HashMap<u32, bool> = self
+            .faces
+            .iter()
+            .flat_map(|&f| mesh.faces[f as usize])
+            .map(|v| (v, stays(v)))
+            .collect();
         let mut removed = Vec::new();
         for &f in &self.faces {
             let face = mesh.faces[f as usize];
-            let all_stay = face
-                .iter()
-                .all(|&v| *stay.entry(v).or_insert_with(|| stays(v)));
+            let all_stay = face.iter().all(|v| stay[v]);
             let crossed =
                 all_stay && (0..3).any(|k| grid.crosses(p2(face[k]), p2(face[(k + 1) % 3])));
             if !all_stay || crossed {
@@ -366,6 +369,7 @@ impl Band {
         if reaches_rim {
             return Err(Retry::Grow);
         }
+        projection.check_folds(mesh, &self.faces, &removed, &stay)?;
         let border_edges: BTreeSet<(u32, u32)> = group
             .iter()
             .flat_map(|&l| {
@@ -502,9 +506,8 @@ struct Projection {
 }
 
 impl Projection {
-    /// Fits the band's plane; a band face that turns over in it means the
-    /// surface folds there.
-    fn of(cx: &Context, faces: &[u32]) -> Result<Projection, Retry> {
+    /// Fits the band's plane, oriented so the faces face its normal.
+    fn of(cx: &Context, faces: &[u32]) -> Projection {
         let mesh = cx.mesh;
         let members: Vec<u32> = faces
             .iter()
@@ -522,24 +525,47 @@ impl Projection {
         } else {
             frame.v
         };
-        let projection = Projection {
+        Projection {
             origin: mesh.vertices[members[0] as usize],
             u: frame.u,
             v,
-        };
-        let turned = faces.iter().filter(|&&f| {
-            let [a, b, c] =
-                mesh.faces[f as usize].map(|i| projection.to2(mesh.vertices[i as usize]));
-            orient(a, b, c) <= 0.0
+        }
+    }
+
+    /// The region triangulated again must be a height field over the
+    /// plane: a removed face, or a kept face at a wall, that turns over in
+    /// the projection means the surface folds there. Kept faces farther in
+    /// may fold (a grazing view elsewhere in the band): they are untouched.
+    fn check_folds(
+        &self,
+        mesh: &Mesh,
+        band: &[u32],
+        removed: &[u32],
+        stay: &HashMap<u32, bool>,
+    ) -> Result<(), Retry> {
+        let removed: BTreeSet<u32> = removed.iter().copied().collect();
+        let touched: BTreeSet<u32> = removed
+            .iter()
+            .flat_map(|&f| mesh.faces[f as usize])
+            .collect();
+        let relevant = band.iter().filter(|&&f| {
+            removed.contains(&f)
+                || mesh.faces[f as usize]
+                    .iter()
+                    .any(|v| touched.contains(v) && stay[v])
         });
-        let turned = turned.count();
+        let turned = relevant
+            .filter(|&&f| {
+                let [a, b, c] = mesh.faces[f as usize].map(|i| self.to2(mesh.vertices[i as usize]));
+                orient(a, b, c) <= 0.0
+            })
+            .count();
         if turned > 0 {
             return Err(Retry::Leave(format!(
-                "the surface folds over its plane near this border ({turned} of {} faces turn over in the projection)",
-                faces.len()
+                "the surface folds over its plane at this border ({turned} faces of the band turn over in the projection)"
             )));
         }
-        Ok(projection)
+        Ok(())
     }
 
     fn to2(&self, p: Point3) -> [f64; 2] {

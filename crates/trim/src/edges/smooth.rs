@@ -129,7 +129,7 @@ pub fn smooth_open_edge(points: &[Point3], beta: &[f64]) -> Vec<Point3> {
         g.extend((1..half).map(|j| -f[c][half - j]));
         g
     });
-    let mut out = filter_and_evaluate(&period, 2.0 * total, ds, &s, beta);
+    let mut out = filter_and_evaluate(&period, 2.0 * total, ds, &s, beta, 0);
     for (o, &si) in out.iter_mut().zip(&s) {
         let l = trend(si);
         *o = std::array::from_fn(|c| o[c] + l[c]);
@@ -158,7 +158,10 @@ pub fn smooth_closed_edge(points: &[Point3], beta: &[f64]) -> Vec<Point3> {
     let mut closed = points.to_vec();
     closed.push(points[0]);
     let samples = resample(&s, &closed, ds, count);
-    let out = filter_and_evaluate(&samples, total, ds, &s[..n], beta);
+    // A closed loop keeps at least its first harmonic (its best-fit
+    // ellipse): a hole whose perimeter is below 2πβ would otherwise
+    // collapse to its centroid.
+    let out = filter_and_evaluate(&samples, total, ds, &s[..n], beta, 1);
     if all_finite(&out) {
         out
     } else {
@@ -346,13 +349,15 @@ impl LowPass {
 
 /// Steps 3–5 (without the trend): filters one period of uniform `samples`
 /// (spacing `ds`, length `period`) at the bank of β levels and evaluates
-/// the blend at arc positions `s` with local resolutions `beta`.
+/// the blend at arc positions `s` with local resolutions `beta`, keeping
+/// at least `min_harmonics` harmonics.
 fn filter_and_evaluate(
     samples: &[Vec<f64>; 3],
     period: f64,
     ds: f64,
     s: &[f64],
     beta: &[f64],
+    min_harmonics: usize,
 ) -> Vec<Point3> {
     let n = samples[0].len();
     let lo = beta.iter().copied().fold(f64::INFINITY, f64::min);
@@ -363,7 +368,7 @@ fn filter_and_evaluate(
     let mut bank: Vec<Arc<[Vec<f64>; 3]>> = Vec::with_capacity(levels.len());
     let mut last_keep = None;
     for &b in &levels {
-        let keep = harmonic_cutoff(period, b, n);
+        let keep = harmonic_cutoff(period, b, n).max(min_harmonics.min(n / 2));
         if last_keep != Some(keep) {
             bank.push(Arc::new(lowpass.filtered(keep)));
             last_keep = Some(keep);

@@ -1,0 +1,290 @@
+//! `meshtrim clean IN OUT`: smooth the jagged border of a triangulated scan.
+//! The mesh's own vertices are the cloud: their local resolution comes from
+//! boundary detection on them, the border loops from the mesh, and the
+//! library replaces the border by its smoothed edge.
+
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use anyhow::{bail, Context, Result};
+use serde::Serialize;
+use trim::clean::{clean_mesh, CleanOptions, CleanReport};
+use trim::mesh::Mesh;
+use trim::BpdOptions;
+
+use crate::cli::CleanArgs;
+use crate::detect::{detect_with_progress, millis, same_file};
+use crate::io::atomic::write_atomic;
+use crate::io::mesh_out::{write_mesh, MeshFormat};
+use crate::io::read_mesh;
+
+/// What one cleanup needs besides its files.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CleanSettings {
+    /// Neighbourhood size of boundary detection.
+    pub k: usize,
+    /// Keep the border through the border vertices (the paper's edges).
+    pub no_offset: bool,
+    /// The paper's isotropic detection.
+    pub no_anisotropy: bool,
+}
+
+/// The summary of one cleanup (for `batch`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CleanOutcome {
+    /// Border loops replaced by their smoothed edge.
+    pub loops: usize,
+    /// Input faces.
+    pub faces_in: usize,
+    /// Output faces.
+    pub faces_out: usize,
+    /// Reading time, ms.
+    pub read_ms: f64,
+    /// Detection and cleanup time, ms.
+    pub clean_ms: f64,
+    /// Writing time, ms.
+    pub write_ms: f64,
+}
+
+/// What `clean` prints and `--report` writes.
+#[derive(Debug, Clone, Serialize)]
+pub struct Report {
+    /// Input and output, as given.
+    pub input: String,
+    /// The output.
+    pub output: String,
+    /// Vertices of the input.
+    pub vertices: usize,
+    /// Border loops of the input.
+    pub loops_in: usize,
+    /// Loops replaced by their smoothed edge.
+    pub loops_smoothed: usize,
+    /// Loops too small to smooth (fewer than four vertices), kept.
+    pub loops_too_small: usize,
+    /// Loops left unchanged, with the reason.
+    pub loops_left: Vec<LeftLoops>,
+    /// Input faces.
+    pub faces_in: usize,
+    /// Input faces removed in the border bands.
+    pub faces_removed: usize,
+    /// New faces.
+    pub faces_added: usize,
+    /// Output faces.
+    pub faces_out: usize,
+    /// New vertices (on the smoothed border).
+    pub vertices_added: usize,
+    /// Smallest angle of the new faces, degrees.
+    pub min_angle_new: f64,
+    /// Area of the input.
+    pub area_in: f64,
+    /// Area of the output.
+    pub area_out: f64,
+    /// Reading time, ms.
+    pub read_ms: f64,
+    /// Boundary detection (local resolution) time, ms.
+    pub detect_ms: f64,
+    /// Border replacement time, ms.
+    pub clean_ms: f64,
+    /// Writing time, ms.
+    pub write_ms: f64,
+}
+
+/// Loops left unchanged.
+#[derive(Debug, Clone, Serialize)]
+pub struct LeftLoops {
+    /// Their indices among the input's border loops.
+    pub loops: Vec<usize>,
+    /// Why.
+    pub reason: String,
+}
+
+/// Runs `meshtrim clean`.
+pub fn run(args: &CleanArgs) -> Result<()> {
+    check_paths(&args.input, &args.output)?;
+    if let Some(report) = &args.report {
+        if report.extension().and_then(|e| e.to_str()) != Some("json") {
+            bail!("{}: the report is JSON: name it .json", report.display());
+        }
+        if same_file(report, &args.input) {
+            bail!(
+                "{}: an output would overwrite this input",
+                args.input.display()
+            );
+        }
+    }
+    let report = clean(&args.input, &args.output, &args.settings())?;
+    if let Some(path) = &args.report {
+        let json = serde_json::to_string_pretty(&report)?;
+        write_atomic(path, |w| w.write_all(json.as_bytes()))?;
+    }
+    if args.json {
+        println!("{}", serde_json::to_string(&report)?);
+    } else {
+        print!("{}", report.table());
+    }
+    Ok(())
+}
+
+/// Cleans one file without printing (the unit of `batch`).
+pub fn clean_file(input: &Path, output: &Path, settings: &CleanSettings) -> Result<CleanOutcome> {
+    check_paths(input, output)?;
+    let r = clean(input, output, settings)?;
+    Ok(CleanOutcome {
+        loops: r.loops_smoothed,
+        faces_in: r.faces_in,
+        faces_out: r.faces_out,
+        read_ms: r.read_ms,
+        clean_ms: r.detect_ms + r.clean_ms,
+        write_ms: r.write_ms,
+    })
+}
+
+/// Refuses unknown output formats and an output that is the input.
+fn check_paths(input: &Path, output: &Path) -> Result<()> {
+    if MeshFormat::from_path(output).is_none() {
+        bail!(
+            "{}: unsupported output format: use .obj, .ply, .stl, .gltf or .glb",
+            output.display()
+        );
+    }
+    if same_file(output, input) {
+        bail!("{}: the output would overwrite this input", input.display());
+    }
+    Ok(())
+}
+
+/// Reads, detects, cleans, writes.
+fn clean(input: &Path, output: &Path, settings: &CleanSettings) -> Result<Report> {
+    let started = Instant::now();
+    let read = read_mesh(input)?;
+    let Some(faces) = read.faces else {
+        bail!(
+            "{}: the file has no faces: `clean` smooths the border of a mesh",
+            input.display()
+        );
+    };
+    let mesh = Mesh {
+        vertices: read.vertices,
+        faces,
+    };
+    let read_time = started.elapsed();
+    let started = Instant::now();
+    let options = BpdOptions {
+        k: settings.k,
+        anisotropy: !settings.no_anisotropy,
+    };
+    let detection = detect_with_progress(&mesh.vertices, &options)
+        .with_context(|| format!("{}: the mesh's vertices", input.display()))?;
+    let detect_time = started.elapsed();
+    let started = Instant::now();
+    let options = CleanOptions {
+        offset: !settings.no_offset,
+    };
+    let (out, cleaned) = clean_mesh(&mesh, &detection.beta, &options)
+        .with_context(|| input.display().to_string())?;
+    let clean_time = started.elapsed();
+    let started = Instant::now();
+    write_mesh(output, &out.vertices, &out.faces)?;
+    let times = [read_time, detect_time, clean_time, started.elapsed()];
+    Ok(Report::new(
+        input,
+        output,
+        mesh.vertices.len(),
+        &cleaned,
+        times,
+    ))
+}
+
+impl CleanArgs {
+    fn settings(&self) -> CleanSettings {
+        CleanSettings {
+            k: self.k,
+            no_offset: self.no_offset,
+            no_anisotropy: self.no_anisotropy,
+        }
+    }
+}
+
+impl Report {
+    fn new(
+        input: &Path,
+        output: &Path,
+        vertices: usize,
+        r: &CleanReport,
+        [read, detect, clean, write]: [Duration; 4],
+    ) -> Self {
+        Report {
+            input: input.display().to_string(),
+            output: output.display().to_string(),
+            vertices,
+            loops_in: r.loops_in,
+            loops_smoothed: r.loops_smoothed,
+            loops_too_small: r.loops_too_small,
+            loops_left: r
+                .loops_left
+                .iter()
+                .map(|l| LeftLoops {
+                    loops: l.loops.clone(),
+                    reason: l.reason.clone(),
+                })
+                .collect(),
+            faces_in: r.faces_in,
+            faces_removed: r.faces_removed,
+            faces_added: r.faces_added,
+            faces_out: r.faces_out,
+            vertices_added: r.vertices_added,
+            min_angle_new: r.min_angle_new,
+            area_in: r.area_in,
+            area_out: r.area_out,
+            read_ms: millis(read),
+            detect_ms: millis(detect),
+            clean_ms: millis(clean),
+            write_ms: millis(write),
+        }
+    }
+
+    /// The report as an aligned two-column table.
+    pub fn table(&self) -> String {
+        let left: usize = self.loops_left.iter().map(|l| l.loops.len()).sum();
+        let mut rows = vec![
+            (
+                "input",
+                format!("{} ({} vertices)", self.input, self.vertices),
+            ),
+            (
+                "loops",
+                format!(
+                    "{} in: {} smoothed, {} too small, {} left",
+                    self.loops_in, self.loops_smoothed, self.loops_too_small, left
+                ),
+            ),
+            (
+                "faces in / out",
+                format!("{} / {}", self.faces_in, self.faces_out),
+            ),
+            (
+                "faces replaced",
+                format!("{} removed, {} new", self.faces_removed, self.faces_added),
+            ),
+            ("smallest new angle", format!("{:.1}°", self.min_angle_new)),
+            (
+                "area in / out",
+                format!("{:.6} / {:.6}", self.area_in, self.area_out),
+            ),
+            ("read time", format!("{:.1} ms", self.read_ms)),
+            ("detect time", format!("{:.1} ms", self.detect_ms)),
+            ("clean time", format!("{:.1} ms", self.clean_ms)),
+            ("write time", format!("{:.1} ms", self.write_ms)),
+            ("output", self.output.clone()),
+        ];
+        for l in &self.loops_left {
+            rows.push((
+                "left unchanged",
+                format!("loops {:?}: {}", l.loops, l.reason),
+            ));
+        }
+        rows.iter()
+            .map(|(label, value)| format!("{label:<20} {value}\n"))
+            .collect()
+    }
+}
