@@ -569,9 +569,9 @@ fn grid_faces(entries: &[u32], cols: usize, rows: usize, vertices: &[Point3]) ->
 /// The triangles of one grid cell, its corners in cyclic order.
 fn cell_faces(quad: [u32; 4], vertices: &[Point3], faces: &mut Vec<[u32; 3]>) {
     let present: Vec<u32> = quad.into_iter().filter(|&v| v != NO_SAMPLE).collect();
-    match present.as_slice() {
-        &[a, b, c] => faces.push([a, b, c]),
-        &[a, b, c, d] => {
+    match *present.as_slice() {
+        [a, b, c] => faces.push([a, b, c]),
+        [a, b, c, d] => {
             let len2 = |i: u32, j: u32| {
                 let (p, q) = (vertices[i as usize], vertices[j as usize]);
                 (0..3).map(|k| (p[k] - q[k]).powi(2)).sum::<f64>()
