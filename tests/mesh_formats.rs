@@ -479,3 +479,63 @@ fn damaged_files_never_panic() {
         }
     }
 }
+
+/// A binary range scan: a 3 × 2 grid whose last entry is empty, over five
+/// vertices; `last` is the fifth entry's vertex index.
+fn range_scan(last: i32) -> Vec<u8> {
+    let mut bytes = b"ply\nformat binary_little_endian 1.0\nobj_info num_cols 3\n\
+        obj_info num_rows 2\nelement vertex 5\nproperty float x\nproperty float y\n\
+        property float z\nelement range_grid 6\nproperty list uchar int vertex_indices\n\
+        end_header\n"
+        .to_vec();
+    for p in [
+        [0f32, 0., 0.],
+        [1., 0., 0.],
+        [2., 0., 0.],
+        [0., 1., 0.],
+        [1., 1., 0.],
+    ] {
+        for c in p {
+            bytes.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    for v in [0, 1, 2, 3, last] {
+        bytes.push(1);
+        bytes.extend_from_slice(&v.to_le_bytes());
+    }
+    bytes.push(0);
+    bytes
+}
+
+#[test]
+fn range_scans_read_as_meshes() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("scan.ply");
+    std::fs::write(&path, range_scan(4)).unwrap();
+    let mesh = read_mesh(&path).unwrap();
+    // A full cell (two triangles) and a cell with three entries.
+    assert_eq!(faces(&mesh).len(), 3);
+    let cloud = meshtrim::io::read_cloud(&path).unwrap();
+    assert_eq!(cloud.points.len(), 5);
+
+    std::fs::write(&path, range_scan(5)).unwrap();
+    let e = error(&path);
+    assert!(e.starts_with(&path.display().to_string()), "{e}");
+    assert!(
+        e.ends_with("range_grid entry 4 refers to vertex 5, but there are only 5 vertices"),
+        "{e}"
+    );
+    // The cloud reader skips the grid, good or bad.
+    assert_eq!(meshtrim::io::read_cloud(&path).unwrap().points.len(), 5);
+
+    // Damaged copies give errors, never panics.
+    let bytes = range_scan(4);
+    for len in 0..bytes.len() {
+        std::fs::write(&path, &bytes[..len]).unwrap();
+        let _ = read_mesh(&path);
+        let mut flipped = bytes.clone();
+        flipped[len] ^= 0x5a;
+        std::fs::write(&path, &flipped).unwrap();
+        let _ = read_mesh(&path);
+    }
+}

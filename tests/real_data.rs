@@ -9,6 +9,10 @@ use std::path::PathBuf;
 
 use meshtrim::io::{read_cloud, read_mesh, Format};
 
+/// Faces and border loops of `bun000.ply` read as a mesh (measured).
+const BUN000_FACES: usize = 79_312;
+const BUN000_LOOPS: usize = 4;
+
 mod common;
 
 fn data(rel: &str) -> PathBuf {
@@ -42,8 +46,37 @@ fn stanford_bunny() {
     cloud("stanford_bunny/bun045.ply", Format::Ply, 40_097, 0);
     cloud("stanford_bunny/bun090.ply", Format::Ply, 30_379, 0);
     cloud("stanford_bunny/chin.ply", Format::Ply, 37_738, 0);
-    let range = read_mesh(&data("stanford_bunny/bun000.ply")).unwrap();
-    assert_eq!(range.faces, None, "a range_grid is not a face element");
+}
+
+/// A single range image read as a mesh: the range_grid gives the faces.
+#[test]
+fn bunny_range_grid_is_a_mesh() {
+    let mesh = read_mesh(&data("stanford_bunny/bun000.ply")).unwrap_or_else(|e| panic!("{e:#}"));
+    let faces = mesh.faces.clone().expect("the range_grid gives faces");
+    let mesh = trim::mesh::Mesh {
+        vertices: mesh.vertices,
+        faces,
+    };
+    // About two triangles per sample, fewer at the borders.
+    assert_eq!(mesh.faces.len(), BUN000_FACES);
+    assert!(mesh.validate().is_ok());
+    assert!(mesh.is_edge_manifold());
+    let loops = mesh.boundary_loops();
+    assert_eq!(loops.len(), BUN000_LOOPS);
+    // The outer border, then small holes where single samples are missing.
+    let mut lengths: Vec<usize> = loops.iter().map(Vec::len).collect();
+    lengths.sort_unstable();
+    assert_eq!(lengths, [4, 4, 10, 1168]);
+    // Faces face the scanner, at +z in the scan's frame.
+    let z: f64 = mesh
+        .faces
+        .iter()
+        .map(|f| {
+            let [a, b, c] = f.map(|v| mesh.vertices[v as usize]);
+            (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+        })
+        .sum();
+    assert!(z > 0.0);
 }
 
 #[test]

@@ -105,7 +105,9 @@ pub fn read_cloud(path: &Path) -> Result<Cloud> {
 /// Reads a mesh: PLY, OBJ, STL (ASCII or binary), glTF or GLB.
 ///
 /// The faces are `None` if a PLY or OBJ file has none; STL and glTF always
-/// give `Some`. See [`MeshInput`] for how the reader is chosen.
+/// give `Some`. A PLY range scan's `range_grid` gives faces (see
+/// [`ply`]); [`read_cloud`] ignores it. See [`MeshInput`] for how the
+/// reader is chosen.
 pub fn read_mesh(path: &Path) -> Result<Mesh> {
     read_mesh_inner(path).with_context(|| path.display().to_string())
 }
@@ -128,7 +130,7 @@ fn read_cloud_inner(path: &Path) -> Result<Cloud> {
 fn read_mesh_inner(path: &Path) -> Result<Mesh> {
     let bytes = std::fs::read(path).context("cannot read")?;
     let mesh = match MeshInput::detect(path, &bytes)? {
-        MeshInput::Ply => ply::read_ply(&bytes)?,
+        MeshInput::Ply => ply::read_ply_mesh(&bytes)?,
         MeshInput::Obj => obj::read_obj(&bytes)?,
         MeshInput::Stl => stl::read_stl(&bytes)?,
         MeshInput::Gltf => {

@@ -102,6 +102,12 @@ impl BoundaryIndex {
     /// Distance from `p` to the true boundary polylines (to the two
     /// segments at the nearest sample).
     pub fn distance(&self, p: P3) -> f64 {
+        self.distance_and_spacing(p).0
+    }
+
+    /// [`Self::distance`] and the intended spacing at the nearest boundary
+    /// sample, to express the distance in local spacings.
+    pub fn distance_and_spacing(&self, p: P3) -> (f64, f64) {
         let nearest = self
             .tree
             .query(&p)
@@ -111,7 +117,7 @@ impl BoundaryIndex {
         let a = self.samples[i];
         let d_prev = dist_to_segment(p, a, self.samples[self.prev[i] as usize]);
         let d_next = dist_to_segment(p, a, self.samples[self.next[i] as usize]);
-        d_prev.min(d_next)
+        (d_prev.min(d_next), self.spacing[i])
     }
 
     /// Total length of the true boundary, in 3D.

@@ -55,6 +55,8 @@
 
 use std::f64::consts::PI;
 
+pub mod jagged;
+
 /// A position in the parameter domain.
 pub type Uv = [f64; 2];
 /// A position in 3D.
@@ -544,7 +546,17 @@ pub fn plane_with_holes(spacing: f64, seed: u64) -> SyntheticCloud {
 /// The plane z = 0 over a 60h × 40h plate with a 15h × 15h rectangular
 /// notch in one long side (two concave corners) and a hole of radius 5h.
 pub fn notched_plate(spacing: f64, seed: u64) -> SyntheticCloud {
-    let h = spacing;
+    jittered(
+        format!("notched plate, h={spacing}"),
+        Surface::Plane,
+        notched_plate_region(spacing),
+        SpacingField::Uniform(spacing),
+        seed,
+    )
+}
+
+/// The region of [`notched_plate`] in units of `h`.
+fn notched_plate_region(h: f64) -> Region {
     let outer = [
         [0.0, 0.0],
         [60.0, 0.0],
@@ -555,20 +567,13 @@ pub fn notched_plate(spacing: f64, seed: u64) -> SyntheticCloud {
         [20.0, 40.0],
         [0.0, 40.0],
     ];
-    let region = Region {
+    Region {
         outer: outer.iter().map(|p| [p[0] * h, p[1] * h]).collect(),
         holes: vec![Circle {
             centre: [47.0 * h, 15.0 * h],
             radius: 5.0 * h,
         }],
-    };
-    jittered(
-        format!("notched plate, h={h}"),
-        Surface::Plane,
-        region,
-        SpacingField::Uniform(h),
-        seed,
-    )
+    }
 }
 
 /// The saddle z = 0.004·(x² − y²) over [−50, 50]² (slopes up to 0.4) with
@@ -592,26 +597,30 @@ pub fn saddle_with_hole(spacing: f64, seed: u64) -> SyntheticCloud {
 /// over a disc of radius 50 (a 720-gon, as smooth as the sampling can tell),
 /// with a hole of radius 12 at (15, −10).
 pub fn curved_disc_with_hole(spacing: f64, seed: u64) -> SyntheticCloud {
+    jittered(
+        format!("curved disc with hole, h={spacing}"),
+        Surface::Saddle { a: 0.004 },
+        curved_disc_region(),
+        SpacingField::Uniform(spacing),
+        seed,
+    )
+}
+
+/// The region of [`curved_disc_with_hole`].
+fn curved_disc_region() -> Region {
     let outer = (0..720)
         .map(|i| {
             let t = i as f64 / 720.0 * 2.0 * PI;
             [50.0 * t.cos(), 50.0 * t.sin()]
         })
         .collect();
-    let region = Region {
+    Region {
         outer,
         holes: vec![Circle {
             centre: [15.0, -10.0],
             radius: 12.0,
         }],
-    };
-    jittered(
-        format!("curved disc with hole, h={spacing}"),
-        Surface::Saddle { a: 0.004 },
-        region,
-        SpacingField::Uniform(spacing),
-        seed,
-    )
+    }
 }
 
 /// A cylinder patch of radius 50: arc length 0..150 (172°) by 0..100 along
