@@ -212,6 +212,18 @@ pub(crate) struct Detected {
 /// Reads the cloud at `path` and runs BPD on it (with the progress bar),
 /// errors naming the file.
 pub(crate) fn read_and_detect(path: &Path, k: usize, no_anisotropy: bool) -> Result<Detected> {
+    read_and_detect_with(path, k, no_anisotropy, true)
+}
+
+/// [`read_and_detect`], with or without the detection's progress bar:
+/// `meshtrim batch` runs several files at once under one bar of its own, so
+/// its files' detections show none.
+pub(crate) fn read_and_detect_with(
+    path: &Path,
+    k: usize,
+    no_anisotropy: bool,
+    progress: bool,
+) -> Result<Detected> {
     let started = Instant::now();
     let cloud = read_cloud(path)?;
     let read_time = started.elapsed();
@@ -220,8 +232,12 @@ pub(crate) fn read_and_detect(path: &Path, k: usize, no_anisotropy: bool) -> Res
         anisotropy: !no_anisotropy,
     };
     let started = Instant::now();
-    let detection = detect_with_progress(&cloud.points, &options)
-        .with_context(|| path.display().to_string())?;
+    let detection = if progress {
+        detect_with_progress(&cloud.points, &options)
+    } else {
+        trim::bpd::detect_boundary(&cloud.points, &options)
+    }
+    .with_context(|| path.display().to_string())?;
     Ok(Detected {
         cloud,
         detection,

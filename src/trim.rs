@@ -13,7 +13,7 @@ use trim::mesh::Mesh;
 use trim::trimming::{trim_mesh, LoopFit, TrimReport};
 
 use crate::cli::TrimArgs;
-use crate::detect::{millis, read_and_detect, same_file, Detected};
+use crate::detect::{millis, read_and_detect_with, same_file, Detected};
 use crate::io::atomic::write_atomic;
 use crate::io::mesh_out::{write_mesh, MeshFormat};
 use crate::io::read_mesh;
@@ -76,15 +76,58 @@ pub struct BorderFit {
     pub vertices: usize,
 }
 
+/// What trimming one mesh is told, beside its paths.
+#[derive(Debug, Clone)]
+pub struct TrimSettings {
+    /// Neighbourhood size of boundary detection, the point itself included.
+    pub k: usize,
+    /// Cut along the smoothed boundary points instead of the estimated edge.
+    pub no_offset: bool,
+    /// The paper's isotropic detection, without the sampling-tensor map.
+    pub no_anisotropy: bool,
+    /// Whether detection may show its own progress bar (not in a batch,
+    /// which has one bar for all files).
+    pub progress: bool,
+}
+
 /// Runs the trimming.
 pub fn run(args: &TrimArgs) -> Result<()> {
     check_paths(args)?;
+    let settings = TrimSettings {
+        k: args.k,
+        no_offset: args.no_offset,
+        no_anisotropy: args.no_anisotropy,
+        progress: true,
+    };
+    let report = trim_file(&args.mesh, &args.cloud, &args.output, &settings)?;
+    if let Some(path) = &args.report {
+        let json = serde_json::to_string_pretty(&report)?;
+        write_atomic(path, |w| w.write_all(json.as_bytes()))?;
+    }
+    if args.json {
+        println!("{}", serde_json::to_string(&report)?);
+    } else {
+        print!("{}", report.table());
+    }
+    Ok(())
+}
+
+/// Trims the mesh at `mesh_path` along the boundary of the cloud at
+/// `cloud_path` and writes it (atomically) to `output`; prints nothing, so
+/// `meshtrim batch` can run it on many files at once. The caller checks
+/// the paths (see [`check_paths`]).
+pub fn trim_file(
+    mesh_path: &Path,
+    cloud_path: &Path,
+    output: &Path,
+    settings: &TrimSettings,
+) -> Result<Report> {
     let started = Instant::now();
-    let input = read_mesh(&args.mesh)?;
+    let input = read_mesh(mesh_path)?;
     let Some(faces) = input.faces else {
         bail!(
             "{}: the file has no faces: give a mesh (the cloud goes second)",
-            args.mesh.display()
+            mesh_path.display()
         );
     };
     let mesh = Mesh {
@@ -97,42 +140,37 @@ pub fn run(args: &TrimArgs) -> Result<()> {
         detection,
         read_time,
         detect_time,
-    } = read_and_detect(&args.cloud, args.k, args.no_anisotropy)?;
+    } = read_and_detect_with(
+        cloud_path,
+        settings.k,
+        settings.no_anisotropy,
+        settings.progress,
+    )?;
     let read_time = mesh_read_time + read_time;
     let started = Instant::now();
     let edges = reconstruct_edges(
         &cloud.points,
         &detection,
         &EdgeOptions {
-            offset: !args.no_offset,
+            offset: !settings.no_offset,
         },
     );
     let edges_time = started.elapsed();
     let started = Instant::now();
     let (out, trimmed) = trim_mesh(&mesh, &cloud.points, &detection, &edges)
-        .with_context(|| format!("{} with {}", args.mesh.display(), args.cloud.display()))?;
+        .with_context(|| format!("{} with {}", mesh_path.display(), cloud_path.display()))?;
     let trim_time = started.elapsed();
     let started = Instant::now();
-    write_mesh(&args.output, &out.vertices, &out.faces)?;
+    write_mesh(output, &out.vertices, &out.faces)?;
     let write_time = started.elapsed();
     let times = [read_time, detect_time, edges_time, trim_time, write_time];
-    let report = Report::new(
-        args,
+    Ok(Report::new(
+        [mesh_path, cloud_path, output],
         cloud.points.len(),
         detection.boundary_count(),
         &trimmed,
         times,
-    );
-    if let Some(path) = &args.report {
-        let json = serde_json::to_string_pretty(&report)?;
-        write_atomic(path, |w| w.write_all(json.as_bytes()))?;
-    }
-    if args.json {
-        println!("{}", serde_json::to_string(&report)?);
-    } else {
-        print!("{}", report.table());
-    }
-    Ok(())
+    ))
 }
 
 /// Refuses unknown output formats and outputs that would overwrite an
@@ -160,7 +198,7 @@ fn check_paths(args: &TrimArgs) -> Result<()> {
 
 impl Report {
     fn new(
-        args: &TrimArgs,
+        [mesh, cloud, output]: [&Path; 3],
         points: usize,
         boundary_points: usize,
         r: &TrimReport,
@@ -172,9 +210,9 @@ impl Report {
             vertices: l.count,
         };
         Report {
-            mesh: args.mesh.display().to_string(),
-            cloud: args.cloud.display().to_string(),
-            output: args.output.display().to_string(),
+            mesh: mesh.display().to_string(),
+            cloud: cloud.display().to_string(),
+            output: output.display().to_string(),
             points,
             boundary_points,
             loops: r.loops.len(),
