@@ -49,6 +49,53 @@ pub enum Command {
     /// are the cloud): the border is replaced by the smoothed boundary,
     /// the gap filled with new faces on the surface.
     Clean(CleanArgs),
+    /// Clean or trim many meshes at once: files, directories and glob
+    /// patterns in, one output each under --out-dir, a line per file and a
+    /// summary report.
+    Batch(BatchArgs),
+}
+
+/// Arguments of `meshtrim batch`.
+#[derive(Debug, Clone, Args)]
+pub struct BatchArgs {
+    /// Meshes (.stl, .ply, .obj, .gltf, .glb): files, directories (walked
+    /// recursively) and glob patterns (quote them: 'scans/*.ply'). A mesh
+    /// S.ext is trimmed when a cloud S.cloud.EXT or S.xyz/.txt/.csv/.asc/
+    /// .pts/.pcd sits beside it, and cleaned otherwise; clouds are never
+    /// inputs themselves.
+    #[arg(required = true, value_name = "INPUTS")]
+    pub inputs: Vec<PathBuf>,
+    /// Where the outputs go: the input's path below the directory argument
+    /// it was found in (or its file name), same extension.
+    #[arg(long, value_name = "DIR")]
+    pub out_dir: PathBuf,
+    /// Look for the clouds here (mirroring the inputs' sub-directories)
+    /// instead of beside the meshes.
+    #[arg(long, value_name = "DIR")]
+    pub cloud_dir: Option<PathBuf>,
+    /// Files processed at once, and threads in all [default: all cores].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
+    pub jobs: Option<u16>,
+    /// Write a line per file to FILE.csv or FILE.json.
+    #[arg(long, value_name = "FILE.csv|FILE.json")]
+    pub report: Option<PathBuf>,
+    /// Skip inputs whose output exists (resumes an interrupted batch).
+    #[arg(long)]
+    pub skip_existing: bool,
+    /// Process only the K-th of N deterministic shards of the sorted input
+    /// list (1-based), e.g. one per machine or array task.
+    #[arg(long, value_name = "K/N")]
+    pub shard: Option<crate::batch::Shard>,
+    /// Neighbourhood size of boundary detection, the point itself included.
+    #[arg(long, default_value_t = 30)]
+    pub k: usize,
+    /// Use the paper's isotropic detection, without the sampling-tensor map.
+    #[arg(long)]
+    pub no_anisotropy: bool,
+    /// Cut along the smoothed boundary points themselves instead of the
+    /// estimated physical edge.
+    #[arg(long)]
+    pub no_offset: bool,
 }
 
 /// Arguments of `meshtrim clean`.
@@ -189,6 +236,7 @@ pub fn run(cli: Cli) -> Result<()> {
         (Some(Command::Trim(args)), _) | (None, Some(args)) => crate::trim::run(&args),
         (Some(Command::Mesh(args)), _) => crate::mesh_cmd::run(&args),
         (Some(Command::Clean(args)), _) => crate::clean_cmd::run(&args),
+        (Some(Command::Batch(args)), _) => crate::batch::run(&args),
         (None, None) => {
             anyhow::bail!("nothing to do: give MESH CLOUD OUT, or a subcommand (see --help)")
         }

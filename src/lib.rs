@@ -9,7 +9,9 @@
 //! - [`detect`] is the `meshtrim detect` subcommand.
 //! - [`edges`] is the `meshtrim edges` subcommand.
 //! - [`clean_cmd`] is `meshtrim clean`.
+//! - [`batch`] is `meshtrim batch`: many meshes at once.
 
+pub mod batch;
 pub mod clean_cmd;
 pub mod cli;
 pub mod detect;
