@@ -342,8 +342,8 @@ fn check_collisions(jobs: &[Job]) -> Result<()> {
     for job in jobs {
         if let Some(first) = outputs.insert(&job.output, &job.input) {
             bail!(
-                "{} and {} would both be written to {}: give them in separate batches or \
-                 through their directory, so sub-directories are kept",
+                "{} and {} would both be written to {}: give them in separate batches, or \
+                 give a directory holding both (its sub-directories are mirrored)",
                 first.display(),
                 job.input.display(),
                 job.output.display()

@@ -1,0 +1,434 @@
+//! End-to-end tests of `meshtrim batch`.
+//!
+//! Trim pairs are the fixture mesh `blade_small_poisson.ply` copied as
+//! `S.ply` beside the fixture cloud `blade_small.ply` copied as
+//! `S.cloud.ply`. Until `meshtrim clean` is merged, clean mode is only
+//! tested through files that fail either way (garbage bytes).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+const MESH: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/fixtures/meshes/blade_small_poisson.ply"
+);
+const CLOUD: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/fixtures/meshes/blade_small.ply"
+);
+/// Faces of the fixture mesh.
+const FACES_IN: u64 = 15909;
+
+/// Runs `meshtrim batch ARGS` in `dir`.
+fn batch(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_meshtrim"))
+        .arg("batch")
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("run meshtrim")
+}
+
+fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+fn assert_ok(run: &Output) {
+    assert!(run.status.success(), "{}", text(&run.stderr));
+}
+
+/// A trim pair `REL.ply` + `REL.cloud.ply` below `dir`.
+fn pair(dir: &Path, rel: &str) {
+    let mesh = dir.join(format!("{rel}.ply"));
+    std::fs::create_dir_all(mesh.parent().unwrap()).unwrap();
+    std::fs::copy(MESH, &mesh).unwrap();
+    std::fs::copy(CLOUD, dir.join(format!("{rel}.cloud.ply"))).unwrap();
+}
+
+/// A file of garbage bytes.
+fn garbage(dir: &Path, rel: &str) {
+    let path = dir.join(rel);
+    std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+    let bytes: Vec<u8> = (0..300u32).map(|i| (i * 97 % 251) as u8).collect();
+    std::fs::write(path, bytes).unwrap();
+}
+
+fn json_report(path: &Path) -> Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// The `input` of each file of a JSON report, in report order.
+fn inputs(report: &Value) -> Vec<String> {
+    report["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f["input"].as_str().unwrap().to_string())
+        .collect()
+}
+
+/// Every file below `dir`, relative, sorted.
+fn files_below(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for entry in std::fs::read_dir(&d).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                stack.push(path);
+            } else {
+                out.push(path.strip_prefix(dir).unwrap().to_path_buf());
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+/// A minimal RFC 4180 reader, for checking the CSV report.
+fn parse_csv(text: &str) -> Vec<Vec<String>> {
+    let (mut rows, mut row, mut field) = (Vec::new(), Vec::new(), String::new());
+    let (mut quoted, mut chars) = (false, text.chars().peekable());
+    while let Some(c) = chars.next() {
+        match (quoted, c) {
+            (true, '"') if chars.peek() == Some(&'"') => {
+                chars.next();
+                field.push('"');
+            }
+            (true, '"') => quoted = false,
+            (true, c) => field.push(c),
+            (false, '"') => quoted = true,
+            (false, ',') => row.push(std::mem::take(&mut field)),
+            (false, '\n') => {
+                row.push(std::mem::take(&mut field));
+                rows.push(std::mem::take(&mut row));
+            }
+            (false, c) => field.push(c),
+        }
+    }
+    rows
+}
+
+#[test]
+fn directories_and_globs_expand_to_sorted_mirrored_outputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    pair(d, "scans/a");
+    pair(d, "scans/sub/b");
+    pair(d, "other/c");
+    std::fs::write(d.join("scans/notes.md"), "not a mesh").unwrap();
+    let run = batch(
+        d,
+        &["scans", "other/*.ply", "--out-dir", "out", "--report", "r.json"],
+    );
+    assert_ok(&run);
+    // Clouds are never inputs; sub-directories of a directory argument are
+    // mirrored, a glob match goes by its file name.
+    assert_eq!(
+        files_below(&d.join("out")),
+        ["a.ply", "c.ply", "sub/b.ply"].map(PathBuf::from)
+    );
+    let report = json_report(&d.join("r.json"));
+    assert_eq!(
+        inputs(&report),
+        ["other/c.ply", "scans/a.ply", "scans/sub/b.ply"]
+    );
+    for file in report["files"].as_array().unwrap() {
+        assert_eq!(file["mode"], "trim", "{file}");
+        assert_eq!(file["status"], "ok", "{file}");
+        assert_eq!(file["loops"], 4, "{file}");
+        assert_eq!(file["faces_in"], FACES_IN, "{file}");
+    }
+    assert_eq!(report["files"][1]["output"], "out/a.ply");
+    assert_eq!(report["files"][2]["output"], "out/sub/b.ply");
+    let stdout = text(&run.stdout);
+    assert!(
+        stdout.contains("ok      scans/sub/b.ply  loops=4  faces 15909→"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("3 files: 3 ok, 0 failed, 0 skipped"),
+        "{stdout}"
+    );
+    // The same file through a directory and a pattern is one input.
+    let again = batch(d, &["scans", "scans/*.ply", "--out-dir", "out2"]);
+    assert_ok(&again);
+    assert!(text(&again.stdout).contains("2 files: 2 ok"));
+}
+
+#[test]
+fn shards_are_disjoint_and_cover_the_sorted_list() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // Failing files are cheap, and sharding does not depend on the outcome.
+    let names: Vec<String> = (0..7).map(|i| format!("in/f{i}.stl")).collect();
+    names.iter().for_each(|n| garbage(d, n));
+    let mut union = Vec::new();
+    for k in 1..=3 {
+        let report = d.join(format!("r{k}.json"));
+        let shard = format!("{k}/3");
+        let run = batch(
+            d,
+            &[
+                "in",
+                "--out-dir",
+                "out",
+                "--shard",
+                &shard,
+                "--report",
+                report.to_str().unwrap(),
+            ],
+        );
+        assert_eq!(run.status.code(), Some(1), "{}", text(&run.stderr));
+        let report = json_report(&report);
+        assert_eq!(report["inputs"], 7);
+        assert_eq!(report["shard"], shard.as_str());
+        let held = inputs(&report);
+        let expected: Vec<String> = (0..7)
+            .filter(|i| i % 3 == k - 1)
+            .map(|i| names[i].clone())
+            .collect();
+        assert_eq!(held, expected, "shard {k}");
+        union.extend(held);
+    }
+    union.sort();
+    assert_eq!(union, names, "every input in exactly one shard");
+    let bad = batch(d, &["in", "--out-dir", "out", "--shard", "0/4"]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(text(&bad.stderr).contains("K must be between 1 and N"));
+}
+
+#[test]
+fn two_inputs_with_one_output_are_refused_before_any_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    pair(d, "scans/a/x");
+    pair(d, "scans/b/x");
+    for args in [["scans/a/x.ply", "scans/b/x.ply"], ["scans/a", "scans/b"]] {
+        let run = batch(d, &[args[0], args[1], "--out-dir", "out"]);
+        let stderr = text(&run.stderr);
+        assert_eq!(run.status.code(), Some(1), "{stderr}");
+        assert!(
+            stderr.contains("scans/a/x.ply and scans/b/x.ply would both be written to out/x.ply"),
+            "{stderr}"
+        );
+        assert!(!d.join("out").exists(), "nothing processed");
+    }
+    // Through their common directory, sub-directories keep them apart.
+    assert_ok(&batch(d, &["scans", "--out-dir", "out"]));
+    assert_eq!(
+        files_below(&d.join("out")),
+        ["a/x.ply", "b/x.ply"].map(PathBuf::from)
+    );
+}
+
+#[test]
+fn an_output_over_an_input_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    pair(d, "scans/a");
+    let run = batch(d, &["scans", "--out-dir", "scans"]);
+    let stderr = text(&run.stderr);
+    assert_eq!(run.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("would overwrite the input"), "{stderr}");
+    assert_eq!(
+        std::fs::read(d.join("scans/a.ply")).unwrap(),
+        std::fs::read(MESH).unwrap()
+    );
+}
+
+#[test]
+fn skip_existing_resumes_without_rewriting() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    pair(d, "scans/a");
+    pair(d, "scans/b");
+    assert_ok(&batch(d, &["scans", "--out-dir", "out"]));
+    // As if interrupted after a: b's output missing, a's marked.
+    std::fs::remove_file(d.join("out/b.ply")).unwrap();
+    std::fs::write(d.join("out/a.ply"), "marker").unwrap();
+    let run = batch(
+        d,
+        &["scans", "--out-dir", "out", "--skip-existing", "--report", "r.csv"],
+    );
+    assert_ok(&run);
+    assert_eq!(std::fs::read(d.join("out/a.ply")).unwrap(), b"marker");
+    assert!(std::fs::read(d.join("out/b.ply")).unwrap().starts_with(b"ply\n"));
+    let stdout = text(&run.stdout);
+    assert!(
+        stdout.contains("skipped scans/a.ply (output exists)"),
+        "{stdout}"
+    );
+    let rows = parse_csv(&std::fs::read_to_string(d.join("r.csv")).unwrap());
+    assert_eq!(rows[1][..4], ["scans/a.ply", "out/a.ply", "trim", "skipped"]);
+    assert_eq!(rows[2][..4], ["scans/b.ply", "out/b.ply", "trim", "ok"]);
+}
+
+#[test]
+fn bad_files_fail_alone_and_the_reports_say_why() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    pair(d, "scans/a");
+    pair(d, "scans/z");
+    // Garbage with no cloud (clean mode) and with one (trim mode).
+    garbage(d, "scans/bad.stl");
+    garbage(d, "scans/worse.ply");
+    std::fs::copy(CLOUD, d.join("scans/worse.cloud.ply")).unwrap();
+    let run = batch(
+        d,
+        &["scans", "--out-dir", "out", "--report", "r.csv", "--jobs", "2"],
+    );
+    let (stdout, stderr) = (text(&run.stdout), text(&run.stderr));
+    assert_eq!(run.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("error: 2 of 4 files failed"), "{stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    assert!(stdout.contains("failed  scans/bad.stl: "), "{stdout}");
+    assert!(stdout.contains("failed  scans/worse.ply: "), "{stdout}");
+    assert!(stdout.contains("4 files: 2 ok, 2 failed, 0 skipped"));
+    // The good files are written whole, the bad ones not at all, and no
+    // temporary file is left behind.
+    assert_eq!(
+        files_below(&d.join("out")),
+        ["a.ply", "z.ply"].map(PathBuf::from)
+    );
+    let rows = parse_csv(&std::fs::read_to_string(d.join("r.csv")).unwrap());
+    assert_eq!(
+        rows[0],
+        [
+            "input",
+            "output",
+            "mode",
+            "status",
+            "error",
+            "loops",
+            "faces_in",
+            "faces_out",
+            "read_ms",
+            "algorithm_ms",
+            "write_ms",
+            "total_ms"
+        ]
+    );
+    assert_eq!(rows.len(), 5, "{rows:?}");
+    let order: Vec<&str> = rows[1..].iter().map(|r| r[0].as_str()).collect();
+    assert_eq!(
+        order,
+        ["scans/a.ply", "scans/bad.stl", "scans/worse.ply", "scans/z.ply"]
+    );
+    let (a, bad, worse) = (&rows[1], &rows[2], &rows[3]);
+    assert_eq!(a[2..8], ["trim", "ok", "", "4", "15909", a[7].as_str()]);
+    let faces_out: u64 = a[7].parse().unwrap();
+    assert!(faces_out > 0 && faces_out < FACES_IN);
+    for ms in &a[8..12] {
+        assert!(ms.parse::<f64>().unwrap() >= 0.0, "{a:?}");
+    }
+    assert_eq!(bad[2..4], ["clean", "failed"]);
+    assert!(!bad[4].is_empty() && bad[5..11].iter().all(String::is_empty));
+    assert_eq!(worse[2..4], ["trim", "failed"]);
+    assert!(worse[4].contains("scans/worse.ply"), "{worse:?}");
+    // The same batch as JSON.
+    let run = batch(
+        d,
+        &["scans", "--out-dir", "out2", "--report", "r.json", "--jobs", "1"],
+    );
+    assert_eq!(run.status.code(), Some(1));
+    let report = json_report(&d.join("r.json"));
+    assert_eq!(report["ok"], 2);
+    assert_eq!(report["failed"], 2);
+    assert_eq!(report["skipped"], 0);
+    assert_eq!(inputs(&report), order);
+    let files = &report["files"];
+    assert_eq!(files[0]["faces_out"], faces_out);
+    assert_eq!(files[2]["error"].as_str().unwrap(), worse[4]);
+    assert!(files[2]["loops"].is_null());
+}
+
+#[test]
+fn outputs_are_identical_on_one_and_two_jobs_and_match_meshtrim_trim() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    pair(d, "scans/a");
+    pair(d, "scans/sub/b");
+    assert_ok(&batch(d, &["scans", "--out-dir", "one", "--jobs", "1"]));
+    assert_ok(&batch(d, &["scans", "--out-dir", "two", "--jobs", "2"]));
+    let files = files_below(&d.join("one"));
+    assert_eq!(files.len(), 2);
+    assert_eq!(files, files_below(&d.join("two")));
+    for f in &files {
+        let (one, two) = (
+            std::fs::read(d.join("one").join(f)).unwrap(),
+            std::fs::read(d.join("two").join(f)).unwrap(),
+        );
+        assert!(one == two, "{} differs between --jobs 1 and 2", f.display());
+    }
+    let single = d.join("single.ply");
+    let run = Command::new(env!("CARGO_BIN_EXE_meshtrim"))
+        .args([MESH, CLOUD, single.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_ok(&run);
+    assert!(std::fs::read(single).unwrap() == std::fs::read(d.join("one/a.ply")).unwrap());
+}
+
+#[test]
+fn an_unknown_report_format_is_refused_up_front() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    pair(d, "scans/a");
+    let run = batch(d, &["scans", "--out-dir", "out", "--report", "r.txt"]);
+    let stderr = text(&run.stderr);
+    assert_eq!(run.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("r.txt: unknown report format: name it .csv or .json"),
+        "{stderr}"
+    );
+    assert!(!d.join("out").exists());
+}
+
+#[test]
+fn missing_inputs_and_clouds_given_as_inputs_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    pair(d, "scans/a");
+    for (arg, says) in [
+        ("nope.ply", "nope.ply: cannot read"),
+        ("scans/*.stl", "matches no mesh file"),
+        ("scans/a.cloud.ply", "not a mesh input"),
+    ] {
+        let run = batch(d, &[arg, "--out-dir", "out"]);
+        let stderr = text(&run.stderr);
+        assert_eq!(run.status.code(), Some(1), "{stderr}");
+        assert!(stderr.contains(says), "{arg}: {stderr}");
+    }
+}
+
+#[test]
+fn cloud_dir_mirrors_the_inputs_and_two_clouds_for_one_mesh_fail_that_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for rel in ["scans/sub/a.ply", "scans/sub/b.ply"] {
+        std::fs::create_dir_all(d.join("scans/sub")).unwrap();
+        std::fs::copy(MESH, d.join(rel)).unwrap();
+    }
+    std::fs::create_dir_all(d.join("clouds/sub")).unwrap();
+    std::fs::copy(CLOUD, d.join("clouds/sub/a.cloud.ply")).unwrap();
+    std::fs::copy(CLOUD, d.join("clouds/sub/b.cloud.ply")).unwrap();
+    std::fs::write(d.join("clouds/sub/b.xyz"), "0 0 0\n").unwrap();
+    let run = batch(
+        d,
+        &["scans", "--cloud-dir", "clouds", "--out-dir", "out", "--report", "r.json"],
+    );
+    assert_eq!(run.status.code(), Some(1), "{}", text(&run.stderr));
+    let report = json_report(&d.join("r.json"));
+    let a = &report["files"][0];
+    assert_eq!((&a["mode"], &a["status"]), (&"trim".into(), &"ok".into()));
+    let b = &report["files"][1];
+    assert_eq!(b["status"], "failed");
+    assert_eq!(
+        b["error"],
+        "several clouds match this mesh (clouds/sub/b.cloud.ply, clouds/sub/b.xyz): keep one"
+    );
+    assert_eq!(files_below(&d.join("out")), [PathBuf::from("sub/a.ply")]);
+}
