@@ -121,7 +121,14 @@ fn directories_and_globs_expand_to_sorted_mirrored_outputs() {
     std::fs::write(d.join("scans/notes.md"), "not a mesh").unwrap();
     let run = batch(
         d,
-        &["scans", "other/*.ply", "--out-dir", "out", "--report", "r.json"],
+        &[
+            "scans",
+            "other/*.ply",
+            "--out-dir",
+            "out",
+            "--report",
+            "r.json",
+        ],
     );
     assert_ok(&run);
     // Clouds are never inputs; sub-directories of a directory argument are
@@ -251,18 +258,30 @@ fn skip_existing_resumes_without_rewriting() {
     std::fs::write(d.join("out/a.ply"), "marker").unwrap();
     let run = batch(
         d,
-        &["scans", "--out-dir", "out", "--skip-existing", "--report", "r.csv"],
+        &[
+            "scans",
+            "--out-dir",
+            "out",
+            "--skip-existing",
+            "--report",
+            "r.csv",
+        ],
     );
     assert_ok(&run);
     assert_eq!(std::fs::read(d.join("out/a.ply")).unwrap(), b"marker");
-    assert!(std::fs::read(d.join("out/b.ply")).unwrap().starts_with(b"ply\n"));
+    assert!(std::fs::read(d.join("out/b.ply"))
+        .unwrap()
+        .starts_with(b"ply\n"));
     let stdout = text(&run.stdout);
     assert!(
         stdout.contains("skipped scans/a.ply (output exists)"),
         "{stdout}"
     );
     let rows = parse_csv(&std::fs::read_to_string(d.join("r.csv")).unwrap());
-    assert_eq!(rows[1][..4], ["scans/a.ply", "out/a.ply", "trim", "skipped"]);
+    assert_eq!(
+        rows[1][..4],
+        ["scans/a.ply", "out/a.ply", "trim", "skipped"]
+    );
     assert_eq!(rows[2][..4], ["scans/b.ply", "out/b.ply", "trim", "ok"]);
 }
 
@@ -278,7 +297,15 @@ fn bad_files_fail_alone_and_the_reports_say_why() {
     std::fs::copy(CLOUD, d.join("scans/worse.cloud.ply")).unwrap();
     let run = batch(
         d,
-        &["scans", "--out-dir", "out", "--report", "r.csv", "--jobs", "2"],
+        &[
+            "scans",
+            "--out-dir",
+            "out",
+            "--report",
+            "r.csv",
+            "--jobs",
+            "2",
+        ],
     );
     let (stdout, stderr) = (text(&run.stdout), text(&run.stderr));
     assert_eq!(run.status.code(), Some(1), "{stderr}");
@@ -315,7 +342,12 @@ fn bad_files_fail_alone_and_the_reports_say_why() {
     let order: Vec<&str> = rows[1..].iter().map(|r| r[0].as_str()).collect();
     assert_eq!(
         order,
-        ["scans/a.ply", "scans/bad.stl", "scans/worse.ply", "scans/z.ply"]
+        [
+            "scans/a.ply",
+            "scans/bad.stl",
+            "scans/worse.ply",
+            "scans/z.ply"
+        ]
     );
     let (a, bad, worse) = (&rows[1], &rows[2], &rows[3]);
     assert_eq!(a[2..8], ["trim", "ok", "", "4", "15909", a[7].as_str()]);
@@ -331,7 +363,15 @@ fn bad_files_fail_alone_and_the_reports_say_why() {
     // The same batch as JSON.
     let run = batch(
         d,
-        &["scans", "--out-dir", "out2", "--report", "r.json", "--jobs", "1"],
+        &[
+            "scans",
+            "--out-dir",
+            "out2",
+            "--report",
+            "r.json",
+            "--jobs",
+            "1",
+        ],
     );
     assert_eq!(run.status.code(), Some(1));
     let report = json_report(&d.join("r.json"));
@@ -418,7 +458,15 @@ fn cloud_dir_mirrors_the_inputs_and_two_clouds_for_one_mesh_fail_that_mesh() {
     std::fs::write(d.join("clouds/sub/b.xyz"), "0 0 0\n").unwrap();
     let run = batch(
         d,
-        &["scans", "--cloud-dir", "clouds", "--out-dir", "out", "--report", "r.json"],
+        &[
+            "scans",
+            "--cloud-dir",
+            "clouds",
+            "--out-dir",
+            "out",
+            "--report",
+            "r.json",
+        ],
     );
     assert_eq!(run.status.code(), Some(1), "{}", text(&run.stderr));
     let report = json_report(&d.join("r.json"));
