@@ -60,9 +60,9 @@ pub enum Command {
 pub struct BatchArgs {
     /// Meshes (.stl, .ply, .obj, .gltf, .glb): files, directories (walked
     /// recursively) and glob patterns (quote them: 'scans/*.ply'). A mesh
-    /// S.ext is trimmed when a cloud S.cloud.EXT or S.xyz/.txt/.csv/.asc/
-    /// .pts/.pcd sits beside it, and cleaned otherwise; clouds are never
-    /// inputs themselves.
+    /// S.ext is trimmed when a cloud S.cloud.EXT or S.EXT with EXT one of
+    /// pcd xyz txt csv asc pts sits beside it, and cleaned otherwise;
+    /// clouds are never inputs themselves.
     #[arg(required = true, value_name = "INPUTS")]
     pub inputs: Vec<PathBuf>,
     /// Where the outputs go: the input's path below the directory argument
