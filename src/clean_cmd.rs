@@ -112,7 +112,7 @@ pub fn run(args: &CleanArgs) -> Result<()> {
             );
         }
     }
-    let report = clean(&args.input, &args.output, &args.settings())?;
+    let report = clean(&args.input, &args.output, &args.settings(), true)?;
     if let Some(path) = &args.report {
         let json = serde_json::to_string_pretty(&report)?;
         write_atomic(path, |w| w.write_all(json.as_bytes()))?;
@@ -128,7 +128,7 @@ pub fn run(args: &CleanArgs) -> Result<()> {
 /// Cleans one file without printing (the unit of `batch`).
 pub fn clean_file(input: &Path, output: &Path, settings: &CleanSettings) -> Result<CleanOutcome> {
     check_paths(input, output)?;
-    let r = clean(input, output, settings)?;
+    let r = clean(input, output, settings, false)?;
     Ok(CleanOutcome {
         loops: r.loops_smoothed,
         faces_in: r.faces_in,
@@ -153,8 +153,9 @@ fn check_paths(input: &Path, output: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Reads, detects, cleans, writes.
-fn clean(input: &Path, output: &Path, settings: &CleanSettings) -> Result<Report> {
+/// Reads, detects (with a progress bar on a terminal when `progress`),
+/// cleans, writes.
+fn clean(input: &Path, output: &Path, settings: &CleanSettings, progress: bool) -> Result<Report> {
     let started = Instant::now();
     let read = read_mesh(input)?;
     let Some(faces) = read.faces else {
@@ -173,8 +174,12 @@ fn clean(input: &Path, output: &Path, settings: &CleanSettings) -> Result<Report
         k: settings.k,
         anisotropy: !settings.no_anisotropy,
     };
-    let detection = detect_with_progress(&mesh.vertices, &options)
-        .with_context(|| format!("{}: the mesh's vertices", input.display()))?;
+    let detection = if progress {
+        detect_with_progress(&mesh.vertices, &options)
+    } else {
+        trim::detect_boundary(&mesh.vertices, &options)
+    }
+    .with_context(|| format!("{}: the mesh's vertices", input.display()))?;
     let detect_time = started.elapsed();
     let started = Instant::now();
     let options = CleanOptions {
