@@ -1,0 +1,150 @@
+//! End-to-end tests of `meshtrim clean IN OUT`.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+const JAGGED: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/fixtures/meshes/blade_jagged.stl"
+);
+const CLOUD: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/fixtures/meshes/blade_small.ply"
+);
+
+fn meshtrim(args: &[&str], threads: Option<&str>) -> Output {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_meshtrim"));
+    cmd.args(args);
+    if let Some(t) = threads {
+        cmd.env("RAYON_NUM_THREADS", t);
+    }
+    cmd.output().expect("run meshtrim")
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().expect("utf-8 path")
+}
+
+fn assert_clean_failure(out: &Output, mentions: &str) {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.starts_with("error: "), "{stderr}");
+    assert!(stderr.contains(mentions), "{stderr} should name {mentions}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}
+
+#[test]
+fn cleans_the_fixture_and_reports() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("sub/clean.ply");
+    let report = dir.path().join("report.json");
+    let run = meshtrim(&["clean", JAGGED, s(&out), "--report", s(&report)], None);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(stdout.contains("4 in: 4 smoothed"), "{stdout}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(json["loops_in"], 4);
+    assert_eq!(json["loops_smoothed"], 4);
+    assert_eq!(json["faces_in"], 5768);
+    assert!(json["faces_added"].as_u64().unwrap() > 100, "{json}");
+    assert!(json["min_angle_new"].as_f64().unwrap() > 10.0, "{json}");
+    // The cleaned border is longer-reaching: the smoothed edge passes
+    // outside the jagged one at its notches, so the area grows.
+    assert!(
+        json["area_out"].as_f64() > json["area_in"].as_f64(),
+        "{json}"
+    );
+    let written = meshtrim::io::read_mesh(&out).unwrap();
+    let faces = written.faces.unwrap();
+    assert_eq!(faces.len() as u64, json["faces_out"].as_u64().unwrap());
+    let mesh = trim::mesh::Mesh {
+        vertices: written.vertices,
+        faces,
+    };
+    assert!(mesh.is_edge_manifold());
+    assert_eq!(mesh.boundary_loops().len(), 4);
+}
+
+#[test]
+fn same_bytes_whatever_the_threads() {
+    let dir = tempfile::tempdir().unwrap();
+    let (a, b) = (dir.path().join("a.stl"), dir.path().join("b.stl"));
+    for (out, threads) in [(&a, "1"), (&b, "2")] {
+        let run = meshtrim(&["clean", JAGGED, s(out), "--json"], Some(threads));
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+    }
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+}
+
+#[test]
+fn a_cloud_is_not_a_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out.ply");
+    let run = meshtrim(&["clean", CLOUD, s(&out)], None);
+    assert_clean_failure(&run, "has no faces");
+    assert!(!out.exists());
+}
+
+#[test]
+fn the_output_never_overwrites_the_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in.stl");
+    std::fs::copy(JAGGED, &input).unwrap();
+    let before = std::fs::read(&input).unwrap();
+    let run = meshtrim(&["clean", s(&input), s(&input)], None);
+    assert_clean_failure(&run, "overwrite");
+    assert_eq!(std::fs::read(&input).unwrap(), before);
+}
+
+#[test]
+fn unknown_output_formats_and_reports_are_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let run = meshtrim(&["clean", JAGGED, s(&dir.path().join("out.xyz"))], None);
+    assert_clean_failure(&run, "unsupported output format");
+    let out = dir.path().join("out.stl");
+    let report = dir.path().join("r.txt");
+    let run = meshtrim(&["clean", JAGGED, s(&out), "--report", s(&report)], None);
+    assert_clean_failure(&run, "name it .json");
+    assert!(!out.exists());
+}
+
+#[test]
+fn a_non_manifold_mesh_is_a_clear_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("fin.obj");
+    // A fan of 40 triangles round a centre, plus a third face on one edge.
+    let mut text = String::from("v 0 0 0\n");
+    for i in 0..40 {
+        let a = i as f64 * std::f64::consts::TAU / 40.0;
+        text += &format!("v {} {} 0\n", a.cos(), a.sin());
+    }
+    text += "v 0.5 0 1\n";
+    for i in 0..40 {
+        text += &format!("f 1 {} {}\n", i + 2, (i + 1) % 40 + 2);
+    }
+    text += "f 1 2 42\n";
+    std::fs::write(&input, text).unwrap();
+    let run = meshtrim(&["clean", s(&input), s(&dir.path().join("o.obj"))], None);
+    assert_clean_failure(&run, "shared by more than two faces");
+}
+
+#[test]
+fn a_truncated_file_is_a_clear_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("cut.stl");
+    let bytes = std::fs::read(JAGGED).unwrap();
+    std::fs::write(&input, &bytes[..bytes.len() / 2]).unwrap();
+    let out = dir.path().join("o.stl");
+    let run = meshtrim(&["clean", s(&input), s(&out)], None);
+    assert_clean_failure(&run, "cut.stl");
+    assert!(!out.exists());
+}
