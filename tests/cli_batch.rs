@@ -2,8 +2,7 @@
 //!
 //! Trim pairs are the fixture mesh `blade_small_poisson.ply` copied as
 //! `S.ply` beside the fixture cloud `blade_small.ply` copied as
-//! `S.cloud.ply`. Until `meshtrim clean` is merged, clean mode is only
-//! tested through files that fail either way (garbage bytes).
+//! `S.cloud.ply`; clean inputs are the jagged fixture `blade_jagged.stl`.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -17,6 +16,10 @@ const MESH: &str = concat!(
 const CLOUD: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
     "/fixtures/meshes/blade_small.ply"
+);
+const JAGGED: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/fixtures/meshes/blade_jagged.stl"
 );
 /// Faces of the fixture mesh.
 const FACES_IN: u64 = 15909;
@@ -410,6 +413,73 @@ fn outputs_are_identical_on_one_and_two_jobs_and_match_meshtrim_trim() {
         .unwrap();
     assert_ok(&run);
     assert!(std::fs::read(single).unwrap() == std::fs::read(d.join("one/a.ply")).unwrap());
+}
+
+/// Clean mode: meshes without a cloud are cleaned, the same bytes as
+/// `meshtrim clean` writes, on one or two jobs, mixed with trim pairs.
+#[test]
+fn meshes_without_a_cloud_are_cleaned_like_meshtrim_clean() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::create_dir_all(d.join("scans/sub")).unwrap();
+    std::fs::copy(JAGGED, d.join("scans/j1.stl")).unwrap();
+    std::fs::copy(JAGGED, d.join("scans/sub/j2.stl")).unwrap();
+    pair(d, "scans/t");
+    for jobs in ["1", "2"] {
+        let out = format!("out{jobs}");
+        let report = format!("r{jobs}.json");
+        let run = batch(
+            d,
+            &[
+                "scans",
+                "--out-dir",
+                &out,
+                "--jobs",
+                jobs,
+                "--report",
+                &report,
+            ],
+        );
+        assert_ok(&run);
+        let stdout = text(&run.stdout);
+        assert_eq!(stdout.matches("ok ").count(), 3, "{stdout}");
+        let files = json_report(&d.join(&report))["files"].clone();
+        let modes: Vec<(String, String, u64)> = files
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| {
+                (
+                    f["mode"].as_str().unwrap().to_string(),
+                    f["status"].as_str().unwrap().to_string(),
+                    f["loops"].as_u64().unwrap(),
+                )
+            })
+            .collect();
+        assert_eq!(
+            modes,
+            [
+                ("clean".into(), "ok".into(), 4),
+                ("clean".into(), "ok".into(), 4),
+                ("trim".into(), "ok".into(), 4)
+            ]
+        );
+    }
+    let single = d.join("single.stl");
+    let run = Command::new(env!("CARGO_BIN_EXE_meshtrim"))
+        .args(["clean", JAGGED, single.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert_ok(&run);
+    let single = std::fs::read(single).unwrap();
+    for out in [
+        "out1/j1.stl",
+        "out2/j1.stl",
+        "out1/sub/j2.stl",
+        "out2/sub/j2.stl",
+    ] {
+        assert!(std::fs::read(d.join(out)).unwrap() == single, "{out}");
+    }
 }
 
 #[test]
