@@ -65,10 +65,14 @@ use crate::neighbours::NeighbourIndex;
 
 /// Vertices closer than this many β to a smoothed loop are replaced.
 pub const MARGIN: f64 = 0.5;
+/// Largest share of a smoothed loop's vertices that untwisting it may drop
+/// (where the low-pass filter pulls the two sides of a deep, narrow notch
+/// across each other, the notch is cut off).
+pub const MAX_UNTWIST: f64 = 0.15;
 /// Rings of faces around a border the band starts with …
 pub const FIRST_DEPTH: u32 = 3;
 /// … and the most it grows to.
-pub const MAX_DEPTH: u32 = 12;
+pub const MAX_DEPTH: u32 = 30;
 
 /// Options of the cleanup.
 #[derive(Debug, Clone, PartialEq)]
@@ -164,8 +168,25 @@ pub fn clean_mesh(
         topology: &topology,
         beta_median: median(beta),
     };
-    let patches = replace_all(&context);
-    let mut out = assemble(mesh, &patches, &mut report);
+    let mut outcomes = replace_all(&context);
+    let mut out = loop {
+        let (out, origin) = assemble(mesh, &outcomes);
+        let bad = patches_breaking_manifold(&out, &origin);
+        if bad.is_empty() {
+            break out;
+        }
+        // A safety net: a patch whose faces would make an edge non-manifold
+        // (not seen on the test data) is dropped, its loops left.
+        for g in bad {
+            if let Some(patch) = outcomes[g].patch.take() {
+                outcomes[g].left.push(LeftLoops {
+                    loops: patch.loops,
+                    reason: "its new faces would meet others at a non-manifold edge".into(),
+                });
+            }
+        }
+    };
+    summarise(&outcomes, &out, &mut report);
     out.remove_unused_vertices();
     check_manifold(&out)?;
     report.faces_out = out.faces.len();
@@ -197,12 +218,12 @@ struct Patch {
     faces: Vec<[u32; 3]>,
 }
 
-/// One band's outcome: its faces (to detect bands that overlap) and the
-/// patch, or why its loops stay.
+/// One group's outcome: the band of its replaced loops (to detect bands
+/// that overlap), their patch, and the loops that stay, with why.
 struct Outcome {
-    loops: Vec<usize>,
     band: Vec<u32>,
-    patch: Result<Patch, String>,
+    patch: Option<Patch>,
+    left: Vec<LeftLoops>,
 }
 
 /// Replaces every smoothable loop, merging loops whose bands overlap until
@@ -239,65 +260,118 @@ fn first_overlap(outcomes: &[Outcome]) -> Option<(usize, usize)> {
     None
 }
 
-/// Tries growing bands around one group of loops.
+/// Replaces one group of loops, growing the band while the cut reaches
+/// its rim. A loop that cannot be replaced (its band folds, its smoothed
+/// loop crosses itself or the kept mesh) is left as it is and the others
+/// are tried again without it, so one bad border does not spoil its
+/// neighbours.
 fn replace_group(cx: &Context, group: &[usize]) -> Outcome {
-    let sources: Vec<u32> = group
-        .iter()
-        .flat_map(|&l| cx.borders[l].iter().copied())
-        .collect();
-    let mut depth = FIRST_DEPTH;
-    loop {
-        let band = Band::around(cx, &sources, depth);
-        let result = band.replace(cx, group);
-        let outcome = |patch| Outcome {
-            loops: group.to_vec(),
-            band: band.faces.clone(),
-            patch,
-        };
-        match result {
-            Err(Retry::Grow) if depth < MAX_DEPTH => depth = (depth * 3 / 2).min(MAX_DEPTH),
-            Err(Retry::Grow) => {
-                return outcome(Err(format!(
-                    "the smoothed border runs more than {MAX_DEPTH} rings of faces from the mesh border"
-                )))
+    let mut active = group.to_vec();
+    let mut left = Vec::new();
+    'attempt: while !active.is_empty() {
+        let mut depth = FIRST_DEPTH;
+        loop {
+            let band = Band::around(cx, &active, depth);
+            let failure = match band.replace(cx, &active) {
+                Ok(mut patch) => {
+                    patch.loops = active;
+                    return Outcome {
+                        band: band.faces,
+                        patch: Some(patch),
+                        left,
+                    };
+                }
+                Err(Retry::Grow(_)) if depth < MAX_DEPTH => {
+                    depth = (depth * 3 / 2).min(MAX_DEPTH);
+                    continue;
+                }
+                Err(Retry::Grow(culprits)) => Failure {
+                    reason: format!(
+                        "the smoothed border runs more than {MAX_DEPTH} rings of faces from the mesh border"
+                    ),
+                    culprits,
+                },
+                Err(Retry::Leave(failure)) => failure,
+            };
+            let mut culprits: Vec<usize> = failure
+                .culprits
+                .iter()
+                .filter_map(|&k| active.get(k).copied())
+                .collect();
+            culprits.sort_unstable();
+            culprits.dedup();
+            if culprits.is_empty() {
+                culprits = active.clone();
             }
-            Err(Retry::Leave(reason)) => return outcome(Err(reason)),
-            Ok(patch) => return outcome(Ok(patch)),
+            active.retain(|l| !culprits.contains(l));
+            left.push(LeftLoops {
+                loops: culprits,
+                reason: failure.reason,
+            });
+            continue 'attempt;
         }
+    }
+    Outcome {
+        band: Vec::new(),
+        patch: None,
+        left,
     }
 }
 
 /// Why a band could not be replaced as it is.
 enum Retry {
-    /// The cut reaches the band's rim: take more rings.
-    Grow,
-    /// The loops stay, for this reason.
-    Leave(String),
+    /// The cut reaches the band's rim: take more rings. Holds the loops
+    /// (positions in the group) whose cut reaches it.
+    Grow(Vec<usize>),
+    /// Some loops must stay.
+    Leave(Failure),
+}
+
+/// Why some loops stay: `culprits` are positions in the group (empty when
+/// the whole group is concerned).
+struct Failure {
+    reason: String,
+    culprits: Vec<usize>,
+}
+
+fn leave(reason: impl Into<String>, culprits: Vec<usize>) -> Retry {
+    Retry::Leave(Failure {
+        reason: reason.into(),
+        culprits,
+    })
 }
 
 /// The faces within some rings of a group's border, projected.
 struct Band {
     depth: u32,
-    /// Ring distance of each band vertex from the border.
-    rings_from_border: HashMap<u32, u32>,
+    /// Ring distance of each band vertex from the border, and the loop
+    /// (position in the group) it is nearest to.
+    rings_from_border: HashMap<u32, (u32, usize)>,
     /// Band faces, ascending.
     faces: Vec<u32>,
 }
 
 impl Band {
-    /// Faces with a vertex less than `depth` rings from `sources`.
-    fn around(cx: &Context, sources: &[u32], depth: u32) -> Band {
-        let mut distance: HashMap<u32, u32> = sources.iter().map(|&v| (v, 0)).collect();
+    /// Faces with a vertex less than `depth` rings from the border of the
+    /// `group`'s loops.
+    fn around(cx: &Context, group: &[usize], depth: u32) -> Band {
+        let mut distance: HashMap<u32, (u32, usize)> = HashMap::new();
+        for (k, &l) in group.iter().enumerate() {
+            for &v in &cx.borders[l] {
+                distance.entry(v).or_insert((0, k));
+            }
+        }
         let mut frontier: Vec<u32> = distance.keys().copied().collect();
         frontier.sort_unstable();
         for d in 1..=depth {
             let mut next = Vec::new();
             for &v in &frontier {
+                let origin = distance[&v].1;
                 for &f in cx.topology.faces_of(v) {
                     for w in cx.mesh.faces[f as usize] {
                         distance.entry(w).or_insert_with(|| {
                             next.push(w);
-                            d
+                            (d, origin)
                         });
                     }
                 }
@@ -307,7 +381,7 @@ impl Band {
         }
         let faces: BTreeSet<u32> = distance
             .iter()
-            .filter(|&(_, &d)| d < depth)
+            .filter(|&(_, &(d, _))| d < depth)
             .flat_map(|(&v, _)| cx.topology.faces_of(v).iter().copied())
             .collect();
         Band {
@@ -331,8 +405,13 @@ impl Band {
                 ring
             })
             .collect();
-        let grid = untwist(&mut rings, cx.beta_median, &mut DelaunayReport::default())
-            .map_err(|e| Retry::Leave(e.to_string()))?;
+        let grid = untwist(
+            &mut rings,
+            cx.beta_median,
+            MAX_UNTWIST,
+            &mut DelaunayReport::default(),
+        )
+        .map_err(|e| untwist_failure(e, &rings))?;
         let has_outer = rings.iter().any(|r| r.area() > 0.0);
         let old_border: BTreeSet<u32> = group
             .iter()
@@ -361,15 +440,30 @@ impl Band {
                 removed.push(f);
             }
         }
-        let reaches_rim = removed.iter().any(|&f| {
-            mesh.faces[f as usize]
-                .iter()
-                .any(|v| self.rings_from_border[v] + 1 >= self.depth)
-        });
-        if reaches_rim {
-            return Err(Retry::Grow);
+        // Faces that turn over in the projection (a range scan's skirt
+        // across a depth jump at a silhouette, a fold) go too when they
+        // touch what goes: the gap filling replaces them by one layer.
+        let turned: BTreeSet<u32> = self
+            .faces
+            .iter()
+            .copied()
+            .filter(|&f| {
+                let [a, b, c] = mesh.faces[f as usize].map(p2);
+                orient(a, b, c) <= 0.0
+            })
+            .collect();
+        let removed = with_turned_neighbours(mesh, removed, &turned);
+        let at_rim: BTreeSet<usize> = removed
+            .iter()
+            .flat_map(|&f| mesh.faces[f as usize])
+            .map(|v| self.rings_from_border[&v])
+            .filter(|&(d, _)| d + 1 >= self.depth)
+            .map(|(_, origin)| origin)
+            .collect();
+        if !at_rim.is_empty() {
+            return Err(Retry::Grow(at_rim.into_iter().collect()));
         }
-        projection.check_folds(mesh, &self.faces, &removed, &stay)?;
+        check_folds(mesh, self, &removed, &stay, &turned)?;
         let border_edges: BTreeSet<(u32, u32)> = group
             .iter()
             .flat_map(|&l| {
@@ -377,14 +471,19 @@ impl Band {
                 (0..b.len()).map(move |i| (b[i], b[(i + 1) % b.len()]))
             })
             .collect();
-        let walls = walls(mesh, &self.faces, &removed, &border_edges);
+        let walls = walls(mesh, &self.faces, &removed, &border_edges, &stay);
+        // The vertices of turned faces belong to a fold's second layer: the
+        // new faces are made without them.
+        let folded: BTreeSet<u32> = turned
+            .iter()
+            .flat_map(|&f| mesh.faces[f as usize])
+            .collect();
         let free: BTreeSet<u32> = removed
             .iter()
             .flat_map(|&f| mesh.faces[f as usize])
-            .filter(|v| stay[v])
+            .filter(|v| stay[v] && !folded.contains(v))
             .collect();
         let mut patch = triangulate(mesh, &projection, &rings, &walls, &free)?;
-        patch.loops = group.to_vec();
         patch.removed = removed;
         Ok(patch)
     }
@@ -397,6 +496,7 @@ fn walls(
     band: &[u32],
     removed: &[u32],
     group_border: &BTreeSet<(u32, u32)>,
+    stay: &HashMap<u32, bool>,
 ) -> Vec<[u32; 2]> {
     let removed_set: BTreeSet<u32> = removed.iter().copied().collect();
     let mut uses: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
@@ -419,7 +519,10 @@ fn walls(
                 .collect();
             let wall = match others.first() {
                 Some(g) => !removed_set.contains(g),
-                None => !group_border.contains(&(a, b)),
+                // The border of a loop outside the group (too small, or
+                // left): it bounds the new faces where it stays, and is
+                // absorbed where the new border takes its vertices.
+                None => !group_border.contains(&(a, b)) && stay[&a] && stay[&b],
             };
             if wall {
                 walls.push([a, b]);
@@ -441,47 +544,54 @@ fn triangulate(
     let mut cdt = Cdt::new();
     let mut patch = Patch::default();
     let mut handle_of: HashMap<u32, spade::handles::FixedVertexHandle> = HashMap::new();
-    let coincide = || Retry::Leave("two vertices coincide in the projection of the band".into());
-    let mut insert = |cdt: &mut Cdt, p: [f64; 2], id: u32| -> Result<_, Retry> {
+    let coincide = |ring: Option<usize>| {
+        leave(
+            "two vertices coincide in the projection of the band",
+            ring.into_iter().collect(),
+        )
+    };
+    let mut insert = |cdt: &mut Cdt, p: [f64; 2], id: u32, ring: Option<usize>| {
         if let Some(&h) = handle_of.get(&id) {
             return Ok(h);
         }
         if let PositionInTriangulation::OnVertex(_) = cdt.locate(crate::delaunay::point(p)) {
-            return Err(coincide());
+            return Err(coincide(ring));
         }
-        let h = cdt.insert(Node::new(p, id)).map_err(|_| coincide())?;
+        let h = cdt.insert(Node::new(p, id)).map_err(|_| coincide(ring))?;
         handle_of.insert(id, h);
         Ok(h)
     };
     let mut ring_handles = Vec::new();
-    for ring in rings {
+    for (k, ring) in rings.iter().enumerate() {
         let mut hs = Vec::with_capacity(ring.len());
         for (j, &p) in ring.p2.iter().enumerate() {
             let id = n + patch.vertices.len() as u32;
             patch.vertices.push(ring.p3[j]);
-            hs.push(insert(&mut cdt, p, id)?);
+            hs.push(insert(&mut cdt, p, id, Some(k))?);
         }
         ring_handles.push(hs);
     }
     let wall_vertices: BTreeSet<u32> = walls.iter().flatten().copied().collect();
     for &v in wall_vertices.iter().chain(free) {
-        insert(&mut cdt, projection.to2(mesh.vertices[v as usize]), v)?;
+        insert(&mut cdt, projection.to2(mesh.vertices[v as usize]), v, None)?;
     }
-    let crossing = || Retry::Leave("the smoothed border crosses the kept mesh".into());
-    let constrain = |cdt: &mut Cdt, a, b| {
+    let constrain = |cdt: &mut Cdt, a, b, ring: Option<usize>| {
         if obstacle(cdt, a, b).is_some() {
-            return Err(crossing());
+            return Err(leave(
+                "the smoothed border crosses the kept mesh",
+                ring.into_iter().collect(),
+            ));
         }
         cdt.add_constraint(a, b);
         Ok(())
     };
-    for hs in &ring_handles {
+    for (k, hs) in ring_handles.iter().enumerate() {
         for j in 0..hs.len() {
-            constrain(&mut cdt, hs[j], hs[(j + 1) % hs.len()])?;
+            constrain(&mut cdt, hs[j], hs[(j + 1) % hs.len()], Some(k))?;
         }
     }
     for w in walls {
-        constrain(&mut cdt, handle_of[&w[0]], handle_of[&w[1]])?;
+        constrain(&mut cdt, handle_of[&w[0]], handle_of[&w[1]], None)?;
     }
     for f in inside_faces(&cdt) {
         let vs = cdt.face(f).vertices();
@@ -509,63 +619,35 @@ impl Projection {
     /// Fits the band's plane, oriented so the faces face its normal.
     fn of(cx: &Context, faces: &[u32]) -> Projection {
         let mesh = cx.mesh;
-        let members: Vec<u32> = faces
-            .iter()
-            .flat_map(|&f| mesh.faces[f as usize])
-            .collect::<BTreeSet<u32>>()
-            .into_iter()
-            .collect();
-        let frame = fit_plane(&mesh.vertices, &members);
-        let facing: f64 = faces
-            .iter()
-            .map(|&f| dot(face_normal(mesh, f), frame.normal))
-            .sum();
-        let v = if facing < 0.0 {
-            frame.v.map(|c| -c)
-        } else {
-            frame.v
-        };
-        Projection {
-            origin: mesh.vertices[members[0] as usize],
-            u: frame.u,
-            v,
-        }
-    }
-
-    /// The region triangulated again must be a height field over the
-    /// plane: a removed face, or a kept face at a wall, that turns over in
-    /// the projection means the surface folds there. Kept faces farther in
-    /// may fold (a grazing view elsewhere in the band): they are untouched.
-    fn check_folds(
-        &self,
-        mesh: &Mesh,
-        band: &[u32],
-        removed: &[u32],
-        stay: &HashMap<u32, bool>,
-    ) -> Result<(), Retry> {
-        let removed: BTreeSet<u32> = removed.iter().copied().collect();
-        let touched: BTreeSet<u32> = removed
-            .iter()
-            .flat_map(|&f| mesh.faces[f as usize])
-            .collect();
-        let relevant = band.iter().filter(|&&f| {
-            removed.contains(&f)
-                || mesh.faces[f as usize]
-                    .iter()
-                    .any(|v| touched.contains(v) && stay[v])
+        let origin = mesh.vertices[mesh.faces[faces[0] as usize][0] as usize];
+        // The area-weighted mean face normal, not the best-fit plane: a
+        // range scan faces its scanner everywhere, so every face projects
+        // the right way up along the mean normal even where a band that
+        // curves round a silhouette has a best-fit plane at a steep angle.
+        let sum = faces.iter().fold([0.0; 3], |acc, &f| {
+            let n = face_normal(mesh, f);
+            [acc[0] + n[0], acc[1] + n[1], acc[2] + n[2]]
         });
-        let turned = relevant
-            .filter(|&&f| {
-                let [a, b, c] = mesh.faces[f as usize].map(|i| self.to2(mesh.vertices[i as usize]));
-                orient(a, b, c) <= 0.0
-            })
-            .count();
-        if turned > 0 {
-            return Err(Retry::Leave(format!(
-                "the surface folds over its plane at this border ({turned} faces of the band turn over in the projection)"
-            )));
+        let length = norm2(sum).sqrt();
+        let normal = if length > 0.0 {
+            sum.map(|c| c / length)
+        } else {
+            let members: Vec<u32> = faces.iter().flat_map(|&f| mesh.faces[f as usize]).collect();
+            fit_plane(&mesh.vertices, &members).normal
+        };
+        // Any tangent axis: the coordinate axis least aligned with n.
+        let axis = (0..3)
+            .min_by(|&a, &b| normal[a].abs().total_cmp(&normal[b].abs()))
+            .unwrap_or(0);
+        let mut e = [0.0; 3];
+        e[axis] = 1.0;
+        let u = cross(normal, e);
+        let u = u.map(|c| c / norm2(u).sqrt());
+        Projection {
+            origin,
+            u,
+            v: cross(normal, u),
         }
-        Ok(())
     }
 
     fn to2(&self, p: Point3) -> [f64; 2] {
@@ -579,54 +661,79 @@ fn face_normal(mesh: &Mesh, f: u32) -> Point3 {
     cross(sub(b, a), sub(c, a))
 }
 
-/// The input with every successful patch applied; failures go to the
-/// report.
-fn assemble(mesh: &Mesh, outcomes: &[Outcome], report: &mut CleanReport) -> Mesh {
+/// The input with every patch applied, and for each output face the
+/// outcome whose patch made it (`None` for input faces).
+fn assemble(mesh: &Mesh, outcomes: &[Outcome]) -> (Mesh, Vec<Option<usize>>) {
     let n = mesh.vertices.len() as u32;
     let mut removed = vec![false; mesh.faces.len()];
     let mut vertices = mesh.vertices.clone();
     let mut new_faces = Vec::new();
-    let mut min_angle = f64::INFINITY;
-    for outcome in outcomes {
-        let patch = match &outcome.patch {
-            Ok(patch) => patch,
-            Err(reason) => {
-                report.loops_left.push(LeftLoops {
-                    loops: outcome.loops.clone(),
-                    reason: reason.clone(),
-                });
-                continue;
-            }
+    for (g, outcome) in outcomes.iter().enumerate() {
+        let Some(patch) = &outcome.patch else {
+            continue;
         };
-        report.loops_smoothed += patch.loops.len();
-        report.faces_removed += patch.removed.len();
         for &f in &patch.removed {
             removed[f as usize] = true;
         }
         let base = vertices.len() as u32;
         vertices.extend_from_slice(&patch.vertices);
-        report.vertices_added += patch.vertices.len();
         for face in &patch.faces {
-            let face = face.map(|id| if id < n { id } else { base + id - n });
-            min_angle = min_angle.min(smallest_angle(&vertices, face));
-            new_faces.push(face);
+            new_faces.push((g, face.map(|id| if id < n { id } else { base + id - n })));
         }
     }
-    report.faces_added = new_faces.len();
+    let mut faces: Vec<[u32; 3]> = Vec::with_capacity(mesh.faces.len() + new_faces.len());
+    let mut origin = Vec::with_capacity(faces.capacity());
+    for (f, _) in mesh.faces.iter().zip(&removed).filter(|(_, &r)| !r) {
+        faces.push(*f);
+        origin.push(None);
+    }
+    for (g, f) in new_faces {
+        faces.push(f);
+        origin.push(Some(g));
+    }
+    (Mesh { vertices, faces }, origin)
+}
+
+/// The outcomes whose new faces use an edge more than twice or twice the
+/// same way.
+fn patches_breaking_manifold(mesh: &Mesh, origin: &[Option<usize>]) -> BTreeSet<usize> {
+    let mut directed: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
+    for (i, f) in mesh.faces.iter().enumerate() {
+        for k in 0..3 {
+            directed.entry((f[k], f[(k + 1) % 3])).or_default().push(i);
+        }
+    }
+    let mut bad = BTreeSet::new();
+    for (&(a, b), faces) in &directed {
+        let reverse = directed.get(&(b, a)).map_or(0, Vec::len);
+        if faces.len() > 1 || reverse > 1 {
+            bad.extend(faces.iter().filter_map(|&i| origin[i]));
+        }
+    }
+    bad
+}
+
+/// Counts what the applied patches did.
+fn summarise(outcomes: &[Outcome], out: &Mesh, report: &mut CleanReport) {
+    let mut min_angle = f64::INFINITY;
+    for outcome in outcomes {
+        report.loops_left.extend(outcome.left.iter().cloned());
+        if let Some(patch) = &outcome.patch {
+            report.loops_smoothed += patch.loops.len();
+            report.faces_removed += patch.removed.len();
+            report.faces_added += patch.faces.len();
+            report.vertices_added += patch.vertices.len();
+        }
+    }
+    let new_faces = &out.faces[out.faces.len() - report.faces_added..];
+    for &face in new_faces {
+        min_angle = min_angle.min(smallest_angle(&out.vertices, face));
+    }
     report.min_angle_new = if min_angle.is_finite() {
         min_angle
     } else {
         0.0
     };
-    let mut faces: Vec<[u32; 3]> = mesh
-        .faces
-        .iter()
-        .zip(&removed)
-        .filter(|(_, &r)| !r)
-        .map(|(f, _)| *f)
-        .collect();
-    faces.extend(new_faces);
-    Mesh { vertices, faces }
 }
 
 /// Smallest angle of a triangle, in degrees.
@@ -695,6 +802,97 @@ impl Topology {
     fn faces_of(&self, v: u32) -> &[u32] {
         &self.faces[self.start[v as usize] as usize..self.start[v as usize + 1] as usize]
     }
+}
+
+/// The loop to leave when the smoothed loops cross: the one that crosses
+/// itself, or the smaller of two that cross each other.
+fn untwist_failure(error: MeshError, rings: &[Ring]) -> Retry {
+    match error {
+        MeshError::LoopNotSimple {
+            index,
+            vertices,
+            dropped,
+        } => leave(
+            format!(
+                "its smoothed loop crosses itself in the band's projection (untwisting it would drop {dropped} of its {vertices} vertices)"
+            ),
+            vec![index],
+        ),
+        MeshError::LoopsCross { a, b } => {
+            let smaller = if rings[a].len() <= rings[b].len() { a } else { b };
+            leave(
+                "its smoothed loop crosses the smoothed loop of another border",
+                vec![smaller],
+            )
+        }
+        other => leave(other.to_string(), Vec::new()),
+    }
+}
+
+/// The faces kept next to the region triangulated again must not turn over
+/// in the projection: the new faces would overlap them. (Turned faces
+/// inside the band are removed; kept faces farther in may turn over, a
+/// grazing view elsewhere: they are untouched.)
+fn check_folds(
+    mesh: &Mesh,
+    band: &Band,
+    removed: &[u32],
+    stay: &HashMap<u32, bool>,
+    turned: &BTreeSet<u32>,
+) -> Result<(), Retry> {
+    let removed_set: BTreeSet<u32> = removed.iter().copied().collect();
+    let touched: BTreeSet<u32> = removed
+        .iter()
+        .flat_map(|&f| mesh.faces[f as usize])
+        .collect();
+    let overlapped: Vec<u32> = turned
+        .iter()
+        .copied()
+        .filter(|f| !removed_set.contains(f))
+        .filter(|&f| {
+            mesh.faces[f as usize]
+                .iter()
+                .any(|v| touched.contains(v) && stay[v])
+        })
+        .collect();
+    if overlapped.is_empty() {
+        return Ok(());
+    }
+    let culprits: BTreeSet<usize> = overlapped
+        .iter()
+        .flat_map(|&f| mesh.faces[f as usize])
+        .map(|v| band.rings_from_border[&v].1)
+        .collect();
+    Err(leave(
+        format!(
+            "the surface folds over its plane at this border ({} kept faces next to the new ones turn over in the projection)",
+            overlapped.len()
+        ),
+        culprits.into_iter().collect(),
+    ))
+}
+
+/// `removed` and every turned face connected to it through turned faces
+/// (sharing a vertex), ascending.
+fn with_turned_neighbours(mesh: &Mesh, removed: Vec<u32>, turned: &BTreeSet<u32>) -> Vec<u32> {
+    let mut by_vertex: HashMap<u32, Vec<u32>> = HashMap::new();
+    for &f in turned {
+        for v in mesh.faces[f as usize] {
+            by_vertex.entry(v).or_default().push(f);
+        }
+    }
+    let mut all: BTreeSet<u32> = removed.iter().copied().collect();
+    let mut stack = removed;
+    while let Some(f) = stack.pop() {
+        for v in mesh.faces[f as usize] {
+            for &g in by_vertex.get(&v).map_or(&[][..], Vec::as_slice) {
+                if all.insert(g) {
+                    stack.push(g);
+                }
+            }
+        }
+    }
+    all.into_iter().collect()
 }
 
 #[cfg(test)]

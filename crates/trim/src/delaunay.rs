@@ -207,7 +207,7 @@ pub fn delaunay_mesh_with_report(
         ring.p2 = ring.p3.iter().map(|&p| to2(p)).collect();
         report.loop_vertices_merged += ring.merge_coincident();
     }
-    let grid = untwist(&mut rings, beta_median, &mut report)?;
+    let grid = untwist(&mut rings, beta_median, MAX_REPAIR, &mut report)?;
 
     // 4. Which cloud points go in.
     let class: Vec<u8> = (0..n)
@@ -614,6 +614,7 @@ pub(crate) fn segments_meet(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) 
 pub(crate) fn untwist(
     rings: &mut [Ring],
     beta_median: f64,
+    max_repair: f64,
     report: &mut DelaunayReport,
 ) -> Result<SegmentGrid, MeshError> {
     let original: Vec<usize> = rings.iter().map(Ring::len).collect();
@@ -653,7 +654,7 @@ pub(crate) fn untwist(
         }
         let gone = keep.iter().filter(|&&k| !k).count();
         dropped[l] += gone;
-        let limit = ((MAX_REPAIR * original[l] as f64) as usize).max(4);
+        let limit = ((max_repair * original[l] as f64) as usize).max(4);
         if dropped[l] > limit {
             return Err(MeshError::LoopNotSimple {
                 index: l,
@@ -900,7 +901,7 @@ mod tests {
         p[6] = [2.0, 0.5];
         let mut rings = vec![ring(p)];
         let mut report = DelaunayReport::default();
-        let grid = untwist(&mut rings, 1.0, &mut report).unwrap();
+        let grid = untwist(&mut rings, 1.0, MAX_REPAIR, &mut report).unwrap();
         assert!(grid.first_crossing().is_none());
         assert_eq!(report.loop_vertices_dropped, 2);
         assert!(grid.parity([5.0, 5.0]) && !grid.parity([11.0, 5.0]));
@@ -916,7 +917,7 @@ mod tests {
         let mut rings = vec![ring(p)];
         let mut report = DelaunayReport::default();
         assert!(matches!(
-            untwist(&mut rings, 1.0, &mut report),
+            untwist(&mut rings, 1.0, MAX_REPAIR, &mut report),
             Err(MeshError::LoopNotSimple { index: 0, .. })
         ));
     }
@@ -929,7 +930,7 @@ mod tests {
         ];
         let mut report = DelaunayReport::default();
         assert!(matches!(
-            untwist(&mut rings, 1.0, &mut report),
+            untwist(&mut rings, 1.0, MAX_REPAIR, &mut report),
             Err(MeshError::LoopsCross { a: 0, b: 1 })
         ));
         assert!(MeshError::LoopsCross { a: 0, b: 1 }
