@@ -326,3 +326,108 @@ def border_metrics(vertices, faces, cloud):
         "faces": int(len(faces)),
         "vertices": int(len(vertices)),
     }
+
+
+def fan_boundary_loops(faces):
+    """Boundary loops with pinched vertices split: at a vertex where
+    several border loops touch, an incoming boundary edge continues with
+    the outgoing one of the same fan of faces (found by turning around the
+    vertex through the faces), so the count does not depend on the order of
+    a walk. Needs an edge-manifold mesh."""
+    faces = np.asarray(faces, np.int64)
+    n = int(faces.max()) + 1 if len(faces) else 0
+    d = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    third = np.concatenate([faces[:, 2], faces[:, 0], faces[:, 1]])
+    key = d[:, 0] * n + d[:, 1]
+    order = np.argsort(key)
+    skey, sthird = key[order], third[order]
+    twin = np.isin(d[:, 1] * n + d[:, 0], skey)
+    border = d[~twin]
+    nxt = {}
+    for a, b in border:
+        a, b = int(a), int(b)
+        # Turn around b: from the face with a->b, the edge b->c; across it.
+        i = np.searchsorted(skey, a * n + b)
+        c = int(sthird[i])
+        while True:
+            j = np.searchsorted(skey, c * n + b)
+            if j < len(skey) and skey[j] == c * n + b:
+                c = int(sthird[j])
+            else:
+                break
+        nxt[(a, b)] = (b, c)
+    loops, seen = [], set()
+    for e in nxt:
+        if e in seen:
+            continue
+        loop = []
+        while e not in seen:
+            seen.add(e)
+            loop.append(e[0])
+            e = nxt[e]
+        loops.append(loop)
+    return loops
+
+
+def min_angle(vertices, faces):
+    """Smallest interior angle of the triangles, degrees."""
+    x = vertices[faces]
+    best = np.inf
+    for k in range(3):
+        a = x[:, (k + 1) % 3] - x[:, k]
+        b = x[:, (k + 2) % 3] - x[:, k]
+        c = np.einsum("ij,ij->i", a, b) / (np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1))
+        best = min(best, float(np.degrees(np.arccos(np.clip(c, -1, 1))).min()))
+    return best
+
+
+def meshset(vertices, faces):
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertex_matrix=np.asarray(vertices, np.float64),
+                               face_matrix=np.asarray(faces, np.int32)))
+    return ms
+
+
+def pymeshlab_validity(vertices, faces):
+    """What PyMeshLab says about a mesh: its topological measures
+    (non-manifold edges and vertices, boundary loops as ``boundary_edges``
+    and ``number_holes``, connected components), and what its repair filters
+    would change: faces re-oriented by ``meshing_re_orient_faces_coherently``
+    (compared face by face), vertices merged by
+    ``meshing_remove_duplicate_vertices``, faces removed by
+    ``meshing_remove_null_faces`` and
+    ``meshing_remove_duplicate_faces``."""
+    ms = meshset(vertices, faces)
+    topo = ms.get_topological_measures()
+    out = {
+        "non_manifold_edges": int(topo["non_two_manifold_edges"]),
+        "non_manifold_vertices": int(topo["non_two_manifold_vertices"]),
+        "boundary_edges": int(topo["boundary_edges"]),
+        "holes": int(topo["number_holes"]),
+        "components": int(topo["connected_components_number"]),
+    }
+    f0 = ms.current_mesh().face_matrix().copy()
+    ms.meshing_re_orient_faces_coherently()
+    f1 = ms.current_mesh().face_matrix()
+    # A coherent piece may come back unchanged or flipped as a whole; count
+    # the faces turned against the majority of their piece (-1: the filter
+    # changed more than the orientation).
+    if f0.shape != f1.shape or not np.array_equal(np.sort(f0, 1), np.sort(f1, 1)):
+        out["reoriented"] = -1
+    else:
+        kept = np.zeros(len(f0), dtype=bool)
+        for k in range(3):
+            kept |= np.all(np.roll(f0, k, axis=1) == f1, axis=1)
+        flipped = int((~kept).sum())
+        out["reoriented"] = min(flipped, len(f0) - flipped) if out["components"] == 1 else flipped
+    ms = meshset(vertices, faces)
+    n = ms.current_mesh().vertex_number()
+    ms.meshing_remove_duplicate_vertices()
+    out["duplicate_vertices"] = n - ms.current_mesh().vertex_number()
+    ms = meshset(vertices, faces)
+    m = ms.current_mesh().face_number()
+    ms.meshing_remove_null_faces()
+    out["null_faces"] = m - ms.current_mesh().face_number()
+    ms.meshing_remove_duplicate_faces()
+    out["duplicate_faces"] = m - out["null_faces"] - ms.current_mesh().face_number()
+    return out

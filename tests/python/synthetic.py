@@ -203,6 +203,8 @@ class Cloud:
     area: float  # true area of the part
     spacing: float  # sampling pitch h
     stretch_max: float = 1.0  # largest stretch of the surface map over the points
+    surface: object = None  # the map (u, v) -> xyz
+    region: Region | None = None  # the part's region of the parameter domain
 
     @property
     def n(self) -> int:
@@ -227,6 +229,8 @@ def _make(name, surface, region, h, seed, scale):
         area=true_area(surface, region, scale),
         spacing=h,
         stretch_max=float(_stretch(surface, u, v, scale).max()),
+        surface=surface,
+        region=region,
     )
 
 
@@ -313,14 +317,15 @@ def write_cloud_ply(path, points, normals=None) -> None:
         f.write(rec.tobytes())
 
 
-def write_mesh_ply(path, vertices, faces, quality=None) -> None:
-    """Binary little-endian PLY mesh: ``float x y z`` (+ ``float quality``),
-    ``list uchar int vertex_indices``."""
+def write_mesh_ply(path, vertices, faces, quality=None, double=False) -> None:
+    """Binary little-endian PLY mesh: ``float x y z`` (``double`` with
+    ``double=True``) (+ ``float quality``), ``list uchar int vertex_indices``."""
     v = np.asarray(vertices)
     f = np.asarray(faces, dtype="<i4")
+    ctype, cfmt = ("double", "<f8") if double else ("float", "<f4")
     header = ["ply", "format binary_little_endian 1.0", f"element vertex {len(v)}"]
-    header += [f"property float {c}" for c in "xyz"]
-    fields = [("x", "<f4"), ("y", "<f4"), ("z", "<f4")]
+    header += [f"property {ctype} {c}" for c in "xyz"]
+    fields = [("x", cfmt), ("y", cfmt), ("z", cfmt)]
     if quality is not None:
         header.append("property float quality")
         fields.append(("quality", "<f4"))

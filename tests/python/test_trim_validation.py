@@ -23,8 +23,6 @@ its Poisson envelope closes the open base; trimming must open it again.
 from __future__ import annotations
 
 import json
-import os
-import subprocess
 import sys
 from pathlib import Path
 
@@ -32,22 +30,11 @@ import numpy as np
 import pytest
 
 HERE = Path(__file__).resolve().parent
-ROOT = HERE.parent.parent
 sys.path.insert(0, str(HERE))
 
+from meshtrim_cli import run_meshtrim, shared_data  # noqa: E402
 import poisson  # noqa: E402
 import synthetic  # noqa: E402
-
-MESHTRIM = Path(os.environ.get("MESHTRIM", ROOT / "target" / "release" / "meshtrim"))
-def shared_data(rel: str) -> Path:
-    """The real scans: beside the repository, via MESHTRIM_SHARED_DATA, or
-    at /work/shared/data. Missing data is a failure, not a skip."""
-    candidates = [Path(p) for p in [os.environ.get("MESHTRIM_SHARED_DATA")] if p]
-    candidates += [ROOT.parent / "shared" / "data", Path("/work/shared/data")]
-    for c in candidates:
-        if c.is_dir():
-            return c / rel
-    pytest.fail(f"the real test data is missing: looked in {candidates}")
 
 CASES = {
     "blade4": lambda: synthetic.blade(4.0, 1),
@@ -55,14 +42,6 @@ CASES = {
     "plate": lambda: synthetic.notched_plate(1.0, 1),
     "disc": lambda: synthetic.curved_disc(1.5, 1),
 }
-
-
-def run_meshtrim(*args):
-    if not MESHTRIM.exists():
-        pytest.fail(f"{MESHTRIM} missing: build with cargo build --release")
-    r = subprocess.run([str(MESHTRIM), *map(str, args)], capture_output=True, text=True, timeout=600)
-    assert r.returncode == 0, f"meshtrim {args} failed:\n{r.stdout}\n{r.stderr}"
-    return r
 
 
 @pytest.fixture(scope="session", params=sorted(CASES))

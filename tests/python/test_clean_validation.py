@@ -1,0 +1,388 @@
+"""Validation of `meshtrim clean` with independent tools (issue 5).
+
+Synthetic cases (blade with three holes at 4 and 8 mm, notched plate,
+curved disc with a hole): the jittered cloud is triangulated here, with
+scipy's Delaunay in its parameter domain (:mod:`jagged`, independent of the
+Rust generator), so its border zig-zags through the outermost samples; it
+is written as a binary PLY (double coordinates) and cleaned by
+`meshtrim clean`. Checked on the output:
+
+- border loops = the true loops, and every loop smoothed;
+- border (loop vertices and edge midpoints) -> true boundary: mean <= 0.25
+  spacings, largest <= 1.0, and closer than the jagged input's;
+- the area closer to the true area than the input's;
+- PyMeshLab: no non-manifold edges or vertices, as many holes as true
+  loops, one piece, `meshing_re_orient_faces_coherently` turns no face,
+  `meshing_remove_duplicate_vertices`, `meshing_remove_null_faces` and
+  `meshing_remove_duplicate_faces` remove nothing; directed edges used once
+  (numpy); every face facing the true normal;
+- new faces: smallest angle (the report's, checked against the faces not in
+  the input) above 10 degrees and not below the input's smallest angle;
+- every output vertex off the border is an input vertex, bit for bit.
+
+`--no-offset` keeps the border through the border vertices: it stays about
+as far from the truth as the jagged input and farther than the default.
+
+Real scans (face000, lato000 from MeshLab's samples, the bunny's bun000
+range grid): exit 0, PyMeshLab finds no non-manifold edge, no more
+non-manifold vertices than in the input, nothing to merge or remove; the
+border loops (split at pinched vertices) do not grow; at least the measured
+share of the loops is smoothed.
+
+Measured (seed 1; spacings; area as a fraction of the true area):
+
+============  ===========  ===========  =============  ============
+case          input mean/  output mean/ area in / out  min angle in /
+              max          max                         out (new)
+============  ===========  ===========  =============  ============
+blade 4 mm    0.350/0.913  0.117/0.511  0.9741/0.9985  12.96/22.77
+blade 8 mm    0.291/0.702  0.129/0.603  0.9554/1.0060  13.45/17.67
+plate         0.408/0.833  0.155/0.537  0.9529/0.9941  13.06/16.11
+disc          0.390/1.002  0.123/0.606  0.9706/0.9954  11.45/21.52
+============  ===========  ===========  =============  ============
+
+--no-offset on the blade at 4 mm: 0.348/0.825. Seeds 2-5: input mean
+0.28-0.40, output mean 0.12-0.18, largest 0.40-0.85, every loop smoothed,
+smallest new angle 15.8-24.5 degrees.
+
+Real scans (loops split at pinched vertices, as meshtrim counts them):
+
+=======  =====  =========  ================  ==================  =========
+scan     loops  smoothed   non-manifold      min angle in / new  new faces
+         in/out            vertices in/out   (degrees)           < 10 deg
+=======  =====  =========  ================  ==================  =========
+face000  44/43  22         6/4               9.44 / 1.37         45 of 1483
+lato000  19/19  17         2/0               8.78 / 1.54         70 of 3442
+bun000   4/4    0          4/4               0.85 / -            -
+=======  =====  =========  ================  ==================  =========
+
+The two xfail (strict) tests record what is not met yet: bun000 smooths
+none of its loops (a 4-vertex hole whose smoothed loop crosses itself takes
+the other loops of its band group with it), and on face000 and lato000 new
+faces, almost all touching the new border, go down to 1.4 degrees.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+
+import jagged  # noqa: E402
+import poisson  # noqa: E402
+import synthetic  # noqa: E402
+from meshtrim_cli import run_meshtrim, shared_data  # noqa: E402
+
+CASES = {
+    "blade4": lambda: synthetic.blade(4.0, 1),
+    "blade8": lambda: synthetic.blade(8.0, 1),
+    "plate": lambda: synthetic.notched_plate(1.0, 1),
+    "disc": lambda: synthetic.curved_disc(1.5, 1),
+}
+
+MIN_ANGLE_SLACK = 1.0
+"""The output's smallest angle may be this much (degrees) below the
+input's (measured: it is 2.6 to 10 degrees above)."""
+
+
+def read_mesh(path):
+    verts, faces = synthetic.read_ply(path)
+    return np.stack([verts["x"], verts["y"], verts["z"]], axis=1), faces
+
+
+def clean(directory, name, vertices, faces, *flags):
+    """Writes the mesh, runs `meshtrim clean` on it; (V, F, report)."""
+    src = directory / f"{name}.ply"
+    out = directory / f"{name}_clean.ply"
+    report = directory / f"{name}_report.json"
+    synthetic.write_mesh_ply(src, vertices, faces, double=True)
+    run_meshtrim("clean", src, out, "--report", report, *flags)
+    v, f = read_mesh(out)
+    return v, f, json.loads(report.read_text())
+
+
+@pytest.fixture(scope="module", params=sorted(CASES))
+def case(request, tmp_path_factory):
+    cloud = CASES[request.param]()
+    d = tmp_path_factory.mktemp(f"clean_{request.param}")
+    v, f, source = jagged.jagged_mesh(cloud)
+    ov, of, report = clean(d, request.param, v, f)
+    truth = poisson.PolylineDistance(cloud.loops)
+    c = {
+        "name": request.param,
+        "cloud": cloud,
+        "in": (v, f),
+        "source": source,
+        "out": (ov, of),
+        "report": report,
+        "err_in": jagged.border_error(v, f, cloud, truth),
+        "err_out": jagged.border_error(ov, of, cloud, truth),
+        "area_in": poisson.mesh_area(v, f) / cloud.area,
+        "area_out": poisson.mesh_area(ov, of) / cloud.area,
+        "angle_in": poisson.min_angle(v, f),
+        "angle_out": poisson.min_angle(ov, of),
+    }
+    print(
+        f"\n{c['name']}: border in {c['err_in'][0]:.3f}/{c['err_in'][1]:.3f} out "
+        f"{c['err_out'][0]:.3f}/{c['err_out'][1]:.3f} spacings; area in {c['area_in']:.4f} "
+        f"out {c['area_out']:.4f}; min angle in {c['angle_in']:.2f} out {c['angle_out']:.2f} "
+        f"new {report['min_angle_new']:.2f}"
+    )
+    return c
+
+
+def test_jagged_input_is_what_scanners_make(case):
+    """The generator's mesh: valid, the true loop count, a jagged border
+    inside the truth (the Rust generator: 0.27-0.39 spacings)."""
+    v, f = case["in"]
+    pm = poisson.pymeshlab_validity(v, f)
+    assert pm["non_manifold_edges"] == 0 and pm["non_manifold_vertices"] == 0, pm
+    assert pm["holes"] == len(case["cloud"].loops), pm
+    assert len(poisson.fan_boundary_loops(f)) == len(case["cloud"].loops)
+    assert 0.25 < case["err_in"][0] < 0.6, case["err_in"]
+    assert case["area_in"] < 1.0
+
+
+def test_loops(case):
+    rep, cloud = case["report"], case["cloud"]
+    n = len(cloud.loops)
+    assert len(poisson.fan_boundary_loops(case["out"][1])) == n
+    assert rep["loops_in"] == n and rep["loops_smoothed"] == n, rep
+    assert rep["loops_left"] == [] and rep["loops_too_small"] == 0, rep
+
+
+def test_border_on_the_true_border(case):
+    mean_in, max_in = case["err_in"]
+    mean_out, max_out = case["err_out"]
+    assert mean_out <= 0.25, case["err_out"]
+    assert max_out <= 1.0, case["err_out"]
+    assert mean_out < mean_in and max_out < max_in, (case["err_in"], case["err_out"])
+
+
+def test_area_closer_to_the_truth(case):
+    assert abs(case["area_out"] - 1.0) < abs(case["area_in"] - 1.0), (case["area_in"], case["area_out"])
+    rep = case["report"]
+    v, f = case["in"]
+    ov, of = case["out"]
+    assert rep["area_in"] == pytest.approx(poisson.mesh_area(v, f), rel=1e-9)
+    assert rep["area_out"] == pytest.approx(poisson.mesh_area(ov, of), rel=1e-9)
+    assert rep["faces_out"] == len(of) and rep["faces_in"] == len(f)
+    assert rep["faces_out"] == rep["faces_in"] - rep["faces_removed"] + rep["faces_added"]
+
+
+def test_valid_by_pymeshlab(case):
+    v, f = case["out"]
+    pm = poisson.pymeshlab_validity(v, f)
+    print(f"\n{case['name']}: {pm}")
+    assert pm["non_manifold_edges"] == 0 and pm["non_manifold_vertices"] == 0, pm
+    assert pm["holes"] == len(case["cloud"].loops), pm
+    assert pm["components"] == 1, pm
+    assert pm["reoriented"] == 0, pm
+    assert pm["duplicate_vertices"] == 0 and pm["null_faces"] == 0 and pm["duplicate_faces"] == 0, pm
+    assert poisson.orientation_consistent(f)
+    scale = float(np.linalg.norm(v.max(0) - v.min(0)))
+    assert poisson.degenerate_triangles(v, f, scale) == 0
+
+
+def test_faces_face_the_true_normal(case):
+    v, f = case["out"]
+    cloud = case["cloud"]
+    n = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    _, nearest = poisson.cKDTree(cloud.points).query(v[f].mean(axis=1))
+    assert np.all(np.einsum("ij,ij->i", n, cloud.normals[nearest]) > 0)
+
+
+def new_faces(case):
+    """The output faces that are not input faces (compared by coordinates)."""
+    v, f = case["in"]
+    ov, of = case["out"]
+    old = {tuple(sorted(map(tuple, tri))) for tri in v[f]}
+    return np.array([tuple(sorted(map(tuple, tri))) not in old for tri in ov[of]])
+
+
+def test_no_slivers(case):
+    rep = case["report"]
+    ov, of = case["out"]
+    fresh = new_faces(case)
+    assert fresh.sum() == rep["faces_added"], (fresh.sum(), rep)
+    assert rep["min_angle_new"] == pytest.approx(poisson.min_angle(ov, of[fresh]), abs=1e-6)
+    assert rep["min_angle_new"] > 10.0, rep
+    assert case["angle_out"] >= case["angle_in"] - MIN_ANGLE_SLACK, (case["angle_in"], case["angle_out"])
+
+
+def test_interior_vertices_are_input_vertices(case):
+    v, _ = case["in"]
+    ov, of = case["out"]
+    on_border = np.zeros(len(ov), dtype=bool)
+    on_border[poisson.boundary_edges(of).ravel()] = True
+    inputs = {tuple(p) for p in v}
+    off_border = [tuple(p) in inputs for p in ov[~on_border]]
+    assert all(off_border), f"{len(off_border) - sum(off_border)} new vertices off the border"
+    # New vertices: exactly the report's, all on the border.
+    new = np.array([tuple(p) not in inputs for p in ov])
+    assert new.sum() == case["report"]["vertices_added"]
+
+
+def test_no_offset_keeps_the_inward_bias(tmp_path):
+    """The paper's edges run through the border vertices: the border stays
+    about where the jagged one was (measured on the blade at 4 mm: 0.348
+    against 0.350), farther than with the offset (0.117)."""
+    cloud = CASES["blade4"]()
+    v, f, _ = jagged.jagged_mesh(cloud)
+    truth = poisson.PolylineDistance(cloud.loops)
+    before = jagged.border_error(v, f, cloud, truth)
+    ov, of, rep = clean(tmp_path, "paper", v, f, "--no-offset")
+    dv, df, _ = clean(tmp_path, "default", v, f)
+    paper = jagged.border_error(ov, of, cloud, truth)
+    default = jagged.border_error(dv, df, cloud, truth)
+    print(f"\nblade4: input {before}, --no-offset {paper}, default {default}")
+    assert rep["loops_smoothed"] == len(cloud.loops), rep
+    assert paper[0] > 0.8 * before[0], (before, paper)
+    assert paper[0] > default[0] + 0.1, (paper, default)
+    assert len(poisson.fan_boundary_loops(of)) == len(cloud.loops)
+    pm = poisson.pymeshlab_validity(ov, of)
+    assert pm["non_manifold_edges"] == 0 and pm["non_manifold_vertices"] == 0 and pm["reoriented"] == 0, pm
+
+
+def test_batch_cleans_a_directory(tmp_path):
+    """`meshtrim batch DIR` with two meshes and no clouds: both cleaned."""
+    scans = tmp_path / "scans"
+    scans.mkdir()
+    meshes = {}
+    for name, make in (("plate", lambda: synthetic.notched_plate(2.0, 3)), ("blade", lambda: synthetic.blade(8.0, 2))):
+        cloud = make()
+        v, f, _ = jagged.jagged_mesh(cloud)
+        synthetic.write_mesh_ply(scans / f"{name}.ply", v, f, double=True)
+        meshes[name] = (cloud, v, f)
+    out = tmp_path / "out"
+    report = tmp_path / "batch.csv"
+    run_meshtrim("batch", scans, "--out-dir", out, "--report", report, "--jobs", "2")
+    rows = list(csv.DictReader(report.open()))
+    assert len(rows) == 2, rows
+    for row in rows:
+        assert row["mode"] == "clean" and row["status"] == "ok", row
+    for name, (cloud, v, f) in meshes.items():
+        path = out / f"{name}.ply"
+        assert path.exists(), sorted(out.rglob("*"))
+        ov, of = read_mesh(path)
+        row = next(r for r in rows if Path(r["input"]).name == f"{name}.ply")
+        assert int(row["faces_in"]) == len(f) and int(row["faces_out"]) == len(of), row
+        assert int(row["loops"]) == len(cloud.loops), row
+        assert jagged.border_error(ov, of, cloud)[0] < jagged.border_error(v, f, cloud)[0]
+
+
+# --------------------------------------------------------------------------
+# Real scans.
+
+REAL = {
+    # name: (path, measured smoothed loops / loops in)
+    "face000": ("meshlab_scans/face000.ply", 22 / 44),
+    "lato000": ("meshlab_scans/lato000.ply", 17 / 19),
+    "bun000": ("stanford_bunny/bun000.ply", 0 / 4),
+}
+
+
+_SCANS = {}
+
+
+def clean_scan(name, tmp_path_factory):
+    """Cleans one real scan once per session (the xfail tests below reuse
+    the result) and measures input and output."""
+    if name in _SCANS:
+        return _SCANS[name]
+    rel, share = REAL[name]
+    src = shared_data(rel)
+    d = tmp_path_factory.mktemp(f"scan_{name}")
+    out = d / f"{name}_clean.ply"
+    report = d / "report.json"
+    run_meshtrim("clean", src, out, "--report", report)
+    # PyMeshLab reads the bunny's range grid as faces, too.
+    iv, if_ = poisson.load_mesh(src)
+    ov, of = poisson.load_mesh(out)
+    rep = json.loads(report.read_text())
+    s = {
+        "name": name,
+        "share": share,
+        "in": (iv, if_),
+        "out": (ov, of),
+        "report": rep,
+        "pm_in": poisson.pymeshlab_validity(iv, if_),
+        "pm_out": poisson.pymeshlab_validity(ov, of),
+        "loops_in": len(poisson.fan_boundary_loops(if_)),
+        "loops_out": len(poisson.fan_boundary_loops(of)),
+    }
+    print(
+        f"\n{name}: loops {s['loops_in']} -> {s['loops_out']}, smoothed {rep['loops_smoothed']}, "
+        f"left {[len(x['loops']) for x in rep['loops_left']]}, min angle in "
+        f"{poisson.min_angle(iv, if_):.2f} new {rep['min_angle_new']:.2f}; in {s['pm_in']}; out {s['pm_out']}"
+    )
+    _SCANS[name] = s
+    return s
+
+
+@pytest.fixture(scope="module", params=sorted(REAL))
+def scan(request, tmp_path_factory):
+    return clean_scan(request.param, tmp_path_factory)
+
+
+def test_scan_valid(scan):
+    pm_in, pm = scan["pm_in"], scan["pm_out"]
+    assert pm["non_manifold_edges"] == 0, pm
+    # Pinched border vertices of the scan itself stay (face000: 6 in, 4
+    # out; bun000: 4 and 4); cleaning adds none.
+    assert pm["non_manifold_vertices"] <= pm_in["non_manifold_vertices"], (pm_in, pm)
+    assert pm["reoriented"] == 0 and poisson.orientation_consistent(scan["out"][1]), pm
+    assert pm["duplicate_vertices"] == 0 and pm["null_faces"] == 0 and pm["duplicate_faces"] == 0, pm
+    v, f = scan["out"]
+    assert poisson.degenerate_triangles(v, f, float(np.linalg.norm(v.max(0) - v.min(0)))) == 0
+
+
+def test_scan_loops(scan):
+    rep = scan["report"]
+    assert rep["loops_in"] == scan["loops_in"], rep
+    assert scan["loops_out"] <= scan["loops_in"]
+    left = sum(len(x["loops"]) for x in rep["loops_left"])
+    assert rep["loops_smoothed"] + rep["loops_too_small"] + left == rep["loops_in"], rep
+    assert all(x["reason"] for x in rep["loops_left"]), rep
+    assert rep["loops_smoothed"] >= scan["share"] * rep["loops_in"], rep
+    assert rep["faces_out"] == len(scan["out"][1]), rep
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "bun000: a 4-vertex hole whose smoothed loop crosses itself shares a band group "
+    "with the other loops, so all 4 loops are left unchanged (0 smoothed)"))
+def test_bunny_scan_smoothed(tmp_path_factory):
+    rep = clean_scan("bun000", tmp_path_factory)["report"]
+    assert rep["loops_smoothed"] > 0, rep
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "real scans: new faces reach 1.37 deg (face000) and 1.54 deg (lato000), below the "
+    "10 deg of the synthetic cases and the inputs' own 9.4 and 8.8 deg"))
+def test_scan_new_faces_no_slivers(tmp_path_factory):
+    for name in ("face000", "lato000"):
+        rep = clean_scan(name, tmp_path_factory)["report"]
+        assert rep["min_angle_new"] > 10.0, (name, rep["min_angle_new"])
+
+
+def test_fan_boundary_loops_split_pinched_vertices():
+    """Two triangles touching at one vertex: two loops, whatever the order;
+    a flipped face and a duplicated vertex are caught by the checks."""
+    f = np.array([[0, 1, 2], [0, 3, 4]])
+    assert len(poisson.fan_boundary_loops(f)) == 2
+    assert len(poisson.fan_boundary_loops(f[::-1])) == 2
+    v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0], [2, 0, 0]], float)
+    v2 = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]], float)
+    quad = np.array([[0, 1, 2], [0, 2, 3]])
+    assert poisson.pymeshlab_validity(v2, quad)["reoriented"] == 0
+    assert poisson.pymeshlab_validity(v2, np.array([[0, 1, 2], [0, 3, 2]]))["reoriented"] == 1
+    dup = np.vstack([v2, v2[:1]])
+    assert poisson.pymeshlab_validity(dup, np.array([[0, 1, 2], [4, 2, 3]]))["duplicate_vertices"] == 1
+    assert poisson.pymeshlab_validity(v, np.array([[0, 1, 4], [0, 1, 2]]))["null_faces"] == 1
