@@ -50,11 +50,14 @@
 use std::collections::{BTreeSet, HashMap};
 
 use rayon::prelude::*;
-use spade::{PositionInTriangulation, Triangulation};
+use spade::handles::FixedVertexHandle;
+use spade::{
+    AngleLimit, Point2 as SpadePoint, PositionInTriangulation, RefinementParameters, Triangulation,
+};
 
-use crate::cloud::{cross, dot, norm2, sub, Point3};
+use crate::cloud::{cross, dist2, dot, norm2, sub, Point3};
 use crate::delaunay::{
-    inside_faces, median, obstacle, orient, untwist, Cdt, DelaunayReport, Node, Ring,
+    inside_faces, median, obstacle, orient, untwist, Cdt, DelaunayReport, Node, Ring, STEINER,
 };
 use crate::edges::cluster::MIN_LOOP_POINTS;
 use crate::edges::loop_from_tour;
@@ -69,6 +72,15 @@ pub const MARGIN: f64 = 0.5;
 /// (where the low-pass filter pulls the two sides of a deep, narrow notch
 /// across each other, the notch is cut off).
 pub const MAX_UNTWIST: f64 = 0.15;
+/// Consecutive smoothed loop vertices closer than this many β are merged:
+/// where a zig-zag border is smoothed, its vertices bunch up, and a short
+/// border segment against interior vertices a spacing away makes a
+/// sliver.
+pub const MIN_GAP: f64 = 0.4;
+/// Refinement of the gap: new faces' smallest angle aimed at (degrees) …
+pub const REFINE_ANGLE: f64 = 20.0;
+/// … leaving faces below this many β² alone.
+pub const REFINE_MIN_AREA: f64 = 0.05;
 /// Rings of faces around a border the band starts with …
 pub const FIRST_DEPTH: u32 = 3;
 /// … and the most it grows to.
@@ -155,7 +167,7 @@ pub fn clean_mesh(
         .map(|(border, &smooth)| {
             smooth.then(|| {
                 let lp = loop_from_tour(&mesh.vertices, beta, border.clone(), index.as_ref());
-                Ring::from_loop(&lp, beta)
+                even_out(Ring::from_loop(&lp, beta))
             })
         })
         .collect();
@@ -483,7 +495,7 @@ impl Band {
             .flat_map(|&f| mesh.faces[f as usize])
             .filter(|v| stay[v] && !folded.contains(v))
             .collect();
-        let mut patch = triangulate(mesh, &projection, &rings, &walls, &free)?;
+        let mut patch = triangulate(mesh, &projection, &rings, &walls, &free, cx.beta_median)?;
         patch.removed = removed;
         Ok(patch)
     }
@@ -539,11 +551,12 @@ fn triangulate(
     rings: &[Ring],
     walls: &[[u32; 2]],
     free: &BTreeSet<u32>,
+    scale: f64,
 ) -> Result<Patch, Retry> {
     let n = mesh.vertices.len() as u32;
     let mut cdt = Cdt::new();
     let mut patch = Patch::default();
-    let mut handle_of: HashMap<u32, spade::handles::FixedVertexHandle> = HashMap::new();
+    let mut handle_of: HashMap<u32, FixedVertexHandle> = HashMap::new();
     let coincide = |ring: Option<usize>| {
         leave(
             "two vertices coincide in the projection of the band",
@@ -593,6 +606,7 @@ fn triangulate(
     for w in walls {
         constrain(&mut cdt, handle_of[&w[0]], handle_of[&w[1]], None)?;
     }
+    refine_gap(&mut cdt, mesh, &mut patch, scale);
     for f in inside_faces(&cdt) {
         let vs = cdt.face(f).vertices();
         let mut ids = vs.map(|v| v.data().id);
@@ -606,6 +620,92 @@ fn triangulate(
         patch.faces.push(ids);
     }
     Ok(patch)
+}
+
+/// Where the gap is wide and holds no mesh vertex (a deep notch the
+/// smoothed border bridges), its triangles would join border vertices far
+/// apart in thin slivers: Delaunay refinement (spade, Ruppert/Chew) adds
+/// points inside the new faces until their angles reach [`REFINE_ANGLE`].
+/// The constraints are never split (a point on a wall would open a crack
+/// against the kept face there). Each added point is lifted onto the
+/// plane of the unrefined triangle it falls in, whose corners are points
+/// of the surface.
+fn refine_gap(cdt: &mut Cdt, mesh: &Mesh, patch: &mut Patch, scale: f64) {
+    let n = mesh.vertices.len() as u32;
+    let before = cdt.clone();
+    let parameters = RefinementParameters::<f64>::new()
+        .exclude_outer_faces(true)
+        .keep_constraint_edges()
+        .with_angle_limit(AngleLimit::from_deg(REFINE_ANGLE))
+        .with_min_required_area(REFINE_MIN_AREA * scale * scale)
+        .with_max_additional_vertices(4 * before.num_vertices() + 16);
+    cdt.refine(parameters);
+    let position = |id: u32| {
+        if id < n {
+            mesh.vertices[id as usize]
+        } else {
+            patch.vertices[(id - n) as usize]
+        }
+    };
+    let added: Vec<(FixedVertexHandle, Point3)> = cdt
+        .fixed_vertices()
+        .filter(|&h| cdt.vertex(h).data().id == STEINER)
+        .map(|h| (h, lift(&before, cdt.vertex(h).position(), &position)))
+        .collect();
+    for (h, p) in added {
+        cdt.vertex_data_mut(h).id = n + patch.vertices.len() as u32;
+        patch.vertices.push(p);
+    }
+}
+
+/// The 3D point of the surface at `p` of the unrefined triangulation: the
+/// barycentric blend of its triangle's (or edge's) corners.
+fn lift(cdt: &Cdt, p: SpadePoint<f64>, position: &impl Fn(u32) -> Point3) -> Point3 {
+    let blend = |ids: &[u32], weights: &[f64]| {
+        let mut q = [0.0; 3];
+        for (&id, &w) in ids.iter().zip(weights) {
+            let x = position(id);
+            for c in 0..3 {
+                q[c] += w * x[c];
+            }
+        }
+        q
+    };
+    let along = |e: spade::handles::FixedDirectedEdgeHandle| {
+        let edge = cdt.directed_edge(e);
+        let (a, b) = (edge.from(), edge.to());
+        let (pa, pb) = (a.position(), b.position());
+        let d = [pb.x - pa.x, pb.y - pa.y];
+        let len2 = d[0] * d[0] + d[1] * d[1];
+        let t = if len2 > 0.0 {
+            (((p.x - pa.x) * d[0] + (p.y - pa.y) * d[1]) / len2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        blend(&[a.data().id, b.data().id], &[1.0 - t, t])
+    };
+    match cdt.locate(p) {
+        PositionInTriangulation::OnVertex(v) => position(cdt.vertex(v).data().id),
+        PositionInTriangulation::OnEdge(e) | PositionInTriangulation::OutsideOfConvexHull(e) => {
+            along(e)
+        }
+        PositionInTriangulation::OnFace(f) => {
+            let vs = cdt.face(f).vertices();
+            let [a, b, c] = vs.map(|v| {
+                let q = v.position();
+                [q.x, q.y]
+            });
+            let area = orient(a, b, c);
+            let q = [p.x, p.y];
+            let weights = [
+                orient(q, b, c) / area,
+                orient(a, q, c) / area,
+                orient(a, b, q) / area,
+            ];
+            blend(&vs.map(|v| v.data().id), &weights)
+        }
+        PositionInTriangulation::NoTriangulation => position(0),
+    }
 }
 
 /// The best-fit plane of a band, oriented with its faces.
@@ -893,6 +993,36 @@ fn with_turned_neighbours(mesh: &Mesh, removed: Vec<u32>, turned: &BTreeSet<u32>
         }
     }
     all.into_iter().collect()
+}
+
+/// Drops each smoothed loop vertex closer than [`MIN_GAP`]·β to the last
+/// one kept (and, at the end, to the first), so that the new border's
+/// segments are not much shorter than the mesh's edges.
+fn even_out(mut ring: Ring) -> Ring {
+    let m = ring.p3.len();
+    if m < 2 * MIN_LOOP_POINTS {
+        return ring;
+    }
+    let mut keep = vec![true; m];
+    let mut last = 0;
+    for j in 1..m {
+        let close = dist2(ring.p3[j], ring.p3[last]).sqrt() < MIN_GAP * ring.beta[j];
+        let closing = dist2(ring.p3[j], ring.p3[0]).sqrt() < MIN_GAP * ring.beta[j];
+        if close || closing {
+            keep[j] = false;
+        } else {
+            last = j;
+        }
+    }
+    if keep.iter().filter(|&&k| k).count() >= MIN_LOOP_POINTS {
+        let mut k = keep.iter();
+        ring.p3.retain(|_| *k.next().unwrap_or(&true));
+        let mut k = keep.iter();
+        ring.reference.retain(|_| *k.next().unwrap_or(&true));
+        let mut k = keep.iter();
+        ring.beta.retain(|_| *k.next().unwrap_or(&true));
+    }
+    ring
 }
 
 #[cfg(test)]

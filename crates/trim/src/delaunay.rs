@@ -389,6 +389,18 @@ impl Node {
     }
 }
 
+/// Id of a vertex inserted by refinement until it gets its own.
+pub(crate) const STEINER: u32 = u32::MAX;
+
+impl From<Point2<f64>> for Node {
+    fn from(position: Point2<f64>) -> Self {
+        Node {
+            position,
+            id: STEINER,
+        }
+    }
+}
+
 impl HasPosition for Node {
     type Scalar = f64;
     fn position(&self) -> Point2<f64> {
