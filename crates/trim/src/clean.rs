@@ -1005,11 +1005,12 @@ fn even_out(mut ring: Ring) -> Ring {
     }
     let mut keep = vec![true; m];
     let mut last = 0;
-    for j in 1..m {
-        let close = dist2(ring.p3[j], ring.p3[last]).sqrt() < MIN_GAP * ring.beta[j];
-        let closing = dist2(ring.p3[j], ring.p3[0]).sqrt() < MIN_GAP * ring.beta[j];
+    for (j, kept) in keep.iter_mut().enumerate().skip(1) {
+        let gap = MIN_GAP * ring.beta[j];
+        let close = dist2(ring.p3[j], ring.p3[last]).sqrt() < gap;
+        let closing = dist2(ring.p3[j], ring.p3[0]).sqrt() < gap;
         if close || closing {
-            keep[j] = false;
+            *kept = false;
         } else {
             last = j;
         }
