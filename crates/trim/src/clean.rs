@@ -454,7 +454,10 @@ impl Band {
         }
         // Faces that turn over in the projection (a range scan's skirt
         // across a depth jump at a silhouette, a fold) go too when they
-        // touch what goes: the gap filling replaces them by one layer.
+        // touch what goes and lie inside the band: the gap filling
+        // replaces them by one layer. Kept faces beyond may turn over: the
+        // new faces join them along the walls with opposite edge
+        // directions all the same (the safety net below checks it).
         let turned: BTreeSet<u32> = self
             .faces
             .iter()
@@ -464,7 +467,11 @@ impl Band {
                 orient(a, b, c) <= 0.0
             })
             .collect();
-        let removed = with_turned_neighbours(mesh, removed, &turned);
+        let removed = with_turned_neighbours(mesh, removed, &turned, |f| {
+            mesh.faces[f as usize]
+                .iter()
+                .all(|v| self.rings_from_border[v].0 + 2 < self.depth)
+        });
         let at_rim: BTreeSet<usize> = removed
             .iter()
             .flat_map(|&f| mesh.faces[f as usize])
@@ -475,7 +482,6 @@ impl Band {
         if !at_rim.is_empty() {
             return Err(Retry::Grow(at_rim.into_iter().collect()));
         }
-        check_folds(mesh, self, &removed, &stay, &turned)?;
         let border_edges: BTreeSet<(u32, u32)> = group
             .iter()
             .flat_map(|&l| {
@@ -929,52 +935,14 @@ fn untwist_failure(error: MeshError, rings: &[Ring]) -> Retry {
     }
 }
 
-/// The faces kept next to the region triangulated again must not turn over
-/// in the projection: the new faces would overlap them. (Turned faces
-/// inside the band are removed; kept faces farther in may turn over, a
-/// grazing view elsewhere: they are untouched.)
-fn check_folds(
-    mesh: &Mesh,
-    band: &Band,
-    removed: &[u32],
-    stay: &HashMap<u32, bool>,
-    turned: &BTreeSet<u32>,
-) -> Result<(), Retry> {
-    let removed_set: BTreeSet<u32> = removed.iter().copied().collect();
-    let touched: BTreeSet<u32> = removed
-        .iter()
-        .flat_map(|&f| mesh.faces[f as usize])
-        .collect();
-    let overlapped: Vec<u32> = turned
-        .iter()
-        .copied()
-        .filter(|f| !removed_set.contains(f))
-        .filter(|&f| {
-            mesh.faces[f as usize]
-                .iter()
-                .any(|v| touched.contains(v) && stay[v])
-        })
-        .collect();
-    if overlapped.is_empty() {
-        return Ok(());
-    }
-    let culprits: BTreeSet<usize> = overlapped
-        .iter()
-        .flat_map(|&f| mesh.faces[f as usize])
-        .map(|v| band.rings_from_border[&v].1)
-        .collect();
-    Err(leave(
-        format!(
-            "the surface folds over its plane at this border ({} kept faces next to the new ones turn over in the projection)",
-            overlapped.len()
-        ),
-        culprits.into_iter().collect(),
-    ))
-}
-
 /// `removed` and every turned face connected to it through turned faces
 /// (sharing a vertex), ascending.
-fn with_turned_neighbours(mesh: &Mesh, removed: Vec<u32>, turned: &BTreeSet<u32>) -> Vec<u32> {
+fn with_turned_neighbours(
+    mesh: &Mesh,
+    removed: Vec<u32>,
+    turned: &BTreeSet<u32>,
+    inner: impl Fn(u32) -> bool,
+) -> Vec<u32> {
     let mut by_vertex: HashMap<u32, Vec<u32>> = HashMap::new();
     for &f in turned {
         for v in mesh.faces[f as usize] {
@@ -986,7 +954,7 @@ fn with_turned_neighbours(mesh: &Mesh, removed: Vec<u32>, turned: &BTreeSet<u32>
     while let Some(f) = stack.pop() {
         for v in mesh.faces[f as usize] {
             for &g in by_vertex.get(&v).map_or(&[][..], Vec::as_slice) {
-                if all.insert(g) {
+                if inner(g) && all.insert(g) {
                     stack.push(g);
                 }
             }
