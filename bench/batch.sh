@@ -172,7 +172,7 @@ print()
 print(f"start-up: `meshtrim --version` {startup_ms:.2f} ms (mean of 20); "
       f"`python -c 'import pymeshlab'` {py_startup_ms:.0f} ms (mean of 5)")
 c = json.load(open(f"{d}/clean_one.json"))
-print(f"algorithm split, `meshtrim clean` on one thread, on {os.path.basename(c['input'])}: detection {c['detect_ms']:.1f} ms, "
+print(f"algorithm split, `meshtrim clean` on one thread, on {os.path.basename(c['input'])}: local resolution {c['resolution_ms']:.1f} ms, "
       f"border replacement {c['clean_ms']:.1f} ms (read {c['read_ms']:.1f}, write {c['write_ms']:.1f})")
 print(f"outputs of 1 and 2 jobs byte-identical: {identical}")
 print()

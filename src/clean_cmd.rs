@@ -1,6 +1,7 @@
 //! `meshtrim clean IN OUT`: smooth the jagged border of a triangulated scan.
 //! The mesh's own vertices are the cloud: their local resolution comes from
-//! boundary detection on them, the border loops from the mesh, and the
+//! BPD's neighbourhoods on them (the resolution pass only), the border loops
+//! from the mesh, and the
 //! library replaces the border by its smoothed edge.
 
 use std::path::Path;
@@ -13,7 +14,7 @@ use trim::mesh::Mesh;
 use trim::BpdOptions;
 
 use crate::cli::CleanArgs;
-use crate::detect::{detect_with_progress, millis, same_file};
+use crate::detect::{millis, same_file};
 use crate::io::atomic::write_atomic;
 use crate::io::mesh_out::{write_mesh, MeshFormat};
 use crate::io::read_mesh;
@@ -81,8 +82,8 @@ pub struct Report {
     pub area_out: f64,
     /// Reading time, ms.
     pub read_ms: f64,
-    /// Boundary detection (local resolution) time, ms.
-    pub detect_ms: f64,
+    /// Local resolution (β of every vertex) time, ms.
+    pub resolution_ms: f64,
     /// Border replacement time, ms.
     pub clean_ms: f64,
     /// Writing time, ms.
@@ -112,7 +113,7 @@ pub fn run(args: &CleanArgs) -> Result<()> {
             );
         }
     }
-    let report = clean(&args.input, &args.output, &args.settings(), true)?;
+    let report = clean(&args.input, &args.output, &args.settings())?;
     if let Some(path) = &args.report {
         let json = serde_json::to_string_pretty(&report)?;
         write_atomic(path, |w| w.write_all(json.as_bytes()))?;
@@ -128,13 +129,13 @@ pub fn run(args: &CleanArgs) -> Result<()> {
 /// Cleans one file without printing (the unit of `batch`).
 pub fn clean_file(input: &Path, output: &Path, settings: &CleanSettings) -> Result<CleanOutcome> {
     check_paths(input, output)?;
-    let r = clean(input, output, settings, false)?;
+    let r = clean(input, output, settings)?;
     Ok(CleanOutcome {
         loops: r.loops_smoothed,
         faces_in: r.faces_in,
         faces_out: r.faces_out,
         read_ms: r.read_ms,
-        clean_ms: r.detect_ms + r.clean_ms,
+        clean_ms: ((r.resolution_ms + r.clean_ms) * 10.0).round() / 10.0,
         write_ms: r.write_ms,
     })
 }
@@ -153,9 +154,8 @@ fn check_paths(input: &Path, output: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Reads, detects (with a progress bar on a terminal when `progress`),
-/// cleans, writes.
-fn clean(input: &Path, output: &Path, settings: &CleanSettings, progress: bool) -> Result<Report> {
+/// Reads, finds the local resolution, cleans, writes.
+fn clean(input: &Path, output: &Path, settings: &CleanSettings) -> Result<Report> {
     let started = Instant::now();
     let read = read_mesh(input)?;
     let Some(faces) = read.faces else {
@@ -174,23 +174,21 @@ fn clean(input: &Path, output: &Path, settings: &CleanSettings, progress: bool) 
         k: settings.k,
         anisotropy: !settings.no_anisotropy,
     };
-    let detection = if progress {
-        detect_with_progress(&mesh.vertices, &options)
-    } else {
-        trim::detect_boundary(&mesh.vertices, &options)
-    }
-    .with_context(|| format!("{}: the mesh's vertices", input.display()))?;
-    let detect_time = started.elapsed();
+    // Only β is needed: the mesh knows its border (BPD's labels would be
+    // thrown away), and β alone takes about half the time.
+    let beta = trim::bpd::local_resolution(&mesh.vertices, &options)
+        .with_context(|| format!("{}: the mesh's vertices", input.display()))?;
+    let resolution_time = started.elapsed();
     let started = Instant::now();
     let options = CleanOptions {
         offset: !settings.no_offset,
     };
-    let (out, cleaned) = clean_mesh(&mesh, &detection.beta, &options)
-        .with_context(|| input.display().to_string())?;
+    let (out, cleaned) =
+        clean_mesh(&mesh, &beta, &options).with_context(|| input.display().to_string())?;
     let clean_time = started.elapsed();
     let started = Instant::now();
     write_mesh(output, &out.vertices, &out.faces)?;
-    let times = [read_time, detect_time, clean_time, started.elapsed()];
+    let times = [read_time, resolution_time, clean_time, started.elapsed()];
     Ok(Report::new(
         input,
         output,
@@ -216,7 +214,7 @@ impl Report {
         output: &Path,
         vertices: usize,
         r: &CleanReport,
-        [read, detect, clean, write]: [Duration; 4],
+        [read, resolution, clean, write]: [Duration; 4],
     ) -> Self {
         Report {
             input: input.display().to_string(),
@@ -242,7 +240,7 @@ impl Report {
             area_in: r.area_in,
             area_out: r.area_out,
             read_ms: millis(read),
-            detect_ms: millis(detect),
+            resolution_ms: millis(resolution),
             clean_ms: millis(clean),
             write_ms: millis(write),
         }
@@ -277,7 +275,7 @@ impl Report {
                 format!("{:.6} / {:.6}", self.area_in, self.area_out),
             ),
             ("read time", format!("{:.1} ms", self.read_ms)),
-            ("detect time", format!("{:.1} ms", self.detect_ms)),
+            ("resolution time", format!("{:.1} ms", self.resolution_ms)),
             ("clean time", format!("{:.1} ms", self.clean_ms)),
             ("write time", format!("{:.1} ms", self.write_ms)),
             ("output", self.output.clone()),
