@@ -298,3 +298,18 @@ fn nan_in_pcd_is_dropped_and_counted() {
     assert_eq!(v["points"], 40);
     assert_eq!(v["dropped_non_finite"], 2);
 }
+
+/// A triangulated scan is a cloud too: `detect` reads an STL's vertices
+/// (shared, as the STL reader merges them).
+#[test]
+fn an_stl_scan_is_read_as_its_vertices() {
+    let stl = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/fixtures/meshes/blade_jagged.stl"
+    );
+    let out = meshtrim(&["detect", stl, "--json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["points"], 3003, "{json}");
+    assert!(json["boundary_points"].as_u64().unwrap() > 200, "{json}");
+}

@@ -43,6 +43,9 @@ pub enum Format {
     Obj,
     /// One point per line, the first three columns being x, y and z.
     Text,
+    /// A mesh format that only meshes use (STL, glTF, GLB): its vertices
+    /// are the cloud (a triangulated scan's own samples).
+    MeshVertices,
 }
 
 impl Format {
@@ -53,6 +56,7 @@ impl Format {
             Format::Pcd => "pcd",
             Format::Obj => "obj",
             Format::Text => "text",
+            Format::MeshVertices => "mesh vertices (stl, gltf, glb)",
         }
     }
 
@@ -114,8 +118,16 @@ pub fn read_mesh(path: &Path) -> Result<Mesh> {
 
 fn read_cloud_inner(path: &Path) -> Result<Cloud> {
     let bytes = std::fs::read(path).context("cannot read")?;
-    let format = detect_format(path, &bytes)?;
+    let format = match detect_format(path, &bytes) {
+        Ok(format) => format,
+        // A triangulated scan (STL, glTF) is a cloud too: its vertices.
+        Err(error) => match MeshInput::detect(path, &bytes) {
+            Ok(MeshInput::Stl | MeshInput::Gltf) => Format::MeshVertices,
+            _ => return Err(error),
+        },
+    };
     let cloud = match format {
+        Format::MeshVertices => from_mesh(parse_mesh(path, &bytes)?, format),
         Format::Ply => from_mesh(ply::read_ply(&bytes)?, format),
         Format::Obj => from_mesh(obj::read_obj(&bytes)?, format),
         Format::Pcd => pcd::read_pcd(&bytes)?,
@@ -129,13 +141,19 @@ fn read_cloud_inner(path: &Path) -> Result<Cloud> {
 
 fn read_mesh_inner(path: &Path) -> Result<Mesh> {
     let bytes = std::fs::read(path).context("cannot read")?;
-    let mesh = match MeshInput::detect(path, &bytes)? {
-        MeshInput::Ply => ply::read_ply_mesh(&bytes)?,
-        MeshInput::Obj => obj::read_obj(&bytes)?,
-        MeshInput::Stl => stl::read_stl(&bytes)?,
+    parse_mesh(path, &bytes)
+}
+
+/// Parses a mesh file's bytes (`path` for its extension and, for glTF,
+/// the directory of its buffers).
+fn parse_mesh(path: &Path, bytes: &[u8]) -> Result<Mesh> {
+    let mesh = match MeshInput::detect(path, bytes)? {
+        MeshInput::Ply => ply::read_ply_mesh(bytes)?,
+        MeshInput::Obj => obj::read_obj(bytes)?,
+        MeshInput::Stl => stl::read_stl(bytes)?,
         MeshInput::Gltf => {
             let dir = path.parent().unwrap_or(Path::new(""));
-            gltf_io::read_gltf(&bytes, dir)?
+            gltf_io::read_gltf(bytes, dir)?
         }
     };
     if mesh.vertices.is_empty() {
