@@ -81,6 +81,8 @@ pub const MIN_GAP: f64 = 0.4;
 pub const REFINE_ANGLE: f64 = 20.0;
 /// … leaving faces below this many β² alone.
 pub const REFINE_MIN_AREA: f64 = 0.05;
+/// Times the faces round crossing walls are removed before a band gives up.
+pub const WALL_REPAIRS: usize = 8;
 /// Rings of faces around a border the band starts with …
 pub const FIRST_DEPTH: u32 = 3;
 /// … and the most it grows to.
@@ -330,6 +332,13 @@ fn replace_group(cx: &Context, group: &[usize]) -> Outcome {
     }
 }
 
+/// Why the gap could not be triangulated: walls crossing (with the mesh
+/// vertices involved), or anything else.
+enum Blocked {
+    Walls(Vec<u32>),
+    Other(Retry),
+}
+
 /// Why a band could not be replaced as it is.
 enum Retry {
     /// The cut reaches the band's rim: take more rings. Holds the loops
@@ -467,21 +476,12 @@ impl Band {
                 orient(a, b, c) <= 0.0
             })
             .collect();
-        let removed = with_turned_neighbours(mesh, removed, &turned, |f| {
+        let inner = |f: u32| {
             mesh.faces[f as usize]
                 .iter()
                 .all(|v| self.rings_from_border[v].0 + 2 < self.depth)
-        });
-        let at_rim: BTreeSet<usize> = removed
-            .iter()
-            .flat_map(|&f| mesh.faces[f as usize])
-            .map(|v| self.rings_from_border[&v])
-            .filter(|&(d, _)| d + 1 >= self.depth)
-            .map(|(_, origin)| origin)
-            .collect();
-        if !at_rim.is_empty() {
-            return Err(Retry::Grow(at_rim.into_iter().collect()));
-        }
+        };
+        let mut removed = with_turned_neighbours(mesh, removed, &turned, inner);
         let border_edges: BTreeSet<(u32, u32)> = group
             .iter()
             .flat_map(|&l| {
@@ -489,21 +489,58 @@ impl Band {
                 (0..b.len()).map(move |i| (b[i], b[(i + 1) % b.len()]))
             })
             .collect();
-        let walls = walls(mesh, &self.faces, &removed, &border_edges, &stay);
         // The vertices of turned faces belong to a fold's second layer: the
         // new faces are made without them.
         let folded: BTreeSet<u32> = turned
             .iter()
             .flat_map(|&f| mesh.faces[f as usize])
             .collect();
-        let free: BTreeSet<u32> = removed
-            .iter()
-            .flat_map(|&f| mesh.faces[f as usize])
-            .filter(|v| stay[v] && !folded.contains(v))
-            .collect();
-        let mut patch = triangulate(mesh, &projection, &rings, &walls, &free, cx.beta_median)?;
-        patch.removed = removed;
-        Ok(patch)
+        // Where a fold beyond the turned faces makes two walls cross in the
+        // projection, the faces round the crossing go too, and the gap is
+        // triangulated again, a few times at most.
+        for _ in 0..=WALL_REPAIRS {
+            let at_rim: BTreeSet<usize> = removed
+                .iter()
+                .flat_map(|&f| mesh.faces[f as usize])
+                .map(|v| self.rings_from_border[&v])
+                .filter(|&(d, _)| d + 1 >= self.depth)
+                .map(|(_, origin)| origin)
+                .collect();
+            if !at_rim.is_empty() {
+                return Err(Retry::Grow(at_rim.into_iter().collect()));
+            }
+            let walls = walls(mesh, &self.faces, &removed, &border_edges, &stay);
+            let free: BTreeSet<u32> = removed
+                .iter()
+                .flat_map(|&f| mesh.faces[f as usize])
+                .filter(|v| stay[v] && !folded.contains(v))
+                .collect();
+            match triangulate(mesh, &projection, &rings, &walls, &free, cx.beta_median) {
+                Ok(mut patch) => {
+                    patch.removed = removed;
+                    return Ok(patch);
+                }
+                Err(Blocked::Walls(vertices)) => {
+                    let before = removed.len();
+                    let mut all: BTreeSet<u32> = removed.into_iter().collect();
+                    all.extend(
+                        vertices
+                            .iter()
+                            .flat_map(|&v| cx.topology.faces_of(v).iter().copied())
+                            .filter(|&f| self.faces.binary_search(&f).is_ok()),
+                    );
+                    removed = all.into_iter().collect();
+                    if removed.len() == before {
+                        break;
+                    }
+                }
+                Err(Blocked::Other(retry)) => return Err(retry),
+            }
+        }
+        Err(leave(
+            "the mesh folds over the new border's plane beside it",
+            Vec::new(),
+        ))
     }
 }
 
@@ -558,7 +595,7 @@ fn triangulate(
     walls: &[[u32; 2]],
     free: &BTreeSet<u32>,
     scale: f64,
-) -> Result<Patch, Retry> {
+) -> Result<Patch, Blocked> {
     let n = mesh.vertices.len() as u32;
     let mut cdt = Cdt::new();
     let mut patch = Patch::default();
@@ -586,20 +623,27 @@ fn triangulate(
         for (j, &p) in ring.p2.iter().enumerate() {
             let id = n + patch.vertices.len() as u32;
             patch.vertices.push(ring.p3[j]);
-            hs.push(insert(&mut cdt, p, id, Some(k))?);
+            hs.push(insert(&mut cdt, p, id, Some(k)).map_err(Blocked::Other)?);
         }
         ring_handles.push(hs);
     }
     let wall_vertices: BTreeSet<u32> = walls.iter().flatten().copied().collect();
     for &v in wall_vertices.iter().chain(free) {
-        insert(&mut cdt, projection.to2(mesh.vertices[v as usize]), v, None)?;
+        insert(&mut cdt, projection.to2(mesh.vertices[v as usize]), v, None)
+            .map_err(Blocked::Other)?;
     }
     let constrain = |cdt: &mut Cdt, a, b, ring: Option<usize>| {
-        if obstacle(cdt, a, b).is_some() {
-            return Err(leave(
-                "the smoothed border crosses the kept mesh",
-                ring.into_iter().collect(),
-            ));
+        if let Some(other) = obstacle(cdt, a, b) {
+            return Err(match ring {
+                Some(k) => {
+                    Blocked::Other(leave("the smoothed border crosses the kept mesh", vec![k]))
+                }
+                None => Blocked::Walls(vec![
+                    cdt.vertex(a).data().id,
+                    cdt.vertex(b).data().id,
+                    other,
+                ]),
+            });
         }
         cdt.add_constraint(a, b);
         Ok(())
