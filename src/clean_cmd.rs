@@ -15,7 +15,6 @@ use trim::BpdOptions;
 
 use crate::cli::CleanArgs;
 use crate::detect::{millis, same_file};
-use crate::io::atomic::write_atomic;
 use crate::io::mesh_out::{write_mesh, MeshFormat};
 use crate::io::read_mesh;
 
@@ -114,16 +113,7 @@ pub fn run(args: &CleanArgs) -> Result<()> {
         }
     }
     let report = clean(&args.input, &args.output, &args.settings())?;
-    if let Some(path) = &args.report {
-        let json = serde_json::to_string_pretty(&report)?;
-        write_atomic(path, |w| w.write_all(json.as_bytes()))?;
-    }
-    if args.json {
-        println!("{}", serde_json::to_string(&report)?);
-    } else {
-        print!("{}", report.table());
-    }
-    Ok(())
+    crate::report::emit(&report, args.report.as_deref(), args.json)
 }
 
 /// Cleans one file without printing (the unit of `batch`).
@@ -245,9 +235,10 @@ impl Report {
             write_ms: millis(write),
         }
     }
+}
 
-    /// The report as an aligned two-column table.
-    pub fn table(&self) -> String {
+impl crate::report::Table for Report {
+    fn table(&self) -> String {
         let left: usize = self.loops_left.iter().map(|l| l.loops.len()).sum();
         let mut rows = vec![
             (
@@ -286,8 +277,6 @@ impl Report {
                 format!("loops {:?}: {}", l.loops, l.reason),
             ));
         }
-        rows.iter()
-            .map(|(label, value)| format!("{label:<20} {value}\n"))
-            .collect()
+        crate::report::rows(&rows)
     }
 }

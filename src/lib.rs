@@ -18,4 +18,5 @@ pub mod detect;
 pub mod edges;
 pub mod io;
 pub mod mesh_cmd;
+pub mod report;
 pub mod trim;

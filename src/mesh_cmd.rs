@@ -11,7 +11,6 @@ use trim::edges::{reconstruct_edges, EdgeOptions};
 
 use crate::cli::MeshArgs;
 use crate::detect::{millis, read_and_detect, Detected};
-use crate::io::atomic::write_atomic;
 use crate::io::mesh_out::{write_mesh, MeshFormat};
 
 /// What `mesh` prints and `--report` writes.
@@ -78,16 +77,7 @@ pub fn run(args: &MeshArgs) -> Result<()> {
     let write_time = started.elapsed();
     let times = [read_time, detect_time, edges_time, mesh_time, write_time];
     let report = Report::new(args, cloud.points.len(), mesh.faces.len(), &made, times);
-    if let Some(path) = &args.report {
-        let json = serde_json::to_string_pretty(&report)?;
-        write_atomic(path, |w| w.write_all(json.as_bytes()))?;
-    }
-    if args.json {
-        println!("{}", serde_json::to_string(&report)?);
-    } else {
-        print!("{}", report.table());
-    }
-    Ok(())
+    crate::report::emit(&report, args.report.as_deref(), args.json)
 }
 
 impl Report {
@@ -116,9 +106,10 @@ impl Report {
             write_ms: millis(write),
         }
     }
+}
 
-    /// The report as an aligned two-column table.
-    pub fn table(&self) -> String {
+impl crate::report::Table for Report {
+    fn table(&self) -> String {
         let rows = [
             ("cloud", format!("{} ({} points)", self.cloud, self.points)),
             ("points used", self.points_used.to_string()),
@@ -134,8 +125,6 @@ impl Report {
             ("write time", format!("{:.1} ms", self.write_ms)),
             ("output", self.output.clone()),
         ];
-        rows.iter()
-            .map(|(label, value)| format!("{label:<20} {value}\n"))
-            .collect()
+        crate::report::rows(&rows)
     }
 }

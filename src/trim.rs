@@ -14,7 +14,6 @@ use trim::trimming::{trim_mesh, LoopFit, TrimReport};
 
 use crate::cli::TrimArgs;
 use crate::detect::{millis, read_and_detect_with, same_file, Detected};
-use crate::io::atomic::write_atomic;
 use crate::io::mesh_out::{write_mesh, MeshFormat};
 use crate::io::read_mesh;
 
@@ -100,16 +99,7 @@ pub fn run(args: &TrimArgs) -> Result<()> {
         progress: true,
     };
     let report = trim_file(&args.mesh, &args.cloud, &args.output, &settings)?;
-    if let Some(path) = &args.report {
-        let json = serde_json::to_string_pretty(&report)?;
-        write_atomic(path, |w| w.write_all(json.as_bytes()))?;
-    }
-    if args.json {
-        println!("{}", serde_json::to_string(&report)?);
-    } else {
-        print!("{}", report.table());
-    }
-    Ok(())
+    crate::report::emit(&report, args.report.as_deref(), args.json)
 }
 
 /// Trims the mesh at `mesh_path` along the boundary of the cloud at
@@ -232,9 +222,10 @@ impl Report {
             write_ms: millis(write),
         }
     }
+}
 
-    /// The report as an aligned two-column table.
-    pub fn table(&self) -> String {
+impl crate::report::Table for Report {
+    fn table(&self) -> String {
         let worst = self
             .border_to_edge
             .iter()
@@ -269,8 +260,6 @@ impl Report {
             ("write time", format!("{:.1} ms", self.write_ms)),
             ("output", self.output.clone()),
         ];
-        rows.iter()
-            .map(|(label, value)| format!("{label:<20} {value}\n"))
-            .collect()
+        crate::report::rows(&rows)
     }
 }

@@ -1,7 +1,9 @@
 //! End-to-end tests of the main job, `meshtrim MESH CLOUD OUT`.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+
+mod common;
+use common::{assert_clean_failure, meshtrim};
 
 const MESH: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -12,29 +14,12 @@ const CLOUD: &str = concat!(
     "/fixtures/meshes/blade_small.ply"
 );
 
-fn meshtrim(args: &[&str], threads: Option<&str>) -> Output {
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_meshtrim"));
-    cmd.args(args);
-    if let Some(t) = threads {
-        cmd.env("RAYON_NUM_THREADS", t);
-    }
-    cmd.output().expect("run meshtrim")
-}
-
 fn temp_dir() -> tempfile::TempDir {
     tempfile::tempdir().expect("temporary directory")
 }
 
 fn path(dir: &Path, name: &str) -> PathBuf {
     dir.join(name)
-}
-
-fn assert_clean_failure(out: &Output, mentions: &str) {
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{stderr}");
-    assert!(stderr.starts_with("error: "), "{stderr}");
-    assert!(stderr.contains(mentions), "{stderr} should name {mentions}");
-    assert!(!stderr.contains("panicked"), "{stderr}");
 }
 
 #[test]

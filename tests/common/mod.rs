@@ -6,6 +6,7 @@ use std::path::PathBuf;
 /// repository, or where `MESHTRIM_SHARED_DATA` points, or at the workplace's
 /// `/work/shared/data` when the repository is a clone elsewhere. The data is
 /// part of the test set, so not finding it is a failure, not a skip.
+#[allow(dead_code)]
 pub fn shared_data(rel: &str) -> PathBuf {
     let beside = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data"));
     let candidates: Vec<PathBuf> = std::env::var_os("MESHTRIM_SHARED_DATA")
@@ -17,4 +18,27 @@ pub fn shared_data(rel: &str) -> PathBuf {
         panic!("the real test data is missing: looked in {candidates:?} (set MESHTRIM_SHARED_DATA)")
     });
     root.join(rel)
+}
+
+/// Runs the `meshtrim` binary with `args`, on `threads` rayon threads when
+/// given.
+#[allow(dead_code)] // each test binary uses its own share of the helpers
+pub fn meshtrim(args: &[&str], threads: Option<&str>) -> std::process::Output {
+    let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_meshtrim"));
+    cmd.args(args);
+    if let Some(t) = threads {
+        cmd.env("RAYON_NUM_THREADS", t);
+    }
+    cmd.output().expect("run meshtrim")
+}
+
+/// Asserts a run failed cleanly: exit status 1, one `error: ` message that
+/// names `mentions`, no panic.
+#[allow(dead_code)]
+pub fn assert_clean_failure(out: &std::process::Output, mentions: &str) {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.starts_with("error: "), "{stderr}");
+    assert!(stderr.contains(mentions), "{stderr} should name {mentions}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
 }
