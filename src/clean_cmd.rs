@@ -18,16 +18,9 @@ use crate::detect::{millis, same_file};
 use crate::io::mesh_out::{write_mesh, MeshFormat};
 use crate::io::read_mesh;
 
-/// What one cleanup needs besides its files.
-#[derive(Debug, Clone, PartialEq)]
-pub struct CleanSettings {
-    /// Neighbourhood size of boundary detection.
-    pub k: usize,
-    /// Keep the border through the border vertices (the paper's edges).
-    pub no_offset: bool,
-    /// The paper's isotropic detection.
-    pub no_anisotropy: bool,
-}
+/// What one cleanup needs besides its files: the detection and edge
+/// options.
+pub type CleanSettings = crate::cli::Stages;
 
 /// The summary of one cleanup (for `batch`).
 #[derive(Debug, Clone, PartialEq)]
@@ -112,7 +105,7 @@ pub fn run(args: &CleanArgs) -> Result<()> {
             );
         }
     }
-    let report = clean(&args.input, &args.output, &args.settings())?;
+    let report = clean(&args.input, &args.output, &args.stages)?;
     crate::report::emit(&report, args.report.as_deref(), args.json)
 }
 
@@ -186,16 +179,6 @@ fn clean(input: &Path, output: &Path, settings: &CleanSettings) -> Result<Report
         &cleaned,
         times,
     ))
-}
-
-impl CleanArgs {
-    fn settings(&self) -> CleanSettings {
-        CleanSettings {
-            k: self.k,
-            no_offset: self.no_offset,
-            no_anisotropy: self.no_anisotropy,
-        }
-    }
 }
 
 impl Report {

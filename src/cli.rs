@@ -86,16 +86,9 @@ pub struct BatchArgs {
     /// list (1-based), e.g. one per machine or array task.
     #[arg(long, value_name = "K/N")]
     pub shard: Option<crate::batch::Shard>,
-    /// Neighbourhood size of boundary detection, the point itself included.
-    #[arg(long, default_value_t = 30)]
-    pub k: usize,
-    /// Use the paper's isotropic detection, without the sampling-tensor map.
-    #[arg(long)]
-    pub no_anisotropy: bool,
-    /// Cut along the smoothed boundary points themselves instead of the
-    /// estimated physical edge.
-    #[arg(long)]
-    pub no_offset: bool,
+    /// Detection and edge options.
+    #[command(flatten)]
+    pub stages: Stages,
 }
 
 /// Arguments of `meshtrim clean`.
@@ -109,19 +102,28 @@ pub struct CleanArgs {
     /// Also write the report as JSON to this file.
     #[arg(long, value_name = "FILE.json")]
     pub report: Option<PathBuf>,
+    /// Detection and edge options.
+    #[command(flatten)]
+    pub stages: Stages,
+    /// Print the report as one JSON object.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The options of detection and edge reconstruction that every command
+/// after `detect` shares.
+#[derive(Debug, Clone, PartialEq, Args)]
+pub struct Stages {
     /// Neighbourhood size of boundary detection, the point itself included.
     #[arg(long, default_value_t = 30)]
     pub k: usize,
     /// Use the paper's isotropic detection, without the sampling-tensor map.
     #[arg(long)]
     pub no_anisotropy: bool,
-    /// Put the new border through the smoothed border vertices (the
-    /// paper's edges) instead of the estimated physical edge.
+    /// Use the paper's edges, through the boundary points, instead of the
+    /// estimated physical edge half a row beyond them.
     #[arg(long)]
     pub no_offset: bool,
-    /// Print the report as one JSON object.
-    #[arg(long)]
-    pub json: bool,
 }
 
 /// Arguments of `meshtrim mesh`.
@@ -135,16 +137,9 @@ pub struct MeshArgs {
     /// Also write the report as JSON to this file.
     #[arg(long, value_name = "FILE.json")]
     pub report: Option<PathBuf>,
-    /// Neighbourhood size of boundary detection, the point itself included.
-    #[arg(long, default_value_t = 30)]
-    pub k: usize,
-    /// Use the paper's isotropic detection, without the sampling-tensor map.
-    #[arg(long)]
-    pub no_anisotropy: bool,
-    /// Bound the mesh by the smoothed boundary points themselves (the
-    /// paper's edges) instead of the estimated physical edge.
-    #[arg(long)]
-    pub no_offset: bool,
+    /// Detection and edge options.
+    #[command(flatten)]
+    pub stages: Stages,
     /// Print the report as one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -173,13 +168,26 @@ pub struct TrimArgs {
     /// Use the paper's isotropic detection, without the sampling-tensor map.
     #[arg(long)]
     pub no_anisotropy: bool,
-    /// Cut along the smoothed boundary points themselves (the paper's
-    /// edges) instead of the estimated physical edge.
+    /// Use the paper's edges, through the boundary points, instead of the
+    /// estimated physical edge half a row beyond them.
     #[arg(long)]
     pub no_offset: bool,
     /// Print the report as one JSON object.
     #[arg(long)]
     pub json: bool,
+}
+
+impl TrimArgs {
+    /// The detection and edge options. (The main job's arguments spell
+    /// them out: clap cannot tell whether a flattened group inside the
+    /// optional top-level arguments was given.)
+    pub fn stages(&self) -> Stages {
+        Stages {
+            k: self.k,
+            no_anisotropy: self.no_anisotropy,
+            no_offset: self.no_offset,
+        }
+    }
 }
 
 /// Arguments of `meshtrim detect`.
@@ -212,17 +220,9 @@ pub struct EdgesArgs {
     /// directories are created.
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
-    /// Neighbourhood size of boundary detection, the point itself included.
-    #[arg(long, default_value_t = 30)]
-    pub k: usize,
-    /// Use the paper's isotropic detection tests, without the
-    /// sampling-tensor map.
-    #[arg(long)]
-    pub no_anisotropy: bool,
-    /// Keep the smoothed edges where the boundary points are (the paper's
-    /// edges) instead of moving them out to the surface's estimated edge.
-    #[arg(long)]
-    pub no_offset: bool,
+    /// Detection and edge options.
+    #[command(flatten)]
+    pub stages: Stages,
     /// Print the summary as one JSON object.
     #[arg(long)]
     pub json: bool,

@@ -54,10 +54,10 @@ pub fn run(args: &EdgesArgs) -> Result<()> {
         detection,
         read_time,
         detect_time,
-    } = read_and_detect(&args.cloud, args.k, args.no_anisotropy)?;
+    } = read_and_detect(&args.cloud, args.stages.k, args.stages.no_anisotropy)?;
     let started = Instant::now();
     let edge_options = EdgeOptions {
-        offset: !args.no_offset,
+        offset: !args.stages.no_offset,
     };
     let edges = reconstruct_edges(&cloud.points, &detection, &edge_options);
     let edges_time = started.elapsed();
@@ -112,7 +112,7 @@ impl Summary {
             read_ms: millis(read),
             detect_ms: millis(detect),
             edges_ms: millis(reconstruct),
-            offset: !args.no_offset,
+            offset: !args.stages.no_offset,
         }
     }
 

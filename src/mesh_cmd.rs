@@ -61,10 +61,10 @@ pub fn run(args: &MeshArgs) -> Result<()> {
         detection,
         read_time,
         detect_time,
-    } = read_and_detect(&args.cloud, args.k, args.no_anisotropy)?;
+    } = read_and_detect(&args.cloud, args.stages.k, args.stages.no_anisotropy)?;
     let started = Instant::now();
     let edge_options = EdgeOptions {
-        offset: !args.no_offset,
+        offset: !args.stages.no_offset,
     };
     let edges = reconstruct_edges(&cloud.points, &detection, &edge_options);
     let edges_time = started.elapsed();

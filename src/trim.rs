@@ -93,9 +93,9 @@ pub struct TrimSettings {
 pub fn run(args: &TrimArgs) -> Result<()> {
     check_paths(args)?;
     let settings = TrimSettings {
-        k: args.k,
-        no_offset: args.no_offset,
-        no_anisotropy: args.no_anisotropy,
+        k: args.stages().k,
+        no_offset: args.stages().no_offset,
+        no_anisotropy: args.stages().no_anisotropy,
         progress: true,
     };
     let report = trim_file(&args.mesh, &args.cloud, &args.output, &settings)?;

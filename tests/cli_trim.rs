@@ -190,3 +190,28 @@ fn the_delaunay_path_meshes_the_cloud_and_refuses_a_folded_surface() {
     );
     assert!(!out.exists());
 }
+
+/// The main job takes the stage options without a subcommand.
+#[test]
+fn the_main_job_takes_the_stage_options() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("t.ply");
+    let run = meshtrim(
+        &[
+            MESH,
+            CLOUD,
+            out.to_str().unwrap(),
+            "--no-offset",
+            "--k",
+            "20",
+            "--json",
+        ],
+        None,
+    );
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert!(out.exists());
+}

@@ -155,9 +155,9 @@ fn work(job: &Job, args: &BatchArgs) -> Result<Outcome> {
     match &job.cloud {
         CloudMatch::None => {
             let settings = CleanSettings {
-                k: args.k,
-                no_offset: args.no_offset,
-                no_anisotropy: args.no_anisotropy,
+                k: args.stages.k,
+                no_offset: args.stages.no_offset,
+                no_anisotropy: args.stages.no_anisotropy,
             };
             let o = clean_file(&job.input, &job.output, &settings)?;
             Ok(Outcome {
@@ -171,9 +171,9 @@ fn work(job: &Job, args: &BatchArgs) -> Result<Outcome> {
         }
         CloudMatch::One(cloud) => {
             let settings = TrimSettings {
-                k: args.k,
-                no_offset: args.no_offset,
-                no_anisotropy: args.no_anisotropy,
+                k: args.stages.k,
+                no_offset: args.stages.no_offset,
+                no_anisotropy: args.stages.no_anisotropy,
                 progress: false,
             };
             let r = trim_file(&job.input, cloud, &job.output, &settings)?;
