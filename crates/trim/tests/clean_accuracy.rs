@@ -92,15 +92,7 @@ fn cleaned_meshes_are_valid_and_keep_the_interior() {
         let name = &c.truth.name;
         let out = &c.output;
         assert!(out.is_edge_manifold(), "{name}");
-        let mut directed = std::collections::HashSet::new();
-        for f in &out.faces {
-            for k in 0..3 {
-                assert!(
-                    directed.insert((f[k], f[(k + 1) % 3])),
-                    "{name}: edge run twice the same way"
-                );
-            }
-        }
+        assert_consistently_oriented(out, &name);
         assert!(
             c.report.min_angle_new > 10.0,
             "{name}: {}",
@@ -256,15 +248,7 @@ fn random_jagged_meshes_are_cleaned() {
         let name = format!("{} case {case} noise {noise:.3}", truth.name);
         let (out, report) = clean_mesh_of(&input);
         assert!(out.is_edge_manifold(), "{name}");
-        let mut directed = std::collections::HashSet::new();
-        for f in &out.faces {
-            for k in 0..3 {
-                assert!(
-                    directed.insert((f[k], f[(k + 1) % 3])),
-                    "{name}: misoriented"
-                );
-            }
-        }
+        assert_consistently_oriented(&out, &name);
         assert_eq!(
             report.loops_smoothed,
             truth.boundary.len(),
@@ -281,4 +265,18 @@ fn random_jagged_meshes_are_cleaned() {
 fn clean_mesh_of(input: &Mesh) -> (Mesh, CleanReport) {
     let beta = trim::bpd::local_resolution(&input.vertices, &BpdOptions::default()).unwrap();
     clean_mesh(input, &beta, &CleanOptions::default()).unwrap()
+}
+
+/// Every directed edge is used once: neighbouring faces run their shared
+/// edge in opposite directions.
+fn assert_consistently_oriented(mesh: &Mesh, name: &str) {
+    let mut directed = std::collections::HashSet::new();
+    for f in &mesh.faces {
+        for k in 0..3 {
+            assert!(
+                directed.insert((f[k], f[(k + 1) % 3])),
+                "{name}: an edge run twice the same way"
+            );
+        }
+    }
 }
