@@ -92,7 +92,7 @@ fn cleaned_meshes_are_valid_and_keep_the_interior() {
         let name = &c.truth.name;
         let out = &c.output;
         assert!(out.is_edge_manifold(), "{name}");
-        assert_consistently_oriented(out, &name);
+        assert_consistently_oriented(out, name);
         assert!(
             c.report.min_angle_new > 10.0,
             "{name}: {}",
