@@ -24,11 +24,7 @@ fn main() -> anyhow::Result<()> {
     for &file in SCANS {
         let cloud = meshtrim::io::read_cloud(&data.join(file))?;
         let found = detect_boundary(&cloud.points, &BpdOptions::default())?;
-        let edges = reconstruct_edges(
-            &cloud.points,
-            &found,
-            &EdgeOptions { offset: false },
-        );
+        let edges = reconstruct_edges(&cloud.points, &found, &EdgeOptions { offset: false });
         let per_loop: Vec<_> = edges
             .loops
             .iter()

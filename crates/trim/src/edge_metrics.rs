@@ -6,7 +6,9 @@
 //! - [`polyline_to_truth_in_spacings`]: how far an edge strays from the
 //!   true boundary of a synthetic cloud, in local spacings;
 //! - [`true_corners`] and [`match_corners`]: corners of the true boundary
-//!   and how many of them a corner finder recovers.
+//!   and how many of them a corner finder recovers;
+//! - [`tour_jumps`]: steps of a loop that jump across the surface (longer
+//!   than 3β and not a BPD link).
 //!
 //! Distances to a polyline are exact (to its segments, not its vertices):
 //! the polyline is sampled at most `δ` apart (δ its mean segment length,
