@@ -5,14 +5,18 @@
 //! the one closed tour through all its points must then jump across the
 //! surface somewhere. A step of a tour is *supported* when its two points
 //! are at most 3β apart (β the larger local resolution of the two) or BPD
-//! linked them; a *jump* is an unsupported step ([`crate::edge_metrics::
-//! tour_jumps`] counts them). A tour without jumps is kept as it is.
+//! linked them; a *jump* is an unsupported step
+//! ([`tour_jumps`](crate::edge_metrics::tour_jumps) counts them). A tour without jumps is kept as it is.
 //! Otherwise it is cut at every jump into pieces that follow the borders,
 //! and the pieces' ends are joined again, nearest pair first, by supported
 //! steps only (an end joins at most one other end, possibly the other end
 //! of its own chain, which closes it). Closed chains of at least
-//! [`MIN_LOOP_POINTS`] points are the loops; open chains (a border whose
-//! rest was never found) and shorter ones are dropped and counted. No
+//! [`MIN_LOOP_POINTS`] points are loops; an open chain is closed along the
+//! links (from either end, the shortest link path back to the chain that
+//! makes the longest cycle; the rest of the chain likewise), and what
+//! cannot close is dropped and counted. Last, longest first, a loop within
+//! 3β of longer loops all along (a parallel copy of their border inside a
+//! thick band of boundary points) is dropped and counted too. No
 //! threshold beyond the local resolution is involved: 3β is the step
 //! length a border sampled at resolution β never needs.
 
@@ -30,9 +34,7 @@ pub const JUMP_BETAS: f64 = 3.0;
 /// Is the step between `a` and `b` supported: at most 3β long (the larger
 /// β of the two), or a link? `links` are sorted pairs, smaller index first.
 pub fn supported(points: &[Point3], beta: &[f64], links: &[[u32; 2]], a: u32, b: u32) -> bool {
-    let scale = JUMP_BETAS * beta[a as usize].max(beta[b as usize]);
-    dist2(points[a as usize], points[b as usize]) <= scale * scale
-        || links.binary_search(&[a.min(b), a.max(b)]).is_ok()
+    within_jump(points, beta, a, b) || links.binary_search(&[a.min(b), a.max(b)]).is_ok()
 }
 
 /// Cuts a closed `tour` at its jumps and joins the pieces again by
@@ -190,7 +192,31 @@ pub fn split_at_jumps(
             None => dropped += 1,
         }
     }
-    (loops, dropped)
+    // A loop that runs within 3β of longer loops all along is a parallel
+    // copy of their border (a cycle inside a thick band of boundary
+    // points), not a border of its own.
+    loops.sort_by(|x, y| y.len().cmp(&x.len()).then(x.cmp(y)));
+    let mut kept: Vec<Vec<u32>> = Vec::new();
+    for ring in loops {
+        let shadowed = ring.iter().all(|&p| {
+            kept.iter()
+                .flatten()
+                .any(|&q| within_jump(points, beta, p, q))
+        });
+        if shadowed {
+            dropped += 1;
+        } else {
+            kept.push(ring);
+        }
+    }
+    kept.sort_unstable();
+    (kept, dropped)
+}
+
+/// Are `a` and `b` at most 3β apart (the larger β of the two)?
+fn within_jump(points: &[Point3], beta: &[f64], a: u32, b: u32) -> bool {
+    let scale = JUMP_BETAS * beta[a as usize].max(beta[b as usize]);
+    dist2(points[a as usize], points[b as usize]) <= scale * scale
 }
 
 /// The longest cycle of at least [`MIN_LOOP_POINTS`] points made of a run
