@@ -6,7 +6,9 @@
 //! - [`polyline_to_truth_in_spacings`]: how far an edge strays from the
 //!   true boundary of a synthetic cloud, in local spacings;
 //! - [`true_corners`] and [`match_corners`]: corners of the true boundary
-//!   and how many of them a corner finder recovers.
+//!   and how many of them a corner finder recovers;
+//! - [`tour_jumps`]: steps of a loop that jump across the surface (longer
+//!   than 3β and not a BPD link).
 //!
 //! Distances to a polyline are exact (to its segments, not its vertices):
 //! the polyline is sampled at most `δ` apart (δ its mean segment length,
@@ -556,4 +558,37 @@ mod tests {
         assert_eq!(one.count, 1);
         assert!((one.mean - 2.0).abs() < 1e-9);
     }
+}
+
+/// Jumps of one closed tour of boundary points.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Jumps {
+    /// Tour steps (including the closing one) longer than 3 β and not
+    /// joined by a BPD link.
+    pub count: usize,
+    /// The longest such step, in β (the larger β of its two ends); 0
+    /// without jumps.
+    pub longest_in_beta: f64,
+}
+
+/// Steps of a closed `tour` (indices into `points`) that jump across the
+/// surface: consecutive points farther apart than 3 β (the larger local
+/// resolution of the two) and not joined by one of `links` (BPD's
+/// [`crate::Detection::links`], sorted pairs, smaller index first).
+pub fn tour_jumps(points: &[Point3], beta: &[f64], links: &[[u32; 2]], tour: &[u32]) -> Jumps {
+    let n = tour.len();
+    let mut jumps = Jumps::default();
+    if n < 2 {
+        return jumps;
+    }
+    for k in 0..n {
+        let (a, b) = (tour[k], tour[(k + 1) % n]);
+        let d = dist2(points[a as usize], points[b as usize]).sqrt();
+        let scale = beta[a as usize].max(beta[b as usize]);
+        if d > 3.0 * scale && links.binary_search(&[a.min(b), a.max(b)]).is_err() {
+            jumps.count += 1;
+            jumps.longest_in_beta = jumps.longest_in_beta.max(d / scale);
+        }
+    }
+    jumps
 }

@@ -3,7 +3,9 @@
 //!
 //! 1. [`cluster`] groups the boundary points into separate boundaries by the
 //!    links BPD found between them and thins spurs away;
-//! 2. [`order`] turns each group into a closed tour;
+//! 2. [`order`] turns each group into a closed tour; [`split`] cuts a tour
+//!    that jumps across the surface (two borders in one group) into loops
+//!    that follow the links;
 //! 3. [`corners`] finds the corners of each loop (section 3.1), which split
 //!    it into edges;
 //! 4. each edge is smoothed by a spatial low-pass filter (section 3.3);
@@ -16,6 +18,7 @@ pub mod corners;
 pub mod offset;
 pub mod order;
 pub mod smooth;
+pub mod split;
 
 use rayon::prelude::*;
 
@@ -76,9 +79,12 @@ impl Loop {
 pub struct Edges {
     /// The loops, in a deterministic order (by smallest point index).
     pub loops: Vec<Loop>,
-    /// Groups of boundary points too small or too thin to close a loop.
+    /// Groups of boundary points too small or too thin to close a loop,
+    /// and pieces of jumping tours that closed no loop of their own (see
+    /// [`split`]).
     pub dropped_clusters: usize,
-    /// Boundary points removed as spurs, strays or isolated points.
+    /// Boundary points removed as spurs, strays or isolated points, or
+    /// left on no loop when a jumping tour was split.
     pub thinned_points: usize,
 }
 
@@ -86,29 +92,35 @@ pub struct Edges {
 /// corners and smoothed edges (see the module doc for the steps).
 pub fn reconstruct_edges(points: &[Point3], detection: &Detection, options: &EdgeOptions) -> Edges {
     let clusters = cluster::cluster_boundary(&detection.boundary, &detection.links);
-    let index = options.offset.then(|| NeighbourIndex::new(points));
-    let loops = clusters
+    let tours: Vec<Vec<u32>> = clusters
         .clusters
         .par_iter()
         .zip(&clusters.links)
-        .map(|(members, links)| build_loop(points, &detection.beta, members, links, index.as_ref()))
+        .map(|(members, links)| order::closed_tour(points, members, links))
+        .collect();
+    // A tour that jumps (a step longer than 3β that no link supports) went
+    // across the surface between borders its cluster joins: it is cut at
+    // its jumps and the pieces are joined again by supported steps only.
+    let split: Vec<(Vec<Vec<u32>>, usize)> = tours
+        .into_par_iter()
+        .zip(&clusters.links)
+        .map(|(tour, links)| split::split_at_jumps(points, &detection.beta, links, tour))
+        .collect();
+    let dropped_pieces: usize = split.iter().map(|t| t.1).sum();
+    let mut tours: Vec<Vec<u32>> = split.into_iter().flat_map(|t| t.0).collect();
+    tours.sort_unstable();
+    let index = options.offset.then(|| NeighbourIndex::new(points));
+    let on_loops: std::collections::BTreeSet<u32> = tours.iter().flatten().copied().collect();
+    let clustered: usize = clusters.clusters.iter().map(Vec::len).sum();
+    let loops = tours
+        .into_par_iter()
+        .map(|tour| loop_from_tour(points, &detection.beta, tour, index.as_ref()))
         .collect();
     Edges {
         loops,
-        dropped_clusters: clusters.dropped_clusters,
-        thinned_points: clusters.thinned_points,
+        dropped_clusters: clusters.dropped_clusters + dropped_pieces,
+        thinned_points: clusters.thinned_points + (clustered - on_loops.len()),
     }
-}
-
-fn build_loop(
-    points: &[Point3],
-    beta: &[f64],
-    members: &[u32],
-    links: &[[u32; 2]],
-    index: Option<&NeighbourIndex>,
-) -> Loop {
-    let tour = order::closed_tour(points, members, links);
-    loop_from_tour(points, beta, tour, index)
 }
 
 /// Corners, smoothed edges and (with `index`, the cloud's neighbour index)

@@ -56,7 +56,7 @@ fn dist(points: &[Point3], a: u32, b: u32) -> f64 {
 
 /// Rotates the tour to start at its smallest index, and orients it so the
 /// second entry is the smaller of that point's two tour neighbours.
-fn canonical(mut tour: Vec<u32>) -> Vec<u32> {
+pub(crate) fn canonical(mut tour: Vec<u32>) -> Vec<u32> {
     let Some(start) = (0..tour.len()).min_by_key(|&i| tour[i]) else {
         return tour;
     };

@@ -1,0 +1,416 @@
+//! Tours cut at their jumps and joined again by supported steps.
+//!
+//! On real range scans a cluster can hold two borders joined at two places
+//! (an outer border and a depth-discontinuity border touching it twice);
+//! the one closed tour through all its points must then jump across the
+//! surface somewhere. A step of a tour is *supported* when its two points
+//! are at most 3β apart (β the larger local resolution of the two) or BPD
+//! linked them; a *jump* is an unsupported step
+//! ([`tour_jumps`](crate::edge_metrics::tour_jumps) counts them). A tour without jumps is kept as it is.
+//! Otherwise it is cut at every jump into pieces that follow the borders,
+//! and the pieces' ends are joined again, nearest pair first, by supported
+//! steps only (an end joins at most one other end, possibly the other end
+//! of its own chain, which closes it). Closed chains of at least
+//! [`MIN_LOOP_POINTS`] points are loops; an open chain is closed along the
+//! links (from either end, the shortest link path back to the chain that
+//! makes the longest cycle; the rest of the chain likewise), and what
+//! cannot close is dropped and counted. Last, longest first, a loop within
+//! 3β of longer loops all along (a parallel copy of their border inside a
+//! thick band of boundary points) is dropped and counted too. No
+//! threshold beyond the local resolution is involved: 3β is the step
+//! length a border sampled at resolution β never needs.
+
+use std::cmp::Reverse;
+use std::collections::{BinaryHeap, HashMap, HashSet};
+
+use crate::cloud::{dist2, Point3};
+
+use super::cluster::MIN_LOOP_POINTS;
+use super::order::canonical;
+
+/// Factor of β above which a step no link supports is a jump.
+pub const JUMP_BETAS: f64 = 3.0;
+
+/// Is the step between `a` and `b` supported: at most 3β long (the larger
+/// β of the two), or a link? `links` are sorted pairs, smaller index first.
+pub fn supported(points: &[Point3], beta: &[f64], links: &[[u32; 2]], a: u32, b: u32) -> bool {
+    within_jump(points, beta, a, b) || links.binary_search(&[a.min(b), a.max(b)]).is_ok()
+}
+
+/// Cuts a closed `tour` at its jumps and joins the pieces again by
+/// supported steps; returns the closed loops (canonical: smallest index
+/// first) and the number of pieces or chains dropped. A tour without jumps
+/// comes back unchanged.
+pub fn split_at_jumps(
+    points: &[Point3],
+    beta: &[f64],
+    links: &[[u32; 2]],
+    tour: Vec<u32>,
+) -> (Vec<Vec<u32>>, usize) {
+    let n = tour.len();
+    let ok = |a: u32, b: u32| supported(points, beta, links, a, b);
+    let Some(first_jump) = (0..n).find(|&k| !ok(tour[k], tour[(k + 1) % n])) else {
+        return (vec![tour], 0);
+    };
+    // Pieces: maximal runs of supported steps, starting after a jump.
+    let mut pieces: Vec<Vec<u32>> = Vec::new();
+    let mut current = Vec::new();
+    for j in 1..=n {
+        let k = (first_jump + j) % n;
+        current.push(tour[k]);
+        if !ok(tour[k], tour[(k + 1) % n]) {
+            pieces.push(std::mem::take(&mut current));
+        }
+    }
+    // End e = 2·piece + side (0: first point, 1: last point).
+    let end_point = |e: usize| {
+        let p = &pieces[e / 2];
+        if e & 1 == 0 {
+            p[0]
+        } else {
+            p[p.len() - 1]
+        }
+    };
+    let ends = 2 * pieces.len();
+    let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
+    for e in 0..ends {
+        for f in e + 1..ends {
+            // A one-point piece does not close on itself.
+            if f == e + 1 && e & 1 == 0 && pieces[e / 2].len() == 1 {
+                continue;
+            }
+            let (a, b) = (end_point(e), end_point(f));
+            if ok(a, b) {
+                pairs.push((dist2(points[a as usize], points[b as usize]), e, f));
+            }
+        }
+    }
+    pairs.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2)));
+    let mut partner = vec![usize::MAX; ends];
+    let mut closed = vec![false; pieces.len()];
+    // Chains as union–find over pieces; a chain closes at most once.
+    let mut parent: Vec<usize> = (0..pieces.len()).collect();
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    for &(_, e, f) in &pairs {
+        if partner[e] != usize::MAX || partner[f] != usize::MAX {
+            continue;
+        }
+        let (re, rf) = (root(&mut parent, e / 2), root(&mut parent, f / 2));
+        if re == rf {
+            if closed[re] {
+                continue;
+            }
+            closed[re] = true;
+        } else {
+            if closed[re] || closed[rf] {
+                continue;
+            }
+            parent[re.max(rf)] = re.min(rf);
+        }
+        partner[e] = f;
+        partner[f] = e;
+    }
+    // Walk each chain from a free end (open) or from any end (closed).
+    let mut visited = vec![false; pieces.len()];
+    let mut loops = Vec::new();
+    let mut dropped = 0;
+    let walk = |start: usize, visited: &mut [bool]| -> (Vec<u32>, bool) {
+        let mut chain = Vec::new();
+        let mut e = start;
+        loop {
+            let piece = e / 2;
+            visited[piece] = true;
+            if e & 1 == 0 {
+                chain.extend_from_slice(&pieces[piece]);
+            } else {
+                chain.extend(pieces[piece].iter().rev());
+            }
+            let next = partner[e ^ 1];
+            if next == usize::MAX {
+                return (chain, false);
+            }
+            if next == start || visited[next / 2] {
+                return (chain, true);
+            }
+            e = next;
+        }
+    };
+    let mut open = Vec::new();
+    for e in 0..ends {
+        // Open chains first, from their free end.
+        if partner[e] == usize::MAX && !visited[e / 2] {
+            open.push(walk(e, &mut visited).0);
+        }
+    }
+    for p in 0..pieces.len() {
+        if !visited[p] {
+            let (chain, closed) = walk(2 * p, &mut visited);
+            if closed && chain.len() >= MIN_LOOP_POINTS {
+                loops.push(canonical(chain));
+            } else {
+                open.push(chain);
+            }
+        }
+    }
+    // Open chains, longest first, are closed along the links through
+    // points no loop holds yet.
+    let mut used: HashSet<u32> = loops.iter().flatten().copied().collect();
+    let mut adjacency: HashMap<u32, Vec<u32>> = HashMap::new();
+    for &[a, b] in links {
+        adjacency.entry(a).or_default().push(b);
+        adjacency.entry(b).or_default().push(a);
+    }
+    // Longest first (popped from the end).
+    open.sort_by(|x, y| x.len().cmp(&y.len()).then(y.cmp(x)));
+    while let Some(chain) = open.pop() {
+        // The runs of the chain that no loop took meanwhile.
+        let runs: Vec<Vec<u32>> = chain
+            .split(|p| used.contains(p))
+            .filter(|run| run.len() >= 2)
+            .map(<[u32]>::to_vec)
+            .collect();
+        if runs.len() != 1 {
+            dropped += usize::from(runs.is_empty());
+            open.extend(runs);
+            continue;
+        }
+        let chain = runs.into_iter().next().expect("one run");
+        match peel_cycle(points, &adjacency, &used, &chain) {
+            Some((ring, rest)) => {
+                used.extend(ring.iter().copied());
+                loops.push(canonical(ring));
+                if rest.len() >= 2 {
+                    open.push(rest);
+                }
+            }
+            None => dropped += 1,
+        }
+    }
+    // A loop that runs within 3β of longer loops all along is a parallel
+    // copy of their border (a cycle inside a thick band of boundary
+    // points), not a border of its own.
+    loops.sort_by(|x, y| y.len().cmp(&x.len()).then(x.cmp(y)));
+    let mut kept: Vec<Vec<u32>> = Vec::new();
+    for ring in loops {
+        let shadowed = ring.iter().all(|&p| {
+            kept.iter()
+                .flatten()
+                .any(|&q| within_jump(points, beta, p, q))
+        });
+        if shadowed {
+            dropped += 1;
+        } else {
+            kept.push(ring);
+        }
+    }
+    kept.sort_unstable();
+    (kept, dropped)
+}
+
+/// Are `a` and `b` at most 3β apart (the larger β of the two)?
+fn within_jump(points: &[Point3], beta: &[f64], a: u32, b: u32) -> bool {
+    let scale = JUMP_BETAS * beta[a as usize].max(beta[b as usize]);
+    dist2(points[a as usize], points[b as usize]) <= scale * scale
+}
+
+/// The longest cycle of at least [`MIN_LOOP_POINTS`] points made of a run
+/// of the open `chain` from one of its ends and a path along the links
+/// from that end back to the chain (through points neither on the chain
+/// nor `used`); returns it and the rest of the chain beyond the run.
+fn peel_cycle(
+    points: &[Point3],
+    adjacency: &HashMap<u32, Vec<u32>>,
+    used: &HashSet<u32>,
+    chain: &[u32],
+) -> Option<(Vec<u32>, Vec<u32>)> {
+    let position: HashMap<u32, usize> = chain.iter().enumerate().map(|(i, &p)| (p, i)).collect();
+    let n = chain.len();
+    let mut best: Option<(Vec<u32>, Vec<u32>)> = None;
+    for from_start in [false, true] {
+        let end = if from_start { chain[0] } else { chain[n - 1] };
+        for (target, path) in link_paths(
+            points,
+            adjacency,
+            end,
+            |p| used.contains(&p) || position.contains_key(&p),
+            |p| position.contains_key(&p),
+        ) {
+            let j = position[&target];
+            let (mut ring, rest) = if from_start {
+                (chain[..=j].to_vec(), chain[j + 1..].to_vec())
+            } else {
+                (chain[j..].to_vec(), chain[..j].to_vec())
+            };
+            // The path runs from `end` to `target`: after the run's last
+            // point when the run starts at `end`, reversed otherwise.
+            if from_start {
+                ring.extend(path.iter().rev());
+            } else {
+                ring.extend(path.iter());
+            }
+            let longer = match &best {
+                Some(b) => ring.len() > b.0.len(),
+                None => true,
+            };
+            if ring.len() >= MIN_LOOP_POINTS && longer {
+                best = Some((ring, rest));
+            }
+        }
+    }
+    best
+}
+
+/// Shortest paths along the links from `from` (Dijkstra, Euclidean
+/// lengths, ties by index) through points that are not `blocked`, to every
+/// `target` point reached (targets end a path; `from` is not one). Returns
+/// each target with the points strictly between.
+fn link_paths(
+    points: &[Point3],
+    adjacency: &HashMap<u32, Vec<u32>>,
+    from: u32,
+    blocked: impl Fn(u32) -> bool,
+    target: impl Fn(u32) -> bool,
+) -> Vec<(u32, Vec<u32>)> {
+    let mut best: HashMap<u32, (f64, u32)> = HashMap::from([(from, (0.0, from))]);
+    let mut heap = BinaryHeap::from([Reverse((Length(0.0), from))]);
+    let mut reached = Vec::new();
+    while let Some(Reverse((Length(d), v))) = heap.pop() {
+        if d > best[&v].0 {
+            continue;
+        }
+        if v != from && target(v) {
+            let mut path = Vec::new();
+            let mut at = best[&v].1;
+            while at != from {
+                path.push(at);
+                at = best[&at].1;
+            }
+            path.reverse();
+            reached.push((v, path));
+            continue;
+        }
+        for &w in adjacency.get(&v).map_or(&[][..], Vec::as_slice) {
+            if w == from || (blocked(w) && !target(w)) {
+                continue;
+            }
+            let nd = d + dist2(points[v as usize], points[w as usize]).sqrt();
+            if !best.get(&w).is_some_and(|&(old, _)| nd >= old) {
+                best.insert(w, (nd, v));
+                heap.push(Reverse((Length(nd), w)));
+            }
+        }
+    }
+    reached.sort_unstable();
+    reached
+}
+
+/// A path length ordered for the heap (lengths are finite).
+struct Length(f64);
+
+impl PartialEq for Length {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other).is_eq()
+    }
+}
+
+impl Eq for Length {}
+
+impl PartialOrd for Length {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Length {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&other.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::edge_metrics::tour_jumps;
+    use crate::edges::{cluster::cluster_boundary, order::closed_tour};
+
+    /// Two concentric rings (radius 10 and 5, spacing ≈ 1) joined at two
+    /// places by radial bridges of linked points: one cluster, which no
+    /// single tour can follow without jumping across the surface.
+    fn rings_joined_twice() -> (Vec<Point3>, Vec<[u32; 2]>, usize, usize) {
+        let mut points = Vec::new();
+        let mut links = Vec::new();
+        let ring = |points: &mut Vec<Point3>, links: &mut Vec<[u32; 2]>, r: f64, n: usize| {
+            let first = points.len() as u32;
+            for i in 0..n {
+                let t = i as f64 / n as f64 * std::f64::consts::TAU;
+                points.push([r * t.cos(), r * t.sin(), 0.0]);
+                let (a, b) = (first + i as u32, first + ((i + 1) % n) as u32);
+                links.push([a.min(b), a.max(b)]);
+            }
+            first
+        };
+        let (outer_n, inner_n) = (60, 30);
+        let outer = ring(&mut points, &mut links, 10.0, outer_n);
+        let inner = ring(&mut points, &mut links, 5.0, inner_n);
+        // Bridges at angle 0 and π: points at radius 6..9.
+        for (o, i, sign) in [(outer, inner, 1.0), (outer + 30, inner + 15, -1.0)] {
+            let mut previous = i;
+            for r in 6..=9 {
+                let p = points.len() as u32;
+                points.push([sign * r as f64, 0.0, 0.0]);
+                links.push([previous.min(p), previous.max(p)]);
+                previous = p;
+            }
+            links.push([o.min(previous), o.max(previous)]);
+        }
+        links.sort_unstable();
+        (points, links, outer_n, inner_n)
+    }
+
+    #[test]
+    fn two_borders_joined_twice_give_two_loops_without_jumps() {
+        let (points, links, outer_n, inner_n) = rings_joined_twice();
+        let beta = vec![1.1; points.len()];
+        let clusters = cluster_boundary(&vec![true; points.len()], &links);
+        assert_eq!(clusters.clusters.len(), 1);
+        let tour = closed_tour(&points, &clusters.clusters[0], &clusters.links[0]);
+        assert!(tour_jumps(&points, &beta, &links, &tour).count > 0);
+        let (loops, _dropped) = split_at_jumps(&points, &beta, &clusters.links[0], tour);
+        assert_eq!(loops.len(), 2, "{loops:?}");
+        for l in &loops {
+            assert_eq!(tour_jumps(&points, &beta, &links, l).count, 0, "{l:?}");
+        }
+        // One loop round each ring.
+        let on = |l: &Vec<u32>, from: usize, n: usize| {
+            (from..from + n)
+                .filter(|&i| l.contains(&(i as u32)))
+                .count()
+        };
+        let mut rings: Vec<(usize, usize)> = loops
+            .iter()
+            .map(|l| (on(l, 0, outer_n), on(l, outer_n, inner_n)))
+            .collect();
+        rings.sort_unstable();
+        assert!(rings[0].0 <= 1 && rings[0].1 == inner_n, "{rings:?}");
+        assert!(rings[1].0 == outer_n && rings[1].1 <= 1, "{rings:?}");
+    }
+
+    #[test]
+    fn a_tour_without_jumps_is_kept() {
+        let points: Vec<Point3> = (0..12)
+            .map(|i| {
+                let t = i as f64 / 12.0 * std::f64::consts::TAU;
+                [3.0 * t.cos(), 3.0 * t.sin(), 0.0]
+            })
+            .collect();
+        let tour: Vec<u32> = (0..12).collect();
+        let (loops, dropped) = split_at_jumps(&points, &[1.0; 12], &[], tour.clone());
+        assert_eq!((loops, dropped), (vec![tour], 0));
+    }
+}
