@@ -17,35 +17,46 @@
 //!    vertices) and, unless switched off, the outward offset to the
 //!    physical edge ([`crate::edges::offset`]): the smoothed loop passes
 //!    outside the jagged border at its notches and inside it at its spikes.
+//!    Vertices closer than [`MIN_GAP`]·β to the previous one are merged.
 //! 3. **The band.** Around each loop, the faces within a few rings of its
 //!    border (starting at [`FIRST_DEPTH`] rings, grown to [`MAX_DEPTH`]
-//!    while the cut reaches the band's rim) are projected onto their
-//!    best-fit plane, oriented with the faces. A band whose faces do not
-//!    all keep their orientation in the projection folds over it, and its
-//!    loop is left unchanged (reported). Loops whose bands share a face are
-//!    handled together.
+//!    while the cut reaches the band's rim) are projected along their
+//!    area-weighted mean normal (a range scan faces its scanner
+//!    everywhere, so its faces stay the right way up even where the band's
+//!    best-fit plane is steep). Loops whose bands share a face are handled
+//!    together.
 //! 4. **What goes.** Within the band, a vertex stays when it lies on the
 //!    surface's side of the smoothed loops and farther than [`MARGIN`]·βᵢ
 //!    from them (closer, it would only make a sliver against the new
 //!    border), and is not a vertex of the old border. Faces with a vertex
-//!    that goes, or crossed by a smoothed loop, are removed.
+//!    that goes, or crossed by a smoothed loop, are removed, and with them
+//!    the faces that turn over in the projection and touch them (a
+//!    skirt across a depth jump at a silhouette), inside the band.
 //! 5. **The gap is filled.** The removed region and the gap between the
 //!    old border and the smoothed loops are triangulated again, in the
 //!    projection, by a constrained Delaunay triangulation (spade, exact
 //!    predicates) of the smoothed loops' vertices, the kept vertices of the
-//!    removed faces, and, as constraints, the smoothed loops and the edges
-//!    where removed faces met kept ones (and the borders of small loops
-//!    the band takes in). The faces between these curves — by a parity
-//!    flood fill across the constraints — are the new ones. Every vertex
-//!    of them is a point of the surface already (a mesh vertex, or a
-//!    smoothed loop vertex), so the new faces follow the surface without
-//!    any lifting; Delaunay maximises their smallest angles.
+//!    removed faces (not those of turned faces), and, as constraints, the
+//!    smoothed loops and the *walls*: the edges where removed faces met
+//!    kept ones (and the borders of small loops the band takes in). The
+//!    faces between these curves — by a parity flood fill across the
+//!    constraints — are the new ones. Where walls cross in the projection
+//!    (a fold beside the band), the faces round the crossing go too and
+//!    the gap is triangulated again, at most [`WALL_REPAIRS`] times. Where
+//!    the gap is wide, Delaunay refinement adds points lifted onto the
+//!    unrefined triangles ([`REFINE_ANGLE`]); otherwise every vertex is a
+//!    point of the surface already (a mesh vertex or a smoothed loop
+//!    vertex), so the new faces follow the surface without any lifting.
 //! 6. Unused vertices are removed. Vertices outside the bands keep their
 //!    exact coordinates and the faces there are untouched.
 //!
-//! A constraint that would cross another, or two vertices that coincide in
-//! the projection, leave the loops of that band unchanged (reported) rather
-//! than produce a broken mesh.
+//! A loop whose band cannot be replaced safely (its smoothed loop crosses
+//! itself by more than [`MAX_UNTWIST`] or crosses another loop or the kept
+//! mesh, its walls keep crossing, its cut runs deeper than [`MAX_DEPTH`]
+//! rings) is left unchanged and reported, and the other loops of its band
+//! are tried again without it. A patch whose faces would meet others at a
+//! non-manifold or same-direction edge is dropped the same way, so the
+//! output is never a broken mesh.
 
 use std::collections::{BTreeSet, HashMap};
 
