@@ -1152,4 +1152,57 @@ mod tests {
         assert!(report.min_angle_new > 5.0, "{report:?}");
         check_manifold(&out).unwrap();
     }
+
+    /// A closed surface has no border: it comes back as it was.
+    #[test]
+    fn a_closed_mesh_is_returned_unchanged() {
+        let vertices = vec![
+            [1.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, -1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 0.0, -1.0],
+        ];
+        let faces = vec![
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ];
+        let mesh = Mesh { vertices, faces };
+        let (out, report) = clean_mesh(&mesh, &[1.0; 6], &CleanOptions::default()).unwrap();
+        assert_eq!(out, mesh);
+        assert_eq!(report.loops_in, 0);
+        assert_eq!(report.faces_out, 8);
+    }
+
+    /// Misoriented and non-manifold meshes are clear errors.
+    #[test]
+    fn bad_topology_is_an_error() {
+        let mut mesh = jagged_annulus(8.0, 3.0, 3);
+        let beta = vec![1.0; mesh.vertices.len()];
+        mesh.faces[0].swap(1, 2);
+        assert!(matches!(
+            clean_mesh(&mesh, &beta, &CleanOptions::default()),
+            Err(MeshError::Misoriented { .. })
+        ));
+        let mut mesh = jagged_annulus(8.0, 3.0, 3);
+        let f = mesh.faces[0];
+        mesh.vertices.push([0.0, 0.0, 5.0]);
+        let apex = mesh.vertices.len() as u32 - 1;
+        mesh.faces.push([f[0], f[1], apex]);
+        assert!(matches!(
+            clean_mesh(
+                &mesh,
+                &vec![1.0; mesh.vertices.len()],
+                &CleanOptions::default()
+            ),
+            Err(MeshError::NonManifold { .. })
+        ));
+    }
 }
