@@ -550,3 +550,51 @@ fn cloud_dir_mirrors_the_inputs_and_two_clouds_for_one_mesh_fail_that_mesh() {
     );
     assert_eq!(files_below(&d.join("out")), [PathBuf::from("sub/a.ply")]);
 }
+
+/// `part.ply` without faces beside `part.stl` is the STL's cloud (a cloud
+/// with the same stem and a cloud extension): the STL is trimmed with it
+/// and the PLY is not an input. A PLY with faces beside an STL is a mesh of
+/// its own: both are cleaned.
+#[test]
+fn a_same_stem_ply_without_faces_is_the_cloud() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::create_dir_all(d.join("scans")).unwrap();
+    let poisson = meshtrim::io::read_mesh(Path::new(MESH)).unwrap();
+    meshtrim::io::write_mesh(
+        &d.join("scans/part.stl"),
+        &poisson.vertices,
+        poisson.faces.as_ref().unwrap(),
+    )
+    .unwrap();
+    std::fs::copy(CLOUD, d.join("scans/part.ply")).unwrap();
+    std::fs::copy(JAGGED, d.join("scans/other.stl")).unwrap();
+    let jagged = meshtrim::io::read_mesh(Path::new(JAGGED)).unwrap();
+    meshtrim::io::write_mesh(
+        &d.join("scans/other.ply"),
+        &jagged.vertices,
+        jagged.faces.as_ref().unwrap(),
+    )
+    .unwrap();
+    let run = batch(d, &["scans", "--out-dir", "out", "--report", "r.json"]);
+    assert_ok(&run);
+    let files = json_report(&d.join("r.json"))["files"].clone();
+    let rows: Vec<(String, String)> = files
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| {
+            let input = f["input"].as_str().unwrap();
+            let name = Path::new(input).file_name().unwrap().to_str().unwrap();
+            (name.to_string(), f["mode"].as_str().unwrap().to_string())
+        })
+        .collect();
+    assert_eq!(
+        rows,
+        [
+            ("other.ply".to_string(), "clean".to_string()),
+            ("other.stl".to_string(), "clean".to_string()),
+            ("part.stl".to_string(), "trim".to_string()),
+        ]
+    );
+}

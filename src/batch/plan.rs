@@ -195,7 +195,8 @@ fn walk(dir: &Path, root: &Path, skip: Option<&Path>, found: &mut Vec<Found>) ->
             if skip.is_none() || path.canonicalize().ok().as_deref() != skip {
                 walk(&path, root, skip, found)?;
             }
-        } else if (kind.is_file() || path.is_file()) && is_mesh_input(&path) {
+        } else if (kind.is_file() || path.is_file()) && is_mesh_input(&path) && !paired_cloud(&path)
+        {
             let rel = path.strip_prefix(root).unwrap_or(&path).to_path_buf();
             found.push(Found { path, rel });
         }
@@ -214,7 +215,7 @@ fn expand_glob(pattern: &Path, skip: Option<&Path>) -> Result<Vec<Found>> {
     let (mut found, mut outputs) = (Vec::new(), 0);
     for path in paths {
         let path = path.with_context(|| format!("{text}: cannot read a match"))?;
-        if !path.is_file() || !is_mesh_input(&path) {
+        if !path.is_file() || !is_mesh_input(&path) || paired_cloud(&path) {
             continue;
         }
         if skip.is_some_and(|s| path.canonicalize().is_ok_and(|p| p.starts_with(s))) {
@@ -273,6 +274,58 @@ fn cloud_stem(path: &Path) -> Option<&str> {
     }
 }
 
+/// A `.ply` or `.obj` file that sits beside a mesh of the same stem with
+/// another mesh extension (`part.ply` beside `part.stl`) and holds no
+/// faces is that mesh's cloud, not an input: the issue's "a cloud with the
+/// same stem and a cloud extension". Only the header (PLY) or the lines
+/// (OBJ) are read.
+fn paired_cloud(path: &Path) -> bool {
+    let ext = extension(path);
+    if !matches!(ext.as_str(), "ply" | "obj") || cloud_stem(path).is_some() {
+        return false;
+    }
+    let has_mesh_sibling = MESH_EXTENSIONS.iter().filter(|&&e| e != ext).any(|e| {
+        [e.to_string(), e.to_ascii_uppercase()]
+            .iter()
+            .any(|e| path.with_extension(e).is_file())
+    });
+    has_mesh_sibling && !has_faces(path, &ext)
+}
+
+/// True if a PLY header declares faces (or a range grid) or an OBJ file
+/// has an `f` line; unreadable files count as meshes (they fail later,
+/// with their own error).
+fn has_faces(path: &Path, ext: &str) -> bool {
+    use std::io::{BufRead, BufReader};
+    let Ok(file) = std::fs::File::open(path) else {
+        return true;
+    };
+    let mut lines = BufReader::new(file).split(b'\n');
+    if ext == "obj" {
+        return lines
+            .map_while(std::result::Result::ok)
+            .any(|l| l.starts_with(b"f ") || l.starts_with(b"f\t"));
+    }
+    for line in lines
+        .by_ref()
+        .take(10_000)
+        .map_while(std::result::Result::ok)
+    {
+        let text = String::from_utf8_lossy(&line);
+        let words: Vec<&str> = text.split_whitespace().collect();
+        match words.as_slice() {
+            ["end_header"] => return false,
+            ["element", "face" | "range_grid", count]
+                if count.parse::<u64>().map_or(true, |n| n > 0) =>
+            {
+                return true;
+            }
+            _ => {}
+        }
+    }
+    true
+}
+
 /// The clouds of each directory looked in, listed once (a batch of
 /// thousands of meshes in one directory must not list it thousands of
 /// times).
@@ -324,11 +377,14 @@ fn list_clouds(dir: &Path) -> Result<HashMap<String, Vec<PathBuf>>> {
     let mut clouds: HashMap<String, Vec<PathBuf>> = HashMap::new();
     for entry in entries {
         let name = PathBuf::from(entry.file_name());
-        if let Some(stem) = cloud_stem(&name) {
-            clouds
-                .entry(stem.to_string())
-                .or_default()
-                .push(dir.join(&name));
+        let path = dir.join(&name);
+        let stem = cloud_stem(&name).or_else(|| {
+            paired_cloud(&path)
+                .then(|| name.file_stem().and_then(OsStr::to_str))
+                .flatten()
+        });
+        if let Some(stem) = stem {
+            clouds.entry(stem.to_string()).or_default().push(path);
         }
     }
     clouds.values_mut().for_each(|v| v.sort());
