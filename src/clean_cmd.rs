@@ -7,16 +7,15 @@
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use serde::Serialize;
 use trim::clean::{clean_mesh, CleanOptions, CleanReport};
-use trim::mesh::Mesh;
 use trim::BpdOptions;
 
 use crate::cli::CleanArgs;
-use crate::detect::{millis, same_file};
-use crate::io::mesh_out::{write_mesh, MeshFormat};
-use crate::io::read_mesh;
+use crate::detect::millis;
+use crate::io::mesh_out::write_mesh;
+use crate::io::read_mesh_with_faces;
 
 /// What one cleanup needs besides its files: the detection and edge
 /// options.
@@ -93,25 +92,14 @@ pub struct LeftLoops {
 
 /// Runs `meshtrim clean`.
 pub fn run(args: &CleanArgs) -> Result<()> {
-    check_paths(&args.input, &args.output)?;
-    if let Some(report) = &args.report {
-        if report.extension().and_then(|e| e.to_str()) != Some("json") {
-            bail!("{}: the report is JSON: name it .json", report.display());
-        }
-        if same_file(report, &args.input) {
-            bail!(
-                "{}: an output would overwrite this input",
-                args.input.display()
-            );
-        }
-    }
+    crate::report::check_outputs(&args.output, args.report.as_deref(), &[&args.input])?;
     let report = clean(&args.input, &args.output, &args.stages)?;
     crate::report::emit(&report, args.report.as_deref(), args.json)
 }
 
 /// Cleans one file without printing (the unit of `batch`).
 pub fn clean_file(input: &Path, output: &Path, settings: &CleanSettings) -> Result<CleanOutcome> {
-    check_paths(input, output)?;
+    crate::report::check_outputs(output, None, &[input])?;
     let r = clean(input, output, settings)?;
     Ok(CleanOutcome {
         loops: r.loops_smoothed,
@@ -123,34 +111,10 @@ pub fn clean_file(input: &Path, output: &Path, settings: &CleanSettings) -> Resu
     })
 }
 
-/// Refuses unknown output formats and an output that is the input.
-fn check_paths(input: &Path, output: &Path) -> Result<()> {
-    if MeshFormat::from_path(output).is_none() {
-        bail!(
-            "{}: unsupported output format: use .obj, .ply, .stl, .gltf or .glb",
-            output.display()
-        );
-    }
-    if same_file(output, input) {
-        bail!("{}: the output would overwrite this input", input.display());
-    }
-    Ok(())
-}
-
 /// Reads, finds the local resolution, cleans, writes.
 fn clean(input: &Path, output: &Path, settings: &CleanSettings) -> Result<Report> {
     let started = Instant::now();
-    let read = read_mesh(input)?;
-    let Some(faces) = read.faces else {
-        bail!(
-            "{}: the file has no faces: `clean` smooths the border of a mesh",
-            input.display()
-        );
-    };
-    let mesh = Mesh {
-        vertices: read.vertices,
-        faces,
-    };
+    let mesh = read_mesh_with_faces(input, "`clean` smooths the border of a mesh")?;
     let read_time = started.elapsed();
     let started = Instant::now();
     let options = BpdOptions {

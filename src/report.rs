@@ -35,3 +35,28 @@ pub fn rows(rows: &[(&str, String)]) -> String {
         .map(|(label, value)| format!("{label:<20} {value}\n"))
         .collect()
 }
+
+/// Refuses, before any work, an unknown mesh output format, a report not
+/// named `.json`, and an output or report that would overwrite one of the
+/// `inputs`.
+pub fn check_outputs(output: &Path, report: Option<&Path>, inputs: &[&Path]) -> Result<()> {
+    use anyhow::bail;
+    if crate::io::MeshFormat::from_path(output).is_none() {
+        bail!(
+            "{}: unsupported output format: use .obj, .ply, .stl, .gltf or .glb",
+            output.display()
+        );
+    }
+    if let Some(report) = report {
+        if report.extension().and_then(|e| e.to_str()) != Some("json") {
+            bail!("{}: the report is JSON: name it .json", report.display());
+        }
+    }
+    for input in inputs {
+        let overwrites = |out: &Path| crate::detect::same_file(out, input);
+        if overwrites(output) || report.is_some_and(overwrites) {
+            bail!("{}: an output would overwrite this input", input.display());
+        }
+    }
+    Ok(())
+}

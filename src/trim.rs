@@ -6,16 +6,15 @@
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use serde::Serialize;
 use trim::edges::{reconstruct_edges, EdgeOptions};
-use trim::mesh::Mesh;
 use trim::trimming::{trim_mesh, LoopFit, TrimReport};
 
 use crate::cli::TrimArgs;
-use crate::detect::{millis, read_and_detect_with, same_file, Detected};
-use crate::io::mesh_out::{write_mesh, MeshFormat};
-use crate::io::read_mesh;
+use crate::detect::{millis, read_and_detect_with, Detected};
+use crate::io::mesh_out::write_mesh;
+use crate::io::read_mesh_with_faces;
 
 /// What the trimming prints and `--report` writes.
 #[derive(Debug, Clone, Serialize)]
@@ -113,17 +112,7 @@ pub fn trim_file(
     settings: &TrimSettings,
 ) -> Result<Report> {
     let started = Instant::now();
-    let input = read_mesh(mesh_path)?;
-    let Some(faces) = input.faces else {
-        bail!(
-            "{}: the file has no faces: give a mesh (the cloud goes second)",
-            mesh_path.display()
-        );
-    };
-    let mesh = Mesh {
-        vertices: input.vertices,
-        faces,
-    };
+    let mesh = read_mesh_with_faces(mesh_path, "give a mesh (the cloud goes second)")?;
     let mesh_read_time = started.elapsed();
     let Detected {
         cloud,
@@ -166,24 +155,11 @@ pub fn trim_file(
 /// Refuses unknown output formats and outputs that would overwrite an
 /// input, before any work.
 fn check_paths(args: &TrimArgs) -> Result<()> {
-    if MeshFormat::from_path(&args.output).is_none() {
-        bail!(
-            "{}: unsupported output format: use .obj, .ply, .stl, .gltf or .glb",
-            args.output.display()
-        );
-    }
-    if let Some(report) = &args.report {
-        if report.extension().and_then(|e| e.to_str()) != Some("json") {
-            bail!("{}: the report is JSON: name it .json", report.display());
-        }
-    }
-    for input in [&args.mesh, &args.cloud] {
-        let overwrites = |out: &Path| same_file(out, input);
-        if overwrites(&args.output) || args.report.as_deref().is_some_and(overwrites) {
-            bail!("{}: an output would overwrite this input", input.display());
-        }
-    }
-    Ok(())
+    crate::report::check_outputs(
+        &args.output,
+        args.report.as_deref(),
+        &[&args.mesh, &args.cloud],
+    )
 }
 
 impl Report {

@@ -116,6 +116,19 @@ pub fn read_mesh(path: &Path) -> Result<Mesh> {
     read_mesh_inner(path).with_context(|| path.display().to_string())
 }
 
+/// Reads a mesh that must have faces (for the commands that cut or clean
+/// one); a file without faces is an error naming the file and `hint`.
+pub fn read_mesh_with_faces(path: &Path, hint: &str) -> Result<trim::mesh::Mesh> {
+    let read = read_mesh(path)?;
+    let Some(faces) = read.faces else {
+        bail!("{}: the file has no faces: {hint}", path.display());
+    };
+    Ok(trim::mesh::Mesh {
+        vertices: read.vertices,
+        faces,
+    })
+}
+
 fn read_cloud_inner(path: &Path) -> Result<Cloud> {
     let bytes = std::fs::read(path).context("cannot read")?;
     let format = match detect_format(path, &bytes) {

@@ -163,6 +163,12 @@ pub fn clean_mesh(
     if mesh.faces.is_empty() {
         return Err(MeshError::NoFaces);
     }
+    if beta.len() != mesh.vertices.len() {
+        return Err(MeshError::ResolutionLength {
+            values: beta.len(),
+            vertices: mesh.vertices.len(),
+        });
+    }
     check_manifold(mesh)?;
     let borders = mesh.boundary_loops();
     let mut report = CleanReport {
@@ -254,21 +260,20 @@ struct Outcome {
 /// Replaces every smoothable loop, merging loops whose bands overlap until
 /// no two bands share a face.
 fn replace_all(cx: &Context) -> Vec<Outcome> {
-    let seeds: Vec<usize> = (0..cx.rings.len())
+    let mut groups: Vec<Vec<usize>> = (0..cx.rings.len())
         .filter(|&l| cx.rings[l].is_some())
+        .map(|l| vec![l])
         .collect();
-    let mut groups: Vec<Vec<usize>> = seeds.iter().map(|&l| vec![l]).collect();
-    loop {
-        let outcomes: Vec<Outcome> = groups.par_iter().map(|g| replace_group(cx, g)).collect();
-        match first_overlap(&outcomes) {
-            None => return outcomes,
-            Some((a, b)) => {
-                let taken = groups.remove(b);
-                groups[a].extend(taken);
-                groups[a].sort_unstable();
-            }
-        }
+    let mut outcomes: Vec<Outcome> = groups.par_iter().map(|g| replace_group(cx, g)).collect();
+    // Only the merged group is replaced again: the others do not change.
+    while let Some((a, b)) = first_overlap(&outcomes) {
+        let taken = groups.remove(b);
+        outcomes.remove(b);
+        groups[a].extend(taken);
+        groups[a].sort_unstable();
+        outcomes[a] = replace_group(cx, &groups[a]);
     }
+    outcomes
 }
 
 /// Two outcomes whose bands share a face (indices, a < b).
@@ -1181,9 +1186,15 @@ mod tests {
         assert_eq!(report.faces_out, 8);
     }
 
-    /// Misoriented and non-manifold meshes are clear errors.
+    /// Misoriented and non-manifold meshes, and resolutions that do not
+    /// match the vertices, are clear errors.
     #[test]
     fn bad_topology_is_an_error() {
+        let mesh = jagged_annulus(8.0, 3.0, 3);
+        assert!(matches!(
+            clean_mesh(&mesh, &[1.0; 3], &CleanOptions::default()),
+            Err(MeshError::ResolutionLength { values: 3, .. })
+        ));
         let mut mesh = jagged_annulus(8.0, 3.0, 3);
         let beta = vec![1.0; mesh.vertices.len()];
         mesh.faces[0].swap(1, 2);

@@ -104,6 +104,14 @@ pub enum MeshError {
         /// Vertices a repair would have dropped.
         dropped: usize,
     },
+    /// The local resolutions given do not match the vertices.
+    #[error("{values} local resolutions given for {vertices} vertices")]
+    ResolutionLength {
+        /// Values given.
+        values: usize,
+        /// Vertices of the mesh.
+        vertices: usize,
+    },
     /// Some edges are shared by more than two faces.
     #[error("{edges} edges are shared by more than two faces; the mesh must be edge-manifold (repair it first, e.g. MeshLab's \"Repair non Manifold Edges\")")]
     NonManifold {
