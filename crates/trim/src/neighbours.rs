@@ -9,6 +9,7 @@
 //! tree's internal layout.
 
 use std::num::NonZeroUsize;
+use std::ops::Range;
 
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 
@@ -56,41 +57,17 @@ impl<'a> NeighbourIndex<'a> {
     /// depends on the tree; so the query asks for one more than needed and
     /// widens until the tie is enclosed, then cuts by rank.
     pub fn nearest(&self, i: usize, k: usize, out: &mut Vec<u32>) {
-        self.nearest_near_last(i, k, out, &mut QueryHint::default());
-    }
-
-    /// [`Self::nearest`], faster when consecutive calls with the same `hint`
-    /// ask about nearby points: the last answer bounds the search radius.
-    /// The result does not depend on the hint.
-    pub fn nearest_near_last(&self, i: usize, k: usize, out: &mut Vec<u32>, hint: &mut QueryHint) {
         out.clear();
         let k = k.min(self.points.len());
         if k == 0 {
             return;
         }
         let p = self.points[i];
-        // Triangle inequality: the last point's k nearest all lie within
-        // r = d_k(last) + |p − last| of p, so p's k nearest do too.
-        let bound = hint.last.map(|(q, d_k)| {
-            let r = (d_k + crate::cloud::dist2(p, self.points[q]).sqrt()) * (1.0 + 1e-9);
-            r * r
-        });
         let mut ask = (k + 1).min(self.points.len());
-        let mut radius = bound;
         let found = loop {
             let query = self.tree.query(&p);
             let n = NonZeroUsize::new(ask).expect("ask ≥ 1");
-            let found = match radius {
-                Some(r2) => query
-                    .nearest_n::<SquaredEuclidean<f64>>(n)
-                    .within::<SquaredEuclidean<f64>>(r2)
-                    .execute(),
-                None => query.nearest_n::<SquaredEuclidean<f64>>(n).execute(),
-            };
-            if found.len() < k {
-                radius = None; // rounding defeated the bound: search freely
-                continue;
-            }
+            let found = query.nearest_n::<SquaredEuclidean<f64>>(n).execute();
             let tie_reaches_end = ask < self.points.len()
                 && found.len() == ask
                 && found[ask - 1].distance <= found[k - 1].distance;
@@ -105,16 +82,129 @@ impl<'a> NeighbourIndex<'a> {
             .collect();
         found.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)).then(a.2.cmp(&b.2)));
         found.truncate(k);
-        hint.last = Some((i, found.iter().map(|n| n.1).fold(0.0, f64::max).sqrt()));
         out.extend(found.iter().map(|n| n.3));
     }
 }
 
-/// The previous query of a sequence of [`NeighbourIndex::nearest_near_last`]
-/// calls: its point and the distance to its k-th nearest.
+impl NeighbourIndex<'_> {
+    /// The k nearest of every point of `run` (positions in the indexed
+    /// slice, best a compact group in space, e.g. an octree cell), written
+    /// `k` per point into `out` in the order of [`Self::nearest`], with the
+    /// same result.
+    ///
+    /// One tree query serves the whole run: the points within a radius G of
+    /// the run's central point c are gathered once. For a point p of the
+    /// run they include every point within G − |p − c| of p; when at least
+    /// k do, p's k nearest (ties included) are among them, exactly. G is
+    /// chosen so that this almost always holds (c's own k-th distance, with
+    /// a margin, plus the run's radius); a point for which it fails gets its
+    /// own tree query.
+    pub fn nearest_of_run(&self, run: Range<usize>, k: usize, out: &mut [u32], s: &mut RunScratch) {
+        let k = k.min(self.points.len());
+        debug_assert_eq!(out.len(), run.len() * k);
+        if k == 0 || run.is_empty() {
+            return;
+        }
+        let centre = self.central_point(run.clone());
+        let pc = self.points[centre];
+        self.nearest(centre, k, &mut s.single);
+        let d_k = dist(pc, self.points[s.single[k - 1] as usize]);
+        let h = run
+            .clone()
+            .map(|p| dist(pc, self.points[p]))
+            .fold(0.0, f64::max);
+        let gather = RUN_MARGIN * d_k + h;
+        // Rounding slack: relative to the distances, and absolute for the
+        // coordinates' own precision far from the origin.
+        let slack = 1e-9 * gather + 1e-13 * magnitude(pc);
+        s.candidates.clear();
+        self.tree
+            .query(&pc)
+            .within::<SquaredEuclidean<f64>>((gather + slack).powi(2))
+            .unsorted()
+            .without_distances()
+            .visit(|found| s.candidates.push(found.item));
+        s.coords.clear();
+        s.coords
+            .extend(s.candidates.iter().map(|&j| self.points[j as usize]));
+        for (p, out) in run.zip(out.chunks_exact_mut(k)) {
+            let pp = self.points[p];
+            let reach = (gather - dist(pc, pp) - slack).max(0.0);
+            if !self.select_nearest(pp, reach * reach, k, s, out) {
+                self.nearest(p, k, &mut s.single);
+                out.copy_from_slice(&s.single);
+            }
+        }
+    }
+
+    /// The run's point closest to the run's mean.
+    fn central_point(&self, run: Range<usize>) -> usize {
+        let n = run.len() as f64;
+        let mut mean = [0.0; 3];
+        for p in run.clone() {
+            for (m, c) in mean.iter_mut().zip(self.points[p]) {
+                *m += c / n;
+            }
+        }
+        let key = |p: &usize| crate::cloud::dist2(mean, self.points[*p]);
+        run.min_by(|a, b| key(a).total_cmp(&key(b)))
+            .expect("run is not empty")
+    }
+
+    /// Writes into `out` the k nearest of `p` among the gathered candidates
+    /// within `reach2` (squared) of it; false if fewer than k are.
+    fn select_nearest(
+        &self,
+        p: Point3,
+        reach2: f64,
+        k: usize,
+        s: &mut RunScratch,
+        out: &mut [u32],
+    ) -> bool {
+        s.keyed.clear();
+        for (&j, &q) in s.candidates.iter().zip(&s.coords) {
+            let d = crate::cloud::dist2(p, q);
+            if d <= reach2 {
+                s.keyed.push((d, self.rank(j), j));
+            }
+        }
+        if s.keyed.len() < k {
+            return false;
+        }
+        let by_distance =
+            |a: &(f64, u32, u32), b: &(f64, u32, u32)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
+        if s.keyed.len() > k {
+            s.keyed.select_nth_unstable_by(k - 1, by_distance);
+        }
+        let nearest = &mut s.keyed[..k];
+        nearest.sort_unstable_by(by_distance);
+        for (o, n) in out.iter_mut().zip(nearest.iter()) {
+            *o = n.2;
+        }
+        true
+    }
+}
+
+/// How far beyond the central point's k-th distance a run gathers (see
+/// [`NeighbourIndex::nearest_of_run`]); the k-th distance varies a little
+/// across a run.
+const RUN_MARGIN: f64 = 1.25;
+
+/// Reusable buffers for [`NeighbourIndex::nearest_of_run`].
 #[derive(Debug, Default, Clone)]
-pub struct QueryHint {
-    last: Option<(usize, f64)>,
+pub struct RunScratch {
+    single: Vec<u32>,
+    candidates: Vec<u32>,
+    coords: Vec<Point3>,
+    keyed: Vec<(f64, u32, u32)>,
+}
+
+fn dist(a: Point3, b: Point3) -> f64 {
+    crate::cloud::dist2(a, b).sqrt()
+}
+
+fn magnitude(p: Point3) -> f64 {
+    p.iter().fold(0.0, |m, c| m.max(c.abs()))
 }
 
 /// Reference k-NN by sorting all distances; for tests.
@@ -167,22 +257,26 @@ mod tests {
     }
 
     #[test]
-    fn hinted_queries_match_plain_ones() {
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
-        let pts: Vec<Point3> = (0..3000)
-            .map(|_| [rng.random(), rng.random(), rng.random::<f64>() * 0.01])
+    fn run_queries_match_brute_force() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        // A sheet, a few far outliers, and an exact grid full of ties.
+        let mut pts: Vec<Point3> = (0..1500)
+            .map(|_| [rng.random(), rng.random(), rng.random::<f64>() * 0.02])
             .collect();
-        let index = NeighbourIndex::new(&pts);
-        let (mut plain, mut hinted) = (Vec::new(), Vec::new());
-        let mut hint = QueryHint::default();
-        // Far jumps and near steps alike.
-        for i in (0..pts.len())
-            .step_by(3)
-            .chain((0..pts.len()).rev().step_by(101))
-        {
-            index.nearest(i, 30, &mut plain);
-            index.nearest_near_last(i, 30, &mut hinted, &mut hint);
-            assert_eq!(plain, hinted, "point {i}");
+        pts.extend((0..5).map(|i| [10.0 + i as f64, -3.0, 7.0]));
+        pts.extend((0..400).map(|i| [2.0 + (i % 20) as f64 * 0.05, (i / 20) as f64 * 0.05, 0.0]));
+        let ranks: Vec<u32> = (0..pts.len() as u32).rev().collect();
+        let index = NeighbourIndex::new(&pts).with_ranks(&ranks);
+        let mut scratch = RunScratch::default();
+        let (mut single, mut runs) = (Vec::new(), vec![0u32; 30 * 16]);
+        for start in (0..pts.len()).step_by(16) {
+            let run = start..(start + 16).min(pts.len());
+            let out = &mut runs[..run.len() * 30];
+            index.nearest_of_run(run.clone(), 30, out, &mut scratch);
+            for (p, got) in run.zip(out.chunks(30)) {
+                index.nearest(p, 30, &mut single);
+                assert_eq!(got, &single[..], "point {p}");
+            }
         }
     }
 

@@ -25,7 +25,7 @@ use crate::anisotropy::{
 use crate::cloud::{check_not_degenerate, merge_duplicates, Point3, Sites};
 use crate::error::CloudError;
 use crate::frame::{fit_plane, project, Frame, Point2};
-use crate::neighbours::{NeighbourIndex, QueryHint};
+use crate::neighbours::{NeighbourIndex, RunScratch};
 use crate::resolution::{beta_of, nearest_distances};
 
 /// Options of boundary point detection.
@@ -219,35 +219,43 @@ fn neighbourhoods(
     how: TestImpl,
     progress: &(dyn Fn(usize) + Sync),
 ) -> Neighbourhoods {
-    let order = spatial_order(sites);
+    let (order, keys) = spatial_order(sites);
     let points: Vec<Point3> = order.iter().map(|&i| sites[i as usize]).collect();
     // Ties are broken by site index (input order), which, unlike the
     // spatial order, does not change when the cloud is moved.
     let index = NeighbourIndex::new(&points).with_ranks(&order);
     let mut lists = vec![0u32; points.len() * k];
-    let block = block_len(points.len());
-    for (b, chunk) in lists.chunks_mut(block * k).enumerate() {
-        let fill = |(members, hint): &mut (Vec<u32>, QueryHint),
-                    (offset, out): (usize, &mut [u32])| {
-            index.nearest_near_last(b * block + offset, k, members, hint);
-            out.copy_from_slice(members);
-        };
-        match how {
-            TestImpl::Fast => chunk
-                .par_chunks_mut(k)
-                .with_min_len(256)
-                .enumerate()
-                .for_each_init(Default::default, fill),
-            TestImpl::Reference => {
-                // The reference asks every query afresh.
-                let mut scratch = Default::default();
-                chunk.chunks_mut(k).enumerate().for_each(|item| {
-                    fill(&mut scratch, item);
-                    scratch.1 = QueryHint::default();
-                });
+    match how {
+        TestImpl::Fast => {
+            let runs = octree_runs(&keys, RUN);
+            let mut rest = lists.as_mut_slice();
+            let mut jobs = Vec::with_capacity(runs.len());
+            for run in runs {
+                let (out, tail) = rest.split_at_mut(run.len() * k);
+                jobs.push((run, out));
+                rest = tail;
+            }
+            let per_block = block_len(points.len()) / RUN;
+            for block in jobs.chunks_mut(per_block) {
+                block
+                    .par_iter_mut()
+                    .for_each_init(RunScratch::default, |scratch, (run, out)| {
+                        index.nearest_of_run(run.clone(), k, out, scratch)
+                    });
+                progress(block.last().map_or(0, |(run, _)| run.end));
             }
         }
-        progress((b * block + chunk.len() / k).min(points.len()));
+        TestImpl::Reference => {
+            // The reference asks every query afresh, one by one.
+            let mut members = Vec::new();
+            for (p, out) in lists.chunks_mut(k).enumerate() {
+                index.nearest(p, k, &mut members);
+                out.copy_from_slice(&members);
+                if p % 4096 == 0 {
+                    progress(p);
+                }
+            }
+        }
     }
     drop(index);
     Neighbourhoods {
@@ -257,6 +265,11 @@ fn neighbourhoods(
         lists,
     }
 }
+
+/// Most points per k-NN run (see [`NeighbourIndex::nearest_of_run`] and
+/// [`octree_runs`]): enough to share one tree query among them, few
+/// enough that the run stays small next to a neighbourhood.
+const RUN: usize = 16;
 
 /// Runs `f` at every position of the spatial order, in blocks (parallel for
 /// the fast implementation), and returns the results in that order.
@@ -442,8 +455,9 @@ fn analyse_point(
 }
 
 /// Indices of `points` sorted along a Morton (Z-order) curve, so that
-/// consecutive queries touch the same part of the tree.
-fn spatial_order(points: &[Point3]) -> Vec<u32> {
+/// consecutive queries touch the same part of the tree, and their Morton
+/// keys in that order.
+fn spatial_order(points: &[Point3]) -> (Vec<u32>, Vec<u64>) {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     for p in points {
@@ -469,7 +483,67 @@ fn spatial_order(points: &[Point3]) -> Vec<u32> {
         })
         .collect();
     keyed.par_sort_unstable();
-    keyed.into_iter().map(|(_, i)| i).collect()
+    keyed.into_iter().map(|(key, i)| (i, key)).unzip()
+}
+
+/// Splits sorted Morton `keys` into runs of at most `max` consecutive
+/// points that each lie in one octree cell: a cell with more points is
+/// split into its eight children, and neighbouring children are merged
+/// back while they fit. Unlike fixed-length stretches of the curve, which
+/// jump between distant cells, every run is compact in space.
+fn octree_runs(keys: &[u64], max: usize) -> Vec<std::ops::Range<usize>> {
+    let mut runs = Vec::with_capacity(2 * keys.len() / max.max(1) + 1);
+    split_cell(keys, 0..keys.len(), 63, max, &mut runs);
+    runs
+}
+
+fn split_cell(
+    keys: &[u64],
+    cell: std::ops::Range<usize>,
+    shift: u32,
+    max: usize,
+    runs: &mut Vec<std::ops::Range<usize>>,
+) {
+    if cell.len() <= max || shift == 0 {
+        runs.push(cell);
+        return;
+    }
+    let child_shift = shift - 3;
+    let child_of = |i: usize| (keys[i] >> child_shift) & 7;
+    let mut pending: Option<std::ops::Range<usize>> = None;
+    let mut start = cell.start;
+    while start < cell.end {
+        let child = child_of(start);
+        let end =
+            start + keys[start..cell.end].partition_point(|&key| (key >> child_shift) & 7 == child);
+        match pending.take() {
+            Some(p) if p.len() + (end - start) <= max => pending = Some(p.start..end),
+            Some(p) => {
+                flush(keys, p, child_shift, max, runs);
+                pending = Some(start..end);
+            }
+            None => pending = Some(start..end),
+        }
+        start = end;
+    }
+    if let Some(p) = pending {
+        flush(keys, p, child_shift, max, runs);
+    }
+}
+
+/// Emits merged siblings as one run, or splits an oversized child further.
+fn flush(
+    keys: &[u64],
+    range: std::ops::Range<usize>,
+    child_shift: u32,
+    max: usize,
+    runs: &mut Vec<std::ops::Range<usize>>,
+) {
+    if range.len() <= max {
+        runs.push(range);
+    } else {
+        split_cell(keys, range, child_shift, max, runs);
+    }
 }
 
 /// Spreads the low 21 bits of `x` so they occupy every third bit.
@@ -503,6 +577,42 @@ mod tests {
                 assert_eq!(full, alone, "seed {seed}, anisotropy {anisotropy}");
             }
         }
+    }
+
+    /// Runs cover the Morton order in sequence, hold at most `max` points,
+    /// and each is made of whole octree cells that are siblings: at some
+    /// level, the run's cells share one parent and no cell of that level is
+    /// cut by the run's ends (fixed-length stretches of the curve fail this).
+    #[test]
+    fn octree_runs_are_whole_sibling_cells() {
+        let points = random_sheet(4, 50, 0.3, 1.0);
+        let (_, keys) = spatial_order(&points);
+        let whole_siblings = |run: &std::ops::Range<usize>, level: u32| {
+            let cell = |i: usize| keys[i] >> level;
+            let parent = |i: usize| keys[i] >> (level + 3);
+            parent(run.start) == parent(run.end - 1)
+                && (run.start == 0 || cell(run.start - 1) != cell(run.start))
+                && (run.end == keys.len() || cell(run.end) != cell(run.end - 1))
+        };
+        for max in [1, 5, 16, 40] {
+            let runs = octree_runs(&keys, max);
+            let mut next = 0;
+            for run in &runs {
+                assert_eq!(run.start, next);
+                assert!(!run.is_empty() && run.len() <= max, "{run:?}");
+                assert!(
+                    (0..61).step_by(3).any(|level| whole_siblings(run, level)),
+                    "max {max}: {run:?} cuts a cell"
+                );
+                next = run.end;
+            }
+            assert_eq!(next, keys.len());
+        }
+        let fixed = (0..keys.len() / 16).map(|i| i * 16..i * 16 + 16);
+        assert!(fixed
+            .filter(|run| !(0..61).step_by(3).any(|level| whole_siblings(run, level)))
+            .next()
+            .is_some());
     }
 
     /// A wavy jittered sheet with a hole and a notch, plus uniform noise.

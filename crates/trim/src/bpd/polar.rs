@@ -38,7 +38,9 @@ pub struct PolarScratch {
     theta: Vec<f64>,
     r: Vec<f64>,
     sorted: Vec<f64>,
-    used: Vec<bool>,
+    /// 0 for neighbours still free, +∞ for linked ones.
+    blocked: Vec<f64>,
+    cost: Vec<f64>,
 }
 
 /// Runs the surrounding-path test on neighbours `nb` (relative to P_i,
@@ -70,33 +72,37 @@ pub fn surrounding_path_is_open(nb: &[Point2], s: &mut PolarScratch) -> bool {
     }
     // Eq. 4: start nearest the pole and the sector's bisector.
     let normalised = |t: f64| wrap_positive(t - theta_min) / width;
-    let start = argmin(nb.len(), |j| s.r[j] + (normalised(s.theta[j]) - 0.5).abs());
-    s.used.clear();
-    s.used.resize(nb.len(), false);
-    s.used[start] = true;
+    s.cost.clear();
+    s.cost
+        .extend((0..nb.len()).map(|j| s.r[j] + (normalised(s.theta[j]) - 0.5).abs()));
+    let start = argmin(&s.cost);
+    // Linked points are blocked by an infinite cost, so the costs of a
+    // step are one branch-free loop over all neighbours, which vectorises.
+    s.blocked.clear();
+    s.blocked.resize(nb.len(), 0.0);
+    s.blocked[start] = f64::INFINITY;
+    s.cost.resize(nb.len(), 0.0);
     let (mut last, mut previous_turn) = (start, 0.0f64);
     let (mut alpha, mut tau) = (0.0f64, 0.0f64);
     for _ in 1..nb.len() {
         let theta_last = s.theta[last];
-        let next = argmin(nb.len(), |p| {
-            if s.used[p] {
-                return f64::INFINITY;
-            }
-            let turn = circular_difference(s.theta[p], theta_last);
-            let c = if previous_turn == 0.0 || turn * previous_turn < 0.0 {
-                1.0
-            } else {
-                -1.0
-            };
-            s.r[p] + c * turn.abs() / width
-        });
+        for (((cost, &theta), &r), &blocked) in
+            s.cost.iter_mut().zip(&s.theta).zip(&s.r).zip(&s.blocked)
+        {
+            let turn = circular_difference(theta, theta_last);
+            // Eq. 5's c: −1 (a bonus) for keeping the previous direction.
+            let step = turn.abs() / width;
+            let keeps_direction = turn * previous_turn > 0.0;
+            *cost = blocked + if keeps_direction { r - step } else { r + step };
+        }
+        let next = argmin(&s.cost);
         let turn = circular_difference(s.theta[next], theta_last);
         alpha += turn;
         tau += turn.abs();
         if turn != 0.0 {
             previous_turn = turn;
         }
-        s.used[next] = true;
+        s.blocked[next] = f64::INFINITY;
         last = next;
         if tau > TAU {
             break;
@@ -110,7 +116,7 @@ pub fn surrounding_path_is_open(nb: &[Point2], s: &mut PolarScratch) -> bool {
 fn occupied_sector(theta: &[f64], sorted: &mut Vec<f64>) -> (f64, f64) {
     sorted.clear();
     sorted.extend_from_slice(theta);
-    sorted.sort_by(f64::total_cmp);
+    insertion_sort(sorted);
     let n = sorted.len();
     let mut gap = sorted[0] + TAU - sorted[n - 1];
     let mut start = sorted[0];
@@ -121,6 +127,20 @@ fn occupied_sector(theta: &[f64], sorted: &mut Vec<f64>) -> (f64, f64) {
         }
     }
     (start, TAU - gap)
+}
+
+/// Sorts a few finite values; cheaper than the library sorts for the
+/// ~30 angles of a neighbourhood.
+fn insertion_sort(v: &mut [f64]) {
+    for i in 1..v.len() {
+        let x = v[i];
+        let mut j = i;
+        while j > 0 && v[j - 1] > x {
+            v[j] = v[j - 1];
+            j -= 1;
+        }
+        v[j] = x;
+    }
 }
 
 /// `a − b` wrapped into (−π, π], for angles from `atan2` (in [−π, π]), whose
@@ -147,10 +167,10 @@ fn wrap_positive(d: f64) -> f64 {
     }
 }
 
-fn argmin(n: usize, mut cost: impl FnMut(usize) -> f64) -> usize {
+/// Index of the smallest cost, the first on ties.
+fn argmin(cost: &[f64]) -> usize {
     let mut best = (f64::INFINITY, 0);
-    for j in 0..n {
-        let c = cost(j);
+    for (j, &c) in cost.iter().enumerate() {
         if c < best.0 {
             best = (c, j);
         }
