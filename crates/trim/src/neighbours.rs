@@ -117,24 +117,33 @@ impl NeighbourIndex<'_> {
         // Rounding slack: relative to the distances, and absolute for the
         // coordinates' own precision far from the origin.
         let slack = 1e-9 * gather + 1e-13 * magnitude(pc);
+        self.gather(pc, gather + slack, s);
+        for (p, out) in run.zip(out.chunks_exact_mut(k)) {
+            let pp = self.points[p];
+            let from_centre = dist(pc, pp);
+            // Every gathered point within `reach` of p is a candidate; and
+            // p's k nearest lie within d_k(c) + |p − c| (that ball holds
+            // c's k nearest), so the nearer of the two radii loses nothing.
+            let reach = (gather - from_centre - slack).min(d_k + from_centre + slack);
+            if !self.select_nearest(pp, reach * reach, k, s, out) {
+                self.nearest(p, k, &mut s.single);
+                out.copy_from_slice(&s.single);
+            }
+        }
+    }
+
+    /// Gathers the points within `radius` of `centre` as candidates.
+    fn gather(&self, centre: Point3, radius: f64, s: &mut RunScratch) {
         s.candidates.clear();
         self.tree
-            .query(&pc)
-            .within::<SquaredEuclidean<f64>>((gather + slack).powi(2))
+            .query(&centre)
+            .within::<SquaredEuclidean<f64>>(radius * radius)
             .unsorted()
             .without_distances()
             .visit(|found| s.candidates.push(found.item));
         s.coords.clear();
         s.coords
             .extend(s.candidates.iter().map(|&j| self.points[j as usize]));
-        for (p, out) in run.zip(out.chunks_exact_mut(k)) {
-            let pp = self.points[p];
-            let reach = (gather - dist(pc, pp) - slack).max(0.0);
-            if !self.select_nearest(pp, reach * reach, k, s, out) {
-                self.nearest(p, k, &mut s.single);
-                out.copy_from_slice(&s.single);
-            }
-        }
     }
 
     /// The run's point closest to the run's mean.
@@ -165,24 +174,29 @@ impl NeighbourIndex<'_> {
         for (&j, &q) in s.candidates.iter().zip(&s.coords) {
             let d = crate::cloud::dist2(p, q);
             if d <= reach2 {
-                s.keyed.push((d, self.rank(j), j));
+                s.keyed.push(candidate_key(d, self.rank(j), j));
             }
         }
         if s.keyed.len() < k {
             return false;
         }
-        let by_distance =
-            |a: &(f64, u32, u32), b: &(f64, u32, u32)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
         if s.keyed.len() > k {
-            s.keyed.select_nth_unstable_by(k - 1, by_distance);
+            s.keyed.select_nth_unstable(k - 1);
         }
         let nearest = &mut s.keyed[..k];
-        nearest.sort_unstable_by(by_distance);
+        nearest.sort_unstable();
         for (o, n) in out.iter_mut().zip(nearest.iter()) {
-            *o = n.2;
+            *o = *n as u32;
         }
         true
     }
+}
+
+/// A candidate as one integer that orders like (distance², rank, index):
+/// the bits of a non-negative f64 order like the number, and integer
+/// comparisons are what the selection and the sort do fastest.
+fn candidate_key(d2: f64, rank: u32, index: u32) -> u128 {
+    (u128::from(d2.to_bits()) << 64) | (u128::from(rank) << 32) | u128::from(index)
 }
 
 /// How far beyond the central point's k-th distance a run gathers (see
@@ -196,7 +210,7 @@ pub struct RunScratch {
     single: Vec<u32>,
     candidates: Vec<u32>,
     coords: Vec<Point3>,
-    keyed: Vec<(f64, u32, u32)>,
+    keyed: Vec<u128>,
 }
 
 fn dist(a: Point3, b: Point3) -> f64 {

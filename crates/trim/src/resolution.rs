@@ -12,10 +12,62 @@ use crate::frame::Point2;
 
 /// Nearest-neighbour distance of every member, within the neighbourhood.
 ///
-/// `out[j]` is the distance from `pts[j]` to the closest other member. Each
-/// pair is measured once; the inner loop's minimum updates are branch-free
-/// and vectorise.
-pub fn nearest_distances(pts: &[Point2], out: &mut Vec<f64>) {
+/// `out[j]` is the distance from `pts[j]` to the closest other member. The
+/// points are copied into coordinate columns and every pair is measured from
+/// both ends: twice the arithmetic of [`nearest_distances_reference`], but
+/// in four independent lanes with no stores in the inner loop, which the
+/// compiler turns into vector instructions (about three times faster for
+/// k = 30). Minima do not depend on the order, so the results are equal.
+pub fn nearest_distances(pts: &[Point2], out: &mut Vec<f64>, columns: &mut Columns) {
+    let n = pts.len();
+    let padded = n.div_ceil(LANES) * LANES;
+    // Padding far away never wins a minimum.
+    columns.x.clear();
+    columns.y.clear();
+    columns.x.extend(pts.iter().map(|p| p[0]));
+    columns.y.extend(pts.iter().map(|p| p[1]));
+    columns.x.resize(padded, f64::INFINITY);
+    columns.y.resize(padded, f64::INFINITY);
+    out.clear();
+    for j in 0..n {
+        let (px, py) = (columns.x[j], columns.y[j]);
+        // The member itself moves to infinity for its own row.
+        columns.x[j] = f64::INFINITY;
+        let mut best = [f64::INFINITY; LANES];
+        for (xs, ys) in columns
+            .x
+            .chunks_exact(LANES)
+            .zip(columns.y.chunks_exact(LANES))
+        {
+            for lane in 0..LANES {
+                let (dx, dy) = (xs[lane] - px, ys[lane] - py);
+                let d = dx * dx + dy * dy;
+                // `if` rather than `f64::min`, whose NaN handling blocks
+                // the plain min instruction (no NaN can occur here).
+                best[lane] = if d < best[lane] { d } else { best[lane] };
+            }
+        }
+        columns.x[j] = px;
+        let best = best
+            .iter()
+            .fold(f64::INFINITY, |m, &d| if d < m { d } else { m });
+        out.push(best.sqrt());
+    }
+}
+
+/// Lanes of [`nearest_distances`]' inner loop.
+const LANES: usize = 4;
+
+/// Reusable coordinate columns for [`nearest_distances`].
+#[derive(Debug, Default, Clone)]
+pub struct Columns {
+    x: Vec<f64>,
+    y: Vec<f64>,
+}
+
+/// [`nearest_distances`] measuring each pair once, the plain way; the
+/// reference for tests.
+pub fn nearest_distances_reference(pts: &[Point2], out: &mut Vec<f64>) {
     out.clear();
     out.resize(pts.len(), f64::INFINITY);
     for j in 0..pts.len() {
@@ -24,10 +76,8 @@ pub fn nearest_distances(pts: &[Point2], out: &mut Vec<f64>) {
         let mut best = head[j];
         for (d_m, &q) in tail.iter_mut().zip(&pts[j + 1..]) {
             let d = dist2(p, q);
-            // `if` rather than `f64::min`, whose NaN handling blocks the
-            // plain min instruction (no NaN can occur here).
-            best = if d < best { d } else { best };
-            *d_m = if d < *d_m { d } else { *d_m };
+            best = best.min(d);
+            *d_m = d_m.min(d);
         }
         head[j] = best;
     }
@@ -66,9 +116,28 @@ mod tests {
             .map(|i| [(i % 6) as f64 * 2.0, (i / 6) as f64 * 2.0])
             .collect();
         let mut d = Vec::new();
-        nearest_distances(&pts, &mut d);
+        nearest_distances(&pts, &mut d, &mut Columns::default());
         assert!(d.iter().all(|&x| (x - 2.0).abs() < 1e-12));
         assert!((beta_of(&d) - 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn columns_match_the_reference_on_random_neighbourhoods() {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(2);
+        let (mut fast, mut plain, mut columns) = (Vec::new(), Vec::new(), Columns::default());
+        for n in (2..64).chain([30; 200]) {
+            let mut pts: Vec<Point2> = (0..n)
+                .map(|_| [rng.random_range(-3.0..3.0), rng.random_range(-1.0..1.0)])
+                .collect();
+            // Members that project onto one another measure 0.
+            if n % 3 == 0 {
+                pts[n - 1] = pts[0];
+            }
+            nearest_distances(&pts, &mut fast, &mut columns);
+            nearest_distances_reference(&pts, &mut plain);
+            assert_eq!(fast, plain, "{pts:?}");
+        }
     }
 
     #[test]

@@ -26,7 +26,7 @@ use crate::cloud::{check_not_degenerate, merge_duplicates, Point3, Sites};
 use crate::error::CloudError;
 use crate::frame::{fit_plane, project, Frame, Point2};
 use crate::neighbours::{NeighbourIndex, RunScratch};
-use crate::resolution::{beta_of, nearest_distances};
+use crate::resolution::{beta_of, nearest_distances, Columns};
 
 /// Options of boundary point detection.
 #[derive(Debug, Clone, PartialEq)]
@@ -369,6 +369,7 @@ struct Verdict {
 struct Scratch {
     projected: Vec<Point2>,
     distances: Vec<f64>,
+    columns: Columns,
     neighbours: Vec<Point2>,
     /// Member slot of each entry of `neighbours`.
     slots: Vec<u32>,
@@ -398,7 +399,7 @@ fn projected_beta(
             *q = apply(&map, *q);
         }
     }
-    nearest_distances(&s.projected, &mut s.distances);
+    nearest_distances(&s.projected, &mut s.distances, &mut s.columns);
     beta_of(&s.distances)
 }
 
