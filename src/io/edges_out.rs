@@ -392,6 +392,7 @@ mod tests {
                     points: vec![[2.0, 1.5, 0.0], [0.1, 1.5, 0.0], [0.0, 0.0, 0.0]],
                 },
             ],
+            sides: Vec::new(),
         };
         let hole = Loop {
             boundary_points: vec![5, 4, 1],
@@ -400,6 +401,7 @@ mod tests {
                 closed: true,
                 points: vec![[0.5, 0.5, 0.25], [1.0, 0.5, -1e-7], [0.75, 1.0, 0.0]],
             }],
+            sides: Vec::new(),
         };
         let edges = Edges {
             loops: vec![square, hole],

@@ -3,6 +3,8 @@
 
 use std::collections::HashMap;
 
+use rayon::prelude::*;
+
 use crate::cloud::{cross, norm2, sub, Point3};
 use crate::error::MeshError;
 
@@ -64,6 +66,26 @@ impl Mesh {
         uses
     }
 
+    /// Every edge of every face as (smaller vertex, larger vertex, face),
+    /// sorted, so that the faces on one edge are next to each other.
+    /// Sorting (in parallel) is several times faster than hashing the edges
+    /// of a large mesh.
+    pub fn sorted_edges(&self) -> Vec<(u32, u32, u32)> {
+        let mut edges: Vec<(u32, u32, u32)> = self
+            .faces
+            .par_iter()
+            .enumerate()
+            .flat_map_iter(|(f, face)| {
+                (0..3).map(move |k| {
+                    let (a, b) = (face[k], face[(k + 1) % 3]);
+                    (a.min(b), a.max(b), f as u32)
+                })
+            })
+            .collect();
+        edges.par_sort_unstable();
+        edges
+    }
+
     /// True if no edge is used by more than two faces.
     pub fn is_edge_manifold(&self) -> bool {
         self.edge_uses().values().all(|&n| n <= 2)
@@ -73,6 +95,21 @@ impl Mesh {
     /// chained into loops of vertex indices. At a vertex where several
     /// border loops touch, the chaining takes the edges in index order.
     pub fn boundary_loops(&self) -> Vec<Vec<u32>> {
+        let edges = self.sorted_edges();
+        let mut next: HashMap<u32, Vec<u32>> = HashMap::new();
+        for on_edge in edges.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
+            if let [(low, high, face)] = on_edge {
+                let (a, b) = directed_edge(self.faces[*face as usize], *low, *high);
+                next.entry(a).or_default().push(b);
+            }
+        }
+        chain_loops(next)
+    }
+
+    /// [`Self::boundary_loops`] with a hash map of edge uses, the plain way;
+    /// the reference for tests.
+    #[cfg(test)]
+    pub(crate) fn boundary_loops_reference(&self) -> Vec<Vec<u32>> {
         let uses = self.edge_uses();
         let mut next: HashMap<u32, Vec<u32>> = HashMap::new();
         for f in &self.faces {
@@ -83,27 +120,7 @@ impl Mesh {
                 }
             }
         }
-        for v in next.values_mut() {
-            v.sort_unstable();
-        }
-        let mut starts: Vec<u32> = next.keys().copied().collect();
-        starts.sort_unstable();
-        let mut loops = Vec::new();
-        for start in starts {
-            while let Some(first) = next.get_mut(&start).and_then(|v| v.pop()) {
-                let mut chain = vec![start];
-                let mut at = first;
-                while at != start {
-                    chain.push(at);
-                    match next.get_mut(&at).and_then(|v| v.pop()) {
-                        Some(b) => at = b,
-                        None => break, // an open chain: non-manifold input
-                    }
-                }
-                loops.push(chain);
-            }
-        }
-        loops
+        chain_loops(next)
     }
 
     /// Drops vertices no face uses, keeping the others in order.
@@ -126,6 +143,40 @@ impl Mesh {
         }
         self.vertices = kept;
     }
+}
+
+/// Chains border edges (`next[a]` holds every b of an edge a → b) into
+/// loops, taking the edges at a vertex in index order.
+fn chain_loops(mut next: HashMap<u32, Vec<u32>>) -> Vec<Vec<u32>> {
+    for v in next.values_mut() {
+        v.sort_unstable();
+    }
+    let mut starts: Vec<u32> = next.keys().copied().collect();
+    starts.sort_unstable();
+    let mut loops = Vec::new();
+    for start in starts {
+        while let Some(first) = next.get_mut(&start).and_then(|v| v.pop()) {
+            let mut chain = vec![start];
+            let mut at = first;
+            while at != start {
+                chain.push(at);
+                match next.get_mut(&at).and_then(|v| v.pop()) {
+                    Some(b) => at = b,
+                    None => break, // an open chain: non-manifold input
+                }
+            }
+            loops.push(chain);
+        }
+    }
+    loops
+}
+
+/// The edge {low, high} of `face` as the face runs along it.
+fn directed_edge(face: [u32; 3], low: u32, high: u32) -> (u32, u32) {
+    (0..3)
+        .map(|k| (face[k], face[(k + 1) % 3]))
+        .find(|&(a, b)| (a.min(b), a.max(b)) == (low, high))
+        .unwrap_or((low, high))
 }
 
 #[cfg(test)]

@@ -107,18 +107,22 @@ pub fn trim_mesh(
 ) -> Result<(Mesh, TrimReport), MeshError> {
     mesh.validate()?;
     let walls = Walls::new(cloud, detection, edges);
-    let mut field: Vec<f64> = mesh
+    // The field, with values within SNAP spacings of the wall set to 0 so
+    // the cut passes through the vertex instead of a sliver beside it.
+    let field_and_snap: Vec<(f64, bool)> = mesh
         .vertices
         .par_iter()
-        .map(|&v| walls.signed_distance(v))
+        .map(|&v| {
+            let (f, spacing) = walls.signed_distance(v);
+            if f != 0.0 && f.abs() < SNAP * spacing {
+                (0.0, true)
+            } else {
+                (f, false)
+            }
+        })
         .collect();
-    let mut snapped = 0;
-    for (v, f) in mesh.vertices.iter().zip(field.iter_mut()) {
-        if *f != 0.0 && f.abs() < SNAP * walls.spacing_near(*v) {
-            *f = 0.0;
-            snapped += 1;
-        }
-    }
+    let snapped = field_and_snap.iter().filter(|s| s.1).count();
+    let field: Vec<f64> = field_and_snap.into_iter().map(|s| s.0).collect();
     let (cut, origin, faces_split) = cut_inside(mesh, &field);
     let (keep, pieces_dropped) = supported_faces(&cut, cloud, &detection.beta)?;
     let mut survived = vec![false; mesh.faces.len()];
@@ -168,7 +172,13 @@ struct Walls {
 
 impl Walls {
     fn new(cloud: &[Point3], detection: &Detection, edges: &Edges) -> Self {
-        let index = NeighbourIndex::new(cloud);
+        // The offset already measured each boundary point's side; without
+        // it (offset off) they are measured here.
+        let index = edges
+            .loops
+            .iter()
+            .any(|lp| lp.sides.len() != lp.boundary_points.len())
+            .then(|| NeighbourIndex::new(cloud));
         let mut w = Walls {
             points: Vec::new(),
             out: Vec::new(),
@@ -180,7 +190,14 @@ impl Walls {
             tree: None,
         };
         for (l, lp) in edges.loops.iter().enumerate() {
-            let sides = edge_sides(&index, &lp.boundary_points);
+            let measured;
+            let sides = match &index {
+                Some(index) if lp.sides.len() != lp.boundary_points.len() => {
+                    measured = edge_sides(index, &lp.boundary_points);
+                    &measured
+                }
+                _ => &lp.sides,
+            };
             let n = lp.boundary_points.len();
             // The loop as one closed polyline: each open edge without its
             // last point, which is the next edge's first (the corner), so
@@ -230,11 +247,12 @@ impl Walls {
         )
     }
 
-    /// f(v): signed distance from v to the nearest wall (negative inside).
-    /// With no loop at all, everything is inside.
-    fn signed_distance(&self, v: Point3) -> f64 {
+    /// f(v): signed distance from v to the nearest wall (negative inside),
+    /// and the local spacing there. With no loop at all, everything is
+    /// inside.
+    fn signed_distance(&self, v: Point3) -> (f64, f64) {
         let Some(i) = self.nearest_point(v) else {
-            return -1.0;
+            return (-1.0, 0.0);
         };
         // The nearest point on the two segments at the nearest vertex.
         let mut best = (dist2(v, self.points[i]), self.points[i], self.vertex_out(i));
@@ -255,7 +273,7 @@ impl Walls {
                 best = (d, q, self.out[a]);
             }
         }
-        dot(sub(v, best.1), best.2)
+        (dot(sub(v, best.1), best.2), self.beta[i])
     }
 
     /// Outward direction at polyline vertex i: the mean of its segments'.
@@ -268,10 +286,6 @@ impl Walls {
         } else {
             b
         }
-    }
-
-    fn spacing_near(&self, v: Point3) -> f64 {
-        self.nearest_point(v).map_or(0.0, |i| self.beta[i])
     }
 
     /// Mean and largest distance from the border vertices of `mesh` to the
@@ -381,12 +395,7 @@ fn supported_faces(
     }
     let piece = face_pieces(cut);
     let pieces = piece.iter().map(|&p| p as usize + 1).max().unwrap_or(0);
-    let vertices: Vec<Vector> = cut
-        .vertices
-        .iter()
-        .map(|v| Vector::new(v[0], v[1], v[2]))
-        .collect();
-    let shape = TriMesh::new(vertices, cut.faces.clone()).map_err(|_| MeshError::NoFaces)?;
+    let projector = SlabProjector::new(cut)?;
     let mut hits = vec![0usize; pieces];
     let mut cell_area = vec![0.0f64; pieces];
     // Each projection is independent: parallel, then summed in cloud order
@@ -394,12 +403,7 @@ fn supported_faces(
     let landed: Vec<Option<u32>> = cloud
         .par_iter()
         .zip(beta)
-        .map(|(p, &b)| {
-            let query = Vector::new(p[0], p[1], p[2]);
-            shape
-                .project_local_point_and_get_location_with_max_dist(query, false, 2.0 * b)
-                .map(|(_, (face, _))| face)
-        })
+        .map(|(p, &b)| projector.nearest_face(*p, 2.0 * b))
         .collect();
     for (face, &b) in landed.iter().zip(beta) {
         if let Some(face) = face {
@@ -426,8 +430,156 @@ fn supported_faces(
     Ok((piece.iter().map(|&p| keep[p as usize]).collect(), dropped))
 }
 
+/// Faces per slab of [`SlabProjector`].
+const SLAB_FACES: usize = 250_000;
+
+/// Closest-face queries on a mesh cut into slabs of faces along its longest
+/// axis, one parry `TriMesh` (and bounding-volume hierarchy) per slab, built
+/// in parallel: parry builds a hierarchy on one thread, which on a
+/// 3M-triangle mesh took longer than projecting a million points. A mesh
+/// of up to [`SLAB_FACES`] faces is one slab.
+struct SlabProjector {
+    slabs: Vec<Slab>,
+}
+
+struct Slab {
+    shape: TriMesh,
+    /// The mesh's index of each of the slab's faces.
+    faces: Vec<u32>,
+    low: Point3,
+    high: Point3,
+}
+
+impl SlabProjector {
+    fn new(mesh: &Mesh) -> Result<Self, MeshError> {
+        let (low, high) = bounds(&mesh.vertices);
+        let axis = (0..3)
+            .max_by(|&a, &b| (high[a] - low[a]).total_cmp(&(high[b] - low[b])))
+            .unwrap_or(0);
+        let mut order: Vec<(f64, u32)> = mesh
+            .faces
+            .par_iter()
+            .enumerate()
+            .map(|(f, face)| {
+                (
+                    face.iter().map(|&v| mesh.vertices[v as usize][axis]).sum(),
+                    f as u32,
+                )
+            })
+            .collect();
+        order.par_sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+        let slab_count = mesh.faces.len().div_ceil(SLAB_FACES).max(1);
+        let per_slab = mesh.faces.len().div_ceil(slab_count);
+        let slabs = order
+            .par_chunks(per_slab.max(1))
+            .map(|chunk| Slab::new(mesh, chunk.iter().map(|o| o.1).collect()))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Self { slabs })
+    }
+
+    /// The face closest to `p` within `max_dist` (the lower index on a tie).
+    fn nearest_face(&self, p: Point3, max_dist: f64) -> Option<u32> {
+        let query = Vector::new(p[0], p[1], p[2]);
+        let mut best: Option<(f64, u32)> = None;
+        for slab in &self.slabs {
+            let limit = best.map_or(max_dist, |b| b.0);
+            if box_distance(p, slab.low, slab.high) > limit {
+                continue;
+            }
+            let Some((projection, (face, _))) = slab
+                .shape
+                .project_local_point_and_get_location_with_max_dist(query, false, limit)
+            else {
+                continue;
+            };
+            let d = (projection.point - query).length();
+            let face = slab.faces[face as usize];
+            if best.is_none_or(|(bd, bf)| d < bd || (d == bd && face < bf)) {
+                best = Some((d, face));
+            }
+        }
+        best.map(|b| b.1)
+    }
+}
+
+impl Slab {
+    fn new(mesh: &Mesh, faces: Vec<u32>) -> Result<Self, MeshError> {
+        let mut used: Vec<u32> = faces.iter().flat_map(|&f| mesh.faces[f as usize]).collect();
+        used.sort_unstable();
+        used.dedup();
+        let local = |v: u32| used.binary_search(&v).map_or(0, |i| i as u32);
+        let triangles: Vec<[u32; 3]> = faces
+            .iter()
+            .map(|&f| mesh.faces[f as usize].map(local))
+            .collect();
+        let points: Vec<Point3> = used.iter().map(|&v| mesh.vertices[v as usize]).collect();
+        let (low, high) = bounds(&points);
+        let vertices = points
+            .iter()
+            .map(|v| Vector::new(v[0], v[1], v[2]))
+            .collect();
+        let shape = TriMesh::new(vertices, triangles).map_err(|_| MeshError::NoFaces)?;
+        Ok(Self {
+            shape,
+            faces,
+            low,
+            high,
+        })
+    }
+}
+
+/// Corners of the axis-aligned bounding box of `points`.
+fn bounds(points: &[Point3]) -> (Point3, Point3) {
+    points.iter().fold(
+        ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
+        |(lo, hi), p| {
+            (
+                [0, 1, 2].map(|a| lo[a].min(p[a])),
+                [0, 1, 2].map(|a| hi[a].max(p[a])),
+            )
+        },
+    )
+}
+
+/// Distance from `p` to the box [low, high] (0 inside).
+fn box_distance(p: Point3, low: Point3, high: Point3) -> f64 {
+    let gap = [0, 1, 2].map(|a| (low[a] - p[a]).max(p[a] - high[a]).max(0.0));
+    norm2(gap).sqrt()
+}
+
 /// Connected pieces of faces sharing an edge; piece ids by first face.
+///
+/// The faces' edges are sorted rather than hashed ([`Mesh::sorted_edges`]);
+/// the faces on one edge are joined to its first.
 fn face_pieces(mesh: &Mesh) -> Vec<u32> {
+    let n = mesh.faces.len();
+    let edges = mesh.sorted_edges();
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    for same_edge in edges.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
+        let first = same_edge[0].2;
+        for other in &same_edge[1..] {
+            let (ra, rb) = (find(&mut parent, first), find(&mut parent, other.2));
+            parent[ra.max(rb) as usize] = ra.min(rb);
+        }
+    }
+    let mut id = vec![u32::MAX; n];
+    let mut next = 0;
+    (0..n)
+        .map(|f| {
+            let r = find(&mut parent, f as u32) as usize;
+            if id[r] == u32::MAX {
+                id[r] = next;
+                next += 1;
+            }
+            id[r]
+        })
+        .collect()
+}
+
+/// [`face_pieces`] with a hash map of edges, the plain way; the reference
+/// for tests.
+#[cfg(test)]
+fn face_pieces_reference(mesh: &Mesh) -> Vec<u32> {
     let n = mesh.faces.len();
     let mut parent: Vec<u32> = (0..n as u32).collect();
     let mut first_on_edge: HashMap<(u32, u32), u32> = HashMap::new();
@@ -466,4 +618,55 @@ fn find(parent: &mut [u32], mut i: u32) -> u32 {
         i = grand;
     }
     i
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{RngExt, SeedableRng};
+
+    /// A grid of quads split into triangles with random faces left out (so
+    /// it falls into pieces), and a few faces repeated on one edge.
+    fn random_grid_mesh(seed: u64, side: u32) -> Mesh {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let at = |i: u32, j: u32| i * (side + 1) + j;
+        let vertices = (0..=side)
+            .flat_map(|i| (0..=side).map(move |j| [i as f64, j as f64, 0.0]))
+            .collect();
+        let mut faces = Vec::new();
+        for i in 0..side {
+            for j in 0..side {
+                if rng.random_range(0.0..1.0) < 0.45 {
+                    faces.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+                }
+                if rng.random_range(0.0..1.0) < 0.45 {
+                    faces.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+                }
+            }
+        }
+        let extra: Vec<[u32; 3]> = faces.iter().step_by(17).copied().collect();
+        faces.extend(extra);
+        Mesh { vertices, faces }
+    }
+
+    #[test]
+    fn sorted_edges_give_the_pieces_of_the_hash_map() {
+        for seed in 0..20 {
+            let mesh = random_grid_mesh(seed, 30);
+            let pieces = face_pieces(&mesh);
+            assert_eq!(pieces, face_pieces_reference(&mesh), "seed {seed}");
+            // Not one piece: the test sees the joining at work.
+            assert!(pieces.iter().max() > Some(&3), "seed {seed}");
+        }
+    }
+
+    #[test]
+    fn sorted_edges_give_the_border_of_the_hash_map() {
+        for seed in 0..20 {
+            let mesh = random_grid_mesh(seed, 30);
+            let loops = mesh.boundary_loops();
+            assert!(loops.len() > 3, "seed {seed}");
+            assert_eq!(loops, mesh.boundary_loops_reference(), "seed {seed}");
+        }
+    }
 }

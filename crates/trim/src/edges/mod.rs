@@ -62,6 +62,9 @@ pub struct Loop {
     /// Edges in loop order: one closed edge when there is no corner,
     /// otherwise one open edge from each corner to the next.
     pub edges: Vec<Edge>,
+    /// The surface's side at each boundary point, which the outward offset
+    /// used (empty when the offset is off); trimming reuses it.
+    pub sides: Vec<offset::EdgeSide>,
 }
 
 impl Loop {
@@ -137,14 +140,15 @@ pub fn loop_from_tour(
     let loop_beta: Vec<f64> = tour.iter().map(|&i| beta[i as usize]).collect();
     let corners = corners::find_corners(&loop_points, &loop_beta);
     let mut edges = smoothed_edges(&loop_points, &loop_beta, &corners);
-    if let Some(index) = index {
-        let sides = offset::edge_sides(index, &tour);
+    let sides = index.map_or_else(Vec::new, |index| offset::edge_sides(index, &tour));
+    if !sides.is_empty() {
         move_edges_outward(&mut edges, &corners, &sides);
     }
     Loop {
         boundary_points: tour,
         corners,
         edges,
+        sides,
     }
 }
 
