@@ -431,7 +431,7 @@ fn supported_faces(
 }
 
 /// Faces per slab of [`SlabProjector`].
-const SLAB_FACES: usize = 250_000;
+const SLAB_FACES: usize = 100_000;
 
 /// Closest-face queries on a mesh cut into slabs of faces along its longest
 /// axis, one parry `TriMesh` (and bounding-volume hierarchy) per slab, built
