@@ -4,25 +4,29 @@
 # with the time of each stage (from --report) and the peak memory
 # (/usr/bin/time). Uses the test venv (created by scripts/python_env.sh).
 #
-#   bash bench/trim.sh [SPACING_MM]     (default 0.38: about 1.1M points)
+#   bash bench/trim.sh [SPACING_MM] [DEPTH]
+#
+# Defaults: 0.38 mm (about 960k points) and Poisson depth 10 (about 756k
+# triangles); depth 11 gives about 2.9M triangles.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 spacing=${1:-0.38}
+depth=${2:-10}
 bash scripts/python_env.sh >/dev/null
 cargo build --release -q --bin meshtrim
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-.venv-test/bin/python - "$work" "$spacing" <<'PY'
+.venv-test/bin/python - "$work" "$spacing" "$depth" <<'PY'
 import sys, time
 sys.path.insert(0, "tests/python")
 import poisson, synthetic
-work, h = sys.argv[1], float(sys.argv[2])
+work, h, depth = sys.argv[1], float(sys.argv[2]), int(sys.argv[3])
 c = synthetic.blade(h, 1)
 synthetic.write_cloud_ply(f"{work}/cloud.ply", c.points, c.normals)
 t = time.time()
-v, f, q = poisson.reconstruct(c.points, c.normals, depth=10)
+v, f, q = poisson.reconstruct(c.points, c.normals, depth=depth)
 synthetic.write_mesh_ply(f"{work}/mesh.ply", v, f, quality=q)
-print(f"cloud: {len(c.points)} points; Poisson depth 10: {len(f)} triangles in {time.time() - t:.0f} s", flush=True)
+print(f"cloud: {len(c.points)} points; Poisson depth {depth}: {len(f)} triangles in {time.time() - t:.0f} s", flush=True)
 PY
 /usr/bin/time -v ./target/release/meshtrim "$work/mesh.ply" "$work/cloud.ply" "$work/out.ply" \
     --report "$work/report.json" > "$work/stdout" 2> "$work/time"
