@@ -8,9 +8,9 @@
 //! along each line. With OUT.ply the cloud is also written (binary PLY) so
 //! that `bench/bpd.sh` can time Open3D on the very same points.
 //!
-//! Detection runs `BENCH_REPEAT` times (default 3 up to 1.5M points, else
-//! 1) and the fastest run is reported, which damps noise from other work on
-//! the machine.
+//! Detection runs `BENCH_REPEAT` times (default: 3 up to 1.5M points, 1
+//! above) and the fastest run is reported, which damps noise from other
+//! work on the machine; the peak memory is the first run's.
 
 use std::io::Write;
 use std::time::Instant;

@@ -3,8 +3,6 @@
 
 use std::collections::HashMap;
 
-use rayon::prelude::*;
-
 use crate::cloud::{cross, norm2, sub, Point3};
 use crate::error::MeshError;
 
@@ -68,21 +66,52 @@ impl Mesh {
 
     /// Every edge of every face as (smaller vertex, larger vertex, face),
     /// sorted, so that the faces on one edge are next to each other.
-    /// Sorting (in parallel) is several times faster than hashing the edges
-    /// of a large mesh.
+    ///
+    /// A counting sort on the smaller vertex (O(edges), no comparisons),
+    /// then a sort of each vertex's few edges: several times faster than
+    /// sorting or hashing all edges of a large mesh; the same result as
+    /// sorting the tuples (tested).
     pub fn sorted_edges(&self) -> Vec<(u32, u32, u32)> {
-        let mut edges: Vec<(u32, u32, u32)> = self
-            .faces
-            .par_iter()
-            .enumerate()
-            .flat_map_iter(|(f, face)| {
+        let mut start = vec![0u32; self.vertices.len() + 1];
+        for face in &self.faces {
+            for k in 0..3 {
+                start[face[k].min(face[(k + 1) % 3]) as usize + 1] += 1;
+            }
+        }
+        for v in 1..start.len() {
+            start[v] += start[v - 1];
+        }
+        let mut edges = vec![(0u32, 0u32, 0u32); 3 * self.faces.len()];
+        let mut fill = start.clone();
+        for (f, face) in self.faces.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (face[k], face[(k + 1) % 3]);
+                let slot = &mut fill[a.min(b) as usize];
+                edges[*slot as usize] = (a.min(b), a.max(b), f as u32);
+                *slot += 1;
+            }
+        }
+        // Faces were visited in order, so each vertex's edges are sorted by
+        // face already; a stable sort by the larger vertex finishes.
+        for v in 0..self.vertices.len() {
+            edges[start[v] as usize..start[v + 1] as usize].sort_by_key(|e| e.1);
+        }
+        edges
+    }
+
+    /// [`Self::sorted_edges`] by sorting the tuples; the reference for tests.
+    #[cfg(test)]
+    pub(crate) fn sorted_edges_reference(&self) -> Vec<(u32, u32, u32)> {
+        let mut edges: Vec<(u32, u32, u32)> = (0..self.faces.len())
+            .flat_map(|f| {
+                let face = self.faces[f];
                 (0..3).map(move |k| {
                     let (a, b) = (face[k], face[(k + 1) % 3]);
                     (a.min(b), a.max(b), f as u32)
                 })
             })
             .collect();
-        edges.par_sort_unstable();
+        edges.sort_unstable();
         edges
     }
 

@@ -456,23 +456,48 @@ impl SlabProjector {
         let axis = (0..3)
             .max_by(|&a, &b| (high[a] - low[a]).total_cmp(&(high[b] - low[b])))
             .unwrap_or(0);
-        let mut order: Vec<(f64, u32)> = mesh
+        // Faces binned by centroid along the axis (a counting sort: no
+        // comparisons, face order kept within a bin), and the bins cut into
+        // slabs of about SLAB_FACES.
+        const BINS: usize = 4096;
+        let span = (high[axis] - low[axis]).max(f64::MIN_POSITIVE);
+        let bin_of: Vec<u16> = mesh
             .faces
             .par_iter()
-            .enumerate()
-            .map(|(f, face)| {
-                (
-                    face.iter().map(|&v| mesh.vertices[v as usize][axis]).sum(),
-                    f as u32,
-                )
+            .map(|face| {
+                let centre = face
+                    .iter()
+                    .map(|&v| mesh.vertices[v as usize][axis])
+                    .sum::<f64>()
+                    / 3.0;
+                (((centre - low[axis]) / span * BINS as f64) as usize).min(BINS - 1) as u16
             })
             .collect();
-        order.par_sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
-        let slab_count = mesh.faces.len().div_ceil(SLAB_FACES).max(1);
-        let per_slab = mesh.faces.len().div_ceil(slab_count);
-        let slabs = order
-            .par_chunks(per_slab.max(1))
-            .map(|chunk| Slab::new(mesh, chunk.iter().map(|o| o.1).collect()))
+        let mut start = vec![0usize; BINS + 1];
+        for &b in &bin_of {
+            start[b as usize + 1] += 1;
+        }
+        for b in 1..=BINS {
+            start[b] += start[b - 1];
+        }
+        let mut order = vec![0u32; mesh.faces.len()];
+        let mut fill = start.clone();
+        for (f, &b) in bin_of.iter().enumerate() {
+            order[fill[b as usize]] = f as u32;
+            fill[b as usize] += 1;
+        }
+        let mut cuts = vec![0];
+        for &end in &start[1..] {
+            if end - cuts[cuts.len() - 1] >= SLAB_FACES {
+                cuts.push(end);
+            }
+        }
+        if cuts[cuts.len() - 1] < order.len() {
+            cuts.push(order.len());
+        }
+        let slabs = cuts
+            .par_windows(2)
+            .map(|w| Slab::new(mesh, order[w[0]..w[1]].to_vec()))
             .collect::<Result<Vec<_>, _>>()?;
         Ok(Self { slabs })
     }
@@ -657,6 +682,18 @@ mod tests {
             assert_eq!(pieces, face_pieces_reference(&mesh), "seed {seed}");
             // Not one piece: the test sees the joining at work.
             assert!(pieces.iter().max() > Some(&3), "seed {seed}");
+        }
+    }
+
+    #[test]
+    fn counting_sort_of_edges_matches_sorting() {
+        for seed in 0..20 {
+            let mesh = random_grid_mesh(seed, 25);
+            assert_eq!(
+                mesh.sorted_edges(),
+                mesh.sorted_edges_reference(),
+                "seed {seed}"
+            );
         }
     }
 
