@@ -17,6 +17,7 @@
 pub mod anisotropy;
 pub mod bpd;
 pub mod clean;
+pub mod closest_face;
 pub mod cloud;
 pub mod delaunay;
 pub mod edge_metrics;

@@ -39,12 +39,10 @@
 use std::collections::HashMap;
 
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
-use parry3d_f64::math::Vector;
-use parry3d_f64::query::PointQueryWithLocation;
-use parry3d_f64::shape::TriMesh;
 use rayon::prelude::*;
 
 use crate::bpd::Detection;
+use crate::closest_face::FaceIndex;
 use crate::cloud::{dist2, dot, norm2, sub, Point3};
 use crate::edges::offset::{edge_sides, outward};
 use crate::edges::Edges;
@@ -395,7 +393,7 @@ fn supported_faces(
     }
     let piece = face_pieces(cut);
     let pieces = piece.iter().map(|&p| p as usize + 1).max().unwrap_or(0);
-    let projector = SlabProjector::new(cut)?;
+    let projector = FaceIndex::new(cut);
     let mut hits = vec![0usize; pieces];
     let mut cell_area = vec![0.0f64; pieces];
     // Each projection is independent: parallel, then summed in cloud order
@@ -428,148 +426,6 @@ fn supported_faces(
     }
     let dropped = keep.iter().filter(|&&k| !k).count();
     Ok((piece.iter().map(|&p| keep[p as usize]).collect(), dropped))
-}
-
-/// Faces per slab of [`SlabProjector`].
-const SLAB_FACES: usize = 100_000;
-
-/// Closest-face queries on a mesh cut into slabs of faces along its longest
-/// axis, one parry `TriMesh` (and bounding-volume hierarchy) per slab, built
-/// in parallel: parry builds a hierarchy on one thread, which on a
-/// 3M-triangle mesh took longer than projecting a million points. A mesh
-/// of up to [`SLAB_FACES`] faces is one slab.
-struct SlabProjector {
-    slabs: Vec<Slab>,
-}
-
-struct Slab {
-    shape: TriMesh,
-    /// The mesh's index of each of the slab's faces.
-    faces: Vec<u32>,
-    low: Point3,
-    high: Point3,
-}
-
-impl SlabProjector {
-    fn new(mesh: &Mesh) -> Result<Self, MeshError> {
-        let (low, high) = bounds(&mesh.vertices);
-        let axis = (0..3)
-            .max_by(|&a, &b| (high[a] - low[a]).total_cmp(&(high[b] - low[b])))
-            .unwrap_or(0);
-        // Faces binned by centroid along the axis (a counting sort: no
-        // comparisons, face order kept within a bin), and the bins cut into
-        // slabs of about SLAB_FACES.
-        const BINS: usize = 4096;
-        let span = (high[axis] - low[axis]).max(f64::MIN_POSITIVE);
-        let bin_of: Vec<u16> = mesh
-            .faces
-            .par_iter()
-            .map(|face| {
-                let centre = face
-                    .iter()
-                    .map(|&v| mesh.vertices[v as usize][axis])
-                    .sum::<f64>()
-                    / 3.0;
-                (((centre - low[axis]) / span * BINS as f64) as usize).min(BINS - 1) as u16
-            })
-            .collect();
-        let mut start = vec![0usize; BINS + 1];
-        for &b in &bin_of {
-            start[b as usize + 1] += 1;
-        }
-        for b in 1..=BINS {
-            start[b] += start[b - 1];
-        }
-        let mut order = vec![0u32; mesh.faces.len()];
-        let mut fill = start.clone();
-        for (f, &b) in bin_of.iter().enumerate() {
-            order[fill[b as usize]] = f as u32;
-            fill[b as usize] += 1;
-        }
-        let mut cuts = vec![0];
-        for &end in &start[1..] {
-            if end - cuts[cuts.len() - 1] >= SLAB_FACES {
-                cuts.push(end);
-            }
-        }
-        if cuts[cuts.len() - 1] < order.len() {
-            cuts.push(order.len());
-        }
-        let slabs = cuts
-            .par_windows(2)
-            .map(|w| Slab::new(mesh, order[w[0]..w[1]].to_vec()))
-            .collect::<Result<Vec<_>, _>>()?;
-        Ok(Self { slabs })
-    }
-
-    /// The face closest to `p` within `max_dist` (the lower index on a tie).
-    fn nearest_face(&self, p: Point3, max_dist: f64) -> Option<u32> {
-        let query = Vector::new(p[0], p[1], p[2]);
-        let mut best: Option<(f64, u32)> = None;
-        for slab in &self.slabs {
-            let limit = best.map_or(max_dist, |b| b.0);
-            if box_distance(p, slab.low, slab.high) > limit {
-                continue;
-            }
-            let Some((projection, (face, _))) = slab
-                .shape
-                .project_local_point_and_get_location_with_max_dist(query, false, limit)
-            else {
-                continue;
-            };
-            let d = (projection.point - query).length();
-            let face = slab.faces[face as usize];
-            if best.is_none_or(|(bd, bf)| d < bd || (d == bd && face < bf)) {
-                best = Some((d, face));
-            }
-        }
-        best.map(|b| b.1)
-    }
-}
-
-impl Slab {
-    fn new(mesh: &Mesh, faces: Vec<u32>) -> Result<Self, MeshError> {
-        let mut used: Vec<u32> = faces.iter().flat_map(|&f| mesh.faces[f as usize]).collect();
-        used.sort_unstable();
-        used.dedup();
-        let local = |v: u32| used.binary_search(&v).map_or(0, |i| i as u32);
-        let triangles: Vec<[u32; 3]> = faces
-            .iter()
-            .map(|&f| mesh.faces[f as usize].map(local))
-            .collect();
-        let points: Vec<Point3> = used.iter().map(|&v| mesh.vertices[v as usize]).collect();
-        let (low, high) = bounds(&points);
-        let vertices = points
-            .iter()
-            .map(|v| Vector::new(v[0], v[1], v[2]))
-            .collect();
-        let shape = TriMesh::new(vertices, triangles).map_err(|_| MeshError::NoFaces)?;
-        Ok(Self {
-            shape,
-            faces,
-            low,
-            high,
-        })
-    }
-}
-
-/// Corners of the axis-aligned bounding box of `points`.
-fn bounds(points: &[Point3]) -> (Point3, Point3) {
-    points.iter().fold(
-        ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
-        |(lo, hi), p| {
-            (
-                [0, 1, 2].map(|a| lo[a].min(p[a])),
-                [0, 1, 2].map(|a| hi[a].max(p[a])),
-            )
-        },
-    )
-}
-
-/// Distance from `p` to the box [low, high] (0 inside).
-fn box_distance(p: Point3, low: Point3, high: Point3) -> f64 {
-    let gap = [0, 1, 2].map(|a| (low[a] - p[a]).max(p[a] - high[a]).max(0.0));
-    norm2(gap).sqrt()
 }
 
 /// Connected pieces of faces sharing an edge; piece ids by first face.
