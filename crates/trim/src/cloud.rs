@@ -8,6 +8,8 @@
 //! label and resolution of its site. Points that differ in any bit are kept
 //! as they are.
 
+use rayon::prelude::*;
+
 use crate::error::CloudError;
 
 /// A point in 3D, in the cloud's own units.
@@ -53,8 +55,10 @@ pub fn merge_duplicates(points: &[Point3]) -> Result<Sites, CloudError> {
     }
     // Sort indices by coordinate bits (+0.0 and -0.0 are the same point).
     let key = |p: &Point3| p.map(|c| (c + 0.0).to_bits());
+    // Sorted in parallel: (key, index) is a total order, so the result
+    // does not depend on the threads.
     let mut order: Vec<u32> = (0..points.len() as u32).collect();
-    order.sort_unstable_by_key(|&i| (key(&points[i as usize]), i));
+    order.par_sort_unstable_by_key(|&i| (key(&points[i as usize]), i));
     let mut site_of = vec![u32::MAX; points.len()];
     let mut first_of_run = vec![0u32; points.len()];
     for w in 0..order.len() {
