@@ -88,7 +88,7 @@ startup_ms=$(startup 20 "$bin/meshtrim" --version)
 # The algorithm's own split (boundary detection on all vertices, then the
 # border replacement) on the first file, from `meshtrim clean --report`,
 # on one thread like `batch --jobs 1`.
-first=$(find "$dir/in" -name 'jagged_*.stl' | sort | head -n 1)
+first=$(find "$dir/in" -name 'jagged_*.stl' | sort | sed -n 1p)  # sed reads all: no SIGPIPE under pipefail
 RAYON_NUM_THREADS=1 "$bin/meshtrim" clean "$first" "$dir/clean_one.stl" --report "$dir/clean_one.json" > /dev/null
 py_startup_ms=$(startup 5 bench-venv/bin/python -c "import pymeshlab")
 
