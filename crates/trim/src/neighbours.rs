@@ -144,6 +144,12 @@ impl NeighbourIndex<'_> {
         s.coords.clear();
         s.coords
             .extend(s.candidates.iter().map(|&j| self.points[j as usize]));
+        s.rank_and_index.clear();
+        s.rank_and_index.extend(
+            s.candidates
+                .iter()
+                .map(|&j| (u64::from(self.rank(j)) << 32) | u64::from(j)),
+        );
     }
 
     /// The run's point closest to the run's mean.
@@ -170,13 +176,17 @@ impl NeighbourIndex<'_> {
         s: &mut RunScratch,
         out: &mut [u32],
     ) -> bool {
+        // Every candidate is written and only those within reach advance
+        // the end: no branch to mispredict on a coin-flip test.
         s.keyed.clear();
-        for (&j, &q) in s.candidates.iter().zip(&s.coords) {
+        s.keyed.resize(s.candidates.len(), 0);
+        let mut len = 0;
+        for (&rank_and_index, &q) in s.rank_and_index.iter().zip(&s.coords) {
             let d = crate::cloud::dist2(p, q);
-            if d <= reach2 {
-                s.keyed.push(candidate_key(d, self.rank(j), j));
-            }
+            s.keyed[len] = (u128::from(d.to_bits()) << 64) | u128::from(rank_and_index);
+            len += usize::from(d <= reach2);
         }
+        s.keyed.truncate(len);
         if s.keyed.len() < k {
             return false;
         }
@@ -192,13 +202,6 @@ impl NeighbourIndex<'_> {
     }
 }
 
-/// A candidate as one integer that orders like (distance², rank, index):
-/// the bits of a non-negative f64 order like the number, and integer
-/// comparisons are what the selection and the sort do fastest.
-fn candidate_key(d2: f64, rank: u32, index: u32) -> u128 {
-    (u128::from(d2.to_bits()) << 64) | (u128::from(rank) << 32) | u128::from(index)
-}
-
 /// How far beyond the central point's k-th distance a run gathers (see
 /// [`NeighbourIndex::nearest_of_run`]); the k-th distance varies a little
 /// across a run.
@@ -210,6 +213,11 @@ pub struct RunScratch {
     single: Vec<u32>,
     candidates: Vec<u32>,
     coords: Vec<Point3>,
+    /// Each candidate's rank (high half) and index (low half).
+    rank_and_index: Vec<u64>,
+    /// Candidates as one integer each that orders like (distance², rank,
+    /// index): the bits of a non-negative f64 order like the number, and
+    /// integer comparisons are what the selection and the sort do fastest.
     keyed: Vec<u128>,
 }
 
