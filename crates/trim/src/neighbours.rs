@@ -96,9 +96,13 @@ impl NeighbourIndex<'_> {
     /// the run's central point c are gathered once. For a point p of the
     /// run they include every point within G − |p − c| of p; when at least
     /// k do, p's k nearest (ties included) are among them, exactly. G is
-    /// chosen so that this almost always holds (c's own k-th distance, with
-    /// a margin, plus the run's radius); a point for which it fails gets its
-    /// own tree query.
+    /// chosen so that this almost always holds: c's k-th distance d_k with
+    /// a margin, plus the run's radius. d_k is first estimated by the
+    /// previous run's (consecutive runs are neighbours in space, and a tree
+    /// query for c cost more than the guess at a million points) and
+    /// checked: c's k nearest must lie within G; if not, c gets its own
+    /// tree query. A point for which the gathered set cannot prove its
+    /// answer gets its own tree query too.
     pub fn nearest_of_run(&self, run: Range<usize>, k: usize, out: &mut [u32], s: &mut RunScratch) {
         let k = k.min(self.points.len());
         debug_assert_eq!(out.len(), run.len() * k);
@@ -107,17 +111,35 @@ impl NeighbourIndex<'_> {
         }
         let centre = self.central_point(run.clone());
         let pc = self.points[centre];
-        self.nearest(centre, k, &mut s.single);
-        let d_k = dist(pc, self.points[s.single[k - 1] as usize]);
         let h = run
             .clone()
             .map(|p| dist(pc, self.points[p]))
             .fold(0.0, f64::max);
-        let gather = RUN_MARGIN * d_k + h;
         // Rounding slack: relative to the distances, and absolute for the
         // coordinates' own precision far from the origin.
-        let slack = 1e-9 * gather + 1e-13 * magnitude(pc);
-        self.gather(pc, gather + slack, s);
+        let slack = |r: f64| 1e-9 * r + 1e-13 * magnitude(pc);
+        // The previous run's k-th distance estimates c's: gather with it
+        // and check that c's own k nearest are inside; if not, ask the tree.
+        let guessed = s.last_d_k.and_then(|estimate| {
+            let gather = RUN_MARGIN * estimate + h;
+            self.gather(pc, gather + slack(gather), s);
+            let reach = gather - slack(gather);
+            let mut own = std::mem::take(&mut s.single);
+            own.resize(k, 0);
+            let found = self.select_nearest(pc, reach * reach, k, s, &mut own);
+            let d_k = found.then(|| dist(pc, self.points[own[k - 1] as usize]));
+            s.single = own;
+            d_k.map(|d_k| (d_k, gather))
+        });
+        let (d_k, gather) = guessed.unwrap_or_else(|| {
+            self.nearest(centre, k, &mut s.single);
+            let d_k = dist(pc, self.points[s.single[k - 1] as usize]);
+            let gather = RUN_MARGIN * d_k + h;
+            self.gather(pc, gather + slack(gather), s);
+            (d_k, gather)
+        });
+        s.last_d_k = Some(d_k);
+        let slack = slack(gather);
         for (p, out) in run.zip(out.chunks_exact_mut(k)) {
             let pp = self.points[p];
             let from_centre = dist(pc, pp);
@@ -210,6 +232,8 @@ const RUN_MARGIN: f64 = 1.25;
 /// Reusable buffers for [`NeighbourIndex::nearest_of_run`].
 #[derive(Debug, Default, Clone)]
 pub struct RunScratch {
+    /// The last run's central k-th distance, the next run's first guess.
+    last_d_k: Option<f64>,
     single: Vec<u32>,
     candidates: Vec<u32>,
     coords: Vec<Point3>,
