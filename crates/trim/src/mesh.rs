@@ -72,7 +72,16 @@ impl Mesh {
     /// sorting or hashing all edges of a large mesh; the same result as
     /// sorting the tuples (tested).
     pub fn sorted_edges(&self) -> Vec<(u32, u32, u32)> {
-        let mut start = vec![0u32; self.vertices.len() + 1];
+        // Sized by the largest index used, so a face that names a vertex
+        // past the end (an invalid mesh, which `validate` reports) still
+        // gets its edges instead of a panic.
+        let vertices = self
+            .faces
+            .iter()
+            .flatten()
+            .max()
+            .map_or(0, |&v| v as usize + 1);
+        let mut start = vec![0u32; vertices + 1];
         for face in &self.faces {
             for k in 0..3 {
                 start[face[k].min(face[(k + 1) % 3]) as usize + 1] += 1;
@@ -93,7 +102,7 @@ impl Mesh {
         }
         // Faces were visited in order, so each vertex's edges are sorted by
         // face already; a stable sort by the larger vertex finishes.
-        for v in 0..self.vertices.len() {
+        for v in 0..vertices {
             edges[start[v] as usize..start[v + 1] as usize].sort_by_key(|e| e.1);
         }
         edges

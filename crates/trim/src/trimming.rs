@@ -544,7 +544,14 @@ mod tests {
     #[test]
     fn counting_sort_of_edges_matches_sorting() {
         for seed in 0..20 {
-            let mesh = random_grid_mesh(seed, 25);
+            let mut mesh = random_grid_mesh(seed, 25);
+            assert_eq!(
+                mesh.sorted_edges(),
+                mesh.sorted_edges_reference(),
+                "seed {seed}"
+            );
+            // An index past the vertices: no panic, the same edges.
+            mesh.faces.push([0, 1, mesh.vertices.len() as u32 + 5]);
             assert_eq!(
                 mesh.sorted_edges(),
                 mesh.sorted_edges_reference(),
