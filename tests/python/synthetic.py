@@ -282,6 +282,17 @@ def curved_disc(spacing: float = 1.5, seed: int = 1) -> Cloud:
     return _make(f"curved disc h={spacing:g}", saddle(0.004), region, spacing, seed, 100.0)
 
 
+# The validation suite's cases by name (issue 4's list: blade-like surface
+# with three holes at two resolutions, notched plate, curved disc with a
+# hole); the trim and clean suites both run them.
+VALIDATION_CASES = {
+    "blade4": lambda: blade(4.0, 1),
+    "blade8": lambda: blade(8.0, 1),
+    "plate": lambda: notched_plate(1.0, 1),
+    "disc": lambda: curved_disc(1.5, 1),
+}
+
+
 def validation_clouds(seed: int = 1) -> list[Cloud]:
     """The clouds of the validation suite (issue 4)."""
     return [
@@ -444,3 +455,4 @@ def _selftest():
 
 if __name__ == "__main__":
     _selftest()
+

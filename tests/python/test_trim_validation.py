@@ -36,12 +36,7 @@ from meshtrim_cli import run_meshtrim, shared_data  # noqa: E402
 import poisson  # noqa: E402
 import synthetic  # noqa: E402
 
-CASES = {
-    "blade4": lambda: synthetic.blade(4.0, 1),
-    "blade8": lambda: synthetic.blade(8.0, 1),
-    "plate": lambda: synthetic.notched_plate(1.0, 1),
-    "disc": lambda: synthetic.curved_disc(1.5, 1),
-}
+CASES = synthetic.VALIDATION_CASES
 
 
 @pytest.fixture(scope="session", params=sorted(CASES))

@@ -124,13 +124,14 @@ impl NeighbourIndex<'_> {
             let gather = RUN_MARGIN * estimate + h;
             self.gather(pc, gather + slack(gather), s);
             let reach = gather - slack(gather);
-            let mut own = std::mem::take(&mut s.single);
+            let mut own = std::mem::take(&mut s.centre);
             own.resize(k, 0);
             let found = self.select_nearest(pc, reach * reach, k, s, &mut own);
-            let d_k = found.then(|| dist(pc, self.points[own[k - 1] as usize]));
-            s.single = own;
-            d_k.map(|d_k| (d_k, gather))
+            s.centre = own;
+            found.then(|| (dist(pc, self.points[s.centre[k - 1] as usize]), gather))
         });
+        // With a good guess, c's k nearest are already in `s.centre`.
+        let centre_known = guessed.is_some();
         let (d_k, gather) = guessed.unwrap_or_else(|| {
             self.nearest(centre, k, &mut s.single);
             let d_k = dist(pc, self.points[s.single[k - 1] as usize]);
@@ -141,6 +142,10 @@ impl NeighbourIndex<'_> {
         s.last_d_k = Some(d_k);
         let slack = slack(gather);
         for (p, out) in run.zip(out.chunks_exact_mut(k)) {
+            if p == centre && centre_known {
+                out.copy_from_slice(&s.centre);
+                continue;
+            }
             let pp = self.points[p];
             let from_centre = dist(pc, pp);
             // Every gathered point within `reach` of p is a candidate; and
@@ -234,6 +239,8 @@ const RUN_MARGIN: f64 = 1.25;
 pub struct RunScratch {
     /// The last run's central k-th distance, the next run's first guess.
     last_d_k: Option<f64>,
+    /// The run's central point's k nearest, when the guess found them.
+    centre: Vec<u32>,
     single: Vec<u32>,
     candidates: Vec<u32>,
     coords: Vec<Point3>,

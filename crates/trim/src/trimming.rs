@@ -439,22 +439,10 @@ fn face_pieces(mesh: &Mesh) -> Vec<u32> {
     for same_edge in edges.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
         let first = same_edge[0].2;
         for other in &same_edge[1..] {
-            let (ra, rb) = (find(&mut parent, first), find(&mut parent, other.2));
-            parent[ra.max(rb) as usize] = ra.min(rb);
+            join(&mut parent, first, other.2);
         }
     }
-    let mut id = vec![u32::MAX; n];
-    let mut next = 0;
-    (0..n)
-        .map(|f| {
-            let r = find(&mut parent, f as u32) as usize;
-            if id[r] == u32::MAX {
-                id[r] = next;
-                next += 1;
-            }
-            id[r]
-        })
-        .collect()
+    piece_ids(&mut parent)
 }
 
 /// [`face_pieces`] with a hash map of edges, the plain way; the reference
@@ -469,8 +457,7 @@ fn face_pieces_reference(mesh: &Mesh) -> Vec<u32> {
             let (a, b) = (face[k], face[(k + 1) % 3]);
             match first_on_edge.entry((a.min(b), a.max(b))) {
                 std::collections::hash_map::Entry::Occupied(e) => {
-                    let (ra, rb) = (find(&mut parent, *e.get()), find(&mut parent, f as u32));
-                    parent[ra.max(rb) as usize] = ra.min(rb);
+                    join(&mut parent, *e.get(), f as u32);
                 }
                 std::collections::hash_map::Entry::Vacant(e) => {
                     e.insert(f as u32);
@@ -478,11 +465,23 @@ fn face_pieces_reference(mesh: &Mesh) -> Vec<u32> {
             }
         }
     }
+    piece_ids(&mut parent)
+}
+
+/// Joins the sets of `a` and `b` under the smaller root.
+fn join(parent: &mut [u32], a: u32, b: u32) {
+    let (ra, rb) = (find(parent, a), find(parent, b));
+    parent[ra.max(rb) as usize] = ra.min(rb);
+}
+
+/// Piece ids 0, 1, … in the order of each set's first member.
+fn piece_ids(parent: &mut [u32]) -> Vec<u32> {
+    let n = parent.len();
     let mut id = vec![u32::MAX; n];
     let mut next = 0;
     (0..n)
         .map(|f| {
-            let r = find(&mut parent, f as u32) as usize;
+            let r = find(parent, f as u32) as usize;
             if id[r] == u32::MAX {
                 id[r] = next;
                 next += 1;

@@ -505,6 +505,7 @@ fn split_cell(
     max: usize,
     runs: &mut Vec<std::ops::Range<usize>>,
 ) {
+    // A cell (or merged siblings) that fits is a run.
     if cell.len() <= max || shift == 0 {
         runs.push(cell);
         return;
@@ -520,7 +521,7 @@ fn split_cell(
         match pending.take() {
             Some(p) if p.len() + (end - start) <= max => pending = Some(p.start..end),
             Some(p) => {
-                flush(keys, p, child_shift, max, runs);
+                split_cell(keys, p, child_shift, max, runs);
                 pending = Some(start..end);
             }
             None => pending = Some(start..end),
@@ -528,22 +529,7 @@ fn split_cell(
         start = end;
     }
     if let Some(p) = pending {
-        flush(keys, p, child_shift, max, runs);
-    }
-}
-
-/// Emits merged siblings as one run, or splits an oversized child further.
-fn flush(
-    keys: &[u64],
-    range: std::ops::Range<usize>,
-    child_shift: u32,
-    max: usize,
-    runs: &mut Vec<std::ops::Range<usize>>,
-) {
-    if range.len() <= max {
-        runs.push(range);
-    } else {
-        split_cell(keys, range, child_shift, max, runs);
+        split_cell(keys, p, child_shift, max, runs);
     }
 }
 
