@@ -1,0 +1,364 @@
+//! Seeded mutation fuzzing of every reader: valid small files in each
+//! format meshtrim reads are truncated, overwritten, spliced and given
+//! absurd header numbers, thousands of times, and read back as a cloud and
+//! as a mesh. Bad input must give an error naming the file, never a panic,
+//! an abort or an allocation sized by a header's claim.
+
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::Path;
+
+use meshtrim::io::{read_cloud, read_mesh, write_mesh};
+
+/// Mutated copies per seed file.
+const MUTATIONS: usize = 4000;
+
+#[test]
+fn mutated_files_give_errors_not_panics() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let mut failures = Vec::new();
+    let mut errors = 0usize;
+    let mut reads = 0usize;
+    for (name, bytes) in seed_files(dir.path()) {
+        let path = dir.path().join(&name);
+        std::fs::write(&path, &bytes).expect("write a seed file");
+        // Every seed is a valid cloud; those in a mesh format are valid
+        // meshes too (text and PCD files are clouds only).
+        assert!(
+            matches!(read_as_cloud(&path), Outcome::Read),
+            "the seed {name} does not read"
+        );
+        let mesh_format = ["ply", "obj", "stl", "glb", "gltf"]
+            .iter()
+            .any(|e| name.ends_with(e));
+        if mesh_format {
+            assert!(
+                matches!(read_as_mesh(&path), Outcome::Read),
+                "the seed {name} does not read as a mesh"
+            );
+        }
+        let mut rng = SplitMix64(0x5eed ^ bytes.len() as u64);
+        for m in 0..MUTATIONS {
+            let mutated = mutate(&bytes, &mut rng);
+            let path = dir.path().join(format!("m{m}_{name}"));
+            std::fs::write(&path, &mutated).expect("write a mutated file");
+            for (what, outcome) in [
+                ("cloud", read_as_cloud(&path)),
+                ("mesh", read_as_mesh(&path)),
+            ] {
+                reads += 1;
+                match outcome {
+                    Outcome::Read => {}
+                    Outcome::Error(message) => {
+                        errors += 1;
+                        if !message.contains(&*path.to_string_lossy()) {
+                            failures.push(format!(
+                                "{name} #{m} as {what}: error without the file name: {message}"
+                            ));
+                        }
+                    }
+                    Outcome::Panic(message) => {
+                        let kept = dir.path().join(format!("panic_{m}_{name}"));
+                        std::fs::copy(&path, &kept).ok();
+                        failures.push(format!("{name} #{m} as {what}: panic: {message}"));
+                    }
+                }
+            }
+            std::fs::remove_file(&path).ok();
+        }
+    }
+    eprintln!(
+        "{reads} reads of mutated files, {errors} errors, {} failures",
+        failures.len()
+    );
+    // Most mutations must be caught: a fuzzer whose inputs all read fine
+    // would be testing nothing.
+    assert!(
+        errors * 4 > reads,
+        "only {errors} of {reads} mutated reads failed"
+    );
+    assert!(
+        failures.is_empty(),
+        "{} failures, first ones: {:#?}",
+        failures.len(),
+        &failures[..failures.len().min(10)]
+    );
+}
+
+enum Outcome {
+    Read,
+    Error(String),
+    Panic(String),
+}
+
+fn read_as_cloud(path: &Path) -> Outcome {
+    guarded(|| read_cloud(path).map(|_| ()))
+}
+
+fn read_as_mesh(path: &Path) -> Outcome {
+    guarded(|| read_mesh(path).map(|_| ()))
+}
+
+fn guarded(read: impl FnOnce() -> anyhow::Result<()>) -> Outcome {
+    let previous = std::panic::take_hook();
+    std::panic::set_hook(Box::new(|_| {}));
+    let result = catch_unwind(AssertUnwindSafe(read));
+    std::panic::set_hook(previous);
+    match result {
+        Ok(Ok(())) => Outcome::Read,
+        Ok(Err(e)) => Outcome::Error(format!("{e:#}")),
+        Err(payload) => Outcome::Panic(
+            payload
+                .downcast_ref::<String>()
+                .cloned()
+                .or_else(|| payload.downcast_ref::<&str>().map(|s| s.to_string()))
+                .unwrap_or_default(),
+        ),
+    }
+}
+
+/// Small valid files of every format and encoding, with their names (the
+/// extension picks the reader, as on the command line).
+fn seed_files(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let (vertices, faces) = small_mesh();
+    let mut seeds = Vec::new();
+    // The writers' own formats: binary PLY, OBJ, binary STL, GLB, glTF.
+    for ext in ["ply", "obj", "stl", "glb", "gltf"] {
+        let path = dir.join(format!("seed.{ext}"));
+        write_mesh(&path, &vertices, &faces).expect("write a seed mesh");
+        seeds.push((
+            format!("written.{ext}"),
+            std::fs::read(&path).expect("read it back"),
+        ));
+    }
+    seeds.push((
+        "ascii.ply".into(),
+        ascii_ply(&vertices, &faces).into_bytes(),
+    ));
+    seeds.push(("big_endian.ply".into(), big_endian_ply(&vertices)));
+    seeds.push(("range_grid.ply".into(), range_grid_ply().into_bytes()));
+    seeds.push((
+        "ascii.stl".into(),
+        ascii_stl(&vertices, &faces).into_bytes(),
+    ));
+    seeds.push(("cloud.xyz".into(), text_cloud(&vertices, " ").into_bytes()));
+    seeds.push((
+        "cloud.csv".into(),
+        format!("x,y,z\n{}", text_cloud(&vertices, ",")).into_bytes(),
+    ));
+    seeds.push(("ascii.pcd".into(), pcd(&vertices, "ascii")));
+    seeds.push(("binary.pcd".into(), pcd(&vertices, "binary")));
+    seeds.push(("compressed.pcd".into(), pcd(&vertices, "binary_compressed")));
+    seeds
+}
+
+/// A 4 × 4 grid of vertices, slightly bent, and its 18 triangles.
+fn small_mesh() -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+    let vertices = (0..16)
+        .map(|i| {
+            let (x, y) = ((i % 4) as f64, (i / 4) as f64);
+            [x, y, 0.1 * x * y]
+        })
+        .collect();
+    let mut faces = Vec::new();
+    for r in 0..3u32 {
+        for c in 0..3u32 {
+            let a = r * 4 + c;
+            faces.push([a, a + 1, a + 5]);
+            faces.push([a, a + 5, a + 4]);
+        }
+    }
+    (vertices, faces)
+}
+
+fn ascii_ply(vertices: &[[f64; 3]], faces: &[[u32; 3]]) -> String {
+    let mut s = format!(
+        "ply\nformat ascii 1.0\ncomment made by a test\nobj_info scanner 1\n\
+         element camera 1\nproperty float view_px\nproperty float view_py\n\
+         element vertex {}\nproperty float x\nproperty float y\nproperty float z\n\
+         property float nx\nproperty float ny\nproperty float nz\nproperty uchar red\n\
+         element face {}\nproperty list uchar int vertex_indices\nend_header\n1 2\n",
+        vertices.len(),
+        faces.len()
+    );
+    for v in vertices {
+        s += &format!("{} {} {} 0 0 1 200\n", v[0], v[1], v[2]);
+    }
+    for f in faces {
+        s += &format!("3 {} {} {}\n", f[0], f[1], f[2]);
+    }
+    s
+}
+
+fn big_endian_ply(vertices: &[[f64; 3]]) -> Vec<u8> {
+    let mut out = format!(
+        "ply\nformat binary_big_endian 1.0\nelement vertex {}\nproperty double x\n\
+         property double y\nproperty double z\nproperty int confidence\nend_header\n",
+        vertices.len()
+    )
+    .into_bytes();
+    for v in vertices {
+        v.iter().for_each(|c| out.extend(c.to_be_bytes()));
+        out.extend(7i32.to_be_bytes());
+    }
+    out
+}
+
+/// A 3 × 3 range grid with one missing sample, as Stanford's range scans.
+fn range_grid_ply() -> String {
+    let mut s = String::from(
+        "ply\nformat ascii 1.0\nobj_info num_cols 3\nobj_info num_rows 3\n\
+         element vertex 8\nproperty float x\nproperty float y\nproperty float z\n\
+         element range_grid 9\nproperty list uchar int vertex_indices\nend_header\n",
+    );
+    for i in 0..8 {
+        s += &format!("{} {} 0.5\n", i % 3, i / 3);
+    }
+    for cell in 0..9 {
+        s += &match cell {
+            0..=3 => format!("1 {cell}\n"),
+            4 => "0\n".to_string(),
+            _ => format!("1 {}\n", cell - 1),
+        };
+    }
+    s
+}
+
+fn ascii_stl(vertices: &[[f64; 3]], faces: &[[u32; 3]]) -> String {
+    let mut s = String::from("solid test\n");
+    for f in faces {
+        s += "facet normal 0 0 1\nouter loop\n";
+        for &i in f {
+            let v = vertices[i as usize];
+            s += &format!("vertex {} {} {}\n", v[0], v[1], v[2]);
+        }
+        s += "endloop\nendfacet\n";
+    }
+    s + "endsolid test\n"
+}
+
+fn text_cloud(vertices: &[[f64; 3]], separator: &str) -> String {
+    vertices
+        .iter()
+        .map(|v| format!("{}{separator}{}{separator}{}\n", v[0], v[1], v[2]))
+        .collect()
+}
+
+fn pcd(vertices: &[[f64; 3]], data: &str) -> Vec<u8> {
+    let n = vertices.len();
+    let mut out = format!(
+        "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z intensity\nSIZE 4 4 4 4\nTYPE F F F F\n\
+         COUNT 1 1 1 1\nWIDTH {n}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {n}\nDATA {data}\n"
+    )
+    .into_bytes();
+    let fields = |v: &[f64; 3]| [v[0] as f32, v[1] as f32, v[2] as f32, 0.5];
+    match data {
+        "ascii" => vertices.iter().for_each(|v| {
+            let f = fields(v);
+            out.extend(format!("{} {} {} {}\n", f[0], f[1], f[2], f[3]).bytes());
+        }),
+        "binary" => vertices
+            .iter()
+            .for_each(|v| fields(v).iter().for_each(|c| out.extend(c.to_le_bytes()))),
+        _ => {
+            // binary_compressed: the fields one after another, LZF-packed.
+            let mut soa = Vec::new();
+            for k in 0..4 {
+                vertices
+                    .iter()
+                    .for_each(|v| soa.extend(fields(v)[k].to_le_bytes()));
+            }
+            let packed = lzf::compress(&soa).unwrap_or_else(|_| soa.clone());
+            out.extend((packed.len() as u32).to_le_bytes());
+            out.extend((soa.len() as u32).to_le_bytes());
+            out.extend(packed);
+        }
+    }
+    out
+}
+
+/// One random damage to `bytes`: the kinds a disk, a transfer or a
+/// careless script cause, plus the numbers a header can lie with.
+fn mutate(bytes: &[u8], rng: &mut SplitMix64) -> Vec<u8> {
+    let mut out = bytes.to_vec();
+    let at = |rng: &mut SplitMix64, len: usize| rng.below(len.max(1));
+    match rng.below(7) {
+        0 => out.truncate(at(rng, bytes.len())),
+        1 => {
+            for _ in 0..=rng.below(4) {
+                let i = at(rng, out.len());
+                out[i] = rng.next() as u8;
+            }
+        }
+        2 => {
+            const TELLING: &[u8] = b"\0\xff9-.e \n\t,+nN";
+            let i = at(rng, out.len());
+            out[i] = TELLING[rng.below(TELLING.len())];
+        }
+        3 => {
+            let (i, n) = (at(rng, out.len()), 1 + rng.below(16));
+            out.drain(i..(i + n).min(out.len()));
+        }
+        4 => {
+            let i = at(rng, out.len());
+            let junk: Vec<u8> = (0..1 + rng.below(8)).map(|_| rng.next() as u8).collect();
+            out.splice(i..i, junk);
+        }
+        5 => {
+            // A number in the text (header counts, sizes, coordinates)
+            // replaced by an absurd one.
+            const ABSURD: [&str; 8] = [
+                "4294967295",
+                "-1",
+                "0",
+                "1e308",
+                "nan",
+                "99999999999",
+                "2147483648",
+                "65536",
+            ];
+            let digits: Vec<usize> = (0..out.len())
+                .filter(|&i| out[i].is_ascii_digit())
+                .collect();
+            if !digits.is_empty() {
+                let start = digits[rng.below(digits.len())];
+                let end = (start..out.len())
+                    .find(|&i| !out[i].is_ascii_digit())
+                    .unwrap_or(out.len());
+                out.splice(start..end, ABSURD[rng.below(ABSURD.len())].bytes());
+            }
+        }
+        _ => {
+            // A line repeated (a header line twice, a record twice).
+            let i = at(rng, out.len());
+            let start = out[..i]
+                .iter()
+                .rposition(|&b| b == b'\n')
+                .map_or(0, |p| p + 1);
+            let end = out[i..]
+                .iter()
+                .position(|&b| b == b'\n')
+                .map_or(out.len(), |p| i + p + 1);
+            let line = out[start..end].to_vec();
+            out.splice(start..start, line);
+        }
+    }
+    out
+}
+
+/// A small, seeded generator (SplitMix64): the fuzzing is the same on
+/// every run, so a failure reproduces.
+struct SplitMix64(u64);
+
+impl SplitMix64 {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+
+    fn below(&mut self, n: usize) -> usize {
+        (self.next() % n.max(1) as u64) as usize
+    }
+}
