@@ -25,6 +25,7 @@
 
 use crate::cloud::{dot, Point3};
 use crate::frame::{Frame, Point2};
+use crate::neighbours::tie_key;
 use crate::resolution::dist2;
 
 /// A 2×2 linear map, row-major: `[[a, b], [c, d]]`.
@@ -44,6 +45,11 @@ pub fn apply(m: &Map2, p: Point2) -> Point2 {
 
 /// cos²(60°): e2 must make at least this much of an angle with e1's line.
 const COS2_MIN_ANGLE: f64 = 0.25;
+
+/// Relative slack of the 60° test, far above rounding (~10⁻¹⁵ near the
+/// origin, ~10⁻⁹ a million spacings away) and far below any angle that
+/// matters.
+const ANGLE_TOLERANCE: f64 = 1e-7;
 
 /// A point's two sampling vectors e1, e2 in 3D, in its own tangent plane;
 /// zero where the neighbourhood has none (all members in one direction).
@@ -115,13 +121,19 @@ fn nearest_vector(pts: &[Point2], j: usize, away_from: Option<Point2>) -> Option
     let mut best: Option<(f64, Point2)> = None;
     for (m, &q) in pts.iter().enumerate() {
         let d2 = dist2(p, q);
-        if m == j || d2 == 0.0 || best.is_some_and(|(b, _)| d2 >= b) {
+        // Near-equal distances tie and the earlier member keeps the place
+        // (see `tie_key`): on quantised clouds rounding, not geometry,
+        // would otherwise choose.
+        if m == j || d2 == 0.0 || best.is_some_and(|(b, _)| tie_key(d2) >= tie_key(b)) {
             continue;
         }
         let e = [q[0] - p[0], q[1] - p[1]];
         if let Some(e1) = away_from {
+            // "At least 60°" includes 60° within rounding, which
+            // quantised (hexagonal) samplings produce exactly.
             let dot = e[0] * e1[0] + e[1] * e1[1];
-            if dot * dot > COS2_MIN_ANGLE * (e1[0] * e1[0] + e1[1] * e1[1]) * d2 {
+            let limit = COS2_MIN_ANGLE * (e1[0] * e1[0] + e1[1] * e1[1]) * d2;
+            if dot * dot > limit * (1.0 + ANGLE_TOLERANCE) {
                 continue;
             }
         }

@@ -70,17 +70,24 @@ impl<'a> NeighbourIndex<'a> {
             let found = query.nearest_n::<SquaredEuclidean<f64>>(n).execute();
             let tie_reaches_end = ask < self.points.len()
                 && found.len() == ask
-                && found[ask - 1].distance <= found[k - 1].distance;
+                && tie_key(found[ask - 1].distance) <= tie_key(found[k - 1].distance);
             if !tie_reaches_end {
                 break found;
             }
             ask = (2 * ask).min(self.points.len());
         };
-        let mut found: Vec<(bool, f64, u32, u32)> = found
+        let mut found: Vec<(bool, u64, u32, u32)> = found
             .iter()
-            .map(|n| (n.item as usize != i, n.distance, self.rank(n.item), n.item))
+            .map(|n| {
+                (
+                    n.item as usize != i,
+                    tie_key(n.distance),
+                    self.rank(n.item),
+                    n.item,
+                )
+            })
             .collect();
-        found.sort_unstable_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)).then(a.2.cmp(&b.2)));
+        found.sort_unstable();
         found.truncate(k);
         out.extend(found.iter().map(|n| n.3));
     }
@@ -210,7 +217,7 @@ impl NeighbourIndex<'_> {
         let mut len = 0;
         for (&rank_and_index, &q) in s.rank_and_index.iter().zip(&s.coords) {
             let d = crate::cloud::dist2(p, q);
-            s.keyed[len] = (u128::from(d.to_bits()) << 64) | u128::from(rank_and_index);
+            s.keyed[len] = (u128::from(tie_key(d)) << 64) | u128::from(rank_and_index);
             len += usize::from(d <= reach2);
         }
         s.keyed.truncate(len);
@@ -222,6 +229,12 @@ impl NeighbourIndex<'_> {
         }
         let nearest = &mut s.keyed[..k];
         nearest.sort_unstable();
+        // A point beyond the reach may tie with the k-th (its distance in
+        // the same tie bin) and win on rank: only a k-th strictly below the
+        // reach's bin proves the answer.
+        if (nearest[k - 1] >> 64) as u64 >= tie_key(reach2) {
+            return false;
+        }
         for (o, n) in out.iter_mut().zip(nearest.iter()) {
             *o = *n as u32;
         }
@@ -252,6 +265,30 @@ pub struct RunScratch {
     keyed: Vec<u128>,
 }
 
+/// The order key of a squared distance: its bits rounded to drop the
+/// lowest [`TIE_BITS`], so that distances within 2⁻²⁶ ≈ 1.5·10⁻⁸ of each
+/// other (relative) tie and are ordered by rank. Monotone in the distance.
+///
+/// Quantised coordinates (scanner data) make many neighbours exactly
+/// equidistant in exact arithmetic; in floating point those distances come
+/// out equal or a unit in the last place apart depending on where the
+/// cloud sits, so ordering by the raw bits let a translation change which
+/// of them is the k-th neighbour, and with it β and the labels. The bits
+/// are rounded, not truncated: quantised coordinates give "round" squared
+/// distances (2.125 = 10.001₂) whose low bits are all zero, which
+/// truncation would put exactly on a bin edge, where rounding noise splits
+/// the tie again; rounding puts them in the middle of a bin.
+pub(crate) fn tie_key(d2: f64) -> u64 {
+    (d2.to_bits() + (1 << (TIE_BITS - 1))) >> TIE_BITS
+}
+
+/// Low bits of a squared distance ignored by [`tie_key`]. Wide enough for
+/// the rounding of coordinates 10⁵ spacings from the origin (~10⁻¹⁰
+/// relative), narrow enough that distances that really differ almost never
+/// tie (which would make them depend on the input order): see
+/// `docs/bpd.md`, "Ties and duplicates".
+const TIE_BITS: u32 = 26;
+
 fn dist(a: Point3, b: Point3) -> f64 {
     crate::cloud::dist2(a, b).sqrt()
 }
@@ -263,12 +300,12 @@ fn magnitude(p: Point3) -> f64 {
 /// Reference k-NN by sorting all distances; for tests.
 pub fn nearest_brute_force(points: &[Point3], i: usize, k: usize) -> Vec<u32> {
     let p = points[i];
-    let mut all: Vec<(bool, f64, u32)> = points
+    let mut all: Vec<(bool, u64, u32)> = points
         .iter()
         .enumerate()
-        .map(|(j, q)| (j != i, crate::cloud::dist2(p, *q), j as u32))
+        .map(|(j, q)| (j != i, tie_key(crate::cloud::dist2(p, *q)), j as u32))
         .collect();
-    all.sort_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)).then(a.2.cmp(&b.2)));
+    all.sort_unstable();
     all.into_iter().take(k).map(|t| t.2).collect()
 }
 

@@ -1,0 +1,195 @@
+//! Property tests (proptest) of the whole pipeline on generated patches:
+//! what must hold for every input, not only for the hand-picked ones.
+//!
+//! - Detection does not depend on the order of the input points (on clouds
+//!   without exact distance ties, where the order is the documented
+//!   tie-break).
+//! - The fast detection equals the reference one on awkward clouds:
+//!   quantised coordinates (many exact distance ties), duplicates, a stray
+//!   line of points, far from the origin, any scale.
+//! - Trimming a mesh that overshoots the cloud gives a valid mesh, no
+//!   larger than the input, the same on every run.
+
+use proptest::prelude::*;
+use trim::bpd::detect_boundary_reference;
+use trim::edges::{reconstruct_edges, EdgeOptions};
+use trim::mesh::Mesh;
+use trim::synthetic::{jittered_grid, Circle, Region, SpacingField, Surface};
+use trim::trimming::trim_mesh;
+use trim::{detect_boundary, BpdOptions, Point3};
+
+/// A jittered patch of about `20 × 14 / h²` points on a gently curved
+/// surface, with one hole; `seed` chooses the surface, the hole and the
+/// jitter.
+fn patch(seed: u64, h: f64) -> Vec<Point3> {
+    let surface = surface(seed);
+    let region = region(seed);
+    jittered_grid(&region, SpacingField::Uniform(h), 0.15, None, seed)
+        .into_iter()
+        .map(|(uv, _)| surface.point(uv))
+        .collect()
+}
+
+fn surface(seed: u64) -> Surface {
+    match seed % 3 {
+        0 => Surface::Plane,
+        1 => Surface::Saddle { a: 0.004 },
+        _ => Surface::Cylinder { radius: 30.0 },
+    }
+}
+
+fn region(seed: u64) -> Region {
+    let mut region = Region::rectangle([0.0, 0.0], [20.0, 14.0]);
+    let (cu, cv) = (6.0 + (seed % 7) as f64, 5.0 + (seed % 5) as f64);
+    region.holes.push(Circle {
+        centre: [cu, cv],
+        radius: 2.5,
+    });
+    region
+}
+
+/// The permutation of 0..n drawn from `seed` (Fisher–Yates).
+fn permutation(n: usize, seed: u64) -> Vec<usize> {
+    let mut rng = trim::synthetic::SplitMix64::new(seed);
+    let mut order: Vec<usize> = (0..n).collect();
+    for i in (1..n).rev() {
+        let j = (rng.next_u64() % (i as u64 + 1)) as usize;
+        order.swap(i, j);
+    }
+    order
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 200, ..ProptestConfig::default() })]
+
+    #[test]
+    fn detection_does_not_depend_on_the_input_order(seed in 0u64..1_000_000, shuffle in any::<u64>(), anisotropy in any::<bool>()) {
+        let cloud = patch(seed, 1.0);
+        let order = permutation(cloud.len(), shuffle);
+        let shuffled: Vec<Point3> = order.iter().map(|&i| cloud[i]).collect();
+        let options = BpdOptions { anisotropy, ..BpdOptions::default() };
+        let a = detect_boundary(&cloud, &options).unwrap();
+        let b = detect_boundary(&shuffled, &options).unwrap();
+        for (new, &old) in order.iter().enumerate() {
+            prop_assert_eq!(b.boundary[new], a.boundary[old], "point {} (was {})", new, old);
+            prop_assert_eq!(b.beta[new].to_bits(), a.beta[old].to_bits(), "β of point {}", new);
+        }
+        // The links, mapped back to the original indices.
+        let mut mapped: Vec<[u32; 2]> = b
+            .links
+            .iter()
+            .map(|&[p, q]| {
+                let (p, q) = (order[p as usize] as u32, order[q as usize] as u32);
+                [p.min(q), p.max(q)]
+            })
+            .collect();
+        mapped.sort_unstable();
+        prop_assert_eq!(mapped, a.links.clone());
+    }
+
+    #[test]
+    fn fast_detection_equals_the_reference_on_awkward_clouds(
+        seed in 0u64..1_000_000,
+        quantum in prop_oneof![Just(0.0), Just(0.05), Just(0.25)],
+        duplicates in 0usize..40,
+        stray_line in any::<bool>(),
+        log_scale in -3i32..4,
+        far in any::<bool>(),
+        anisotropy in any::<bool>(),
+    ) {
+        let mut cloud = patch(seed, 1.2);
+        if quantum > 0.0 {
+            for p in &mut cloud {
+                *p = p.map(|c| (c / quantum).round() * quantum);
+            }
+        }
+        let n = cloud.len();
+        for i in 0..duplicates {
+            cloud.push(cloud[(i * 7919) % n]);
+        }
+        if stray_line {
+            // A scan line sticking out of the patch's edge.
+            cloud.extend((1..12).map(|i| [20.0 + 0.8 * i as f64, 7.0, 0.0]));
+        }
+        let scale = 10f64.powi(log_scale);
+        for p in &mut cloud {
+            *p = p.map(|c| c * scale);
+        }
+        let options = BpdOptions { anisotropy, ..BpdOptions::default() };
+        let fast = detect_boundary(&cloud, &options).unwrap();
+        let plain = detect_boundary_reference(&cloud, &options).unwrap();
+        prop_assert_eq!(fast.boundary.len(), cloud.len());
+        prop_assert!(fast.beta.iter().all(|b| b.is_finite() && *b > 0.0));
+        prop_assert_eq!(&fast.boundary, &plain.boundary);
+        prop_assert_eq!(&fast.beta, &plain.beta);
+        prop_assert_eq!(&fast.links, &plain.links);
+        if far {
+            // Far from the origin the coordinates themselves round (at
+            // 1e5 a double's step is 1.5e-11), which on quantised clouds
+            // turns exact distance ties into near ones: the labels must not
+            // move with them (docs/bpd.md, "Ties and duplicates").
+            let moved: Vec<Point3> = cloud.iter().map(|p| p.map(|c| c + 1e5 * scale)).collect();
+            let there = detect_boundary(&moved, &options).unwrap();
+            prop_assert_eq!(&there.boundary, &fast.boundary);
+        }
+    }
+}
+
+/// A grid mesh over the patch's rectangle grown by `margin` on every side
+/// (a reconstruction that overshoots the cloud and caps its hole), on the
+/// same surface, with its vertices jittered.
+fn overshooting_mesh(seed: u64, margin: f64, step: f64) -> Mesh {
+    let surface = surface(seed);
+    let mut rng = trim::synthetic::SplitMix64::new(seed ^ 0xabcd);
+    let (nu, nv) = (
+        ((20.0 + 2.0 * margin) / step) as u32,
+        ((14.0 + 2.0 * margin) / step) as u32,
+    );
+    let mut vertices = Vec::new();
+    for j in 0..=nv {
+        for i in 0..=nu {
+            let u = -margin + i as f64 * step + rng.range(-0.2, 0.2) * step;
+            let v = -margin + j as f64 * step + rng.range(-0.2, 0.2) * step;
+            vertices.push(surface.point([u, v]));
+        }
+    }
+    let at = |i: u32, j: u32| j * (nu + 1) + i;
+    let mut faces = Vec::new();
+    for j in 0..nv {
+        for i in 0..nu {
+            faces.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
+            faces.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
+        }
+    }
+    Mesh { vertices, faces }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+    #[test]
+    fn trimming_gives_a_valid_smaller_mesh_the_same_every_time(
+        seed in 0u64..1_000_000,
+        margin in 0.5f64..4.0,
+        step in 0.4f64..1.5,
+    ) {
+        let cloud = patch(seed, 0.8);
+        let detection = detect_boundary(&cloud, &BpdOptions::default()).unwrap();
+        let edges = reconstruct_edges(&cloud, &detection, &EdgeOptions::default());
+        let mesh = overshooting_mesh(seed, margin, step);
+        let (out, report) = trim_mesh(&mesh, &cloud, &detection, &edges).unwrap();
+        prop_assert!(out.validate().is_ok());
+        prop_assert!(out.vertices.iter().flatten().all(|c| c.is_finite()));
+        prop_assert_eq!(report.faces_in, mesh.faces.len());
+        prop_assert_eq!(report.faces_out, out.faces.len());
+        prop_assert!(report.area_out > 0.0);
+        prop_assert!(report.area_out <= report.area_in * (1.0 + 1e-12));
+        // The hole and the overshoot are gone: the part is smaller than
+        // the mesh by at least most of the margin band.
+        let band = 2.0 * margin * (20.0 + 14.0);
+        prop_assert!(report.area_out < report.area_in - 0.5 * band);
+        let (again, _) = trim_mesh(&mesh, &cloud, &detection, &edges).unwrap();
+        prop_assert_eq!(&again.faces, &out.faces);
+        prop_assert_eq!(&again.vertices, &out.vertices);
+    }
+}
