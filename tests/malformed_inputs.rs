@@ -8,6 +8,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
 
 use meshtrim::io::{read_cloud, read_mesh, write_mesh};
+use trim::synthetic::SplitMix64;
 
 /// Mutated copies per seed file.
 const MUTATIONS: usize = 4000;
@@ -36,7 +37,7 @@ fn mutated_files_give_errors_not_panics() {
                 "the seed {name} does not read as a mesh"
             );
         }
-        let mut rng = SplitMix64(0x5eed ^ bytes.len() as u64);
+        let mut rng = SplitMix64::new(0x5eed ^ bytes.len() as u64);
         for m in 0..MUTATIONS {
             let mutated = mutate(&bytes, &mut rng);
             let path = dir.path().join(format!("m{m}_{name}"));
@@ -280,27 +281,29 @@ fn pcd(vertices: &[[f64; 3]], data: &str) -> Vec<u8> {
 /// careless script cause, plus the numbers a header can lie with.
 fn mutate(bytes: &[u8], rng: &mut SplitMix64) -> Vec<u8> {
     let mut out = bytes.to_vec();
-    let at = |rng: &mut SplitMix64, len: usize| rng.below(len.max(1));
-    match rng.below(7) {
+    let at = |rng: &mut SplitMix64, len: usize| below(rng, len.max(1));
+    match below(rng, 7) {
         0 => out.truncate(at(rng, bytes.len())),
         1 => {
-            for _ in 0..=rng.below(4) {
+            for _ in 0..=below(rng, 4) {
                 let i = at(rng, out.len());
-                out[i] = rng.next() as u8;
+                out[i] = rng.next_u64() as u8;
             }
         }
         2 => {
             const TELLING: &[u8] = b"\0\xff9-.e \n\t,+nN";
             let i = at(rng, out.len());
-            out[i] = TELLING[rng.below(TELLING.len())];
+            out[i] = TELLING[below(rng, TELLING.len())];
         }
         3 => {
-            let (i, n) = (at(rng, out.len()), 1 + rng.below(16));
+            let (i, n) = (at(rng, out.len()), 1 + below(rng, 16));
             out.drain(i..(i + n).min(out.len()));
         }
         4 => {
             let i = at(rng, out.len());
-            let junk: Vec<u8> = (0..1 + rng.below(8)).map(|_| rng.next() as u8).collect();
+            let junk: Vec<u8> = (0..1 + below(rng, 8))
+                .map(|_| rng.next_u64() as u8)
+                .collect();
             out.splice(i..i, junk);
         }
         5 => {
@@ -320,11 +323,11 @@ fn mutate(bytes: &[u8], rng: &mut SplitMix64) -> Vec<u8> {
                 .filter(|&i| out[i].is_ascii_digit())
                 .collect();
             if !digits.is_empty() {
-                let start = digits[rng.below(digits.len())];
+                let start = digits[below(rng, digits.len())];
                 let end = (start..out.len())
                     .find(|&i| !out[i].is_ascii_digit())
                     .unwrap_or(out.len());
-                out.splice(start..end, ABSURD[rng.below(ABSURD.len())].bytes());
+                out.splice(start..end, ABSURD[below(rng, ABSURD.len())].bytes());
             }
         }
         _ => {
@@ -345,20 +348,8 @@ fn mutate(bytes: &[u8], rng: &mut SplitMix64) -> Vec<u8> {
     out
 }
 
-/// A small, seeded generator (SplitMix64): the fuzzing is the same on
-/// every run, so a failure reproduces.
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n.max(1) as u64) as usize
-    }
+/// A uniform draw in 0..n (0 for n = 0) from the seeded generator: the
+/// fuzzing is the same on every run, so a failure reproduces.
+fn below(rng: &mut SplitMix64, n: usize) -> usize {
+    (rng.next_u64() % n.max(1) as u64) as usize
 }
