@@ -25,8 +25,14 @@
 //! - α = Σ Δθ and τ = Σ |Δθ| over the steps; linking stops when no
 //!   neighbour is left or τ > 2π; P_i is a boundary point iff |α| < 2π.
 //!
-//! Ties in γ go to the lower neighbour index (neighbours are sorted by
-//! distance, then index), so the result is deterministic.
+//! Ties, within [`TIE`] (quantised clouds make angles, gaps and costs
+//! exactly equal, and rounding must not choose): γ goes to the lower
+//! neighbour index (neighbours are sorted by distance, then rank); equal
+//! largest gaps to the sector starting first counting round from the
+//! nearest neighbour; a half turn keeps the previous direction; a path
+//! winding exactly 2π counts as surrounding P_i. So the result is
+//! deterministic and does not move with the cloud (`docs/bpd.md`, "Ties
+//! and duplicates").
 
 use std::f64::consts::{FRAC_PI_2, FRAC_PI_4, PI, TAU};
 
@@ -39,6 +45,8 @@ pub struct PolarScratch {
     r: Vec<f64>,
     /// Smallest and largest angle in each of n equal sectors.
     buckets: Vec<(f64, f64)>,
+    /// The gaps between buckets: (gap, angle where it ends).
+    gaps: Vec<(f64, f64)>,
     /// 0 for neighbours still free, +∞ for linked ones.
     blocked: Vec<f64>,
     cost: Vec<f64>,
@@ -52,7 +60,7 @@ pub fn surrounding_path_is_open(nb: &[Point2], s: &mut PolarScratch) -> bool {
     }
     s.theta.clear();
     s.theta.extend(nb.iter().map(|p| atan2(p[1], p[0])));
-    let (theta_min, width) = occupied_sector(&s.theta, &mut s.buckets);
+    let (theta_min, width) = occupied_sector(&s.theta, &mut s.buckets, &mut s.gaps);
     if width <= 0.0 {
         return true;
     }
@@ -94,25 +102,44 @@ pub fn surrounding_path_is_open(nb: &[Point2], s: &mut PolarScratch) -> bool {
         {
             let turn = circular_difference(theta, theta_last);
             // Eq. 5's c: −1 (a bonus) for keeping the previous direction.
+            // A half turn has no direction of its own; it keeps the
+            // previous one (rounding would otherwise pick its sign).
             let step = turn.abs() * per_width;
-            let keeps_direction = turn * previous_turn > 0.0;
+            let half_turn = turn.abs() >= PI - TIE;
+            let keeps_direction = if half_turn {
+                previous_turn != 0.0
+            } else {
+                turn * previous_turn > 0.0
+            };
             *cost = blocked + if keeps_direction { r - step } else { r + step };
         }
         let next = argmin(&s.cost);
-        let turn = circular_difference(s.theta[next], theta_last);
+        let mut turn = circular_difference(s.theta[next], theta_last);
+        if turn.abs() >= PI - TIE {
+            turn = if previous_turn < 0.0 { -PI } else { PI };
+        }
         alpha += turn;
         tau += turn.abs();
-        if turn != 0.0 {
+        if turn.abs() > TIE {
             previous_turn = turn;
         }
         s.blocked[next] = f64::INFINITY;
         last = next;
-        if tau > TAU {
+        // A path that winds exactly once (within ties) goes on, and
+        // counts as surrounding P_i.
+        if tau > TAU + TIE {
             break;
         }
     }
-    alpha.abs() < TAU
+    alpha.abs() < TAU - TIE
 }
+
+/// Angles (radians) and costs closer than this are ties. Far above the
+/// rounding of the local coordinates (about 10⁻¹¹ of a spacing for a cloud
+/// 10⁵ spacings from the origin), where quantised clouds put neighbours at
+/// exactly equal angles, costs and gaps; far below anything the test
+/// weighs.
+const TIE: f64 = 1e-9;
 
 /// Start angle and width of the smallest sector holding all `theta` (in
 /// [−π, π]): the complement of the largest gap between consecutive angles.
@@ -121,9 +148,17 @@ pub fn surrounding_path_is_open(nb: &[Point2], s: &mut PolarScratch) -> bool {
 /// circle cut into n buckets of width 2π/n, the n gaps sum to 2π, so the
 /// largest is at least 2π/n and no gap inside a bucket can beat it; only
 /// the gaps between one non-empty bucket's largest angle and the next one's
-/// smallest count. The same result as [`occupied_sector_sorted`] except
-/// where two gaps are exactly equal.
-fn occupied_sector(theta: &[f64], buckets: &mut Vec<(f64, f64)>) -> (f64, f64) {
+/// smallest count. Gaps within [`TIE`] of the largest tie, and the one
+/// that starts first counting round from the nearest neighbour's angle
+/// (`theta[0]`) wins, so that the choice follows the neighbours, not the
+/// rounding or the ±π seam of the angles. The same result as
+/// [`occupied_sector_sorted`] except where a gap inside a bucket ties with
+/// the largest (all gaps within [`TIE`] of 2π/n).
+fn occupied_sector(
+    theta: &[f64],
+    buckets: &mut Vec<(f64, f64)>,
+    gaps: &mut Vec<(f64, f64)>,
+) -> (f64, f64) {
     let n = theta.len();
     buckets.clear();
     buckets.resize(n, (f64::INFINITY, f64::NEG_INFINITY));
@@ -141,15 +176,36 @@ fn occupied_sector(theta: &[f64], buckets: &mut Vec<(f64, f64)>) -> (f64, f64) {
         .rev()
         .find(|b| b.0 <= b.1)
         .map_or(first.1, |b| b.1);
-    let (mut gap, mut start) = (first.0 + TAU - last, first.0);
+    gaps.clear();
+    gaps.push((first.0 + TAU - last, first.0));
     let mut previous_high = first.1;
     for &(lo, hi) in filled {
-        if lo - previous_high > gap {
-            gap = lo - previous_high;
-            start = lo;
-        }
+        gaps.push((lo - previous_high, lo));
         previous_high = hi;
     }
+    choose_gap(gaps, theta[0])
+}
+
+/// The sector left by the largest of `gaps` (gap, angle where it ends),
+/// ties broken as [`occupied_sector`] says: (start, width).
+fn choose_gap(gaps: &[(f64, f64)], theta_ref: f64) -> (f64, f64) {
+    let largest = gaps.iter().fold(f64::NEG_INFINITY, |m, g| m.max(g.0));
+    // Where a sector starts, counted from the reference direction; a start
+    // within a tie of a full turn is the reference itself.
+    let from_reference = |start: f64| {
+        let a = wrap_positive(start - theta_ref);
+        if a > TAU - TIE {
+            0.0
+        } else {
+            a
+        }
+    };
+    let (gap, start) = gaps
+        .iter()
+        .filter(|g| g.0 >= largest - TIE)
+        .min_by(|a, b| from_reference(a.1).total_cmp(&from_reference(b.1)))
+        .copied()
+        .expect("the largest gap is among the gaps");
     (start, TAU - gap)
 }
 
@@ -159,15 +215,9 @@ fn occupied_sector_sorted(theta: &[f64]) -> (f64, f64) {
     let mut sorted = theta.to_vec();
     sorted.sort_by(f64::total_cmp);
     let n = sorted.len();
-    let mut gap = sorted[0] + TAU - sorted[n - 1];
-    let mut start = sorted[0];
-    for w in sorted.windows(2) {
-        if w[1] - w[0] > gap {
-            gap = w[1] - w[0];
-            start = w[1];
-        }
-    }
-    (start, TAU - gap)
+    let mut gaps = vec![(sorted[0] + TAU - sorted[n - 1], sorted[0])];
+    gaps.extend(sorted.windows(2).map(|w| (w[1] - w[0], w[1])));
+    choose_gap(&gaps, theta[0])
 }
 
 /// `a − b` wrapped into (−π, π], for angles from `atan2` (in [−π, π]), whose
@@ -242,15 +292,13 @@ pub(crate) fn atan2(y: f64, x: f64) -> f64 {
     }
 }
 
-/// Index of the smallest cost, the first on ties.
+/// Index of the smallest cost; on ties (costs within [`TIE`]) the first,
+/// which is the nearest neighbour, then the lowest rank.
 fn argmin(cost: &[f64]) -> usize {
-    let mut best = (f64::INFINITY, 0);
-    for (j, &c) in cost.iter().enumerate() {
-        if c < best.0 {
-            best = (c, j);
-        }
-    }
-    best.1
+    let least = cost
+        .iter()
+        .fold(f64::INFINITY, |m, &c| if c < m { c } else { m });
+    cost.iter().position(|&c| c <= least + TIE).unwrap_or(0)
 }
 
 #[cfg(test)]
@@ -284,7 +332,7 @@ mod tests {
     fn bucketed_sector_matches_sorting_on_random_angles() {
         use rand::{RngExt, SeedableRng};
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
-        let mut buckets = Vec::new();
+        let (mut buckets, mut gaps) = (Vec::new(), Vec::new());
         for case in 0..2000 {
             let n = 1 + case % 40;
             // Clustered angles (a sector), spread ones, and the ends ±π.
@@ -301,7 +349,7 @@ mod tests {
                 theta[n - 1] = -PI;
             }
             assert_eq!(
-                occupied_sector(&theta, &mut buckets),
+                occupied_sector(&theta, &mut buckets, &mut gaps),
                 occupied_sector_sorted(&theta),
                 "{theta:?}"
             );
