@@ -212,4 +212,37 @@ proptest! {
         prop_assert_eq!(&again.faces, &out.faces);
         prop_assert_eq!(&again.vertices, &out.vertices);
     }
+
+    #[test]
+    fn the_whole_job_moves_with_the_part(
+        seed in 0u64..1_000_000,
+        quantum in prop_oneof![Just(0.0), Just(0.05)],
+        shift in prop_oneof![Just(1e3), Just(1e5)],
+    ) {
+        let quantise = |p: Point3| if quantum > 0.0 { p.map(|c| (c / quantum).round() * quantum) } else { p };
+        let cloud: Vec<Point3> = patch(seed, 0.8).into_iter().map(quantise).collect();
+        let mesh = overshooting_mesh(seed, 2.0, 0.7);
+        let job = |cloud: &[Point3], mesh: &Mesh| {
+            let detection = detect_boundary(cloud, &BpdOptions::default()).unwrap();
+            let edges = reconstruct_edges(cloud, &detection, &EdgeOptions::default());
+            let (out, _) = trim_mesh(mesh, cloud, &detection, &edges).unwrap();
+            (detection.boundary, edges.loops.len(), out)
+        };
+        let (labels, loops, out) = job(&cloud, &mesh);
+        let moved_cloud: Vec<Point3> = cloud.iter().map(|p| p.map(|c| c + shift)).collect();
+        let moved_mesh = Mesh {
+            vertices: mesh.vertices.iter().map(|p| p.map(|c| c + shift)).collect(),
+            faces: mesh.faces.clone(),
+        };
+        let (labels2, loops2, out2) = job(&moved_cloud, &moved_mesh);
+        prop_assert_eq!(labels, labels2);
+        prop_assert_eq!(loops, loops2);
+        prop_assert_eq!(&out.faces, &out2.faces);
+        // Coordinates round at the shift's scale (1e5: about 1.5e-11).
+        for (a, b) in out.vertices.iter().zip(&out2.vertices) {
+            for k in 0..3 {
+                prop_assert!((a[k] + shift - b[k]).abs() < 1e-6, "{:?} {:?}", a, b);
+            }
+        }
+    }
 }
