@@ -5,7 +5,9 @@
 //!   exactly; β to the last bits, summed in neighbour order).
 //! - The fast detection equals the reference one on awkward clouds:
 //!   quantised coordinates (many exact distance ties), duplicates, a stray
-//!   line of points, far from the origin, any scale.
+//!   line of points, any scale; and their labels survive a generic
+//!   rotation and a move 10⁵ units away, which round every coordinate.
+//! - The whole job (detect, edges, trim) moves with the part.
 //! - Trimming a mesh that overshoots the cloud gives a valid mesh, no
 //!   larger than the input, the same on every run.
 
@@ -143,6 +145,21 @@ proptest! {
         prop_assert_eq!(&fast.boundary, &plain.boundary);
         prop_assert_eq!(&fast.beta, &plain.beta);
         prop_assert_eq!(&fast.links, &plain.links);
+        {
+            // A generic rotation rounds every coordinate: exact ties become
+            // near ones, which must still tie.
+            let (a, b) = (0.6_f64, 0.9_f64);
+            let (ca, sa, cb, sb) = (a.cos(), a.sin(), b.cos(), b.sin());
+            let rotated: Vec<Point3> = cloud
+                .iter()
+                .map(|p| {
+                    let (x, y) = (ca * p[0] - sa * p[1], sa * p[0] + ca * p[1]);
+                    [x, cb * y - sb * p[2], sb * y + cb * p[2]]
+                })
+                .collect();
+            let turned = detect_boundary(&rotated, &options).unwrap();
+            prop_assert_eq!(&turned.boundary, &fast.boundary);
+        }
         if far {
             // Far from the origin the coordinates themselves round (at
             // 1e5 a double's step is 1.5e-11), which on quantised clouds
