@@ -205,7 +205,9 @@ fn choose_gap(gaps: &[(f64, f64)], theta_ref: f64) -> (f64, f64) {
         .filter(|g| g.0 >= largest - TIE)
         .min_by(|a, b| from_reference(a.1).total_cmp(&from_reference(b.1)))
         .copied()
-        .expect("the largest gap is among the gaps");
+        // Only an all-NaN list (impossible: the angles come from finite
+        // coordinates) has no largest gap.
+        .unwrap_or(gaps[0]);
     (start, TAU - gap)
 }
 
