@@ -118,13 +118,14 @@ pub fn whitening_map(t: [f64; 3]) -> Map2 {
 /// members whose direction is at least 60° from that vector's line count.
 fn nearest_vector(pts: &[Point2], j: usize, away_from: Option<Point2>) -> Option<Point2> {
     let p = pts[j];
-    let mut best: Option<(f64, Point2)> = None;
+    // The best so far by its distance's tie key: near-equal distances tie
+    // and the earlier member keeps the place (see `tie_key`); on quantised
+    // clouds rounding, not geometry, would otherwise choose.
+    let mut best: Option<(u64, Point2)> = None;
     for (m, &q) in pts.iter().enumerate() {
         let d2 = dist2(p, q);
-        // Near-equal distances tie and the earlier member keeps the place
-        // (see `tie_key`): on quantised clouds rounding, not geometry,
-        // would otherwise choose.
-        if m == j || d2 == 0.0 || best.is_some_and(|(b, _)| tie_key(d2) >= tie_key(b)) {
+        let key = tie_key(d2);
+        if m == j || d2 == 0.0 || best.is_some_and(|(b, _)| key >= b) {
             continue;
         }
         let e = [q[0] - p[0], q[1] - p[1]];
@@ -137,7 +138,7 @@ fn nearest_vector(pts: &[Point2], j: usize, away_from: Option<Point2>) -> Option
                 continue;
             }
         }
-        best = Some((d2, e));
+        best = Some((key, e));
     }
     best.map(|(_, e)| e)
 }

@@ -170,7 +170,11 @@ fn occupied_sector(
         *hi = hi.max(t);
     }
     let mut filled = buckets.iter().filter(|b| b.0 <= b.1);
-    let first = *filled.next().expect("theta is not empty");
+    // No bucket filled (no angles): no sector, which the caller reads as
+    // open.
+    let Some(&first) = filled.next() else {
+        return (0.0, 0.0);
+    };
     let last = buckets
         .iter()
         .rev()
