@@ -133,7 +133,7 @@ impl NeighbourIndex<'_> {
             let reach = gather - slack(gather);
             let mut own = std::mem::take(&mut s.centre);
             own.resize(k, 0);
-            let found = self.select_nearest(pc, reach * reach, k, s, &mut own);
+            let found = self.select_within(pc, reach * reach, k, s, &mut own);
             s.centre = own;
             found.then(|| (dist(pc, self.points[s.centre[k - 1] as usize]), gather))
         });
@@ -148,6 +148,10 @@ impl NeighbourIndex<'_> {
         });
         s.last_d_k = Some(d_k);
         let slack = slack(gather);
+        // The previous point's k-th distance: neighbours' k-th distances
+        // differ little, so a little more than it usually encloses k
+        // candidates, far fewer than the proven reach (see `select_nearest`).
+        let mut previous_d_k = d_k;
         for (p, out) in run.zip(out.chunks_exact_mut(k)) {
             if p == centre && centre_known {
                 out.copy_from_slice(&s.centre);
@@ -159,10 +163,12 @@ impl NeighbourIndex<'_> {
             // p's k nearest lie within d_k(c) + |p − c| (that ball holds
             // c's k nearest), so the nearer of the two radii loses nothing.
             let reach = (gather - from_centre - slack).min(d_k + from_centre + slack);
-            if !self.select_nearest(pp, reach * reach, k, s, out) {
+            let guess = GUESS_MARGIN * previous_d_k;
+            if !self.select_nearest(pp, reach * reach, guess * guess, k, s, out) {
                 self.nearest(p, k, &mut s.single);
                 out.copy_from_slice(&s.single);
             }
+            previous_d_k = dist(pp, self.points[out[k - 1] as usize]);
         }
     }
 
@@ -202,7 +208,25 @@ impl NeighbourIndex<'_> {
 
     /// Writes into `out` the k nearest of `p` among the gathered candidates
     /// within `reach2` (squared) of it; false if fewer than k are.
+    ///
+    /// Tries the candidates within the smaller `guess2` first: when they
+    /// prove the answer (k of them, the k-th strictly inside the guess's tie
+    /// bin), it is the same, and selecting among fewer is cheaper.
     fn select_nearest(
+        &self,
+        p: Point3,
+        reach2: f64,
+        guess2: f64,
+        k: usize,
+        s: &mut RunScratch,
+        out: &mut [u32],
+    ) -> bool {
+        (guess2 < reach2 && self.select_within(p, guess2, k, s, out))
+            || self.select_within(p, reach2, k, s, out)
+    }
+
+    /// [`Self::select_nearest`] with one radius.
+    fn select_within(
         &self,
         p: Point3,
         reach2: f64,
@@ -246,6 +270,10 @@ impl NeighbourIndex<'_> {
 /// [`NeighbourIndex::nearest_of_run`]); the k-th distance varies a little
 /// across a run.
 const RUN_MARGIN: f64 = 1.25;
+
+/// How far beyond the previous point's k-th distance a point's selection
+/// first looks (see [`NeighbourIndex::select_nearest`]).
+const GUESS_MARGIN: f64 = 1.1;
 
 /// Reusable buffers for [`NeighbourIndex::nearest_of_run`].
 #[derive(Debug, Default, Clone)]
