@@ -8,7 +8,7 @@
 //! the investigated point at the origin, so distances and angles in the
 //! projection are those of the surface to first order.
 
-use nalgebra::{Matrix3, SymmetricEigen, Vector3};
+use nalgebra::{Matrix3, Vector3};
 
 use crate::cloud::{dot, sub, Point3};
 
@@ -48,17 +48,162 @@ pub fn fit_plane(points: &[Point3], members: &[u32]) -> Frame {
         let d = Vector3::from(d);
         cov += d * d.transpose();
     }
-    let eig = SymmetricEigen::new(cov);
-    let mut order = [0usize, 1, 2];
-    order.sort_by(|&a, &b| eig.eigenvalues[b].total_cmp(&eig.eigenvalues[a]));
-    let axis = |i: usize| {
-        let c = eig.eigenvectors.column(order[i]);
-        [c[0], c[1], c[2]]
-    };
-    let u = canonical_sign(axis(0));
-    let normal = canonical_sign(axis(2));
+    let (_, [normal, _, u]) = symmetric_eigen3(&cov);
+    let u = canonical_sign(u);
+    let normal = canonical_sign(normal);
     let v = crate::cloud::cross(normal, u);
     Frame { u, v, normal }
+}
+
+/// Eigenvalues (ascending) and unit eigenvectors of a symmetric 3×3 matrix,
+/// in closed form: D. Eberly's non-iterative solver ("A Robust Eigensolver
+/// for 3 × 3 Symmetric Matrices", Geometric Tools, 2014). The eigenvalues
+/// come from the trigonometric solution of the characteristic cubic after
+/// scaling and shifting; the eigenvector of the best-separated eigenvalue
+/// from the largest cross product of two rows of A − λI, the middle one in
+/// that vector's orthogonal complement, the third by a cross product, so
+/// the three are orthonormal even when two eigenvalues coincide.
+///
+/// BPD fits a plane per point, and nalgebra's general iterative solver
+/// was a tenth of its time; [`symmetric_eigen3`] agrees with it (see the
+/// tests) in about a third of the time.
+pub fn symmetric_eigen3(a: &Matrix3<f64>) -> ([f64; 3], [Point3; 3]) {
+    let max_abs = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if max_abs == 0.0 || !max_abs.is_finite() {
+        return (
+            [0.0; 3],
+            [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        );
+    }
+    // Scaled to entries in [−1, 1] against overflow and underflow.
+    let s = 1.0 / max_abs;
+    let (a00, a01, a02) = (a[(0, 0)] * s, a[(0, 1)] * s, a[(0, 2)] * s);
+    let (a11, a12, a22) = (a[(1, 1)] * s, a[(1, 2)] * s, a[(2, 2)] * s);
+    let off_diagonal = a01 * a01 + a02 * a02 + a12 * a12;
+    if off_diagonal == 0.0 {
+        return diagonal_eigen([a00, a11, a22], max_abs);
+    }
+    let q = (a00 + a11 + a22) / 3.0;
+    let (b00, b11, b22) = (a00 - q, a11 - q, a22 - q);
+    let p = ((b00 * b00 + b11 * b11 + b22 * b22 + 2.0 * off_diagonal) / 6.0).sqrt();
+    let c00 = b11 * b22 - a12 * a12;
+    let c01 = a01 * b22 - a12 * a02;
+    let c02 = a01 * a12 - b11 * a02;
+    let det = (b00 * c00 - a01 * c01 + a02 * c02) / (p * p * p);
+    let half_det = (0.5 * det).clamp(-1.0, 1.0);
+    let angle = half_det.acos() / 3.0;
+    const TWO_THIRDS_PI: f64 = 2.0 * std::f64::consts::FRAC_PI_3;
+    let beta2 = 2.0 * angle.cos();
+    let beta0 = 2.0 * (angle + TWO_THIRDS_PI).cos();
+    let beta1 = -(beta0 + beta2);
+    let values = [q + p * beta0, q + p * beta1, q + p * beta2];
+    let rows = [[a00, a01, a02], [a01, a11, a12], [a02, a12, a22]];
+    let vectors = if half_det >= 0.0 {
+        let v2 = eigenvector_of_simple(rows, values[2]);
+        let v1 = eigenvector_in_complement(rows, v2, values[1]);
+        [unit_cross(v1, v2), v1, v2]
+    } else {
+        let v0 = eigenvector_of_simple(rows, values[0]);
+        let v1 = eigenvector_in_complement(rows, v0, values[1]);
+        [v0, v1, unit_cross(v0, v1)]
+    };
+    (values.map(|l| l * max_abs), vectors)
+}
+
+/// a × b for orthonormal a and b, renormalised so that rounding does not
+/// leave it a few ulps off unit length (an axis comes out exact).
+fn unit_cross(a: Point3, b: Point3) -> Point3 {
+    let c = crate::cloud::cross(a, b);
+    let length = dot(c, c).sqrt();
+    c.map(|x| x / length)
+}
+
+fn diagonal_eigen(d: [f64; 3], scale: f64) -> ([f64; 3], [Point3; 3]) {
+    let mut order = [0usize, 1, 2];
+    order.sort_by(|&i, &j| d[i].total_cmp(&d[j]));
+    let axis = |i: usize| {
+        let mut e = [0.0; 3];
+        e[i] = 1.0;
+        e
+    };
+    (order.map(|i| d[i] * scale), order.map(axis))
+}
+
+/// Unit eigenvector of an eigenvalue well separated from the other two:
+/// the rows of A − λI span a plane whose normal it is; the largest of the
+/// rows' three cross products is the best-conditioned normal.
+fn eigenvector_of_simple(rows: [Point3; 3], value: f64) -> Point3 {
+    let mut r = rows;
+    for (i, row) in r.iter_mut().enumerate() {
+        row[i] -= value;
+    }
+    let candidates = [
+        crate::cloud::cross(r[0], r[1]),
+        crate::cloud::cross(r[0], r[2]),
+        crate::cloud::cross(r[1], r[2]),
+    ];
+    let (best, length2) = candidates
+        .iter()
+        .map(|c| (c, dot(*c, *c)))
+        .fold((&candidates[0], -1.0), |b, c| if c.1 > b.1 { c } else { b });
+    if length2 <= 0.0 {
+        // A − λI = 0: every vector is an eigenvector.
+        return [1.0, 0.0, 0.0];
+    }
+    // Division, not a reciprocal's product: an axis comes out exactly unit.
+    let length = length2.sqrt();
+    best.map(|c| c / length)
+}
+
+/// Unit eigenvector of `value` orthogonal to the unit eigenvector `w`:
+/// the 2×2 problem of A − λI restricted to w's orthogonal complement.
+fn eigenvector_in_complement(rows: [Point3; 3], w: Point3, value: f64) -> Point3 {
+    let (u, v) = orthogonal_complement(w);
+    let times = |x: Point3| [dot(rows[0], x), dot(rows[1], x), dot(rows[2], x)];
+    let (au, av) = (times(u), times(v));
+    let mut m00 = dot(u, au) - value;
+    let mut m01 = dot(u, av);
+    let mut m11 = dot(v, av) - value;
+    let (abs00, abs01, abs11) = (m00.abs(), m01.abs(), m11.abs());
+    let combine = |a: f64, b: f64| [0, 1, 2].map(|i| a * u[i] - b * v[i]);
+    if abs00.max(abs01) >= abs11 {
+        if abs00.max(abs01) == 0.0 {
+            return u;
+        }
+        if abs00 >= abs01 {
+            m01 /= m00;
+            m00 = 1.0 / (1.0 + m01 * m01).sqrt();
+            m01 *= m00;
+        } else {
+            m00 /= m01;
+            m01 = 1.0 / (1.0 + m00 * m00).sqrt();
+            m00 *= m01;
+        }
+        combine(m01, m00)
+    } else {
+        if abs11 >= abs01 {
+            m01 /= m11;
+            m11 = 1.0 / (1.0 + m01 * m01).sqrt();
+            m01 *= m11;
+        } else {
+            m11 /= m01;
+            m01 = 1.0 / (1.0 + m11 * m11).sqrt();
+            m11 *= m01;
+        }
+        combine(m11, m01)
+    }
+}
+
+/// An orthonormal basis (u, v) of the plane orthogonal to the unit `w`.
+fn orthogonal_complement(w: Point3) -> (Point3, Point3) {
+    let u = if w[0].abs() > w[1].abs() {
+        let length = (w[0] * w[0] + w[2] * w[2]).sqrt();
+        [-w[2] / length, 0.0, w[0] / length]
+    } else {
+        let length = (w[1] * w[1] + w[2] * w[2]).sqrt();
+        [0.0, w[2] / length, -w[1] / length]
+    };
+    (u, crate::cloud::cross(w, u))
 }
 
 /// Flips a unit vector so its largest component is positive, so the frame
@@ -67,11 +212,9 @@ fn canonical_sign(a: Point3) -> Point3 {
     let big = (0..3)
         .max_by(|&i, &j| a[i].abs().total_cmp(&a[j].abs()))
         .unwrap_or(0);
-    if a[big] < 0.0 {
-        [-a[0], -a[1], -a[2]]
-    } else {
-        a
-    }
+    let signed = if a[big] < 0.0 { a.map(|c| -c) } else { a };
+    // + 0.0 turns −0.0 into 0.0, so equal frames compare equal.
+    signed.map(|c| c + 0.0)
 }
 
 /// Projects `members` onto the frame's plane, relative to `points[members[0]]`.
@@ -87,6 +230,98 @@ pub fn project(points: &[Point3], members: &[u32], frame: &Frame, out: &mut Vec<
 #[cfg(test)]
 mod tests {
     use super::*;
+    use nalgebra::SymmetricEigen;
+    use rand::{RngExt, SeedableRng};
+
+    /// Random symmetric matrices Q diag(λ) Qᵀ with awkward spectra: equal,
+    /// nearly equal, zero and widely spread eigenvalues, scales 1e-8..1e8.
+    fn awkward_matrix(rng: &mut rand_chacha::ChaCha8Rng) -> Matrix3<f64> {
+        let q = nalgebra::Rotation3::from_axis_angle(
+            &Vector3::new(rng.random(), rng.random(), rng.random::<f64>() - 0.5)
+                .try_normalize(1e-9)
+                .map_or(Vector3::z_axis(), nalgebra::Unit::new_unchecked),
+            rng.random_range(0.0..6.3),
+        );
+        let scale = 10f64.powf(rng.random_range(-8.0..8.0));
+        let base: f64 = rng.random_range(0.1..1.0);
+        let mut l = [base, rng.random_range(0.0..1.0), rng.random_range(0.0..1.0)];
+        match rng.random_range(0..6) {
+            0 => l[1] = l[0],                 // double eigenvalue
+            1 => l = [l[0]; 3],               // a multiple of I
+            2 => l[2] = 0.0,                  // a plane
+            3 => (l[1], l[2]) = (0.0, 0.0),   // a line
+            4 => l[1] = l[0] * (1.0 + 1e-10), // nearly double
+            _ => l[2] = l[0] * 1e-12,         // nearly a plane
+        }
+        let d = Matrix3::from_diagonal(&Vector3::from(l.map(|x| x * scale)));
+        let m = q.matrix() * d * q.matrix().transpose();
+        (m + m.transpose()) * 0.5
+    }
+
+    /// The closed form agrees with nalgebra's iterative solver: the same
+    /// eigenvalues, orthonormal vectors with small residuals, and the same
+    /// vector (up to sign) wherever its eigenvalue is well separated.
+    #[test]
+    fn closed_form_eigen_matches_nalgebra() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        for case in 0..20_000 {
+            let a = awkward_matrix(&mut rng);
+            let (values, vectors) = symmetric_eigen3(&a);
+            let reference = SymmetricEigen::new(a);
+            let mut want: Vec<(f64, Point3)> = (0..3)
+                .map(|i| {
+                    let c = reference.eigenvectors.column(i);
+                    (reference.eigenvalues[i], [c[0], c[1], c[2]])
+                })
+                .collect();
+            want.sort_by(|x, y| x.0.total_cmp(&y.0));
+            let size = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+            for i in 0..3 {
+                // The trigonometric solution loses half the digits of
+                // eigenvalues that nearly coincide (their vectors are
+                // then nearly arbitrary in a common plane anyway); a
+                // separated eigenvalue and its vector are exact to rounding.
+                let gap = (0..3)
+                    .filter(|&j| j != i)
+                    .map(|j| (want[j].0 - want[i].0).abs())
+                    .fold(f64::INFINITY, f64::min);
+                let separated = gap > 1e-3 * size;
+                let tolerance = if separated { 1e-12 } else { 1e-7 } * size;
+                assert!(
+                    (values[i] - want[i].0).abs() <= tolerance,
+                    "case {case}: {values:?} vs {want:?}"
+                );
+                let e = vectors[i];
+                for j in 0..3 {
+                    let expected = if i == j { 1.0 } else { 0.0 };
+                    assert!((dot(e, vectors[j]) - expected).abs() < 1e-12, "case {case}");
+                }
+                let ae = a * Vector3::from(e);
+                let residual = (ae - Vector3::from(e) * values[i]).norm();
+                assert!(residual <= tolerance, "case {case}: residual {residual:e}");
+                if separated {
+                    let agree = dot(e, want[i].1).abs();
+                    assert!(
+                        (agree - 1.0).abs() < 1e-9,
+                        "case {case}: {e:?} vs {:?}",
+                        want[i].1
+                    );
+                }
+            }
+        }
+    }
+
+    /// Edge cases: zero, diagonal, non-finite input gives no NaN vectors.
+    #[test]
+    fn closed_form_eigen_edge_cases() {
+        let (values, vectors) = symmetric_eigen3(&Matrix3::zeros());
+        assert_eq!(values, [0.0; 3]);
+        assert_eq!(vectors[2], [0.0, 0.0, 1.0]);
+        let d = Matrix3::from_diagonal(&Vector3::new(3.0, 1.0, 2.0));
+        let (values, vectors) = symmetric_eigen3(&d);
+        assert_eq!(values, [1.0, 2.0, 3.0]);
+        assert_eq!(vectors, [[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]]);
+    }
 
     #[test]
     fn plane_of_a_tilted_grid_has_its_normal() {
