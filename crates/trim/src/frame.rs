@@ -292,9 +292,9 @@ mod tests {
                     "case {case}: {values:?} vs {want:?}"
                 );
                 let e = vectors[i];
-                for j in 0..3 {
+                for (j, &other) in vectors.iter().enumerate() {
                     let expected = if i == j { 1.0 } else { 0.0 };
-                    assert!((dot(e, vectors[j]) - expected).abs() < 1e-12, "case {case}");
+                    assert!((dot(e, other) - expected).abs() < 1e-12, "case {case}");
                 }
                 let ae = a * Vector3::from(e);
                 let residual = (ae - Vector3::from(e) * values[i]).norm();
