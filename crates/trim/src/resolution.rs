@@ -13,56 +13,102 @@ use crate::frame::Point2;
 /// Nearest-neighbour distance of every member, within the neighbourhood.
 ///
 /// `out[j]` is the distance from `pts[j]` to the closest other member. The
-/// points are copied into coordinate columns and every pair is measured from
-/// both ends: twice the arithmetic of [`nearest_distances_reference`], but
-/// in four independent lanes with no stores in the inner loop, which the
-/// compiler turns into vector instructions (about three times faster for
-/// k = 30). Minima do not depend on the order, so the results are equal.
+/// points are copied into coordinate columns, padded to whole tiles of
+/// [`LANES`], and the pairs are measured tile by tile over the upper
+/// triangle of tiles only: each distance updates both its row's minimum and
+/// its column's, in independent lanes that the compiler turns into vector
+/// instructions. Half the pairs of a full row-by-row pass and no branch;
+/// minima do not depend on the order and a − b = −(b − a) exactly, so the
+/// results equal [`nearest_distances_reference`]'s.
 pub fn nearest_distances(pts: &[Point2], out: &mut Vec<f64>, columns: &mut Columns) {
     let n = pts.len();
     let padded = n.div_ceil(LANES) * LANES;
-    // Padding far away never wins a minimum.
+    // Padding is infinitely far: it never wins a real member's minimum
+    // (padding against padding gives NaN, which loses every comparison).
     columns.x.clear();
     columns.y.clear();
     columns.x.extend(pts.iter().map(|p| p[0]));
     columns.y.extend(pts.iter().map(|p| p[1]));
     columns.x.resize(padded, f64::INFINITY);
     columns.y.resize(padded, f64::INFINITY);
+    columns.column_best.clear();
+    columns.column_best.resize(padded, f64::INFINITY);
     out.clear();
-    for j in 0..n {
-        let (px, py) = (columns.x[j], columns.y[j]);
-        // The member itself moves to infinity for its own row.
-        columns.x[j] = f64::INFINITY;
-        let mut best = [f64::INFINITY; LANES];
-        for (xs, ys) in columns
-            .x
-            .chunks_exact(LANES)
-            .zip(columns.y.chunks_exact(LANES))
-        {
-            for lane in 0..LANES {
-                let (dx, dy) = (xs[lane] - px, ys[lane] - py);
+    let (xs, ys) = (&columns.x, &columns.y);
+    for row in (0..padded).step_by(LANES) {
+        let mut row_best = [[f64::INFINITY; LANES]; LANES];
+        diagonal_tile(xs, ys, row, &mut row_best);
+        for column in (row + LANES..padded).step_by(LANES) {
+            let column_best: &mut [f64; LANES] = (&mut columns.column_best[column..column + LANES])
+                .try_into()
+                .expect("whole tiles");
+            off_diagonal_tile(xs, ys, row, column, &mut row_best, column_best);
+        }
+        for (r, lanes) in row_best.iter().enumerate().take(n.saturating_sub(row)) {
+            let best = lanes.iter().fold(
+                columns.column_best[row + r],
+                |m, &d| if d < m { d } else { m },
+            );
+            out.push(best.sqrt());
+        }
+    }
+}
+
+/// Pairs within the tile of rows `row..row + LANES`, each member against
+/// the others (its own lane is skipped).
+fn diagonal_tile(xs: &[f64], ys: &[f64], row: usize, row_best: &mut [[f64; LANES]; LANES]) {
+    for (r, best) in row_best.iter_mut().enumerate() {
+        let (px, py) = (xs[row + r], ys[row + r]);
+        for (lane, b) in best.iter_mut().enumerate() {
+            if lane != r {
+                let (dx, dy) = (xs[row + lane] - px, ys[row + lane] - py);
                 let d = dx * dx + dy * dy;
-                // `if` rather than `f64::min`, whose NaN handling blocks
-                // the plain min instruction (no NaN can occur here).
-                best[lane] = if d < best[lane] { d } else { best[lane] };
+                *b = if d < *b { d } else { *b };
             }
         }
-        columns.x[j] = px;
-        let best = best
-            .iter()
-            .fold(f64::INFINITY, |m, &d| if d < m { d } else { m });
-        out.push(best.sqrt());
+    }
+}
+
+/// Pairs between the rows `row..row + LANES` and the columns
+/// `column..column + LANES`: row minima in `row_best` (per lane), column
+/// minima in `column_best`.
+fn off_diagonal_tile(
+    xs: &[f64],
+    ys: &[f64],
+    row: usize,
+    column: usize,
+    row_best: &mut [[f64; LANES]; LANES],
+    column_best: &mut [f64; LANES],
+) {
+    let cx: &[f64; LANES] = xs[column..column + LANES].try_into().expect("whole tiles");
+    let cy: &[f64; LANES] = ys[column..column + LANES].try_into().expect("whole tiles");
+    for (r, best) in row_best.iter_mut().enumerate() {
+        let (px, py) = (xs[row + r], ys[row + r]);
+        for lane in 0..LANES {
+            let (dx, dy) = (cx[lane] - px, cy[lane] - py);
+            let d = dx * dx + dy * dy;
+            // `if` rather than `f64::min`, whose NaN handling blocks the
+            // plain min instruction.
+            best[lane] = if d < best[lane] { d } else { best[lane] };
+            column_best[lane] = if d < column_best[lane] {
+                d
+            } else {
+                column_best[lane]
+            };
+        }
     }
 }
 
 /// Lanes of [`nearest_distances`]' inner loop.
-const LANES: usize = 4;
+const LANES: usize = 2;
 
 /// Reusable coordinate columns for [`nearest_distances`].
 #[derive(Debug, Default, Clone)]
 pub struct Columns {
     x: Vec<f64>,
     y: Vec<f64>,
+    /// Squared minimum of each column over the tiles above the diagonal.
+    column_best: Vec<f64>,
 }
 
 /// [`nearest_distances`] measuring each pair once, the plain way; the
