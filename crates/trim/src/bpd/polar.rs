@@ -69,7 +69,7 @@ pub fn surrounding_path_is_open(nb: &[Point2], s: &mut PolarScratch) -> bool {
     s.r.clear();
     s.r.extend(nb.iter().map(|p| (p[0] * p[0] + p[1] * p[1]).sqrt()));
     let (r_min, r_max) = s.r.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &r| {
-        (lo.min(r), hi.max(r))
+        (if r < lo { r } else { lo }, if r > hi { r } else { hi })
     });
     let r_span = r_max - r_min;
     for r in s.r.iter_mut() {
@@ -166,8 +166,10 @@ fn occupied_sector(
     for &t in theta {
         let b = (((t + PI) * per_bucket) as usize).min(n - 1);
         let (lo, hi) = &mut buckets[b];
-        *lo = lo.min(t);
-        *hi = hi.max(t);
+        // Comparisons, not `f64::min`/`max`, whose NaN handling costs
+        // more (the angles are finite).
+        *lo = if t < *lo { t } else { *lo };
+        *hi = if t > *hi { t } else { *hi };
     }
     let mut filled = buckets.iter().filter(|b| b.0 <= b.1);
     // No bucket filled (no angles): no sector, which the caller reads as
@@ -301,8 +303,20 @@ pub(crate) fn atan2(y: f64, x: f64) -> f64 {
 /// Index of the smallest cost; on ties (costs within [`TIE`]) the first,
 /// which is the nearest neighbour, then the lowest rank.
 fn argmin(cost: &[f64]) -> usize {
-    let least = cost
+    // Four independent minima: one running minimum is a chain of dependent
+    // instructions, which the compiler may not reorder for floats (the
+    // minimum itself does not depend on the order).
+    let mut lanes = [f64::INFINITY; 4];
+    let chunks = cost.chunks_exact(4);
+    let rest = chunks.remainder();
+    for chunk in chunks {
+        for (m, &c) in lanes.iter_mut().zip(chunk) {
+            *m = if c < *m { c } else { *m };
+        }
+    }
+    let least = lanes
         .iter()
+        .chain(rest)
         .fold(f64::INFINITY, |m, &c| if c < m { c } else { m });
     cost.iter().position(|&c| c <= least + TIE).unwrap_or(0)
 }
