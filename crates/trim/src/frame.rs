@@ -8,7 +8,7 @@
 //! the investigated point at the origin, so distances and angles in the
 //! projection are those of the surface to first order.
 
-use nalgebra::{Matrix3, Vector3};
+use nalgebra::Matrix3;
 
 use crate::cloud::{dot, sub, Point3};
 
@@ -35,19 +35,26 @@ pub fn fit_plane(points: &[Point3], members: &[u32]) -> Frame {
     let origin = points[members[0] as usize];
     // Centre on the first member before summing: keeps precision for clouds
     // far from the origin (a translation of 1e5 units must not change labels).
-    let mut mean = [0.0; 3];
+    let mut sum = [0.0; 3];
     for &m in members {
         let d = sub(points[m as usize], origin);
         for a in 0..3 {
-            mean[a] += d[a] / n;
+            sum[a] += d[a];
         }
     }
-    let mut cov = Matrix3::<f64>::zeros();
+    let mean = sum.map(|c| c / n);
+    // The six distinct entries only (nalgebra's d dᵀ would form all nine).
+    let mut c = [0.0; 6];
     for &m in members {
         let d = sub(sub(points[m as usize], origin), mean);
-        let d = Vector3::from(d);
-        cov += d * d.transpose();
+        c[0] += d[0] * d[0];
+        c[1] += d[0] * d[1];
+        c[2] += d[0] * d[2];
+        c[3] += d[1] * d[1];
+        c[4] += d[1] * d[2];
+        c[5] += d[2] * d[2];
     }
+    let cov = Matrix3::new(c[0], c[1], c[2], c[1], c[3], c[4], c[2], c[4], c[5]);
     let (_, [normal, _, u]) = symmetric_eigen3(&cov);
     let u = canonical_sign(u);
     let normal = canonical_sign(normal);
@@ -230,7 +237,7 @@ pub fn project(points: &[Point3], members: &[u32], frame: &Frame, out: &mut Vec<
 #[cfg(test)]
 mod tests {
     use super::*;
-    use nalgebra::SymmetricEigen;
+    use nalgebra::{SymmetricEigen, Vector3};
     use rand::{RngExt, SeedableRng};
 
     /// Random symmetric matrices Q diag(λ) Qᵀ with awkward spectra: equal,
