@@ -21,7 +21,11 @@
 //! Finding each point's vectors once, in its own neighbourhood, costs O(k)
 //! per point instead of O(k²) per neighbourhood, and gives members at the
 //! rim of P_i's neighbourhood their true nearest neighbours rather than the
-//! nearest ones that happen to be inside it.
+//! nearest ones that happen to be inside it. Each point keeps its vectors
+//! as the 3D moment S_j = e1_j e1_jᵀ + e2_j e2_jᵀ ([`sampling_moment`]), so
+//! that T = P (Σ S_j) Pᵀ costs one projection per neighbourhood
+//! ([`sampling_tensor_of_moments`]; [`sampling_tensor`] projects every
+//! vector and is the reference).
 
 use crate::cloud::{dot, Point3};
 use crate::frame::{Frame, Point2};
@@ -83,6 +87,52 @@ pub fn sampling_tensor<'a>(
     t
 }
 
+/// A point's sampling moment S = e1 e1ᵀ + e2 e2ᵀ in 3D (symmetric:
+/// xx, xy, xz, yy, yz, zz).
+pub type SamplingMoment = [f64; 6];
+
+/// S of a point's sampling vectors.
+pub fn sampling_moment([e1, e2]: &SamplingVectors) -> SamplingMoment {
+    let outer = |e: &Point3| {
+        [
+            e[0] * e[0],
+            e[0] * e[1],
+            e[0] * e[2],
+            e[1] * e[1],
+            e[1] * e[2],
+            e[2] * e[2],
+        ]
+    };
+    let (a, b) = (outer(e1), outer(e2));
+    [0, 1, 2, 3, 4, 5].map(|i| a[i] + b[i])
+}
+
+/// [`sampling_tensor`] from the members' moments: projecting each vector on
+/// the plane and summing the outer products equals projecting the summed
+/// moments once, T = P (Σ S_j) Pᵀ with P's rows the frame's u and v; one
+/// projection instead of two per member.
+pub fn sampling_tensor_of_moments<'a>(
+    frame: &Frame,
+    moments: impl Iterator<Item = &'a SamplingMoment>,
+) -> [f64; 3] {
+    let mut sum = [0.0; 6];
+    for m in moments {
+        for (s, x) in sum.iter_mut().zip(m) {
+            *s += x;
+        }
+    }
+    let [xx, xy, xz, yy, yz, zz] = sum;
+    let times = |a: Point3| {
+        [
+            xx * a[0] + xy * a[1] + xz * a[2],
+            xy * a[0] + yy * a[1] + yz * a[2],
+            xz * a[0] + yz * a[1] + zz * a[2],
+        ]
+    };
+    let (su, sv) = (times(frame.u), times(frame.v));
+    [dot(frame.u, su), dot(frame.u, sv), dot(frame.v, sv)]
+}
+
 /// M = T^(-1/2) scaled to unit determinant; the identity if T is singular.
 pub fn whitening_map(t: [f64; 3]) -> Map2 {
     let [a, b, c] = t;
@@ -105,7 +155,8 @@ pub fn whitening_map(t: [f64; 3]) -> Map2 {
         (0.0, 1.0)
     };
     // M = s1 v vᵀ + s2 w wᵀ with s_i = l_i^(-1/2), scaled so s1 s2 = 1.
-    let scale = (l1 * l2).powf(0.25);
+    // Two square roots: the fourth root without a call to pow.
+    let scale = (l1 * l2).sqrt().sqrt();
     let (s1, s2) = (scale / l1.sqrt(), scale / l2.sqrt());
     let (wx, wy) = (-vy, vx);
     [
@@ -211,6 +262,35 @@ mod tests {
                 0.1 * 0.1 + 3.0 * 3.0
             ]
         );
+    }
+
+    /// Projecting the summed moments gives the tensor of the projected
+    /// vectors, to rounding, on random frames and vectors.
+    #[test]
+    fn tensor_of_moments_is_the_tensor_of_projections() {
+        let mut rng = crate::synthetic::SplitMix64::new(9);
+        for _ in 0..2000 {
+            let mut r = || [0; 3].map(|_| rng.range(-2.0, 2.0));
+            let unit = |a: Point3| {
+                let l = dot(a, a).sqrt();
+                a.map(|c| c / l)
+            };
+            let n = unit(r());
+            let u = unit(crate::cloud::cross(n, r()));
+            let frame = Frame {
+                u,
+                v: crate::cloud::cross(n, u),
+                normal: n,
+            };
+            let members: Vec<SamplingVectors> = (0..30).map(|_| [r(), r()]).collect();
+            let plain = sampling_tensor(&frame, members.iter());
+            let moments: Vec<SamplingMoment> = members.iter().map(sampling_moment).collect();
+            let fast = sampling_tensor_of_moments(&frame, moments.iter());
+            let size = plain[0].abs() + plain[2].abs();
+            for (a, b) in plain.iter().zip(&fast) {
+                assert!((a - b).abs() <= 1e-13 * size, "{plain:?} {fast:?}");
+            }
+        }
     }
 
     #[test]

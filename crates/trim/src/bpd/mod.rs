@@ -20,7 +20,8 @@ pub mod polar;
 use rayon::prelude::*;
 
 use crate::anisotropy::{
-    apply, own_sampling_vectors, sampling_tensor, whitening_map, SamplingVectors,
+    apply, own_sampling_vectors, sampling_moment, sampling_tensor_of_moments, whitening_map,
+    SamplingMoment,
 };
 use crate::cloud::{check_not_degenerate, merge_duplicates, Point3, Sites};
 use crate::error::CloudError;
@@ -150,7 +151,10 @@ fn run(
             let members = hoods.at(p);
             let frame = fit_plane(&hoods.points, members);
             project(&hoods.points, members, &frame, &mut s.projected);
-            (own_sampling_vectors(&s.projected, &frame), frame)
+            (
+                sampling_moment(&own_sampling_vectors(&s.projected, &frame)),
+                frame,
+            )
         })
     });
     let verdicts = per_position(&hoods, how, &report(passes - 1), |s, p| {
@@ -179,7 +183,10 @@ pub fn local_resolution(points: &[Point3], options: &BpdOptions) -> Result<Vec<f
             let members = hoods.at(p);
             let frame = fit_plane(&hoods.points, members);
             project(&hoods.points, members, &frame, &mut s.projected);
-            (own_sampling_vectors(&s.projected, &frame), frame)
+            (
+                sampling_moment(&own_sampling_vectors(&s.projected, &frame)),
+                frame,
+            )
         })
     });
     let betas = per_position(&hoods, how, &|_| {}, |s, p| {
@@ -385,7 +392,7 @@ struct Scratch {
 fn projected_beta(
     hoods: &Neighbourhoods,
     p: usize,
-    vectors: Option<&[(SamplingVectors, Frame)]>,
+    vectors: Option<&[(SamplingMoment, Frame)]>,
     s: &mut Scratch,
 ) -> f64 {
     let members = hoods.at(p);
@@ -393,7 +400,8 @@ fn projected_beta(
     let frame = vectors.map_or_else(|| fit_plane(&hoods.points, members), |v| v[p].1);
     project(&hoods.points, members, &frame, &mut s.projected);
     if let Some(vectors) = vectors {
-        let tensor = sampling_tensor(&frame, members.iter().map(|&m| &vectors[m as usize].0));
+        let tensor =
+            sampling_tensor_of_moments(&frame, members.iter().map(|&m| &vectors[m as usize].0));
         let map = whitening_map(tensor);
         for q in s.projected.iter_mut() {
             *q = apply(&map, *q);
@@ -406,7 +414,7 @@ fn projected_beta(
 fn analyse_point(
     hoods: &Neighbourhoods,
     p: usize,
-    vectors: Option<&[(SamplingVectors, Frame)]>,
+    vectors: Option<&[(SamplingMoment, Frame)]>,
     s: &mut Scratch,
     how: TestImpl,
 ) -> Verdict {
