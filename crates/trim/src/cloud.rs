@@ -57,21 +57,15 @@ pub fn merge_duplicates(points: &[Point3]) -> Result<Sites, CloudError> {
     let key = |p: &Point3| p.map(|c| (c + 0.0).to_bits());
     // Sorted in parallel: (key, index) is a total order, so the result
     // does not depend on the threads.
-    // The keys are materialised next to their indices: a comparison then
-    // reads neither the points nor their bits again.
-    let mut keyed: Vec<([u64; 3], u32)> = points
-        .par_iter()
-        .enumerate()
-        .map(|(i, p)| (key(p), i as u32))
-        .collect();
-    keyed.par_sort_unstable();
+    let mut order: Vec<u32> = (0..points.len() as u32).collect();
+    order.par_sort_unstable_by_key(|&i| (key(&points[i as usize]), i));
     let mut site_of = vec![u32::MAX; points.len()];
     let mut first_of_run = vec![0u32; points.len()];
-    for w in 0..keyed.len() {
-        let (k, i) = keyed[w];
-        let same_as_prev = w > 0 && keyed[w - 1].0 == k;
+    for w in 0..order.len() {
+        let i = order[w];
+        let same_as_prev = w > 0 && key(&points[order[w - 1] as usize]) == key(&points[i as usize]);
         first_of_run[i as usize] = if same_as_prev {
-            first_of_run[keyed[w - 1].1 as usize]
+            first_of_run[order[w - 1] as usize]
         } else {
             i
         };
