@@ -275,8 +275,10 @@ fn neighbourhoods(
 
 /// Most points per k-NN run (see [`NeighbourIndex::nearest_of_run`] and
 /// [`octree_runs`]): enough to share one tree query among them, few
-/// enough that the run stays small next to a neighbourhood.
-const RUN: usize = 16;
+/// enough that the run stays small next to a neighbourhood. 32 against 16:
+/// the same time at 12k points, 2 % less at 1M (fewer tree queries where
+/// the tree no longer fits in the cache).
+const RUN: usize = 32;
 
 /// Runs `f` at every position of the spatial order, in blocks (parallel for
 /// the fast implementation), and returns the results in that order.
