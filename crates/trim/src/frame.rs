@@ -15,8 +15,9 @@ use crate::cloud::{dot, sub, Point3};
 /// A point in a neighbourhood's plane, relative to the investigated point.
 pub type Point2 = [f64; 2];
 
-/// An orthonormal frame: two tangent axes and the normal.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// An orthonormal frame: two tangent axes and the normal (all zero by
+/// default: a placeholder, not a frame).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Frame {
     /// First tangent axis (largest spread).
     pub u: Point3,

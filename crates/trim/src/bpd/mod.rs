@@ -127,6 +127,8 @@ struct Neighbourhoods {
     order: Vec<u32>,
     k: usize,
     lists: Vec<u32>,
+    /// Each position's sampling moment and plane, with anisotropy on.
+    sampling: Option<Vec<(SamplingMoment, Frame)>>,
 }
 
 impl Neighbourhoods {
@@ -143,22 +145,14 @@ fn run(
 ) -> Result<Detection, CloudError> {
     let sites = prepare(points, options)?;
     let n = sites.points.len();
-    let passes = if options.anisotropy { 3 } else { 2 };
+    // Neighbourhoods (with each point's sampling moment when the map is on)
+    // and the tests.
+    let passes = 2;
     let report = |pass: usize| move |done: usize| progress((pass * n + done) / passes);
-    let hoods = neighbourhoods(&sites.points, options.k, how, &report(0));
-    let vectors = options.anisotropy.then(|| {
-        per_position(&hoods, how, &report(1), |s, p| {
-            let members = hoods.at(p);
-            let frame = fit_plane(&hoods.points, members);
-            project(&hoods.points, members, &frame, &mut s.projected);
-            (
-                sampling_moment(&own_sampling_vectors(&s.projected, &frame)),
-                frame,
-            )
-        })
-    });
+    let hoods = neighbourhoods(&sites.points, options, how, &report(0));
+    let vectors = hoods.sampling.as_deref();
     let verdicts = per_position(&hoods, how, &report(passes - 1), |s, p| {
-        analyse_point(&hoods, p, vectors.as_deref(), s, how)
+        analyse_point(&hoods, p, vectors, s, how)
     });
     let links = links_in_input_order(&sites, &hoods.order, &verdicts);
     let by_site = to_sites(
@@ -177,22 +171,11 @@ fn run(
 pub fn local_resolution(points: &[Point3], options: &BpdOptions) -> Result<Vec<f64>, CloudError> {
     let sites = prepare(points, options)?;
     let how = TestImpl::Fast;
-    let hoods = neighbourhoods(&sites.points, options.k, how, &|_| {});
-    let vectors = options.anisotropy.then(|| {
-        per_position(&hoods, how, &|_| {}, |s, p| {
-            let members = hoods.at(p);
-            let frame = fit_plane(&hoods.points, members);
-            project(&hoods.points, members, &frame, &mut s.projected);
-            (
-                sampling_moment(&own_sampling_vectors(&s.projected, &frame)),
-                frame,
-            )
-        })
-    });
+    let hoods = neighbourhoods(&sites.points, options, how, &|_| {});
     let betas = per_position(&hoods, how, &|_| {}, |s, p| {
         (
             Decision::Interior,
-            projected_beta(&hoods, p, vectors.as_deref(), s),
+            projected_beta(&hoods, p, hoods.sampling.as_deref(), s),
         )
     });
     let by_site = to_sites(&hoods.order, betas);
@@ -219,41 +202,60 @@ fn prepare(points: &[Point3], options: &BpdOptions) -> Result<Sites, CloudError>
 }
 
 /// Finds every neighbourhood once (step 1), queried in spatial order so
-/// consecutive queries touch the same part of the tree.
+/// consecutive queries touch the same part of the tree; with anisotropy on,
+/// also each point's plane and sampling moment ([`sampling_at`]), which the
+/// fast version computes right after the point's k-NN, while its
+/// neighbours are still in the cache.
 fn neighbourhoods(
     sites: &[Point3],
-    k: usize,
+    options: &BpdOptions,
     how: TestImpl,
     progress: &(dyn Fn(usize) + Sync),
 ) -> Neighbourhoods {
+    let k = options.k;
     let (order, keys) = spatial_order(sites);
     let points: Vec<Point3> = order.iter().map(|&i| sites[i as usize]).collect();
     // Ties are broken by site index (input order), which, unlike the
     // spatial order, does not change when the cloud is moved.
     let index = NeighbourIndex::new(&points).with_ranks(&order);
     let mut lists = vec![0u32; points.len() * k];
+    let mut sampling = options.anisotropy.then(|| {
+        let unset = ([0.0; 6], Frame::default());
+        let mut all = Vec::with_capacity(points.len());
+        all.par_extend(rayon::iter::repeat_n(unset, points.len()));
+        all
+    });
     match how {
         TestImpl::Fast => {
             let runs = octree_runs(&keys, RUN);
             let mut rest = lists.as_mut_slice();
+            let mut rest_sampling = sampling.as_deref_mut().unwrap_or_default();
             let mut jobs = Vec::with_capacity(runs.len());
             for run in runs {
                 let (out, tail) = rest.split_at_mut(run.len() * k);
-                jobs.push((run, out));
+                let sampled = run.len().min(rest_sampling.len());
+                let (out_sampling, tail_sampling) = rest_sampling.split_at_mut(sampled);
+                jobs.push((run, out, out_sampling));
                 rest = tail;
+                rest_sampling = tail_sampling;
             }
             let per_block = block_len(points.len()) / RUN;
             for block in jobs.chunks_mut(per_block) {
-                block
-                    .par_iter_mut()
-                    .for_each_init(RunScratch::default, |scratch, (run, out)| {
-                        index.nearest_of_run(run.clone(), k, out, scratch)
-                    });
-                progress(block.last().map_or(0, |(run, _)| run.end));
+                block.par_iter_mut().for_each_init(
+                    || (RunScratch::default(), Vec::new()),
+                    |(scratch, projected), (run, out, out_sampling)| {
+                        index.nearest_of_run(run.clone(), k, out, scratch);
+                        for (members, o) in out.chunks_exact(k).zip(out_sampling.iter_mut()) {
+                            *o = sampling_at(&points, members, projected);
+                        }
+                    },
+                );
+                progress(block.last().map_or(0, |(run, _, _)| run.end));
             }
         }
         TestImpl::Reference => {
-            // The reference asks every query afresh, one by one.
+            // The reference asks every query afresh, one by one, and finds
+            // the sampling moments in a pass of their own.
             let mut members = Vec::new();
             for (p, out) in lists.chunks_mut(k).enumerate() {
                 index.nearest(p, k, &mut members);
@@ -261,6 +263,10 @@ fn neighbourhoods(
                 if p % 4096 == 0 {
                     progress(p);
                 }
+            }
+            let mut projected = Vec::new();
+            for (members, o) in lists.chunks_exact(k).zip(sampling.iter_mut().flatten()) {
+                *o = sampling_at(&points, members, &mut projected);
             }
         }
     }
@@ -270,7 +276,23 @@ fn neighbourhoods(
         order,
         k,
         lists,
+        sampling,
     }
+}
+
+/// The plane of a neighbourhood (`members`, the point first) and the
+/// point's own sampling moment in it ([`crate::anisotropy`]).
+fn sampling_at(
+    points: &[Point3],
+    members: &[u32],
+    projected: &mut Vec<Point2>,
+) -> (SamplingMoment, Frame) {
+    let frame = fit_plane(points, members);
+    project(points, members, &frame, projected);
+    (
+        sampling_moment(&own_sampling_vectors(projected, &frame)),
+        frame,
+    )
 }
 
 /// Most points per k-NN run (see [`NeighbourIndex::nearest_of_run`] and
