@@ -34,34 +34,34 @@ pub fn nearest_distances(pts: &[Point2], out: &mut Vec<f64>, columns: &mut Colum
     columns.column_best.clear();
     columns.column_best.resize(padded, f64::INFINITY);
     out.clear();
-    let (xs, ys) = (&columns.x, &columns.y);
-    for row in (0..padded).step_by(LANES) {
+    let (x_tiles, _) = columns.x.as_chunks::<LANES>();
+    let (y_tiles, _) = columns.y.as_chunks::<LANES>();
+    let (best_tiles, _) = columns.column_best.as_chunks_mut::<LANES>();
+    for (t, (rx, ry)) in x_tiles.iter().zip(y_tiles).enumerate() {
         let mut row_best = [[f64::INFINITY; LANES]; LANES];
-        diagonal_tile(xs, ys, row, &mut row_best);
-        for column in (row + LANES..padded).step_by(LANES) {
-            let column_best: &mut [f64; LANES] = (&mut columns.column_best[column..column + LANES])
-                .try_into()
-                .expect("whole tiles");
-            off_diagonal_tile(xs, ys, row, column, &mut row_best, column_best);
+        diagonal_tile(rx, ry, &mut row_best);
+        let columns_after = x_tiles[t + 1..].iter().zip(&y_tiles[t + 1..]);
+        for ((cx, cy), column_best) in columns_after.zip(&mut best_tiles[t + 1..]) {
+            off_diagonal_tile((rx, ry), (cx, cy), &mut row_best, column_best);
         }
-        for (r, lanes) in row_best.iter().enumerate().take(n.saturating_sub(row)) {
-            let best = lanes.iter().fold(
-                columns.column_best[row + r],
-                |m, &d| if d < m { d } else { m },
-            );
+        let real_rows = n.saturating_sub(t * LANES);
+        for (lanes, &column) in row_best.iter().zip(&best_tiles[t]).take(real_rows) {
+            let best = lanes.iter().fold(column, |m, &d| if d < m { d } else { m });
             out.push(best.sqrt());
         }
     }
 }
 
-/// Pairs within the tile of rows `row..row + LANES`, each member against
-/// the others (its own lane is skipped).
-fn diagonal_tile(xs: &[f64], ys: &[f64], row: usize, row_best: &mut [[f64; LANES]; LANES]) {
+type Tile = [f64; LANES];
+
+/// Pairs within one tile of rows, each member against the others (its own
+/// lane is skipped).
+fn diagonal_tile(xs: &Tile, ys: &Tile, row_best: &mut [Tile; LANES]) {
     for (r, best) in row_best.iter_mut().enumerate() {
-        let (px, py) = (xs[row + r], ys[row + r]);
+        let (px, py) = (xs[r], ys[r]);
         for (lane, b) in best.iter_mut().enumerate() {
             if lane != r {
-                let (dx, dy) = (xs[row + lane] - px, ys[row + lane] - py);
+                let (dx, dy) = (xs[lane] - px, ys[lane] - py);
                 let d = dx * dx + dy * dy;
                 *b = if d < *b { d } else { *b };
             }
@@ -69,21 +69,15 @@ fn diagonal_tile(xs: &[f64], ys: &[f64], row: usize, row_best: &mut [[f64; LANES
     }
 }
 
-/// Pairs between the rows `row..row + LANES` and the columns
-/// `column..column + LANES`: row minima in `row_best` (per lane), column
-/// minima in `column_best`.
+/// Pairs between a tile of rows and a tile of columns: row minima in
+/// `row_best` (per lane), column minima in `column_best`.
 fn off_diagonal_tile(
-    xs: &[f64],
-    ys: &[f64],
-    row: usize,
-    column: usize,
-    row_best: &mut [[f64; LANES]; LANES],
-    column_best: &mut [f64; LANES],
+    (xs, ys): (&Tile, &Tile),
+    (cx, cy): (&Tile, &Tile),
+    row_best: &mut [Tile; LANES],
+    column_best: &mut Tile,
 ) {
-    let cx: &[f64; LANES] = xs[column..column + LANES].try_into().expect("whole tiles");
-    let cy: &[f64; LANES] = ys[column..column + LANES].try_into().expect("whole tiles");
-    for (r, best) in row_best.iter_mut().enumerate() {
-        let (px, py) = (xs[row + r], ys[row + r]);
+    for (best, (&px, &py)) in row_best.iter_mut().zip(xs.iter().zip(ys)) {
         for lane in 0..LANES {
             let (dx, dy) = (cx[lane] - px, cy[lane] - py);
             let d = dx * dx + dy * dy;
