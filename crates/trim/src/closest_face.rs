@@ -5,7 +5,7 @@
 //!
 //! A bounding-volume hierarchy of our own (the issue allows "your own
 //! BVH"): the faces ordered as a balanced kd-tree over their centroids
-//! (median splits on the longest axis, in parallel), groups of [`LEAF`]
+//! (median splits on the longest axis, in parallel), groups of `LEAF`
 //! consecutive faces as leaves, and each level above pairing consecutive
 //! boxes of the level below, so the tree needs no pointers. Building it
 //! is several times cheaper than parry's binned SAH hierarchy, which parry

@@ -169,36 +169,34 @@ fn eigenvector_in_complement(rows: [Point3; 3], w: Point3, value: f64) -> Point3
     let (u, v) = orthogonal_complement(w);
     let times = |x: Point3| [dot(rows[0], x), dot(rows[1], x), dot(rows[2], x)];
     let (au, av) = (times(u), times(v));
-    let mut m00 = dot(u, au) - value;
-    let mut m01 = dot(u, av);
-    let mut m11 = dot(v, av) - value;
-    let (abs00, abs01, abs11) = (m00.abs(), m01.abs(), m11.abs());
-    let combine = |a: f64, b: f64| [0, 1, 2].map(|i| a * u[i] - b * v[i]);
-    if abs00.max(abs01) >= abs11 {
-        if abs00.max(abs01) == 0.0 {
+    let m00 = dot(u, au) - value;
+    let m01 = dot(u, av);
+    let m11 = dot(v, av) - value;
+    let combine = |(a, b): (f64, f64)| [0, 1, 2].map(|i| a * u[i] - b * v[i]);
+    // The null vector of the 2×2 matrix is orthogonal to its larger row.
+    if m00.abs().max(m01.abs()) >= m11.abs() {
+        if m00 == 0.0 && m01 == 0.0 {
             return u;
         }
-        if abs00 >= abs01 {
-            m01 /= m00;
-            m00 = 1.0 / (1.0 + m01 * m01).sqrt();
-            m01 *= m00;
-        } else {
-            m00 /= m01;
-            m01 = 1.0 / (1.0 + m00 * m00).sqrt();
-            m00 *= m01;
-        }
-        combine(m01, m00)
+        let (c, s) = unit_pair(m00, m01);
+        combine((s, c))
     } else {
-        if abs11 >= abs01 {
-            m01 /= m11;
-            m11 = 1.0 / (1.0 + m01 * m01).sqrt();
-            m01 *= m11;
-        } else {
-            m11 /= m01;
-            m01 = 1.0 / (1.0 + m11 * m11).sqrt();
-            m11 *= m01;
-        }
-        combine(m11, m01)
+        let (c, s) = unit_pair(m11, m01);
+        combine((c, s))
+    }
+}
+
+/// (x, y) scaled to unit length with the sign of its larger component,
+/// dividing by that component first so that nothing overflows.
+fn unit_pair(x: f64, y: f64) -> (f64, f64) {
+    if x.abs() >= y.abs() {
+        let t = y / x;
+        let c = 1.0 / (1.0 + t * t).sqrt();
+        (c, t * c)
+    } else {
+        let t = x / y;
+        let s = 1.0 / (1.0 + t * t).sqrt();
+        (t * s, s)
     }
 }
 

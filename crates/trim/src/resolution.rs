@@ -14,7 +14,7 @@ use crate::frame::Point2;
 ///
 /// `out[j]` is the distance from `pts[j]` to the closest other member. The
 /// points are copied into coordinate columns, padded to whole tiles of
-/// [`LANES`], and the pairs are measured tile by tile over the upper
+/// `LANES`, and the pairs are measured tile by tile over the upper
 /// triangle of tiles only: each distance updates both its row's minimum and
 /// its column's, in independent lanes that the compiler turns into vector
 /// instructions. Half the pairs of a full row-by-row pass and no branch;

@@ -46,7 +46,7 @@
 //! # Noise
 //!
 //! [`SyntheticCloud::with_noise`] moves every point along its true normal by
-//! uniform(−p, p)·spacing[i]: p is a fraction of the intended local
+//! uniform(−p, p)·`spacing[i]`: p is a fraction of the intended local
 //! resolution (p = 0.25 is the paper's "25 % of the cloud resolution"). The
 //! paper moves points along the normal of the k-neighbourhood's best-fit
 //! plane by a percentage of β_i; on these smooth surfaces the true normal is

@@ -88,7 +88,7 @@ const BOX_EDGE: u32 = u32::MAX;
 
 /// Reusable buffers for [`largest_empty_circle_exceeds`]: the cell as a
 /// convex polygon, each vertex with the label of the edge that leaves it
-/// (the neighbour whose bisector it lies on, or [`BOX_EDGE`]).
+/// (the neighbour whose bisector it lies on, or `BOX_EDGE`).
 #[derive(Default, Debug, Clone)]
 pub struct CellScratch {
     poly: Vec<(Point2, u32)>,

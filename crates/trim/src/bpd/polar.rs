@@ -25,7 +25,7 @@
 //! - α = Σ Δθ and τ = Σ |Δθ| over the steps; linking stops when no
 //!   neighbour is left or τ > 2π; P_i is a boundary point iff |α| < 2π.
 //!
-//! Ties, within [`TIE`] (quantised clouds make angles, gaps and costs
+//! Ties, within `TIE` (10⁻⁹) (quantised clouds make angles, gaps and costs
 //! exactly equal, and rounding must not choose): γ goes to the lower
 //! neighbour index (neighbours are sorted by distance, then rank); equal
 //! largest gaps to the sector starting first counting round from the

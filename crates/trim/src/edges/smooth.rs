@@ -93,7 +93,7 @@ const LEVEL_RATIO: f64 = 1.1;
 /// … unless that would need more levels than this.
 const MAX_LEVELS: usize = 16;
 
-/// Smooths an open edge (corner to corner). `points` in order, `beta[i]` the local resolution at points[i] (> 0).
+/// Smooths an open edge (corner to corner). `points` in order, `beta[i]` the local resolution at `points[i]` (> 0).
 /// Returns one smoothed point per input point, at the same arc-length parameter; the first and last points are returned exactly (bit-identical) as given.
 pub fn smooth_open_edge(points: &[Point3], beta: &[f64]) -> Vec<Point3> {
     let n = points.len();
