@@ -104,7 +104,7 @@ pub fn run(args: &TrimArgs) -> Result<()> {
 /// Trims the mesh at `mesh_path` along the boundary of the cloud at
 /// `cloud_path` and writes it (atomically) to `output`; prints nothing, so
 /// `meshtrim batch` can run it on many files at once. The caller checks
-/// the paths (see [`check_paths`]).
+/// the paths (see `check_paths`).
 pub fn trim_file(
     mesh_path: &Path,
     cloud_path: &Path,

@@ -1,7 +1,7 @@
 //! `meshtrim batch INPUTS... --out-dir DIR`: clean or trim many meshes at
 //! once.
 //!
-//! The list of work is fixed first ([`plan`]): inputs expanded, sorted and
+//! The list of work is fixed first (`plan`): inputs expanded, sorted and
 //! de-duplicated, clouds paired, outputs checked, then this run's shard
 //! taken. The files then go through a pool of `--jobs` threads, which the
 //! library's own parallel loops share, so N jobs means N threads in all.
