@@ -23,7 +23,7 @@ use crate::anisotropy::{
     apply, own_sampling_vectors, sampling_moment, sampling_tensor_of_moments, whitening_map,
     SamplingMoment,
 };
-use crate::cloud::{check_not_degenerate, merge_duplicates, Point3, Sites};
+use crate::cloud::{check_not_degenerate, cross, merge_duplicates, Point3, Sites};
 use crate::error::CloudError;
 use crate::frame::{fit_plane, project, Frame, Point2};
 use crate::neighbours::{NeighbourIndex, RunScratch};
@@ -128,7 +128,7 @@ struct Neighbourhoods {
     k: usize,
     lists: Vec<u32>,
     /// Each position's sampling moment and plane, with anisotropy on.
-    sampling: Option<Vec<(SamplingMoment, Frame)>>,
+    sampling: Option<Vec<Sampling>>,
 }
 
 impl Neighbourhoods {
@@ -220,7 +220,7 @@ fn neighbourhoods(
     let index = NeighbourIndex::new(&points).with_ranks(&order);
     let mut lists = vec![0u32; points.len() * k];
     let mut sampling = options.anisotropy.then(|| {
-        let unset = ([0.0; 6], Frame::default());
+        let unset = Sampling::default();
         let mut all = Vec::with_capacity(points.len());
         all.par_extend(rayon::iter::repeat_n(unset, points.len()));
         all
@@ -280,19 +280,36 @@ fn neighbourhoods(
     }
 }
 
+/// A point's sampling moment and the plane of its neighbourhood, kept from
+/// the k-NN pass for the tests. The plane's v axis is not stored: it is
+/// n × u, as [`fit_plane`] computes it (96 bytes per point, not 120).
+#[derive(Debug, Clone, Copy, Default)]
+struct Sampling {
+    moment: SamplingMoment,
+    u: Point3,
+    normal: Point3,
+}
+
+impl Sampling {
+    fn frame(&self) -> Frame {
+        Frame {
+            u: self.u,
+            v: cross(self.normal, self.u),
+            normal: self.normal,
+        }
+    }
+}
+
 /// The plane of a neighbourhood (`members`, the point first) and the
 /// point's own sampling moment in it ([`crate::anisotropy`]).
-fn sampling_at(
-    points: &[Point3],
-    members: &[u32],
-    projected: &mut Vec<Point2>,
-) -> (SamplingMoment, Frame) {
+fn sampling_at(points: &[Point3], members: &[u32], projected: &mut Vec<Point2>) -> Sampling {
     let frame = fit_plane(points, members);
     project(points, members, &frame, projected);
-    (
-        sampling_moment(&own_sampling_vectors(projected, &frame)),
-        frame,
-    )
+    Sampling {
+        moment: sampling_moment(&own_sampling_vectors(projected, &frame)),
+        u: frame.u,
+        normal: frame.normal,
+    }
 }
 
 /// Most points per k-NN run (see [`NeighbourIndex::nearest_of_run`] and
@@ -416,16 +433,18 @@ struct Scratch {
 fn projected_beta(
     hoods: &Neighbourhoods,
     p: usize,
-    vectors: Option<&[(SamplingMoment, Frame)]>,
+    vectors: Option<&[Sampling]>,
     s: &mut Scratch,
 ) -> f64 {
     let members = hoods.at(p);
     // The first pass already fitted this neighbourhood's plane.
-    let frame = vectors.map_or_else(|| fit_plane(&hoods.points, members), |v| v[p].1);
+    let frame = vectors.map_or_else(|| fit_plane(&hoods.points, members), |v| v[p].frame());
     project(&hoods.points, members, &frame, &mut s.projected);
     if let Some(vectors) = vectors {
-        let tensor =
-            sampling_tensor_of_moments(&frame, members.iter().map(|&m| &vectors[m as usize].0));
+        let tensor = sampling_tensor_of_moments(
+            &frame,
+            members.iter().map(|&m| &vectors[m as usize].moment),
+        );
         let map = whitening_map(tensor);
         for q in s.projected.iter_mut() {
             *q = apply(&map, *q);
@@ -438,7 +457,7 @@ fn projected_beta(
 fn analyse_point(
     hoods: &Neighbourhoods,
     p: usize,
-    vectors: Option<&[(SamplingMoment, Frame)]>,
+    vectors: Option<&[Sampling]>,
     s: &mut Scratch,
     how: TestImpl,
 ) -> Verdict {
