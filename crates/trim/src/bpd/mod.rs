@@ -143,23 +143,26 @@ fn run(
     progress: &(dyn Fn(usize) + Sync),
     how: TestImpl,
 ) -> Result<Detection, CloudError> {
-    let sites = prepare(points, options)?;
-    let n = sites.points.len();
+    let Sites {
+        points: sites,
+        site_of,
+    } = prepare(points, options)?;
+    let n = sites.len();
     // Neighbourhoods (with each point's sampling moment when the map is on)
     // and the tests.
     let passes = 2;
     let report = |pass: usize| move |done: usize| progress((pass * n + done) / passes);
-    let hoods = neighbourhoods(&sites.points, options, how, &report(0));
+    let hoods = neighbourhoods(sites, options, how, &report(0));
     let vectors = hoods.sampling.as_deref();
     let verdicts = per_position(&hoods, how, &report(passes - 1), |s, p| {
         analyse_point(&hoods, p, vectors, s, how)
     });
-    let links = links_in_input_order(&sites, &hoods.order, &verdicts);
+    let links = links_in_input_order(&site_of, &hoods.order, &verdicts);
     let by_site = to_sites(
         &hoods.order,
         verdicts.iter().map(|v| (v.decision, v.beta)).collect(),
     );
-    let mut detection = spread_to_input(&sites, &by_site);
+    let mut detection = spread_to_input(&site_of, &by_site);
     detection.links = links;
     Ok(detection)
 }
@@ -169,9 +172,12 @@ fn run(
 /// [`detect_boundary`]'s `beta`, in about half the time. For a mesh's own
 /// vertices, whose border the mesh already knows (`crate::clean`).
 pub fn local_resolution(points: &[Point3], options: &BpdOptions) -> Result<Vec<f64>, CloudError> {
-    let sites = prepare(points, options)?;
+    let Sites {
+        points: sites,
+        site_of,
+    } = prepare(points, options)?;
     let how = TestImpl::Fast;
-    let hoods = neighbourhoods(&sites.points, options, how, &|_| {});
+    let hoods = neighbourhoods(sites, options, how, &|_| {});
     let betas = per_position(&hoods, how, &|_| {}, |s, p| {
         (
             Decision::Interior,
@@ -179,7 +185,7 @@ pub fn local_resolution(points: &[Point3], options: &BpdOptions) -> Result<Vec<f
         )
     });
     let by_site = to_sites(&hoods.order, betas);
-    Ok(spread_to_input(&sites, &by_site).beta)
+    Ok(spread_to_input(&site_of, &by_site).beta)
 }
 
 fn prepare(points: &[Point3], options: &BpdOptions) -> Result<Sites, CloudError> {
@@ -207,14 +213,16 @@ fn prepare(points: &[Point3], options: &BpdOptions) -> Result<Sites, CloudError>
 /// fast version computes right after the point's k-NN, while its
 /// neighbours are still in the cache.
 fn neighbourhoods(
-    sites: &[Point3],
+    sites: Vec<Point3>,
     options: &BpdOptions,
     how: TestImpl,
     progress: &(dyn Fn(usize) + Sync),
 ) -> Neighbourhoods {
     let k = options.k;
-    let (order, keys) = spatial_order(sites);
+    let (order, keys) = spatial_order(&sites);
     let points: Vec<Point3> = order.iter().map(|&i| sites[i as usize]).collect();
+    // The tests need only the copy in spatial order.
+    drop(sites);
     // Ties are broken by site index (input order), which, unlike the
     // spatial order, does not change when the cloud is moved.
     let index = NeighbourIndex::new(&points).with_ranks(&order);
@@ -361,9 +369,9 @@ fn to_sites<T: Copy>(order: &[u32], by_position: Vec<T>) -> Vec<T> {
 }
 
 /// The links found at each position, as pairs of input indices.
-fn links_in_input_order(sites: &Sites, order: &[u32], verdicts: &[Verdict]) -> Vec<[u32; 2]> {
-    let mut first_input = vec![u32::MAX; sites.points.len()];
-    for (input, &site) in sites.site_of.iter().enumerate().rev() {
+fn links_in_input_order(site_of: &[u32], order: &[u32], verdicts: &[Verdict]) -> Vec<[u32; 2]> {
+    let mut first_input = vec![u32::MAX; order.len()];
+    for (input, &site) in site_of.iter().enumerate().rev() {
         first_input[site as usize] = input as u32;
     }
     let input_of = |position: u32| first_input[order[position as usize] as usize];
@@ -381,17 +389,17 @@ fn links_in_input_order(sites: &Sites, order: &[u32], verdicts: &[Verdict]) -> V
     links
 }
 
-fn spread_to_input(sites: &Sites, verdicts: &[(Decision, f64)]) -> Detection {
+/// `verdicts` by site; `site_of` each input point's site.
+fn spread_to_input(site_of: &[u32], verdicts: &[(Decision, f64)]) -> Detection {
     let at = |i: &u32| verdicts[*i as usize];
     Detection {
-        boundary: sites
-            .site_of
+        boundary: site_of
             .iter()
             .map(|i| at(i).0 != Decision::Interior)
             .collect(),
-        beta: sites.site_of.iter().map(|i| at(i).1).collect(),
-        decision: sites.site_of.iter().map(|i| at(i).0).collect(),
-        duplicates: sites.duplicates(),
+        beta: site_of.iter().map(|i| at(i).1).collect(),
+        decision: site_of.iter().map(|i| at(i).0).collect(),
+        duplicates: site_of.len() - verdicts.len(),
         links: Vec::new(),
     }
 }
