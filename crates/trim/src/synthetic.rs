@@ -704,6 +704,22 @@ pub fn blade(spacing: f64, seed: u64) -> SyntheticCloud {
     )
 }
 
+/// [`blade`] with the sampling jitter's half-width chosen (a fraction of
+/// the pitch; [`JITTER`] is the default, 0 a perfect lattice in the
+/// parameter domain, as a decimated profile scan nearly is).
+pub fn blade_with_jitter(spacing: f64, jitter: f64, seed: u64) -> SyntheticCloud {
+    let region = blade_region(spacing);
+    let field = SpacingField::Uniform(spacing);
+    let samples = jittered_grid(&region, field, jitter, None, seed);
+    SyntheticCloud::build(
+        format!("blade {spacing} mm, jitter {jitter}"),
+        BLADE,
+        region,
+        field,
+        samples,
+    )
+}
+
 /// The blade with a pitch growing smoothly (geometrically) by ×10 along
 /// the span, from `min_spacing` at the root to 10·`min_spacing` at the tip
 /// (3.4 → 34 mm is the paper's cloud e), and one hole of radius
