@@ -181,14 +181,20 @@ impl NeighbourIndex<'_> {
             .unsorted()
             .without_distances()
             .visit(|found| s.candidates.push(found.item));
-        s.coords.clear();
-        s.coords
-            .extend(s.candidates.iter().map(|&j| self.points[j as usize]));
         s.rank_and_index.clear();
         s.rank_and_index.extend(
             s.candidates
                 .iter()
                 .map(|&j| (u64::from(self.rank(j)) << 32) | u64::from(j)),
+        );
+        // In rank order, a candidate's position breaks distance ties as its
+        // rank does (see `select_within`).
+        s.rank_and_index.sort_unstable();
+        s.coords.clear();
+        s.coords.extend(
+            s.rank_and_index
+                .iter()
+                .map(|&ri| self.points[(ri as u32) as usize]),
         );
     }
 
@@ -234,14 +240,17 @@ impl NeighbourIndex<'_> {
         s: &mut RunScratch,
         out: &mut [u32],
     ) -> bool {
+        if s.coords.len() > POSITION_MASK as usize {
+            return false; // positions would not fit their bits
+        }
         // Every candidate is written and only those within reach advance
         // the end: no branch to mispredict on a coin-flip test.
         s.keyed.clear();
-        s.keyed.resize(s.candidates.len(), 0);
+        s.keyed.resize(s.coords.len(), 0);
         let mut len = 0;
-        for (&rank_and_index, &q) in s.rank_and_index.iter().zip(&s.coords) {
+        for (position, &q) in s.coords.iter().enumerate() {
             let d = crate::cloud::dist2(p, q);
-            s.keyed[len] = (u128::from(tie_key(d)) << 64) | u128::from(rank_and_index);
+            s.keyed[len] = (tie_key(d) << POSITION_BITS) | position as u64;
             len += usize::from(d <= reach2);
         }
         s.keyed.truncate(len);
@@ -256,11 +265,11 @@ impl NeighbourIndex<'_> {
         // A point beyond the reach may tie with the k-th (its distance in
         // the same tie bin) and win on rank: only a k-th strictly below the
         // reach's bin proves the answer.
-        if (nearest[k - 1] >> 64) as u64 >= tie_key(reach2) {
+        if nearest[k - 1] >> POSITION_BITS >= tie_key(reach2) {
             return false;
         }
         for (o, n) in out.iter_mut().zip(nearest.iter()) {
-            *o = *n as u32;
+            *o = s.rank_and_index[(n & POSITION_MASK) as usize] as u32;
         }
         true
     }
@@ -285,13 +294,24 @@ pub struct RunScratch {
     single: Vec<u32>,
     candidates: Vec<u32>,
     coords: Vec<Point3>,
-    /// Each candidate's rank (high half) and index (low half).
+    /// Each candidate's rank (high half) and index (low half), sorted:
+    /// candidates in rank order.
     rank_and_index: Vec<u64>,
-    /// Candidates as one integer each that orders like (distance², rank,
-    /// index): the bits of a non-negative f64 order like the number, and
-    /// integer comparisons are what the selection and the sort do fastest.
-    keyed: Vec<u128>,
+    /// Candidates as one integer each that orders like (distance², rank):
+    /// the distance's [`tie_key`] above the candidate's position in
+    /// `rank_and_index` ([`POSITION_BITS`]). The bits of a non-negative f64
+    /// order like the number, and comparisons of one machine word are
+    /// what the selection and the sort do fastest.
+    keyed: Vec<u64>,
 }
+
+/// Bits of a candidate's position in its [`RunScratch::keyed`] key. A
+/// [`tie_key`] of a finite squared distance is below 2³⁷ (the f64's 63
+/// value bits less [`TIE_BITS`]), which leaves 27; a run with more
+/// candidates (2²⁷, only in clouds of over a hundred million points all
+/// within one gathering radius) falls back to tree queries.
+const POSITION_BITS: u32 = 64 - (63 - TIE_BITS);
+const POSITION_MASK: u64 = (1 << POSITION_BITS) - 1;
 
 /// The order key of a squared distance: its bits rounded to drop the
 /// lowest [`TIE_BITS`], so that distances within 2⁻²⁶ ≈ 1.5·10⁻⁸ of each
