@@ -7,14 +7,17 @@
 //!   quantised coordinates (many exact distance ties), duplicates, a stray
 //!   line of points, any scale; and their labels survive a generic
 //!   rotation and a move 10⁵ units away, which round every coordinate.
-//! - The whole job (detect, edges, trim) moves with the part.
+//! - The whole job (detect, edges, trim) moves with the part; so does the
+//!   border cleanup of a triangulated scan.
 //! - Trimming a mesh that overshoots the cloud gives a valid mesh, no
 //!   larger than the input, the same on every run.
 
 use proptest::prelude::*;
 use trim::bpd::detect_boundary_reference;
+use trim::clean::{clean_mesh, CleanOptions};
 use trim::edges::{reconstruct_edges, EdgeOptions};
 use trim::mesh::Mesh;
+use trim::synthetic::jagged::jagged_mesh;
 use trim::synthetic::{jittered_grid, Circle, Region, SpacingField, Surface};
 use trim::trimming::trim_mesh;
 use trim::{detect_boundary, BpdOptions, Point3};
@@ -256,6 +259,42 @@ proptest! {
         prop_assert_eq!(loops, loops2);
         prop_assert_eq!(&out.faces, &out2.faces);
         // Coordinates round at the shift's scale (1e5: about 1.5e-11).
+        for (a, b) in out.vertices.iter().zip(&out2.vertices) {
+            for k in 0..3 {
+                prop_assert!((a[k] + shift - b[k]).abs() < 1e-6, "{:?} {:?}", a, b);
+            }
+        }
+    }
+
+    #[test]
+    fn border_cleanup_moves_with_the_part(
+        seed in 0u64..1_000_000,
+        spacing in prop_oneof![Just(1.5), Just(2.0)],
+        disc in any::<bool>(),
+        shift in prop_oneof![Just(1e3), Just(1e5)],
+    ) {
+        let truth = if disc {
+            trim::synthetic::curved_disc_with_hole(spacing + 1.0, seed)
+        } else {
+            trim::synthetic::notched_plate(spacing, seed)
+        };
+        let mesh = jagged_mesh(&truth);
+        let job = |mesh: &Mesh| {
+            let detection = detect_boundary(&mesh.vertices, &BpdOptions::default()).unwrap();
+            clean_mesh(mesh, &detection.beta, &CleanOptions::default()).unwrap()
+        };
+        let (out, report) = job(&mesh);
+        let moved = Mesh {
+            vertices: mesh.vertices.iter().map(|p| p.map(|c| c + shift)).collect(),
+            faces: mesh.faces.clone(),
+        };
+        let (out2, report2) = job(&moved);
+        // Not vacuous: the border was replaced.
+        prop_assert!(report.loops_smoothed > 0 && report.faces_added > 0);
+        prop_assert_eq!(&out.faces, &out2.faces);
+        prop_assert_eq!(report.loops_smoothed, report2.loops_smoothed);
+        prop_assert_eq!(report.faces_added, report2.faces_added);
+        prop_assert_eq!(&report.loops_left, &report2.loops_left);
         for (a, b) in out.vertices.iter().zip(&out2.vertices) {
             for k in 0..3 {
                 prop_assert!((a[k] + shift - b[k]).abs() < 1e-6, "{:?} {:?}", a, b);
