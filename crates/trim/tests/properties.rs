@@ -7,14 +7,16 @@
 //!   quantised coordinates (many exact distance ties), duplicates, a stray
 //!   line of points, any scale; and their labels survive a generic
 //!   rotation and a move 10⁵ units away, which round every coordinate.
-//! - The whole job (detect, edges, trim) moves with the part; so does the
-//!   border cleanup of a triangulated scan.
+//! - The whole job (detect, edges, trim) moves with the part; so do the
+//!   border cleanup of a triangulated scan and the Delaunay mesh of a
+//!   cloud.
 //! - Trimming a mesh that overshoots the cloud gives a valid mesh, no
 //!   larger than the input, the same on every run.
 
 use proptest::prelude::*;
 use trim::bpd::detect_boundary_reference;
 use trim::clean::{clean_mesh, CleanOptions};
+use trim::delaunay::delaunay_mesh;
 use trim::edges::{reconstruct_edges, EdgeOptions};
 use trim::mesh::Mesh;
 use trim::synthetic::jagged::jagged_mesh;
@@ -299,6 +301,42 @@ proptest! {
             for k in 0..3 {
                 prop_assert!((a[k] + shift - b[k]).abs() < 1e-6, "{:?} {:?}", a, b);
             }
+        }
+    }
+
+    #[test]
+    fn the_delaunay_mesh_moves_with_the_part(
+        seed in 0u64..1_000_000,
+        quantum in prop_oneof![Just(0.0), Just(0.05)],
+        shift in prop_oneof![Just(1e3), Just(1e5)],
+    ) {
+        let quantise = |p: Point3| if quantum > 0.0 { p.map(|c| (c / quantum).round() * quantum) } else { p };
+        let cloud: Vec<Point3> = patch(seed, 0.8).into_iter().map(quantise).collect();
+        let job = |cloud: &[Point3]| {
+            let detection = detect_boundary(cloud, &BpdOptions::default()).unwrap();
+            let edges = reconstruct_edges(cloud, &detection, &EdgeOptions::default());
+            delaunay_mesh(cloud, &detection, &edges).unwrap()
+        };
+        let out = job(&cloud);
+        let moved: Vec<Point3> = cloud.iter().map(|p| p.map(|c| c + shift)).collect();
+        let out2 = job(&moved);
+        prop_assert!(!out.faces.is_empty());
+        prop_assert_eq!(out.vertices.len(), out2.vertices.len());
+        for (a, b) in out.vertices.iter().zip(&out2.vertices) {
+            for k in 0..3 {
+                prop_assert!((a[k] + shift - b[k]).abs() < 1e-6, "{:?} {:?}", a, b);
+            }
+        }
+        if quantum == 0.0 {
+            prop_assert_eq!(&out.faces, &out2.faces);
+        } else {
+            // A quantised cloud has exactly co-circular quads (rectangles of
+            // its lattice), where either diagonal is Delaunay and the last
+            // bits of the projected coordinates choose (docs/trimming.md,
+            // "The Delaunay path"): the same border and the same number of
+            // faces, the diagonals free.
+            prop_assert_eq!(out.faces.len(), out2.faces.len());
+            prop_assert_eq!(out.boundary_loops(), out2.boundary_loops());
         }
     }
 }
