@@ -3,7 +3,8 @@
 //!
 //! - Detection does not depend on the order of the input points (labels
 //!   exactly; β to the last bits, summed in neighbour order).
-//! - The fast detection equals the reference one on awkward clouds:
+//! - The fast detection equals the reference one, for any k, on awkward
+//!   clouds:
 //!   quantised coordinates (many exact distance ties), duplicates, a stray
 //!   line of points, any scale; and their labels survive a generic
 //!   rotation and a move 10⁵ units away, which round every coordinate.
@@ -112,6 +113,33 @@ proptest! {
             .collect();
         mapped.sort_unstable();
         prop_assert_eq!(mapped, a.links.clone());
+    }
+
+    #[test]
+    fn fast_detection_equals_the_reference_for_any_k(
+        seed in 0u64..1_000_000,
+        k in prop_oneof![Just(4usize), Just(7), Just(16), Just(45), Just(64)],
+        h in prop_oneof![Just(0.5), Just(1.2)],
+        quantum in prop_oneof![Just(0.0), Just(0.05)],
+        duplicates in 0usize..40,
+        anisotropy in any::<bool>(),
+    ) {
+        let mut cloud = patch(seed, h);
+        if quantum > 0.0 {
+            for p in &mut cloud {
+                *p = p.map(|c| (c / quantum).round() * quantum);
+            }
+        }
+        let n = cloud.len();
+        for i in 0..duplicates {
+            cloud.push(cloud[(i * 7919) % n]);
+        }
+        let options = BpdOptions { k, anisotropy };
+        let fast = detect_boundary(&cloud, &options).unwrap();
+        let plain = detect_boundary_reference(&cloud, &options).unwrap();
+        prop_assert_eq!(&fast.boundary, &plain.boundary);
+        prop_assert_eq!(&fast.beta, &plain.beta);
+        prop_assert_eq!(&fast.links, &plain.links);
     }
 
     #[test]
