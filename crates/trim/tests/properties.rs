@@ -11,6 +11,7 @@
 //! - The whole job (detect, edges, trim) moves with the part; so do the
 //!   border cleanup of a triangulated scan and the Delaunay mesh of a
 //!   cloud.
+//! - Trimming does not depend on the order of the cloud's points.
 //! - Trimming a mesh that overshoots the cloud gives a valid mesh, no
 //!   larger than the input, the same on every run.
 
@@ -365,6 +366,31 @@ proptest! {
             // faces, the diagonals free.
             prop_assert_eq!(out.faces.len(), out2.faces.len());
             prop_assert_eq!(out.boundary_loops(), out2.boundary_loops());
+        }
+    }
+
+    #[test]
+    fn trimming_does_not_depend_on_the_cloud_order(
+        seed in 0u64..1_000_000,
+        shuffle in any::<u64>(),
+    ) {
+        // Unquantised: on a quantised cloud exact distance ties go by input
+        // order already in BPD (docs/bpd.md, "Ties and duplicates").
+        let cloud = patch(seed, 0.8);
+        let order = permutation(cloud.len(), shuffle);
+        let shuffled: Vec<Point3> = order.iter().map(|&i| cloud[i]).collect();
+        let mesh = overshooting_mesh(seed, 2.0, 0.7);
+        let job = |cloud: &[Point3]| {
+            let detection = detect_boundary(cloud, &BpdOptions::default()).unwrap();
+            let edges = reconstruct_edges(cloud, &detection, &EdgeOptions::default());
+            trim_mesh(&mesh, cloud, &detection, &edges).unwrap().0
+        };
+        let (out, out2) = (job(&cloud), job(&shuffled));
+        prop_assert_eq!(&out.faces, &out2.faces);
+        for (a, b) in out.vertices.iter().zip(&out2.vertices) {
+            for k in 0..3 {
+                prop_assert!((a[k] - b[k]).abs() < 1e-6, "{:?} {:?}", a, b);
+            }
         }
     }
 }

@@ -23,8 +23,8 @@ pub mod split;
 use rayon::prelude::*;
 
 use crate::bpd::Detection;
-use crate::cloud::{sub, Point3};
-use crate::neighbours::NeighbourIndex;
+use crate::cloud::{dist2, sub, Point3};
+use crate::neighbours::{tie_key, NeighbourIndex};
 
 /// Options of edge reconstruction.
 #[derive(Debug, Clone, PartialEq)]
@@ -94,12 +94,13 @@ pub struct Edges {
 /// Reconstructs the boundary edges of a cloud from its BPD result: loops,
 /// corners and smoothed edges (see the module doc for the steps).
 pub fn reconstruct_edges(points: &[Point3], detection: &Detection, options: &EdgeOptions) -> Edges {
-    let clusters = cluster::cluster_boundary(&detection.boundary, &detection.links);
+    let canon = CanonicalBoundary::new(points, detection);
+    let clusters = cluster::cluster_boundary(&canon.boundary, &canon.links);
     let tours: Vec<Vec<u32>> = clusters
         .clusters
         .par_iter()
         .zip(&clusters.links)
-        .map(|(members, links)| order::closed_tour(points, members, links))
+        .map(|(members, links)| order::closed_tour(&canon.points, members, links))
         .collect();
     // A tour that jumps (a step longer than 3β that no link supports) went
     // across the surface between borders its cluster joins: it is cut at
@@ -107,7 +108,7 @@ pub fn reconstruct_edges(points: &[Point3], detection: &Detection, options: &Edg
     let split: Vec<(Vec<Vec<u32>>, usize)> = tours
         .into_par_iter()
         .zip(&clusters.links)
-        .map(|(tour, links)| split::split_at_jumps(points, &detection.beta, links, tour))
+        .map(|(tour, links)| split::split_at_jumps(&canon.points, &canon.beta, links, tour))
         .collect();
     let dropped_pieces: usize = split.iter().map(|t| t.1).sum();
     let mut tours: Vec<Vec<u32>> = split.into_iter().flat_map(|t| t.0).collect();
@@ -117,12 +118,71 @@ pub fn reconstruct_edges(points: &[Point3], detection: &Detection, options: &Edg
     let clustered: usize = clusters.clusters.iter().map(Vec::len).sum();
     let loops = tours
         .into_par_iter()
-        .map(|tour| loop_from_tour(points, &detection.beta, tour, index.as_ref()))
+        .map(|tour| {
+            let tour = tour.iter().map(|&c| canon.input[c as usize]).collect();
+            loop_from_tour(points, &detection.beta, tour, index.as_ref())
+        })
         .collect();
     Edges {
         loops,
         dropped_clusters: clusters.dropped_clusters + dropped_pieces,
         thinned_points: clusters.thinned_points + (clustered - on_loops.len()),
+    }
+}
+
+/// The boundary points renumbered 0, 1, … in an order of their own
+/// geometry, in which edge reconstruction works: so every tie-break, each
+/// tour's start and direction and the order of the loops follow the points,
+/// not the order in which the cloud was written (the edges of a shuffled
+/// cloud are the same), nor where it sits (the order is by squared distance
+/// from the boundary points' centroid in [`tie_key`] bins, which a rigid
+/// motion does not change; equal bins, e.g. the symmetric points of a
+/// quantised cloud, go by input index).
+struct CanonicalBoundary {
+    /// Input index of each renumbered point.
+    input: Vec<u32>,
+    /// Their positions and local resolutions.
+    points: Vec<Point3>,
+    beta: Vec<f64>,
+    /// All true: every renumbered point is a boundary point.
+    boundary: Vec<bool>,
+    /// BPD's links between them, renumbered, smaller first, sorted.
+    links: Vec<[u32; 2]>,
+}
+
+impl CanonicalBoundary {
+    fn new(points: &[Point3], detection: &Detection) -> Self {
+        let mut input: Vec<u32> = (0..points.len() as u32)
+            .filter(|&i| detection.boundary[i as usize])
+            .collect();
+        let n = input.len().max(1) as f64;
+        let mut centre = [0.0; 3];
+        for &i in &input {
+            for (c, x) in centre.iter_mut().zip(points[i as usize]) {
+                *c += x / n;
+            }
+        }
+        input.sort_by_cached_key(|&i| (tie_key(dist2(points[i as usize], centre)), i));
+        let mut renumbered = vec![u32::MAX; points.len()];
+        for (c, &i) in input.iter().enumerate() {
+            renumbered[i as usize] = c as u32;
+        }
+        let mut links: Vec<[u32; 2]> = detection
+            .links
+            .iter()
+            .map(|&[a, b]| (renumbered[a as usize], renumbered[b as usize]))
+            .filter(|&(a, b)| a != u32::MAX && b != u32::MAX)
+            .map(|(a, b)| [a.min(b), a.max(b)])
+            .collect();
+        links.sort_unstable();
+        links.dedup();
+        Self {
+            points: input.iter().map(|&i| points[i as usize]).collect(),
+            beta: input.iter().map(|&i| detection.beta[i as usize]).collect(),
+            boundary: vec![true; input.len()],
+            input,
+            links,
+        }
     }
 }
 
