@@ -38,6 +38,44 @@ fn patch(seed: u64, h: f64) -> Vec<Point3> {
         .collect()
 }
 
+/// [`patch`] with every coordinate rounded to a multiple of `quantum`
+/// (none when 0), as scanners write them.
+fn quantised_patch(seed: u64, h: f64, quantum: f64) -> Vec<Point3> {
+    let quantise = |p: Point3| {
+        if quantum > 0.0 {
+            p.map(|c| (c / quantum).round() * quantum)
+        } else {
+            p
+        }
+    };
+    patch(seed, h).into_iter().map(quantise).collect()
+}
+
+/// `points` moved by `shift` along every axis.
+fn moved(points: &[Point3], shift: f64) -> Vec<Point3> {
+    points.iter().map(|p| p.map(|c| c + shift)).collect()
+}
+
+/// `mesh` moved by `shift` along every axis.
+fn moved_mesh(mesh: &Mesh, shift: f64) -> Mesh {
+    Mesh {
+        vertices: moved(&mesh.vertices, shift),
+        faces: mesh.faces.clone(),
+    }
+}
+
+/// Each of `there` is the same of `here` moved by `shift`, within 10⁻⁶
+/// (coordinates round at the shift's scale: 1e5 rounds at about 1.5e-11).
+fn assert_moved(here: &[Point3], there: &[Point3], shift: f64) -> Result<(), TestCaseError> {
+    prop_assert_eq!(here.len(), there.len());
+    for (a, b) in here.iter().zip(there) {
+        for k in 0..3 {
+            prop_assert!((a[k] + shift - b[k]).abs() < 1e-6, "{:?} {:?}", a, b);
+        }
+    }
+    Ok(())
+}
+
 fn surface(seed: u64) -> Surface {
     match seed % 3 {
         0 => Surface::Plane,
@@ -125,12 +163,7 @@ proptest! {
         duplicates in 0usize..40,
         anisotropy in any::<bool>(),
     ) {
-        let mut cloud = patch(seed, h);
-        if quantum > 0.0 {
-            for p in &mut cloud {
-                *p = p.map(|c| (c / quantum).round() * quantum);
-            }
-        }
+        let mut cloud = quantised_patch(seed, h, quantum);
         let n = cloud.len();
         for i in 0..duplicates {
             cloud.push(cloud[(i * 7919) % n]);
@@ -270,8 +303,7 @@ proptest! {
         quantum in prop_oneof![Just(0.0), Just(0.05)],
         shift in prop_oneof![Just(1e3), Just(1e5)],
     ) {
-        let quantise = |p: Point3| if quantum > 0.0 { p.map(|c| (c / quantum).round() * quantum) } else { p };
-        let cloud: Vec<Point3> = patch(seed, 0.8).into_iter().map(quantise).collect();
+        let cloud = quantised_patch(seed, 0.8, quantum);
         let mesh = overshooting_mesh(seed, 2.0, 0.7);
         let job = |cloud: &[Point3], mesh: &Mesh| {
             let detection = detect_boundary(cloud, &BpdOptions::default()).unwrap();
@@ -280,21 +312,11 @@ proptest! {
             (detection.boundary, edges.loops.len(), out)
         };
         let (labels, loops, out) = job(&cloud, &mesh);
-        let moved_cloud: Vec<Point3> = cloud.iter().map(|p| p.map(|c| c + shift)).collect();
-        let moved_mesh = Mesh {
-            vertices: mesh.vertices.iter().map(|p| p.map(|c| c + shift)).collect(),
-            faces: mesh.faces.clone(),
-        };
-        let (labels2, loops2, out2) = job(&moved_cloud, &moved_mesh);
+        let (labels2, loops2, out2) = job(&moved(&cloud, shift), &moved_mesh(&mesh, shift));
         prop_assert_eq!(labels, labels2);
         prop_assert_eq!(loops, loops2);
         prop_assert_eq!(&out.faces, &out2.faces);
-        // Coordinates round at the shift's scale (1e5: about 1.5e-11).
-        for (a, b) in out.vertices.iter().zip(&out2.vertices) {
-            for k in 0..3 {
-                prop_assert!((a[k] + shift - b[k]).abs() < 1e-6, "{:?} {:?}", a, b);
-            }
-        }
+        assert_moved(&out.vertices, &out2.vertices, shift)?;
     }
 
     #[test]
@@ -315,22 +337,14 @@ proptest! {
             clean_mesh(mesh, &detection.beta, &CleanOptions::default()).unwrap()
         };
         let (out, report) = job(&mesh);
-        let moved = Mesh {
-            vertices: mesh.vertices.iter().map(|p| p.map(|c| c + shift)).collect(),
-            faces: mesh.faces.clone(),
-        };
-        let (out2, report2) = job(&moved);
+        let (out2, report2) = job(&moved_mesh(&mesh, shift));
         // Not vacuous: the border was replaced.
         prop_assert!(report.loops_smoothed > 0 && report.faces_added > 0);
         prop_assert_eq!(&out.faces, &out2.faces);
         prop_assert_eq!(report.loops_smoothed, report2.loops_smoothed);
         prop_assert_eq!(report.faces_added, report2.faces_added);
         prop_assert_eq!(&report.loops_left, &report2.loops_left);
-        for (a, b) in out.vertices.iter().zip(&out2.vertices) {
-            for k in 0..3 {
-                prop_assert!((a[k] + shift - b[k]).abs() < 1e-6, "{:?} {:?}", a, b);
-            }
-        }
+        assert_moved(&out.vertices, &out2.vertices, shift)?;
     }
 
     #[test]
@@ -339,23 +353,15 @@ proptest! {
         quantum in prop_oneof![Just(0.0), Just(0.05)],
         shift in prop_oneof![Just(1e3), Just(1e5)],
     ) {
-        let quantise = |p: Point3| if quantum > 0.0 { p.map(|c| (c / quantum).round() * quantum) } else { p };
-        let cloud: Vec<Point3> = patch(seed, 0.8).into_iter().map(quantise).collect();
+        let cloud = quantised_patch(seed, 0.8, quantum);
         let job = |cloud: &[Point3]| {
             let detection = detect_boundary(cloud, &BpdOptions::default()).unwrap();
             let edges = reconstruct_edges(cloud, &detection, &EdgeOptions::default());
             delaunay_mesh(cloud, &detection, &edges).unwrap()
         };
-        let out = job(&cloud);
-        let moved: Vec<Point3> = cloud.iter().map(|p| p.map(|c| c + shift)).collect();
-        let out2 = job(&moved);
+        let (out, out2) = (job(&cloud), job(&moved(&cloud, shift)));
         prop_assert!(!out.faces.is_empty());
-        prop_assert_eq!(out.vertices.len(), out2.vertices.len());
-        for (a, b) in out.vertices.iter().zip(&out2.vertices) {
-            for k in 0..3 {
-                prop_assert!((a[k] + shift - b[k]).abs() < 1e-6, "{:?} {:?}", a, b);
-            }
-        }
+        assert_moved(&out.vertices, &out2.vertices, shift)?;
         if quantum == 0.0 {
             prop_assert_eq!(&out.faces, &out2.faces);
         } else {
@@ -387,10 +393,6 @@ proptest! {
         };
         let (out, out2) = (job(&cloud), job(&shuffled));
         prop_assert_eq!(&out.faces, &out2.faces);
-        for (a, b) in out.vertices.iter().zip(&out2.vertices) {
-            for k in 0..3 {
-                prop_assert!((a[k] - b[k]).abs() < 1e-6, "{:?} {:?}", a, b);
-            }
-        }
+        assert_moved(&out.vertices, &out2.vertices, 0.0)?;
     }
 }
