@@ -11,7 +11,8 @@
 //! - The whole job (detect, edges, trim) moves with the part; so do the
 //!   border cleanup of a triangulated scan and the Delaunay mesh of a
 //!   cloud.
-//! - Trimming does not depend on the order of the cloud's points.
+//! - Trimming and the Delaunay mesh do not depend on the order of the
+//!   cloud's points.
 //! - Trimming a mesh that overshoots the cloud gives a valid mesh, no
 //!   larger than the input, the same on every run.
 
@@ -394,5 +395,37 @@ proptest! {
         let (out, out2) = (job(&cloud), job(&shuffled));
         prop_assert_eq!(&out.faces, &out2.faces);
         assert_moved(&out.vertices, &out2.vertices, 0.0)?;
+    }
+
+    #[test]
+    fn the_delaunay_mesh_does_not_depend_on_the_cloud_order(
+        seed in 0u64..1_000_000,
+        shuffle in any::<u64>(),
+    ) {
+        let cloud = patch(seed, 0.8);
+        let order = permutation(cloud.len(), shuffle);
+        let shuffled: Vec<Point3> = order.iter().map(|&i| cloud[i]).collect();
+        let job = |cloud: &[Point3]| {
+            let detection = detect_boundary(cloud, &BpdOptions::default()).unwrap();
+            let edges = reconstruct_edges(cloud, &detection, &EdgeOptions::default());
+            delaunay_mesh(cloud, &detection, &edges).unwrap()
+        };
+        let (out, out2) = (job(&cloud), job(&shuffled));
+        // The same triangles over the same positions, whatever the numbering.
+        let triangles = |m: &Mesh| {
+            let mut t: Vec<[[u64; 3]; 3]> = m
+                .faces
+                .iter()
+                .map(|f| {
+                    let mut corners = f.map(|v| m.vertices[v as usize].map(f64::to_bits));
+                    let first = (0..3).min_by_key(|&k| corners[k]).unwrap_or(0);
+                    corners.rotate_left(first);
+                    corners
+                })
+                .collect();
+            t.sort_unstable();
+            t
+        };
+        prop_assert_eq!(triangles(&out), triangles(&out2));
     }
 }
