@@ -38,7 +38,12 @@
 //!    its segments added as constraint edges.
 //! 6. **Kept faces.** The faces are classified exactly by a flood fill from
 //!    the outside that flips parity across every constraint edge: odd faces
-//!    (inside the outer border and outside the holes) are kept. They are
+//!    (inside the outer border and outside the holes) are kept. Co-circular
+//!    quads (the lattice rectangles of quantised clouds), where either
+//!    diagonal is Delaunay, take the one through their lowest id
+//!    ([`diagonals`]), and the faces are listed in the order of their ids,
+//!    so that moving the cloud, which rounds its coordinates, changes
+//!    nothing. They are
 //!    lifted back to 3D: cloud points keep their exact coordinates, loop
 //!    vertices take their smoothed 3D positions. Faces are
 //!    counter-clockwise seen from the plane normal's side; so the outer
@@ -58,6 +63,8 @@
 //! below [`DEGENERATE`]·β² (β the median resolution) are counted in the
 //! report, not removed.
 
+use std::collections::{HashMap, HashSet};
+
 use rayon::prelude::*;
 use spade::handles::{FixedFaceHandle, FixedVertexHandle, InnerTag};
 use spade::{
@@ -72,6 +79,9 @@ use crate::error::MeshError;
 use crate::frame::fit_plane;
 use crate::mesh::Mesh;
 use crate::neighbours::NeighbourIndex;
+
+pub mod diagonals;
+use diagonals::canonical_diagonals;
 
 /// Neighbourhood size of the local normals of the height-field check.
 pub const NORMAL_K: usize = 30;
@@ -117,6 +127,9 @@ pub struct DelaunayReport {
     pub misfit_triangles_percent: f64,
     /// Faces below [`DEGENERATE`]·β² (kept, counted).
     pub degenerate_faces: usize,
+    /// Diagonals of co-circular quads flipped to their canonical side
+    /// ([`diagonals`]).
+    pub diagonals_flipped: usize,
     /// For each smoothed loop, its vertices in the output, in loop order.
     pub loops: Vec<Vec<u32>>,
     /// Unit normal of the best-fit plane; faces are counter-clockwise seen
@@ -286,10 +299,11 @@ pub fn delaunay_mesh_with_report(
         ring_handles[l] = hs;
     }
 
-    // 6. Kept faces, lifted.
+    // 6. Kept faces, co-circular quads made canonical, lifted.
     let kept = inside_faces(&cdt);
     let mut out_index = vec![u32::MAX; n + loop_p3.len()];
     let mut faces_ids: Vec<[u32; 3]> = Vec::with_capacity(kept.len());
+    let mut positions = HashMap::new();
     for f in kept {
         let face = cdt.face(f);
         let vs = face.vertices();
@@ -300,10 +314,28 @@ pub fn delaunay_mesh_with_report(
             ids.swap(1, 2);
         }
         faces_ids.push(ids);
-        for id in ids {
+        for (id, p) in vs.map(|v| v.data().id).into_iter().zip(p) {
             out_index[id as usize] = 0;
+            positions.insert(id, [p.x, p.y]);
         }
     }
+    let constraints: HashSet<[u32; 2]> = ring_handles
+        .iter()
+        .flat_map(|hs| {
+            (0..hs.len()).map(|j| {
+                let [a, b] = [hs[j], hs[(j + 1) % hs.len()]].map(|h| cdt.vertex(h).data().id);
+                [a.min(b), a.max(b)]
+            })
+        })
+        .collect();
+    report.diagonals_flipped = canonical_diagonals(&positions, &mut faces_ids, &constraints);
+    // Faces in an order of their own ids (the triangulation's internal
+    // order depends on its history), each starting at its lowest id.
+    for f in faces_ids.iter_mut() {
+        let first = (0..3).min_by_key(|&k| f[k]).unwrap_or(0);
+        f.rotate_left(first);
+    }
+    faces_ids.sort_unstable();
     let mut vertices = Vec::new();
     let mut reference = Vec::new();
     for (id, slot) in out_index.iter_mut().enumerate() {
