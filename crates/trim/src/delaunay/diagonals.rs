@@ -14,6 +14,8 @@
 
 use std::collections::{HashMap, HashSet};
 
+use super::orient;
+
 /// Quads whose in-circle determinant is below this, relative to the
 /// fourth power of their size, count as co-circular. Far above the rounding
 /// of coordinates 10⁵ spacings from the origin (about 10⁻¹⁰ relative),
@@ -110,10 +112,7 @@ fn cocircular(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> bool {
 /// Is the quad p, q, r, s (in this order) strictly convex and
 /// counter-clockwise?
 fn convex(p: [f64; 2], q: [f64; 2], r: [f64; 2], s: [f64; 2]) -> bool {
-    let turn = |a: [f64; 2], b: [f64; 2], c: [f64; 2]| {
-        (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
-    };
-    turn(p, q, r) > 0.0 && turn(q, r, s) > 0.0 && turn(r, s, p) > 0.0 && turn(s, p, q) > 0.0
+    orient(p, q, r) > 0.0 && orient(q, r, s) > 0.0 && orient(r, s, p) > 0.0 && orient(s, p, q) > 0.0
 }
 
 #[cfg(test)]
@@ -162,11 +161,10 @@ mod tests {
         canonical_diagonals(&positions, &mut a, &none);
         canonical_diagonals(&positions, &mut b, &none);
         assert_eq!(canonical(a.clone()), canonical(b));
-        // Every square's diagonal holds its lowest corner (id(i, j)).
+        // Every face stays counter-clockwise.
         for f in &a {
             let [x, y, z] = f.map(|v| positions[&v]);
-            let area = (y[0] - x[0]) * (z[1] - x[1]) - (y[1] - x[1]) * (z[0] - x[0]);
-            assert!(area > 0.0, "{f:?} is not counter-clockwise");
+            assert!(orient(x, y, z) > 0.0, "{f:?} is not counter-clockwise");
         }
     }
 
