@@ -32,6 +32,9 @@ pub struct Report {
     pub loops: usize,
     /// Loop vertices dropped to untwist self-crossing loops.
     pub loop_vertices_dropped: usize,
+    /// Diagonals of co-circular quads (quantised clouds) flipped to the
+    /// canonical side.
+    pub diagonals_flipped: usize,
     /// Output faces.
     pub faces: usize,
     /// Output area.
@@ -97,6 +100,7 @@ impl Report {
             points_near_loop: made.points_near_loop,
             loops: made.loops.len(),
             loop_vertices_dropped: made.loop_vertices_dropped,
+            diagonals_flipped: made.diagonals_flipped,
             faces,
             area: made.area,
             read_ms: millis(read),
@@ -117,6 +121,7 @@ impl crate::report::Table for Report {
             ("points on a loop", self.points_near_loop.to_string()),
             ("loops", self.loops.to_string()),
             ("faces", self.faces.to_string()),
+            ("diagonals flipped", self.diagonals_flipped.to_string()),
             ("area", format!("{:.6}", self.area)),
             ("read time", format!("{:.1} ms", self.read_ms)),
             ("detect time", format!("{:.1} ms", self.detect_ms)),

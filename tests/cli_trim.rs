@@ -215,3 +215,57 @@ fn the_main_job_takes_the_stage_options() {
     );
     assert!(out.exists());
 }
+
+#[test]
+fn the_delaunay_path_gives_the_same_faces_for_a_moved_quantised_cloud() {
+    // A plate with a square hole on an exact lattice (every cell a
+    // co-circular quad), as written at the origin and 1000 units away.
+    let dir = temp_dir();
+    let lattice = |shift: f64| -> String {
+        (0..40 * 30)
+            .map(|k| (k % 40, k / 40))
+            .filter(|&(i, j)| !((15..22).contains(&i) && (10..17).contains(&j)))
+            .map(|(i, j)| {
+                format!(
+                    "{} {} {}\n",
+                    f64::from(i) * 0.5 + shift,
+                    f64::from(j) * 0.5 + shift,
+                    shift
+                )
+            })
+            .collect()
+    };
+    let mut meshes = Vec::new();
+    for (name, shift) in [("here", 0.0), ("there", 1000.0)] {
+        let cloud = path(dir.path(), &format!("{name}.xyz"));
+        std::fs::write(&cloud, lattice(shift)).unwrap();
+        let out = path(dir.path(), &format!("{name}.ply"));
+        let run = meshtrim(
+            &[
+                "mesh",
+                cloud.to_str().unwrap(),
+                out.to_str().unwrap(),
+                "--json",
+            ],
+            None,
+        );
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let json: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+        assert_eq!(json["loops"], 2, "{json}");
+        meshes.push(meshtrim::io::read_mesh(&out).unwrap());
+    }
+    let (here, there) = (&meshes[0], &meshes[1]);
+    assert!(here.faces.as_ref().is_some_and(|f| f.len() > 1000));
+    assert_eq!(here.faces, there.faces);
+    assert_eq!(here.vertices.len(), there.vertices.len());
+    for (a, b) in here.vertices.iter().zip(&there.vertices) {
+        assert!(
+            (0..3).all(|k| (a[k] + 1000.0 - b[k]).abs() < 1e-6),
+            "{a:?} {b:?}"
+        );
+    }
+}
