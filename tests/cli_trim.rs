@@ -18,6 +18,18 @@ fn temp_dir() -> tempfile::TempDir {
     tempfile::tempdir().expect("temporary directory")
 }
 
+/// Runs meshtrim with `args` (which ask for `--json`), asserts that it
+/// succeeded and returns the JSON it printed.
+fn succeeds_with_json(args: &[&str]) -> serde_json::Value {
+    let run = meshtrim(args, None);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    serde_json::from_slice(&run.stdout).unwrap()
+}
+
 fn path(dir: &Path, name: &str) -> PathBuf {
     dir.join(name)
 }
@@ -159,13 +171,7 @@ fn an_output_naming_an_input_is_refused() {
 fn the_delaunay_path_meshes_the_cloud_and_refuses_a_folded_surface() {
     let dir = temp_dir();
     let out = path(dir.path(), "delaunay.ply");
-    let run = meshtrim(&["mesh", CLOUD, out.to_str().unwrap(), "--json"], None);
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
-    let json: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+    let json = succeeds_with_json(&["mesh", CLOUD, out.to_str().unwrap(), "--json"]);
     assert_eq!(json["loops"], 4, "{json}");
     assert!(json["faces"].as_u64().unwrap() > 1000, "{json}");
     // A cylinder patch covering 300° of arc folds over any plane.
@@ -240,21 +246,12 @@ fn the_delaunay_path_gives_the_same_faces_for_a_moved_quantised_cloud() {
         let cloud = path(dir.path(), &format!("{name}.xyz"));
         std::fs::write(&cloud, lattice(shift)).unwrap();
         let out = path(dir.path(), &format!("{name}.ply"));
-        let run = meshtrim(
-            &[
-                "mesh",
-                cloud.to_str().unwrap(),
-                out.to_str().unwrap(),
-                "--json",
-            ],
-            None,
-        );
-        assert!(
-            run.status.success(),
-            "{}",
-            String::from_utf8_lossy(&run.stderr)
-        );
-        let json: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+        let json = succeeds_with_json(&[
+            "mesh",
+            cloud.to_str().unwrap(),
+            out.to_str().unwrap(),
+            "--json",
+        ]);
         assert_eq!(json["loops"], 2, "{json}");
         meshes.push(meshtrim::io::read_mesh(&out).unwrap());
     }

@@ -512,7 +512,19 @@ fn jittered(
     field: SpacingField,
     seed: u64,
 ) -> SyntheticCloud {
-    let samples = jittered_grid(&region, field, JITTER, None, seed);
+    jittered_by(name, surface, region, field, JITTER, seed)
+}
+
+/// [`jittered`] with the jitter's half-width chosen.
+fn jittered_by(
+    name: String,
+    surface: Surface,
+    region: Region,
+    field: SpacingField,
+    jitter: f64,
+    seed: u64,
+) -> SyntheticCloud {
+    let samples = jittered_grid(&region, field, jitter, None, seed);
     SyntheticCloud::build(name, surface, region, field, samples)
 }
 
@@ -708,15 +720,13 @@ pub fn blade(spacing: f64, seed: u64) -> SyntheticCloud {
 /// the pitch; [`JITTER`] is the default, 0 a perfect lattice in the
 /// parameter domain, as a decimated profile scan nearly is).
 pub fn blade_with_jitter(spacing: f64, jitter: f64, seed: u64) -> SyntheticCloud {
-    let region = blade_region(spacing);
-    let field = SpacingField::Uniform(spacing);
-    let samples = jittered_grid(&region, field, jitter, None, seed);
-    SyntheticCloud::build(
+    jittered_by(
         format!("blade {spacing} mm, jitter {jitter}"),
         BLADE,
-        region,
-        field,
-        samples,
+        blade_region(spacing),
+        SpacingField::Uniform(spacing),
+        jitter,
+        seed,
     )
 }
 

@@ -279,7 +279,7 @@ impl Walls {
                 continue;
             }
             let t = (dot(sub(v, pa), ab) / len2).clamp(0.0, 1.0);
-            let q = [0, 1, 2].map(|c| pa[c] + t * ab[c]);
+            let q = lerp(pa, pb, t);
             let d = dist2(v, q);
             if d < best.0 && t > 0.0 && t < 1.0 {
                 let out = unit_or(lerp(self.vertex_out(a), self.vertex_out(b), t), self.out[a]);
@@ -329,7 +329,7 @@ impl Walls {
             let len2 = norm2(ab);
             if len2 > 0.0 {
                 let t = (dot(sub(v, pa), ab) / len2).clamp(0.0, 1.0);
-                best = best.min(dist2(v, [0, 1, 2].map(|c| pa[c] + t * ab[c])));
+                best = best.min(dist2(v, lerp(pa, pb, t)));
             }
         }
         best.sqrt()
