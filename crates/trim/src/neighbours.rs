@@ -202,6 +202,7 @@ impl NeighbourIndex<'_> {
                 .iter()
                 .map(|&ri| self.points[(ri as u32) as usize]),
         );
+        s.keyed.resize(s.coords.len(), 0);
     }
 
     /// The run's point closest to the run's mean.
@@ -250,23 +251,23 @@ impl NeighbourIndex<'_> {
             return false; // positions would not fit their bits
         }
         // Every candidate is written and only those within reach advance
-        // the end: no branch to mispredict on a coin-flip test.
-        s.keyed.clear();
-        s.keyed.resize(s.coords.len(), 0);
+        // the end: no branch to mispredict on a coin-flip test. `keyed`
+        // has one slot per candidate since the gathering, so it is not
+        // cleared per query.
         let mut len = 0;
         for (position, &q) in s.coords.iter().enumerate() {
             let d = crate::cloud::dist2(p, q);
             s.keyed[len] = (tie_key(d) << POSITION_BITS) | position as u64;
             len += usize::from(d <= reach2);
         }
-        s.keyed.truncate(len);
-        if s.keyed.len() < k {
+        let within = &mut s.keyed[..len];
+        if within.len() < k {
             return false;
         }
-        if s.keyed.len() > k {
-            s.keyed.select_nth_unstable(k - 1);
+        if within.len() > k {
+            within.select_nth_unstable(k - 1);
         }
-        let nearest = &mut s.keyed[..k];
+        let nearest = &mut within[..k];
         nearest.sort_unstable();
         // A point beyond the reach may tie with the k-th (its distance in
         // the same tie bin) and win on rank: only a k-th strictly below the
