@@ -53,29 +53,23 @@ pub fn merge_duplicates(points: &[Point3]) -> Result<Sites, CloudError> {
             z: p[2],
         });
     }
-    // Sort (coordinate bits, index) pairs: +0.0 and -0.0 are the same
-    // point. The keys are sorted inline, not looked up through the index
-    // at every comparison, which missed the cache on large clouds (a
-    // third of the time of this step at 1M points). (key, index) is a
-    // total order, so the parallel sort does not depend on the threads.
+    // Sort indices by coordinate bits (+0.0 and -0.0 are the same point).
     let key = |p: &Point3| p.map(|c| (c + 0.0).to_bits());
-    let mut keyed: Vec<([u64; 3], u32)> = points
-        .par_iter()
-        .enumerate()
-        .map(|(i, p)| (key(p), i as u32))
-        .collect();
-    keyed.par_sort_unstable();
-    // Each run of equal keys starts with its lowest index, the site's
-    // first occurrence in the input.
-    let mut first_of_run = vec![0u32; points.len()];
-    for run in keyed.chunk_by(|a, b| a.0 == b.0) {
-        let first = run[0].1;
-        for &(_, i) in run {
-            first_of_run[i as usize] = first;
-        }
-    }
-    drop(keyed);
+    // Sorted in parallel: (key, index) is a total order, so the result
+    // does not depend on the threads.
+    let mut order: Vec<u32> = (0..points.len() as u32).collect();
+    order.par_sort_unstable_by_key(|&i| (key(&points[i as usize]), i));
     let mut site_of = vec![u32::MAX; points.len()];
+    let mut first_of_run = vec![0u32; points.len()];
+    for w in 0..order.len() {
+        let i = order[w];
+        let same_as_prev = w > 0 && key(&points[order[w - 1] as usize]) == key(&points[i as usize]);
+        first_of_run[i as usize] = if same_as_prev {
+            first_of_run[order[w - 1] as usize]
+        } else {
+            i
+        };
+    }
     let mut sites = Vec::new();
     for i in 0..points.len() {
         let first = first_of_run[i] as usize;
