@@ -220,7 +220,7 @@ fn neighbourhoods(
 ) -> Neighbourhoods {
     let k = options.k;
     let (order, keys) = spatial_order(&sites);
-    let points: Vec<Point3> = order.iter().map(|&i| sites[i as usize]).collect();
+    let points: Vec<Point3> = order.par_iter().map(|&i| sites[i as usize]).collect();
     // The tests need only the copy in spatial order.
     drop(sites);
     // Ties are broken by site index (input order), which, unlike the
@@ -518,21 +518,25 @@ fn analyse_point(
 /// consecutive queries touch the same part of the tree, and their Morton
 /// keys in that order.
 fn spatial_order(points: &[Point3]) -> (Vec<u32>, Vec<u64>) {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in points {
-        for a in 0..3 {
-            lo[a] = lo[a].min(p[a]);
-            hi[a] = hi[a].max(p[a]);
-        }
-    }
+    // Minima and maxima are exact whatever the split, and the keys are
+    // computed point by point: the parallel passes give the serial result.
+    let (lo, hi) = points
+        .par_iter()
+        .fold(
+            || ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
+            |(lo, hi), p| (min3(lo, *p), max3(hi, *p)),
+        )
+        .reduce(
+            || ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
+            |(lo_a, hi_a), (lo_b, hi_b)| (min3(lo_a, lo_b), max3(hi_a, hi_b)),
+        );
     let extent = (0..3)
         .map(|a| hi[a] - lo[a])
         .fold(0.0, f64::max)
         .max(f64::MIN_POSITIVE);
     let scale = ((1u64 << 21) - 1) as f64 / extent;
     let mut keyed: Vec<(u64, u32)> = points
-        .iter()
+        .par_iter()
         .enumerate()
         .map(|(i, p)| {
             let cell = |a: usize| ((p[a] - lo[a]) * scale) as u64;
@@ -543,7 +547,15 @@ fn spatial_order(points: &[Point3]) -> (Vec<u32>, Vec<u64>) {
         })
         .collect();
     keyed.par_sort_unstable();
-    keyed.into_iter().map(|(key, i)| (i, key)).unzip()
+    keyed.into_par_iter().map(|(key, i)| (i, key)).unzip()
+}
+
+fn min3(a: Point3, b: Point3) -> Point3 {
+    [0, 1, 2].map(|i| a[i].min(b[i]))
+}
+
+fn max3(a: Point3, b: Point3) -> Point3 {
+    [0, 1, 2].map(|i| a[i].max(b[i]))
 }
 
 /// Splits sorted Morton `keys` into runs of at most `max` consecutive
