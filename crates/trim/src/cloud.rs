@@ -98,12 +98,15 @@ pub fn check_not_degenerate(points: &[Point3]) -> Result<(), CloudError> {
             what: "one point",
         });
     };
+    // In parallel, with the index as the last key so that the farthest
+    // point is the serial `max_by`'s (the last of equals) whatever the
+    // split.
     let far = |from: Point3| {
         points
-            .iter()
-            .copied()
-            .max_by(|p, q| dist2(*p, from).total_cmp(&dist2(*q, from)))
-            .unwrap_or(from)
+            .par_iter()
+            .enumerate()
+            .max_by(|(i, p), (j, q)| dist2(**p, from).total_cmp(&dist2(**q, from)).then(i.cmp(j)))
+            .map_or(from, |(_, p)| *p)
     };
     let b = far(a);
     let extent2 = dist2(a, b);
@@ -115,9 +118,9 @@ pub fn check_not_degenerate(points: &[Point3]) -> Result<(), CloudError> {
     }
     let ab = sub(b, a);
     let off_line2 = points
-        .iter()
+        .par_iter()
         .map(|p| norm2(cross(ab, sub(*p, a))) / extent2)
-        .fold(0.0, f64::max);
+        .reduce(|| 0.0, f64::max);
     // Farthest distance from the line a-b, relative to the extent.
     if off_line2 <= extent2 * 1e-20 {
         return Err(CloudError::Degenerate {
