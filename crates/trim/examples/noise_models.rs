@@ -27,12 +27,7 @@ use trim::{detect_boundary, BpdOptions, Detection};
 const SEED: u64 = 7;
 
 fn main() {
-    let mut clouds: Vec<SyntheticCloud> = [4.0, 8.0, 16.0, 34.0]
-        .into_iter()
-        .enumerate()
-        .map(|(i, h)| synthetic::blade(h, 10 + i as u64))
-        .collect();
-    clouds.push(synthetic::variable_density(3.4, 5));
+    let clouds = synthetic::noise_sweep_clouds();
     let options = BpdOptions::default();
     println!("| cloud | A: uniform ±p·h, true normal | B: exactly ±p·h, true normal | C: +p·β, PCA normal (MATLAB sign) | D: ±p·β, PCA normal |");
     println!("|---|---|---|---|---|");

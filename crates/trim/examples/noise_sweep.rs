@@ -5,16 +5,11 @@
 //! `cargo run --release -p meshtrim-trim --example noise_sweep`
 
 use trim::evaluate::{noise_robustness, percent_sweep, precision_recall};
-use trim::synthetic::{self, SyntheticCloud};
+use trim::synthetic;
 use trim::{detect_boundary, BpdOptions};
 
 fn main() {
-    let mut clouds: Vec<SyntheticCloud> = [4.0, 8.0, 16.0, 34.0]
-        .into_iter()
-        .enumerate()
-        .map(|(i, h)| synthetic::blade(h, 10 + i as u64))
-        .collect();
-    clouds.push(synthetic::variable_density(3.4, 5));
+    let clouds = synthetic::noise_sweep_clouds();
     // The paper's 1 % steps, up to 200 %.
     let sweep = percent_sweep(1.0, 200.0);
     println!(

@@ -716,6 +716,19 @@ pub fn blade(spacing: f64, seed: u64) -> SyntheticCloud {
     )
 }
 
+/// The clouds of the noise sweeps (section 4 of the paper; the Ω / Ψ
+/// tables in `docs/results.md`): [`blade`] at 4, 8, 16 and 34 mm (seeds
+/// 10–13) and [`variable_density`] from 3.4 mm (the paper's cloud e).
+pub fn noise_sweep_clouds() -> Vec<SyntheticCloud> {
+    let mut clouds: Vec<SyntheticCloud> = [4.0, 8.0, 16.0, 34.0]
+        .into_iter()
+        .zip(10..)
+        .map(|(h, seed)| blade(h, seed))
+        .collect();
+    clouds.push(variable_density(3.4, 5));
+    clouds
+}
+
 /// [`blade`] with the sampling jitter's half-width chosen (a fraction of
 /// the pitch; [`JITTER`] is the default, 0 a perfect lattice in the
 /// parameter domain, as a decimated profile scan nearly is).
