@@ -10,6 +10,7 @@ use serde::Serialize;
 use trim::{BpdOptions, CloudError, Detection};
 
 use crate::cli::DetectArgs;
+use crate::console;
 use crate::io::atomic::write_atomic;
 use crate::io::labels::{LabelFormat, Labelled};
 use crate::io::{read_cloud, Cloud, Point3};
@@ -66,14 +67,14 @@ pub fn run(args: &DetectArgs) -> Result<()> {
     }
     let summary = Summary::new(args, &cloud, &detection, read_time, detect_time);
     if args.json {
-        println!("{}", serde_json::to_string(&summary)?);
+        console::print_line(&serde_json::to_string(&summary)?)
     } else {
-        print!("{}", summary.table());
+        let mut text = summary.table();
         if let Some((path, _)) = &output {
-            println!("{:<20} {}", "output", path.display());
+            text += &format!("{:<20} {}\n", "output", path.display());
         }
+        console::print(&text)
     }
-    Ok(())
 }
 
 /// The output's format; refuses unknown extensions and the input itself.

@@ -10,6 +10,7 @@ use trim::edges::{reconstruct_edges, EdgeOptions, Edges};
 use trim::Detection;
 
 use crate::cli::EdgesArgs;
+use crate::console;
 use crate::detect::{millis, read_and_detect, same_file, Detected};
 use crate::io::atomic::write_atomic;
 use crate::io::edges_out::{EdgeData, EdgesFormat};
@@ -70,12 +71,15 @@ pub fn run(args: &EdgesArgs) -> Result<()> {
     let times = [read_time, detect_time, edges_time];
     let summary = Summary::new(args, &cloud, &detection, &edges, times);
     if args.json {
-        println!("{}", serde_json::to_string(&summary)?);
+        console::print_line(&serde_json::to_string(&summary)?)
     } else {
-        print!("{}", summary.table());
-        println!("{:<20} {}", "output", args.output.display());
+        let table = summary.table();
+        console::print(&format!(
+            "{table}{:<20} {}\n",
+            "output",
+            args.output.display()
+        ))
     }
-    Ok(())
 }
 
 /// The output's format; refuses unknown extensions and the input itself.

@@ -10,10 +10,12 @@
 //! - [`edges`] is the `meshtrim edges` subcommand.
 //! - [`clean_cmd`] is `meshtrim clean`.
 //! - [`batch`] is `meshtrim batch`: many meshes at once.
+//! - [`console`] prints summaries to stdout; a closed pipe is not an error.
 
 pub mod batch;
 pub mod clean_cmd;
 pub mod cli;
+pub mod console;
 pub mod detect;
 pub mod edges;
 pub mod io;

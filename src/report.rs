@@ -6,6 +6,7 @@ use std::path::Path;
 use anyhow::Result;
 use serde::Serialize;
 
+use crate::console;
 use crate::io::atomic::write_atomic;
 
 /// A command's report that can print itself as a two-column table.
@@ -22,11 +23,10 @@ pub fn emit<R: Serialize + Table>(report: &R, file: Option<&Path>, json: bool) -
         write_atomic(path, |w| w.write_all(text.as_bytes()))?;
     }
     if json {
-        println!("{}", serde_json::to_string(report)?);
+        console::print_line(&serde_json::to_string(report)?)
     } else {
-        print!("{}", report.table());
+        console::print(&report.table())
     }
-    Ok(())
 }
 
 /// Lays out (label, value) rows as the commands print them.

@@ -177,6 +177,48 @@ fn existing_output_is_replaced_atomically() {
     assert_eq!(names, ["labels.ply"]);
 }
 
+/// A reader that has gone away (`meshtrim … | head -c 0`) does not make a
+/// command panic: its files are written and it succeeds. The pipe's read
+/// end is closed before the run, so every write to stdout fails with a
+/// broken pipe (`println!` panicked there until stop 12).
+#[test]
+fn a_closed_stdout_pipe_is_not_a_panic() {
+    let dir = tempfile::tempdir().unwrap();
+    let labels = dir.path().join("labels.csv");
+    let edges = dir.path().join("edges.obj");
+    let trimmed = dir.path().join("trimmed.ply");
+    let mesh = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/fixtures/meshes/blade_small_poisson.ply"
+    );
+    let cloud = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/fixtures/meshes/blade_small.ply"
+    );
+    let runs: [(&[&str], &Path); 4] = [
+        (&["detect", FIXTURE, "-o", path_str(&labels)], &labels),
+        (
+            &["detect", FIXTURE, "-o", path_str(&labels), "--json"],
+            &labels,
+        ),
+        (&["edges", FIXTURE, "-o", path_str(&edges)], &edges),
+        (&[mesh, cloud, path_str(&trimmed)], &trimmed),
+    ];
+    for (args, output) in runs {
+        let _ = std::fs::remove_file(output);
+        let (reader, writer) = std::io::pipe().expect("a pipe");
+        drop(reader);
+        let run = Command::new(env!("CARGO_BIN_EXE_meshtrim"))
+            .args(args)
+            .stdout(writer)
+            .output()
+            .expect("the meshtrim binary runs");
+        assert!(run.status.success(), "{args:?}: {}", stderr(&run));
+        assert!(!stderr(&run).contains("panicked"), "{args:?}");
+        assert!(output.is_file(), "{args:?} wrote {}", output.display());
+    }
+}
+
 /// Runs `detect` on `input` with an output in a fresh directory, and checks
 /// the failure: exit code 1, the file named, the expected words, no panic,
 /// no output and nothing else left in the output directory.

@@ -24,6 +24,7 @@ use rayon::prelude::*;
 
 use crate::clean_cmd::{clean_file, CleanSettings};
 use crate::cli::BatchArgs;
+use crate::console;
 use crate::detect::millis;
 use crate::trim::{trim_file, TrimSettings};
 
@@ -61,7 +62,7 @@ pub fn run(args: &BatchArgs) -> Result<()> {
     if let (Some(path), Some(format)) = (&args.report, report_format) {
         totals.write(path, format)?;
     }
-    println!("{}", totals.summary());
+    console::print_line(&totals.summary())?;
     let failed = totals.count(Status::Failed);
     if failed > 0 {
         bail!("{failed} of {} files failed", rows.len());
@@ -83,7 +84,9 @@ fn process_all(jobs: &[Job], args: &BatchArgs) -> Result<Vec<Row>> {
             .map(|job| {
                 let row = process(job, args);
                 // Printed above the bar, which is redrawn below it.
-                bar.suspend(|| println!("{}", row.line()));
+                // Best effort: a failing stdout must not stop the files;
+                // the summary below reports it.
+                bar.suspend(|| console::print_line(&row.line())).ok();
                 bar.inc(1);
                 row
             })
