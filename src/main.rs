@@ -1,5 +1,6 @@
 //! `meshtrim`: parse the command line, run, report errors as one line.
 
+use std::io::Write;
 use std::process::ExitCode;
 
 use clap::Parser;
@@ -12,7 +13,9 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             // `{:#}` joins the context chain: "error: FILE: what went wrong".
-            eprintln!("error: {e:#}");
+            // Written, not `eprintln!`ed: a closed stderr pipe must not turn
+            // the error into a panic; the exit code still says it failed.
+            let _ = writeln!(std::io::stderr(), "error: {e:#}");
             ExitCode::FAILURE
         }
     }

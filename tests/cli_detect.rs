@@ -217,6 +217,18 @@ fn a_closed_stdout_pipe_is_not_a_panic() {
         assert!(!stderr(&run).contains("panicked"), "{args:?}");
         assert!(output.is_file(), "{args:?} wrote {}", output.display());
     }
+    // A failing run whose stderr is the closed pipe too still exits with 1
+    // (a panic would give 101).
+    let (reader, writer) = std::io::pipe().expect("a pipe");
+    drop(reader);
+    let missing = dir.path().join("missing.ply");
+    let run = Command::new(env!("CARGO_BIN_EXE_meshtrim"))
+        .args(["detect", path_str(&missing), "-o", path_str(&labels)])
+        .stdout(writer.try_clone().expect("a second write end"))
+        .stderr(writer)
+        .status()
+        .expect("the meshtrim binary runs");
+    assert_eq!(run.code(), Some(1));
 }
 
 /// Runs `detect` on `input` with an output in a fresh directory, and checks
