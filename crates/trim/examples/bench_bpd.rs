@@ -25,7 +25,7 @@ fn main() {
         "linescan" => twisted_sheet(n, 4.0, 7),
         _ => twisted_sheet(n, 1.0, 7),
     };
-    if let Some(path) = args.get(3) {
+    if let Some(path) = args.get(3).filter(|p| !p.is_empty()) {
         write_ply(path, &cloud).expect("write the cloud");
     }
     let default_repeat = if cloud.len() <= 1_500_000 { 3 } else { 1 };
