@@ -71,7 +71,7 @@ pub fn run(args: &DetectArgs) -> Result<()> {
     } else {
         let mut text = summary.table();
         if let Some((path, _)) = &output {
-            text += &format!("{:<20} {}\n", "output", path.display());
+            text += &crate::report::rows(&[("output", path.display().to_string())]);
         }
         console::print(&text)
     }

@@ -73,12 +73,8 @@ pub fn run(args: &EdgesArgs) -> Result<()> {
     if args.json {
         console::print_line(&serde_json::to_string(&summary)?)
     } else {
-        let table = summary.table();
-        console::print(&format!(
-            "{table}{:<20} {}\n",
-            "output",
-            args.output.display()
-        ))
+        let output = crate::report::rows(&[("output", args.output.display().to_string())]);
+        console::print(&(summary.table() + &output))
     }
 }
 
