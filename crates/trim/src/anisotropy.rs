@@ -61,6 +61,8 @@ pub type SamplingVectors = [Point3; 2];
 
 /// e1 and e2 of the investigated point `projected[0]` (at the origin) within
 /// its projected neighbourhood, lifted back to 3D with the frame's axes.
+// Baseline and AVX2 variants, chosen at run time (crate doc, "Vector kernels").
+#[multiversion::multiversion(targets("x86_64+avx2"))]
 pub fn own_sampling_vectors(projected: &[Point2], frame: &Frame) -> SamplingVectors {
     let lift = |e: Option<Point2>| {
         e.map_or([0.0; 3], |e| {
@@ -167,6 +169,7 @@ pub fn whitening_map(t: [f64; 3]) -> Map2 {
 
 /// Vector from `pts[j]` to its nearest other member; with `away_from`, only
 /// members whose direction is at least 60° from that vector's line count.
+#[inline]
 fn nearest_vector(pts: &[Point2], j: usize, away_from: Option<Point2>) -> Option<Point2> {
     let p = pts[j];
     // The best so far by its distance's tie key: near-equal distances tie

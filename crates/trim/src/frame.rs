@@ -31,6 +31,8 @@ pub struct Frame {
 ///
 /// Degenerate neighbourhoods (all members on a line) still get a frame whose
 /// `u` axis follows the line; callers decide what that means.
+// Baseline and AVX2 variants, chosen at run time (crate doc, "Vector kernels").
+#[multiversion::multiversion(targets("x86_64+avx2"))]
 pub fn fit_plane(points: &[Point3], members: &[u32]) -> Frame {
     let n = members.len() as f64;
     let origin = points[members[0] as usize];
@@ -224,6 +226,8 @@ fn canonical_sign(a: Point3) -> Point3 {
 }
 
 /// Projects `members` onto the frame's plane, relative to `points[members[0]]`.
+// Baseline and AVX2 variants, chosen at run time (crate doc, "Vector kernels").
+#[multiversion::multiversion(targets("x86_64+avx2"))]
 pub fn project(points: &[Point3], members: &[u32], frame: &Frame, out: &mut Vec<Point2>) {
     out.clear();
     let origin = points[members[0] as usize];

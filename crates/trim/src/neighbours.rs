@@ -139,7 +139,7 @@ impl NeighbourIndex<'_> {
             let reach = gather - slack(gather);
             let mut own = std::mem::take(&mut s.centre);
             own.resize(k, 0);
-            let found = self.select_within(pc, reach * reach, k, s, &mut own);
+            let found = select_within(pc, reach * reach, k, s, &mut own);
             s.centre = own;
             found.then(|| (dist(pc, self.points[s.centre[k - 1] as usize]), gather))
         });
@@ -234,52 +234,48 @@ impl NeighbourIndex<'_> {
         s: &mut RunScratch,
         out: &mut [u32],
     ) -> bool {
-        (guess2 < reach2 && self.select_within(p, guess2, k, s, out))
-            || self.select_within(p, reach2, k, s, out)
+        (guess2 < reach2 && select_within(p, guess2, k, s, out))
+            || select_within(p, reach2, k, s, out)
     }
+}
 
-    /// [`Self::select_nearest`] with one radius.
-    fn select_within(
-        &self,
-        p: Point3,
-        reach2: f64,
-        k: usize,
-        s: &mut RunScratch,
-        out: &mut [u32],
-    ) -> bool {
-        if s.coords.len() > POSITION_MASK as usize {
-            return false; // positions would not fit their bits
-        }
-        // Every candidate is written and only those within reach advance
-        // the end: no branch to mispredict on a coin-flip test. `keyed`
-        // has one slot per candidate since the gathering, so it is not
-        // cleared per query.
-        let mut len = 0;
-        for (position, &q) in s.coords.iter().enumerate() {
-            let d = crate::cloud::dist2(p, q);
-            s.keyed[len] = (tie_key(d) << POSITION_BITS) | position as u64;
-            len += usize::from(d <= reach2);
-        }
-        let within = &mut s.keyed[..len];
-        if within.len() < k {
-            return false;
-        }
-        if within.len() > k {
-            within.select_nth_unstable(k - 1);
-        }
-        let nearest = &mut within[..k];
-        nearest.sort_unstable();
-        // A point beyond the reach may tie with the k-th (its distance in
-        // the same tie bin) and win on rank: only a k-th strictly below the
-        // reach's bin proves the answer.
-        if nearest[k - 1] >> POSITION_BITS >= tie_key(reach2) {
-            return false;
-        }
-        for (o, n) in out.iter_mut().zip(nearest.iter()) {
-            *o = s.rank_and_index[(n & POSITION_MASK) as usize] as u32;
-        }
-        true
+/// [`NeighbourIndex::select_nearest`] with one radius (it reads only the
+/// gathered candidates in `s`).
+// Baseline and AVX2 variants, chosen at run time (crate doc, "Vector kernels").
+#[multiversion::multiversion(targets("x86_64+avx2"))]
+fn select_within(p: Point3, reach2: f64, k: usize, s: &mut RunScratch, out: &mut [u32]) -> bool {
+    if s.coords.len() > POSITION_MASK as usize {
+        return false; // positions would not fit their bits
     }
+    // Every candidate is written and only those within reach advance
+    // the end: no branch to mispredict on a coin-flip test. `keyed`
+    // has one slot per candidate since the gathering, so it is not
+    // cleared per query.
+    let mut len = 0;
+    for (position, &q) in s.coords.iter().enumerate() {
+        let d = crate::cloud::dist2(p, q);
+        s.keyed[len] = (tie_key(d) << POSITION_BITS) | position as u64;
+        len += usize::from(d <= reach2);
+    }
+    let within = &mut s.keyed[..len];
+    if within.len() < k {
+        return false;
+    }
+    if within.len() > k {
+        within.select_nth_unstable(k - 1);
+    }
+    let nearest = &mut within[..k];
+    nearest.sort_unstable();
+    // A point beyond the reach may tie with the k-th (its distance in
+    // the same tie bin) and win on rank: only a k-th strictly below the
+    // reach's bin proves the answer.
+    if nearest[k - 1] >> POSITION_BITS >= tie_key(reach2) {
+        return false;
+    }
+    for (o, n) in out.iter_mut().zip(nearest.iter()) {
+        *o = s.rank_and_index[(n & POSITION_MASK) as usize] as u32;
+    }
+    true
 }
 
 /// Point count from which (and subtree size down to which) the tree is

@@ -20,6 +20,8 @@ use crate::frame::Point2;
 /// instructions. Half the pairs of a full row-by-row pass and no branch;
 /// minima do not depend on the order and a − b = −(b − a) exactly, so the
 /// results equal [`nearest_distances_reference`]'s.
+// Baseline and AVX2 variants, chosen at run time (crate doc, "Vector kernels").
+#[multiversion::multiversion(targets("x86_64+avx2"))]
 pub fn nearest_distances(pts: &[Point2], out: &mut Vec<f64>, columns: &mut Columns) {
     let n = pts.len();
     let padded = n.div_ceil(LANES) * LANES;

@@ -101,6 +101,8 @@ pub struct CellScratch {
 /// `nb` are the neighbours relative to P_i, nearest first. When the answer
 /// is true the cell in `s` is complete, and [`boundary_neighbours`] can read
 /// it.
+// Baseline and AVX2 variants, chosen at run time (crate doc, "Vector kernels").
+#[multiversion::multiversion(targets("x86_64+avx2"))]
 pub fn largest_empty_circle_exceeds(nb: &[Point2], beta: f64, s: &mut CellScratch) -> bool {
     let reach = nb
         .iter()

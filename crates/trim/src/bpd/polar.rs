@@ -54,6 +54,8 @@ pub struct PolarScratch {
 
 /// Runs the surrounding-path test on neighbours `nb` (relative to P_i,
 /// non-zero). Returns true when no path surrounds P_i: a boundary point.
+// Baseline and AVX2 variants, chosen at run time (crate doc, "Vector kernels").
+#[multiversion::multiversion(targets("x86_64+avx2"))]
 pub fn surrounding_path_is_open(nb: &[Point2], s: &mut PolarScratch) -> bool {
     if nb.len() < 2 {
         return true;
