@@ -139,7 +139,7 @@ impl NeighbourIndex<'_> {
             let reach = gather - slack(gather);
             let mut own = std::mem::take(&mut s.centre);
             own.resize(k, 0);
-            let found = select_within(pc, reach * reach, k, s, &mut own);
+            let found = select_within(pc, 0.0, reach * reach, k, s, &mut own);
             s.centre = own;
             found.then(|| (dist(pc, self.points[s.centre[k - 1] as usize]), gather))
         });
@@ -170,7 +170,7 @@ impl NeighbourIndex<'_> {
             // c's k nearest), so the nearer of the two radii loses nothing.
             let reach = (gather - from_centre - slack).min(d_k + from_centre + slack);
             let guess = GUESS_MARGIN * previous_d_k;
-            if !self.select_nearest(pp, reach * reach, guess * guess, k, s, out) {
+            if !self.select_nearest(pp, from_centre, reach * reach, guess * guess, k, s, out) {
                 self.nearest(p, k, &mut s.single);
                 out.copy_from_slice(&s.single);
             }
@@ -196,13 +196,37 @@ impl NeighbourIndex<'_> {
         // In rank order, a candidate's position breaks distance ties as its
         // rank does (see `select_within`).
         s.rank_and_index.sort_unstable();
+        // Then in shells of equal area by distance from the centre, so
+        // that a query scans only the shells that can reach it (see
+        // `select_within`); each candidate keeps its position in rank
+        // order for the ties. A counting sort: cheaper than sorting by
+        // distance, and the last shell scanned is only 1/SHELLS of them.
+        s.shell_scale = SHELLS as f64 / (radius * radius);
+        let shell_of =
+            |q: Point3| ((crate::cloud::dist2(centre, q) * s.shell_scale) as usize).min(SHELLS - 1);
+        let mut starts = [0u32; SHELLS + 1];
+        s.shells.clear();
+        s.shells.extend(s.rank_and_index.iter().map(|&ri| {
+            let shell = shell_of(self.points[(ri as u32) as usize]);
+            starts[shell + 1] += 1;
+            shell as u8
+        }));
+        for shell in 0..SHELLS {
+            starts[shell + 1] += starts[shell];
+        }
+        s.shell_end.copy_from_slice(&starts[1..]);
+        s.positions.clear();
+        s.positions.resize(s.shells.len(), 0);
         s.coords.clear();
-        s.coords.extend(
-            s.rank_and_index
-                .iter()
-                .map(|&ri| self.points[(ri as u32) as usize]),
-        );
+        s.coords.resize(s.shells.len(), [0.0; 3]);
+        for (position, (&shell, &ri)) in s.shells.iter().zip(&s.rank_and_index).enumerate() {
+            let slot = &mut starts[shell as usize];
+            s.positions[*slot as usize] = position as u32;
+            s.coords[*slot as usize] = self.points[(ri as u32) as usize];
+            *slot += 1;
+        }
         s.keyed.resize(s.coords.len(), 0);
+        s.centre_slack = 1e-12 * magnitude(centre);
     }
 
     /// The run's point closest to the run's mean.
@@ -225,36 +249,54 @@ impl NeighbourIndex<'_> {
     /// Tries the candidates within the smaller `guess2` first: when they
     /// prove the answer (k of them, the k-th strictly inside the guess's tie
     /// bin), it is the same, and selecting among fewer is cheaper.
+    #[allow(clippy::too_many_arguments)]
     fn select_nearest(
         &self,
         p: Point3,
+        from_centre: f64,
         reach2: f64,
         guess2: f64,
         k: usize,
         s: &mut RunScratch,
         out: &mut [u32],
     ) -> bool {
-        (guess2 < reach2 && select_within(p, guess2, k, s, out))
-            || select_within(p, reach2, k, s, out)
+        (guess2 < reach2 && select_within(p, from_centre, guess2, k, s, out))
+            || select_within(p, from_centre, reach2, k, s, out)
     }
 }
 
 /// [`NeighbourIndex::select_nearest`] with one radius (it reads only the
-/// gathered candidates in `s`).
+/// gathered candidates in `s`); `from_centre` is |p − c|.
 // Baseline and AVX2 variants, chosen at run time (crate doc, "Vector kernels").
 #[multiversion::multiversion(targets("x86_64+avx2"))]
-fn select_within(p: Point3, reach2: f64, k: usize, s: &mut RunScratch, out: &mut [u32]) -> bool {
+fn select_within(
+    p: Point3,
+    from_centre: f64,
+    reach2: f64,
+    k: usize,
+    s: &mut RunScratch,
+    out: &mut [u32],
+) -> bool {
     if s.coords.len() > POSITION_MASK as usize {
         return false; // positions would not fit their bits
     }
+    // A candidate q within reach of p has |q − c| ≤ |p − c| + reach: only
+    // the candidates up to that distance from the centre are scanned
+    // (about half of them). The bound is widened for rounding, by far
+    // more than the distances' own error; a candidate let in by the
+    // margin is still measured against `reach2` below.
+    let bound = (from_centre + reach2.sqrt()) * (1.0 + 1e-9) + s.centre_slack;
+    // The same monotone formula as the gathering's shells.
+    let last_shell = ((bound * bound * s.shell_scale) as usize).min(SHELLS - 1);
+    let end = s.shell_end[last_shell] as usize;
     // Every candidate is written and only those within reach advance
     // the end: no branch to mispredict on a coin-flip test. `keyed`
     // has one slot per candidate since the gathering, so it is not
     // cleared per query.
     let mut len = 0;
-    for (position, &q) in s.coords.iter().enumerate() {
+    for (&q, &position) in s.coords[..end].iter().zip(&s.positions) {
         let d = crate::cloud::dist2(p, q);
-        s.keyed[len] = (tie_key(d) << POSITION_BITS) | position as u64;
+        s.keyed[len] = (tie_key(d) << POSITION_BITS) | u64::from(position);
         len += usize::from(d <= reach2);
     }
     let within = &mut s.keyed[..len];
@@ -278,6 +320,9 @@ fn select_within(p: Point3, reach2: f64, k: usize, s: &mut RunScratch, out: &mut
     true
 }
 
+/// Shells of the gathered candidates (see [`NeighbourIndex::gather`]).
+const SHELLS: usize = 32;
+
 /// Point count from which (and subtree size down to which) the tree is
 /// built in parallel.
 const PARALLEL_TREE_FROM: usize = 16384;
@@ -300,6 +345,7 @@ pub struct RunScratch {
     centre: Vec<u32>,
     single: Vec<u32>,
     candidates: Vec<u32>,
+    /// The candidates' points, shell by shell.
     coords: Vec<Point3>,
     /// Each candidate's rank (high half) and index (low half), sorted:
     /// candidates in rank order.
@@ -310,6 +356,17 @@ pub struct RunScratch {
     /// order like the number, and comparisons of one machine word are
     /// what the selection and the sort do fastest.
     keyed: Vec<u64>,
+    /// Each candidate's shell (by rank position): the shells cut the
+    /// gathering ball into [`SHELLS`] of equal area around its centre.
+    shells: Vec<u8>,
+    /// Shells per unit of squared distance from the centre.
+    shell_scale: f64,
+    /// One past the last candidate of each shell, in `coords`.
+    shell_end: [u32; SHELLS],
+    /// The candidates' positions in `rank_and_index`, shell by shell.
+    positions: Vec<u32>,
+    /// Absolute rounding allowance of distances near the centre.
+    centre_slack: f64,
 }
 
 /// Bits of a candidate's position in its [`RunScratch::keyed`] key. A
@@ -421,6 +478,32 @@ mod tests {
             for (p, got) in run.zip(out.chunks(30)) {
                 index.nearest(p, 30, &mut single);
                 assert_eq!(got, &single[..], "point {p}");
+            }
+        }
+    }
+
+    /// Far from the origin and at a small scale the coordinates' rounding
+    /// is largest next to the spacing: the shells the runs scan must still
+    /// hold every point within reach (ties on the quantised grid included).
+    #[test]
+    fn run_queries_match_brute_force_far_from_the_origin() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
+        let mut pts: Vec<Point3> = (0..1200)
+            .map(|_| [rng.random(), rng.random(), rng.random::<f64>() * 0.02])
+            .collect();
+        pts.extend((0..400).map(|i| [2.0 + (i % 20) as f64 * 0.05, (i / 20) as f64 * 0.05, 0.0]));
+        for p in &mut pts {
+            *p = [p[0] * 1e-3 + 1e5, p[1] * 1e-3 - 1e5, p[2] * 1e-3 + 1e5];
+        }
+        let index = NeighbourIndex::new(&pts);
+        let mut scratch = RunScratch::default();
+        let mut out = vec![0u32; 30 * 32];
+        for start in (0..pts.len()).step_by(32) {
+            let run = start..(start + 32).min(pts.len());
+            let out = &mut out[..run.len() * 30];
+            index.nearest_of_run(run.clone(), 30, out, &mut scratch);
+            for (p, got) in run.zip(out.chunks(30)) {
+                assert_eq!(got, &nearest_brute_force(&pts, p, 30)[..], "point {p}");
             }
         }
     }
