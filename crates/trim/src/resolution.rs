@@ -95,8 +95,10 @@ fn off_diagonal_tile(
     }
 }
 
-/// Lanes of [`nearest_distances`]' inner loop.
-const LANES: usize = 2;
+/// Lanes of [`nearest_distances`]' inner loop: one AVX2 register of f64.
+/// 4 against 2: −2.5 % of the 12k benchmark's instructions; 8 spills
+/// registers (+9 %).
+const LANES: usize = 4;
 
 /// Reusable coordinate columns for [`nearest_distances`].
 #[derive(Debug, Default, Clone)]
