@@ -360,12 +360,17 @@ fn block_len(n: usize) -> usize {
 }
 
 /// Reorders per-position results to site order.
-fn to_sites<T: Copy>(order: &[u32], by_position: Vec<T>) -> Vec<T> {
-    let mut by_site = by_position.clone();
-    for (&site, v) in order.iter().zip(by_position) {
-        by_site[site as usize] = v;
+fn to_sites<T: Copy + Send + Sync>(order: &[u32], by_position: Vec<T>) -> Vec<T> {
+    // The inverse permutation first, so the results are gathered in
+    // parallel rather than scattered one by one.
+    let mut position_of = vec![0u32; order.len()];
+    for (position, &site) in order.iter().enumerate() {
+        position_of[site as usize] = position as u32;
     }
-    by_site
+    position_of
+        .par_iter()
+        .map(|&position| by_position[position as usize])
+        .collect()
 }
 
 /// The links found at each position, as pairs of input indices.
@@ -394,11 +399,11 @@ fn spread_to_input(site_of: &[u32], verdicts: &[(Decision, f64)]) -> Detection {
     let at = |i: &u32| verdicts[*i as usize];
     Detection {
         boundary: site_of
-            .iter()
+            .par_iter()
             .map(|i| at(i).0 != Decision::Interior)
             .collect(),
-        beta: site_of.iter().map(|i| at(i).1).collect(),
-        decision: site_of.iter().map(|i| at(i).0).collect(),
+        beta: site_of.par_iter().map(|i| at(i).1).collect(),
+        decision: site_of.par_iter().map(|i| at(i).0).collect(),
         duplicates: site_of.len() - verdicts.len(),
         links: Vec::new(),
     }
