@@ -458,28 +458,47 @@ mod tests {
         assert_eq!(out, vec![24, 17, 23]);
     }
 
-    #[test]
-    fn run_queries_match_brute_force() {
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
-        // A sheet, a few far outliers, and an exact grid full of ties.
-        let mut pts: Vec<Point3> = (0..1500)
+    /// A random sheet of `n` points and an exact 20 × 20 grid full of ties.
+    fn sheet_and_grid(seed: u64, n: usize) -> Vec<Point3> {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let mut pts: Vec<Point3> = (0..n)
             .map(|_| [rng.random(), rng.random(), rng.random::<f64>() * 0.02])
             .collect();
-        pts.extend((0..5).map(|i| [10.0 + i as f64, -3.0, 7.0]));
         pts.extend((0..400).map(|i| [2.0 + (i % 20) as f64 * 0.05, (i / 20) as f64 * 0.05, 0.0]));
-        let ranks: Vec<u32> = (0..pts.len() as u32).rev().collect();
-        let index = NeighbourIndex::new(&pts).with_ranks(&ranks);
+        pts
+    }
+
+    /// Runs of `run_len` consecutive points give `reference`'s 30 nearest.
+    fn assert_runs_match(
+        index: &NeighbourIndex,
+        run_len: usize,
+        mut reference: impl FnMut(usize) -> Vec<u32>,
+    ) {
+        let n = index.points().len();
         let mut scratch = RunScratch::default();
-        let (mut single, mut runs) = (Vec::new(), vec![0u32; 30 * 16]);
-        for start in (0..pts.len()).step_by(16) {
-            let run = start..(start + 16).min(pts.len());
+        let mut runs = vec![0u32; 30 * run_len];
+        for start in (0..n).step_by(run_len) {
+            let run = start..(start + run_len).min(n);
             let out = &mut runs[..run.len() * 30];
             index.nearest_of_run(run.clone(), 30, out, &mut scratch);
             for (p, got) in run.zip(out.chunks(30)) {
-                index.nearest(p, 30, &mut single);
-                assert_eq!(got, &single[..], "point {p}");
+                assert_eq!(got, &reference(p)[..], "point {p}");
             }
         }
+    }
+
+    #[test]
+    fn run_queries_match_single_queries() {
+        // The sheet and grid, and a few far outliers; ties cut by rank.
+        let mut pts = sheet_and_grid(5, 1500);
+        pts.extend((0..5).map(|i| [10.0 + i as f64, -3.0, 7.0]));
+        let ranks: Vec<u32> = (0..pts.len() as u32).rev().collect();
+        let index = NeighbourIndex::new(&pts).with_ranks(&ranks);
+        let mut single = Vec::new();
+        assert_runs_match(&index, 16, |p| {
+            index.nearest(p, 30, &mut single);
+            single.clone()
+        });
     }
 
     /// Far from the origin and at a small scale the coordinates' rounding
@@ -487,25 +506,12 @@ mod tests {
     /// hold every point within reach (ties on the quantised grid included).
     #[test]
     fn run_queries_match_brute_force_far_from_the_origin() {
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
-        let mut pts: Vec<Point3> = (0..1200)
-            .map(|_| [rng.random(), rng.random(), rng.random::<f64>() * 0.02])
+        let pts: Vec<Point3> = sheet_and_grid(9, 1200)
+            .into_iter()
+            .map(|p| [p[0] * 1e-3 + 1e5, p[1] * 1e-3 - 1e5, p[2] * 1e-3 + 1e5])
             .collect();
-        pts.extend((0..400).map(|i| [2.0 + (i % 20) as f64 * 0.05, (i / 20) as f64 * 0.05, 0.0]));
-        for p in &mut pts {
-            *p = [p[0] * 1e-3 + 1e5, p[1] * 1e-3 - 1e5, p[2] * 1e-3 + 1e5];
-        }
         let index = NeighbourIndex::new(&pts);
-        let mut scratch = RunScratch::default();
-        let mut out = vec![0u32; 30 * 32];
-        for start in (0..pts.len()).step_by(32) {
-            let run = start..(start + 32).min(pts.len());
-            let out = &mut out[..run.len() * 30];
-            index.nearest_of_run(run.clone(), 30, out, &mut scratch);
-            for (p, got) in run.zip(out.chunks(30)) {
-                assert_eq!(got, &nearest_brute_force(&pts, p, 30)[..], "point {p}");
-            }
-        }
+        assert_runs_match(&index, 32, |p| nearest_brute_force(&pts, p, 30));
     }
 
     /// Quantised scanner data puts thousands of points on one coordinate
