@@ -303,11 +303,16 @@ fn select_within(
     if within.len() < k {
         return false;
     }
-    if within.len() > k {
+    // Up to 2k candidates (the usual case after the first guess) one
+    // sort is cheaper than a selection and a sort of the k: −1.6 % of the
+    // 12k benchmark's instructions.
+    if within.len() > 2 * k {
         within.select_nth_unstable(k - 1);
+        within[..k].sort_unstable();
+    } else {
+        within.sort_unstable();
     }
-    let nearest = &mut within[..k];
-    nearest.sort_unstable();
+    let nearest = &within[..k];
     // A point beyond the reach may tie with the k-th (its distance in
     // the same tie bin) and win on rank: only a k-th strictly below the
     // reach's bin proves the answer.
