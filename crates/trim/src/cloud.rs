@@ -59,17 +59,15 @@ pub fn merge_duplicates(points: &[Point3]) -> Result<Sites, CloudError> {
     // does not depend on the threads.
     let mut order: Vec<u32> = (0..points.len() as u32).collect();
     order.par_sort_unstable_by_key(|&i| (key(&points[i as usize]), i));
-    let mut site_of = vec![u32::MAX; points.len()];
+    // Each run of equal keys starts with its lowest index, the site's
+    // first occurrence in the input.
     let mut first_of_run = vec![0u32; points.len()];
-    for w in 0..order.len() {
-        let i = order[w];
-        let same_as_prev = w > 0 && key(&points[order[w - 1] as usize]) == key(&points[i as usize]);
-        first_of_run[i as usize] = if same_as_prev {
-            first_of_run[order[w - 1] as usize]
-        } else {
-            i
-        };
+    for run in order.chunk_by(|&a, &b| key(&points[a as usize]) == key(&points[b as usize])) {
+        for &i in run {
+            first_of_run[i as usize] = run[0];
+        }
     }
+    let mut site_of = vec![u32::MAX; points.len()];
     let mut sites = Vec::new();
     for i in 0..points.len() {
         let first = first_of_run[i] as usize;

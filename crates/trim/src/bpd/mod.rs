@@ -158,11 +158,8 @@ fn run(
         analyse_point(&hoods, p, vectors, s, how)
     });
     let links = links_in_input_order(&site_of, &hoods.order, &verdicts);
-    let by_site = to_sites(
-        &hoods.order,
-        verdicts.iter().map(|v| (v.decision, v.beta)).collect(),
-    );
-    let mut detection = spread_to_input(&site_of, &by_site);
+    let by_position: Vec<(Decision, f64)> = verdicts.iter().map(|v| (v.decision, v.beta)).collect();
+    let mut detection = spread_to_input(&site_of, &hoods.order, &by_position);
     detection.links = links;
     Ok(detection)
 }
@@ -184,8 +181,7 @@ pub fn local_resolution(points: &[Point3], options: &BpdOptions) -> Result<Vec<f
             projected_beta(&hoods, p, hoods.sampling.as_deref(), s),
         )
     });
-    let by_site = to_sites(&hoods.order, betas);
-    Ok(spread_to_input(&site_of, &by_site).beta)
+    Ok(spread_to_input(&site_of, &hoods.order, &betas).beta)
 }
 
 fn prepare(points: &[Point3], options: &BpdOptions) -> Result<Sites, CloudError> {
@@ -359,20 +355,6 @@ fn block_len(n: usize) -> usize {
     (n / 256).clamp(4096, 65536)
 }
 
-/// Reorders per-position results to site order.
-fn to_sites<T: Copy + Send + Sync>(order: &[u32], by_position: Vec<T>) -> Vec<T> {
-    // The inverse permutation first, so the results are gathered in
-    // parallel rather than scattered one by one.
-    let mut position_of = vec![0u32; order.len()];
-    for (position, &site) in order.iter().enumerate() {
-        position_of[site as usize] = position as u32;
-    }
-    position_of
-        .par_iter()
-        .map(|&position| by_position[position as usize])
-        .collect()
-}
-
 /// The links found at each position, as pairs of input indices.
 fn links_in_input_order(site_of: &[u32], order: &[u32], verdicts: &[Verdict]) -> Vec<[u32; 2]> {
     let mut first_input = vec![u32::MAX; order.len()];
@@ -394,9 +376,16 @@ fn links_in_input_order(site_of: &[u32], order: &[u32], verdicts: &[Verdict]) ->
     links
 }
 
-/// `verdicts` by site; `site_of` each input point's site.
-fn spread_to_input(site_of: &[u32], verdicts: &[(Decision, f64)]) -> Detection {
-    let at = |i: &u32| verdicts[*i as usize];
+/// `verdicts` by spatial position, in input order: `site_of` is each input
+/// point's site, `order` each position's site.
+fn spread_to_input(site_of: &[u32], order: &[u32], verdicts: &[(Decision, f64)]) -> Detection {
+    // Site → position, so that each input point reads its verdict in one
+    // parallel gather.
+    let mut position_of = vec![0u32; order.len()];
+    for (position, &site) in order.iter().enumerate() {
+        position_of[site as usize] = position as u32;
+    }
+    let at = |i: &u32| verdicts[position_of[*i as usize] as usize];
     Detection {
         boundary: site_of
             .par_iter()
