@@ -162,36 +162,43 @@ fn occupied_sector(
     gaps: &mut Vec<(f64, f64)>,
 ) -> (f64, f64) {
     let n = theta.len();
+    if n == 0 {
+        // No angles: no sector, which the caller reads as open.
+        return (0.0, 0.0);
+    }
     buckets.clear();
     buckets.resize(n, (f64::INFINITY, f64::NEG_INFINITY));
     let per_bucket = n as f64 / TAU;
+    let (mut smallest, mut largest) = (f64::INFINITY, f64::NEG_INFINITY);
     for &t in theta {
-        let b = (((t + PI) * per_bucket) as usize).min(n - 1);
+        // `as u32`: the same bucket as `as usize` for these small,
+        // non-negative values, in fewer instructions.
+        let b = ((((t + PI) * per_bucket) as u32) as usize).min(n - 1);
         let (lo, hi) = &mut buckets[b];
         // Comparisons, not `f64::min`/`max`, whose NaN handling costs
         // more (the angles are finite).
         *lo = if t < *lo { t } else { *lo };
         *hi = if t > *hi { t } else { *hi };
+        smallest = if t < smallest { t } else { smallest };
+        largest = if t > largest { t } else { largest };
     }
-    let mut filled = buckets.iter().filter(|b| b.0 <= b.1);
-    // No bucket filled (no angles): no sector, which the caller reads as
-    // open.
-    let Some(&first) = filled.next() else {
-        return (0.0, 0.0);
-    };
-    let last = buckets
-        .iter()
-        .rev()
-        .find(|b| b.0 <= b.1)
-        .map_or(first.1, |b| b.1);
+    // The gap before each filled bucket, in bucket order, written for
+    // every bucket and kept (the count advanced) only for filled ones: no
+    // branch on which buckets are filled, which no processor predicts.
     gaps.clear();
-    gaps.push((first.0 + TAU - last, first.0));
-    let mut previous_high = first.1;
-    for &(lo, hi) in filled {
-        gaps.push((lo - previous_high, lo));
-        previous_high = hi;
+    gaps.resize(n, (0.0, 0.0));
+    let (mut filled, mut previous_high) = (0, f64::NEG_INFINITY);
+    for &(lo, hi) in buckets.iter() {
+        gaps[filled] = (lo - previous_high, lo);
+        filled += usize::from(lo <= hi);
+        // A filled bucket's angles lie above the previous ones, an empty
+        // one's `hi` is −∞: the maximum is the last filled bucket's.
+        previous_high = if hi > previous_high { hi } else { previous_high };
     }
-    choose_gap(gaps, theta[0])
+    // The first filled bucket starts at the smallest angle; its gap wraps
+    // round from the largest.
+    gaps[0] = (smallest + TAU - largest, smallest);
+    choose_gap(&gaps[..filled], theta[0])
 }
 
 /// The sector left by the largest of `gaps` (gap, angle where it ends),
