@@ -31,8 +31,8 @@ impl Sites {
     }
 }
 
-/// Checks that every coordinate is finite and merges exact duplicates.
-pub fn merge_duplicates(points: &[Point3]) -> Result<Sites, CloudError> {
+/// Checks that the cloud fits u32 indices and every coordinate is finite.
+pub fn check_finite(points: &[Point3]) -> Result<(), CloudError> {
     // Sites, neighbour lists and k-d tree items are u32 indices.
     let max = u32::MAX as usize;
     if points.len() > max {
@@ -53,6 +53,12 @@ pub fn merge_duplicates(points: &[Point3]) -> Result<Sites, CloudError> {
             z: p[2],
         });
     }
+    Ok(())
+}
+
+/// Checks that every coordinate is finite and merges exact duplicates.
+pub fn merge_duplicates(points: &[Point3]) -> Result<Sites, CloudError> {
+    check_finite(points)?;
     // Sort indices by coordinate bits (+0.0 and -0.0 are the same point).
     let key = |p: &Point3| p.map(|c| (c + 0.0).to_bits());
     // Sorted in parallel: (key, index) is a total order, so the result

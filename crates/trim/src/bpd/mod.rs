@@ -23,7 +23,7 @@ use crate::anisotropy::{
     apply, own_sampling_vectors, sampling_moment, sampling_tensor_of_moments, whitening_map,
     SamplingMoment,
 };
-use crate::cloud::{check_not_degenerate, cross, merge_duplicates, Point3, Sites};
+use crate::cloud::{check_finite, check_not_degenerate, cross, merge_duplicates, Point3, Sites};
 use crate::error::CloudError;
 use crate::frame::{fit_plane, project, Frame, Point2};
 use crate::neighbours::{NeighbourIndex, RunScratch};
@@ -144,16 +144,13 @@ fn run(
     progress: &(dyn Fn(usize) + Sync),
     how: TestImpl,
 ) -> Result<Detection, CloudError> {
-    let Sites {
-        points: sites,
-        site_of,
-    } = prepare(points, options)?;
-    let n = sites.len();
+    let Prepared { site_of, spatial } = prepare(points, options)?;
+    let n = spatial.points.len();
     // Neighbourhoods (with each point's sampling moment when the map is on)
     // and the tests.
     let passes = 2;
     let report = |pass: usize| move |done: usize| progress((pass * n + done) / passes);
-    let hoods = neighbourhoods(sites, options, how, &report(0));
+    let hoods = neighbourhoods(spatial, options, how, &report(0));
     let vectors = hoods.sampling.as_deref();
     let verdicts = per_position(&hoods, how, &report(passes - 1), |s, p| {
         analyse_point(&hoods, p, vectors, s, how)
@@ -170,12 +167,9 @@ fn run(
 /// [`detect_boundary`]'s `beta`, in about half the time. For a mesh's own
 /// vertices, whose border the mesh already knows (`crate::clean`).
 pub fn local_resolution(points: &[Point3], options: &BpdOptions) -> Result<Vec<f64>, CloudError> {
-    let Sites {
-        points: sites,
-        site_of,
-    } = prepare(points, options)?;
+    let Prepared { site_of, spatial } = prepare(points, options)?;
     let how = TestImpl::Fast;
-    let hoods = neighbourhoods(sites, options, how, &|_| {});
+    let hoods = neighbourhoods(spatial, options, how, &|_| {});
     let betas = per_position(&hoods, how, &|_| {}, |s, p| {
         (
             Decision::Interior,
@@ -185,23 +179,89 @@ pub fn local_resolution(points: &[Point3], options: &BpdOptions) -> Result<Vec<f
     Ok(spread_to_input(&site_of, &hoods.order, &betas).beta)
 }
 
-fn prepare(points: &[Point3], options: &BpdOptions) -> Result<Sites, CloudError> {
+/// A checked cloud's distinct points (sites) in spatial order.
+struct Prepared {
+    /// For every input point, the index of its site.
+    site_of: Vec<u32>,
+    spatial: SpatialOrder,
+}
+
+/// Sites copied in spatial order ([`spatial_order`]): position p holds
+/// site `order[p]`, whose Morton key is `keys[p]`.
+struct SpatialOrder {
+    points: Vec<Point3>,
+    order: Vec<u32>,
+    keys: Vec<u64>,
+}
+
+/// Exact duplicates merged, then the sites put in spatial order.
+fn merged_in_spatial_order(points: &[Point3]) -> Result<(Sites, SpatialOrder), CloudError> {
+    let sites = merge_duplicates(points)?;
+    let spatial = SpatialOrder::of(&sites.points);
+    Ok((sites, spatial))
+}
+
+impl SpatialOrder {
+    /// True when two sites share a Morton key, as copies of a point do.
+    fn keys_repeat(&self) -> bool {
+        self.keys.par_windows(2).any(|w| w[0] == w[1])
+    }
+
+    fn of(sites: &[Point3]) -> Self {
+        let (order, keys) = spatial_order(sites);
+        let points = order.par_iter().map(|&i| sites[i as usize]).collect();
+        Self {
+            points,
+            order,
+            keys,
+        }
+    }
+}
+
+/// Checks the options and the cloud, merges exact duplicates and puts the
+/// sites in spatial order.
+///
+/// Most clouds have no duplicates, and copies of a point share its Morton
+/// key: when no two points share a key, the points are the sites and the
+/// order of the points is the sites' order, so the sort that merging needs
+/// is skipped (at 1M points, a sort of as many (point, index) pairs).
+fn prepare(points: &[Point3], options: &BpdOptions) -> Result<Prepared, CloudError> {
     if options.k < BpdOptions::MIN_K {
         return Err(CloudError::KTooSmall {
             k: options.k,
             min: BpdOptions::MIN_K,
         });
     }
-    let sites = merge_duplicates(points)?;
-    check_not_degenerate(&sites.points)?;
-    if sites.points.len() < options.k {
+    check_finite(points)?;
+    let in_order = SpatialOrder::of(points);
+    if !in_order.keys_repeat() {
+        check_sites(points, points.len(), options)?;
+        return Ok(Prepared {
+            site_of: (0..points.len() as u32).into_par_iter().collect(),
+            spatial: in_order,
+        });
+    }
+    drop(in_order);
+    let (sites, spatial) = merged_in_spatial_order(points)?;
+    check_sites(&sites.points, points.len(), options)?;
+    Ok(Prepared {
+        site_of: sites.site_of,
+        spatial,
+    })
+}
+
+/// Rejects `distinct` points (in input order) that are degenerate or fewer
+/// than a neighbourhood.
+fn check_sites(distinct: &[Point3], total: usize, options: &BpdOptions) -> Result<(), CloudError> {
+    check_not_degenerate(distinct)?;
+    if distinct.len() < options.k {
         return Err(CloudError::TooFewPoints {
-            distinct: sites.points.len(),
-            total: points.len(),
+            distinct: distinct.len(),
+            total,
             k: options.k,
         });
     }
-    Ok(sites)
+    Ok(())
 }
 
 /// Finds every neighbourhood once (step 1), queried in spatial order so
@@ -210,16 +270,17 @@ fn prepare(points: &[Point3], options: &BpdOptions) -> Result<Sites, CloudError>
 /// fast version computes right after the point's k-NN, while its
 /// neighbours are still in the cache.
 fn neighbourhoods(
-    sites: Vec<Point3>,
+    spatial: SpatialOrder,
     options: &BpdOptions,
     how: TestImpl,
     progress: &(dyn Fn(usize) + Sync),
 ) -> Neighbourhoods {
     let k = options.k;
-    let (order, keys) = spatial_order(&sites);
-    let points: Vec<Point3> = order.par_iter().map(|&i| sites[i as usize]).collect();
-    // The tests need only the copy in spatial order.
-    drop(sites);
+    let SpatialOrder {
+        points,
+        order,
+        keys,
+    } = spatial;
     // Ties are broken by site index (input order), which, unlike the
     // spatial order, does not change when the cloud is moved.
     let index = NeighbourIndex::new(&points).with_ranks(&order);
@@ -728,6 +789,37 @@ mod tests {
         };
         assert_eq!(run(1), run(2));
         assert_eq!(run(1), run(3));
+    }
+
+    #[test]
+    fn copies_of_a_point_always_share_its_morton_key() {
+        let mut cloud = random_sheet(5, 20, 0.1, 1.0);
+        assert!(!SpatialOrder::of(&cloud).keys_repeat());
+        // An exact copy far from the first, and a zero of the other sign.
+        cloud.push(cloud[3]);
+        assert!(SpatialOrder::of(&cloud).keys_repeat());
+        cloud.pop();
+        cloud[7][2] = 0.0;
+        cloud.push([cloud[7][0], cloud[7][1], -0.0]);
+        assert!(SpatialOrder::of(&cloud).keys_repeat());
+    }
+
+    #[test]
+    fn without_copies_merging_finds_the_same_sites_as_skipping_it() {
+        // A twin a hair's breadth away shares a Morton key with its point,
+        // which sends the cloud through the merge; it is no copy, so the
+        // result must be the cloud itself, as on the direct path.
+        let mut cloud = random_sheet(6, 25, 0.1, 1.0);
+        let twin = cloud[11].map(|c| c + 1e-9);
+        cloud.insert(40, twin);
+        let direct = SpatialOrder::of(&cloud);
+        assert!(direct.keys_repeat());
+        let (sites, merged) = merged_in_spatial_order(&cloud).unwrap();
+        let identity: Vec<u32> = (0..cloud.len() as u32).collect();
+        assert_eq!(sites.site_of, identity);
+        assert_eq!(merged.order, direct.order);
+        assert_eq!(merged.keys, direct.keys);
+        assert_eq!(merged.points, direct.points);
     }
 
     #[test]

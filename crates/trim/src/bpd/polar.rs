@@ -193,7 +193,11 @@ fn occupied_sector(
         filled += usize::from(lo <= hi);
         // A filled bucket's angles lie above the previous ones, an empty
         // one's `hi` is −∞: the maximum is the last filled bucket's.
-        previous_high = if hi > previous_high { hi } else { previous_high };
+        previous_high = if hi > previous_high {
+            hi
+        } else {
+            previous_high
+        };
     }
     // The first filled bucket starts at the smallest angle; its gap wraps
     // round from the largest.
