@@ -18,8 +18,13 @@
 //!   through P_i and two neighbours are exactly the circumcircles of the
 //!   Delaunay triangles at P_i, whose centres are the vertices of P_i's
 //!   Voronoi cell. The cell is clipped from a box of half-size L ≥ β by the
-//!   bisectors with the neighbours, nearest first; it stops as soon as no
-//!   vertex is β away from P_i (clipping only shrinks the cell). A vertex on
+//!   bisectors with the neighbours: those within √2·β of P_i first, then the
+//!   rest, each group nearest first; it stops as soon as no vertex is β away
+//!   from P_i (clipping only shrinks the cell, and the cell does not depend
+//!   on the order). The near ones first because on a line scan the nearest
+//!   in 3D are P_i's own scan line, whose bisectors leave the cell open
+//!   across the lines: the map makes the lines evenly spaced in the plane,
+//!   but the neighbours stay in their 3D order. A vertex on
 //!   the box means the cell is unbounded (P_i on the hull) or has a vertex
 //!   beyond L ≥ β: both are boundary cases of the reference, so the answer
 //!   is "some vertex at distance ≥ β". O(k · cell size), no allocation.
@@ -83,6 +88,12 @@ fn circumcentre_with_origin(a: Point2, b: Point2) -> Option<Point2> {
     Some([(na * b[1] - nb * a[1]) / d, (nb * a[0] - na * b[0]) / d])
 }
 
+/// Neighbours within √NEAR·β of P_i clip the cell first. On the 12k
+/// benchmark's line scan the circle test took 52.1M instructions with one
+/// pass, 30.0M / 31.8M / 36.7M with NEAR = 1.5 / 2 / 3; on the isotropic
+/// sheet 25.8M, 27.3M / 26.2M / 26.0M.
+const NEAR: f64 = 2.0;
+
 /// Label of a cell edge that lies on the initial box, not on a bisector.
 const BOX_EDGE: u32 = u32::MAX;
 
@@ -119,21 +130,24 @@ pub fn largest_empty_circle_exceeds(nb: &[Point2], beta: f64, s: &mut CellScratc
     ]);
     let beta2 = beta * beta;
     let mut far2 = 2.0 * l * l; // largest squared vertex distance so far
-    for (j, &q) in nb.iter().enumerate() {
-        let q2 = q[0] * q[0] + q[1] * q[1];
-        // The bisector x·q = |q|²/2 cannot cut a cell within radius |q|/2.
-        if 0.25 * q2 >= far2 {
-            continue;
-        }
-        clip(&s.poly, q, 0.5 * q2, j as u32, &mut s.next);
-        std::mem::swap(&mut s.poly, &mut s.next);
-        far2 = s
-            .poly
-            .iter()
-            .map(|(v, _)| v[0] * v[0] + v[1] * v[1])
-            .fold(0.0, f64::max);
-        if far2 < beta2 {
-            return false;
+    let near2 = NEAR * beta2;
+    for near_pass in [true, false] {
+        for (j, &q) in nb.iter().enumerate() {
+            let q2 = q[0] * q[0] + q[1] * q[1];
+            // The bisector x·q = |q|²/2 cannot cut a cell within radius |q|/2.
+            if (q2 <= near2) != near_pass || 0.25 * q2 >= far2 {
+                continue;
+            }
+            clip(&s.poly, q, 0.5 * q2, j as u32, &mut s.next);
+            std::mem::swap(&mut s.poly, &mut s.next);
+            far2 = s
+                .poly
+                .iter()
+                .map(|(v, _)| v[0] * v[0] + v[1] * v[1])
+                .fold(0.0, f64::max);
+            if far2 < beta2 {
+                return false;
+            }
         }
     }
     far2 >= beta2
