@@ -101,7 +101,8 @@ pub fn detect_boundary(points: &[Point3], options: &BpdOptions) -> Result<Detect
 /// [`detect_boundary`], calling `progress(done)` with the number of distinct
 /// points processed so far (all passes counted together, scaled to the
 /// number of distinct points) after every block of each pass: blocks of
-/// 16,384 points up to 4M points, 256 blocks per pass above.
+/// 16,384 points up to 4.2M points, then 256 blocks per pass up to 16.7M,
+/// then blocks of 65,536.
 pub fn detect_boundary_with_progress(
     points: &[Point3],
     options: &BpdOptions,
@@ -194,19 +195,13 @@ struct SpatialOrder {
     keys: Vec<u64>,
 }
 
-/// Exact duplicates merged, then the sites put in spatial order.
-fn merged_in_spatial_order(points: &[Point3]) -> Result<(Sites, SpatialOrder), CloudError> {
-    let sites = merge_duplicates(points)?;
-    let spatial = SpatialOrder::of(&sites.points);
-    Ok((sites, spatial))
-}
-
 impl SpatialOrder {
     /// True when two sites share a Morton key, as copies of a point do.
     fn keys_repeat(&self) -> bool {
         self.keys.par_windows(2).any(|w| w[0] == w[1])
     }
 
+    /// The sites' Morton order, and their copy in that order.
     fn of(sites: &[Point3]) -> Self {
         let (order, keys) = spatial_order(sites);
         let points = order.par_iter().map(|&i| sites[i as usize]).collect();
@@ -248,6 +243,13 @@ fn prepare(points: &[Point3], options: &BpdOptions) -> Result<Prepared, CloudErr
         site_of: sites.site_of,
         spatial,
     })
+}
+
+/// Exact duplicates merged, then the sites put in spatial order.
+fn merged_in_spatial_order(points: &[Point3]) -> Result<(Sites, SpatialOrder), CloudError> {
+    let sites = merge_duplicates(points)?;
+    let spatial = SpatialOrder::of(&sites.points);
+    Ok((sites, spatial))
 }
 
 /// Rejects `distinct` points (in input order) that are degenerate or fewer
@@ -403,8 +405,8 @@ fn per_position<T: Send>(
             TestImpl::Fast => out.par_extend(
                 range
                     .into_par_iter()
-                    // Pieces of a few hundred microseconds at most, so
-                    // that neither thread waits long at a block's end.
+                    // Pieces of about a hundred microseconds, so that
+                    // neither thread waits long at a block's end.
                     .with_min_len(32)
                     .map_init(Scratch::default, |s, p| f(s, p)),
             ),

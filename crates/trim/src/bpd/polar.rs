@@ -184,7 +184,8 @@ fn occupied_sector(
     }
     // The gap before each filled bucket, in bucket order, written for
     // every bucket and kept (the count advanced) only for filled ones: no
-    // branch on which buckets are filled, which no processor predicts.
+    // branch on which buckets are filled, a coin flip that the processor
+    // often mispredicts.
     gaps.clear();
     gaps.resize(n, (0.0, 0.0));
     let (mut filled, mut previous_high) = (0, f64::NEG_INFINITY);
