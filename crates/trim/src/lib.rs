@@ -39,6 +39,7 @@ pub mod error;
 pub mod evaluate;
 pub mod frame;
 pub mod mesh;
+pub mod morton;
 pub mod neighbours;
 pub mod resolution;
 pub mod synthetic;

@@ -1,10 +1,13 @@
 //! k-nearest-neighbour search (section 2 of the paper: "k-NN ... it finds the
 //! closest k members of the cloud"), with kiddo behind it.
 //!
-//! kiddo's *immutable* tree is used: it is built once from the whole slice,
-//! so it has no bucket that can overflow when many points share one
-//! coordinate value (quantised scanner data), which makes kiddo's mutable
-//! tree fail. The neighbourhood of a point includes the point itself, first.
+//! Two ways to search: kiddo's *immutable* tree, for points in any order
+//! ([`NeighbourIndex::new`]; it is built once from the whole slice, so it
+//! has no bucket that can overflow when many points share one coordinate
+//! value, as quantised scanner data does and kiddo's mutable tree fails
+//! on), and the points' own Morton order ([`NeighbourIndex::in_morton_order`],
+//! [`crate::morton`]), which BPD sorts its points into anyway and which
+//! needs nothing built. The neighbourhood of a point includes the point itself, first.
 //! Ties in distance are broken by index so the result never depends on the
 //! tree's internal layout.
 
@@ -14,12 +17,21 @@ use std::ops::Range;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 
 use crate::cloud::Point3;
+use crate::morton::MortonCells;
 
 /// A k-NN index over a slice of distinct points.
 pub struct NeighbourIndex<'a> {
     points: &'a [Point3],
-    tree: ImmutableKdTree<f64, 3>,
+    search: Search<'a>,
     ranks: Option<&'a [u32]>,
+}
+
+/// How an index finds the points near a place.
+enum Search<'a> {
+    /// kiddo's immutable k-d tree, for points in any order.
+    Tree(ImmutableKdTree<f64, 3>),
+    /// The points' own Morton order ([`crate::morton`]): nothing to build.
+    Morton(MortonCells<'a>),
 }
 
 impl<'a> NeighbourIndex<'a> {
@@ -35,7 +47,18 @@ impl<'a> NeighbourIndex<'a> {
             .expect("point count fits in u32, checked at the entry point");
         Self {
             points,
-            tree,
+            search: Search::Tree(tree),
+            ranks: None,
+        }
+    }
+
+    /// The index of points sorted by Morton key (`cells`, see
+    /// [`crate::morton`]): the same answers as [`Self::new`]'s, found
+    /// through the sorted keys instead of a tree.
+    pub fn in_morton_order(points: &'a [Point3], cells: MortonCells<'a>) -> Self {
+        Self {
+            points,
+            search: Search::Morton(cells),
             ranks: None,
         }
     }
@@ -68,10 +91,17 @@ impl<'a> NeighbourIndex<'a> {
         if k == 0 {
             return;
         }
+        let tree = match &self.search {
+            Search::Tree(tree) => tree,
+            Search::Morton(cells) => {
+                let radius = cells.radius_holding(i, k);
+                return self.nearest_in_cells(cells, i, k, radius, out);
+            }
+        };
         let p = self.points[i];
         let mut ask = (k + 1).min(self.points.len());
         let found = loop {
-            let query = self.tree.query(&p);
+            let query = tree.query(&p);
             let n = NonZeroUsize::new(ask).expect("ask ≥ 1");
             let found = query.nearest_n::<SquaredEuclidean<f64>>(n).execute();
             let tie_reaches_end = ask < self.points.len()
@@ -96,6 +126,52 @@ impl<'a> NeighbourIndex<'a> {
         found.sort_unstable();
         found.truncate(k);
         out.extend(found.iter().map(|n| n.3));
+    }
+
+    /// [`Self::nearest`] when a ball of radius `holding` around point `i`
+    /// is known to hold its k nearest: with Morton cells, the search starts
+    /// there; the tree does not need it.
+    fn nearest_given(&self, i: usize, k: usize, holding: f64, out: &mut Vec<u32>) {
+        match &self.search {
+            Search::Morton(cells) if k > 0 => {
+                out.clear();
+                self.nearest_in_cells(cells, i, k.min(self.points.len()), holding, out)
+            }
+            _ => self.nearest(i, k, out),
+        }
+    }
+
+    /// [`Self::nearest`] through Morton cells, starting from a `radius`
+    /// that holds at least k points: the points within it, sorted as the
+    /// tree's answer is. The radius doubles until the k-th is strictly
+    /// inside its tie bin, so that no point outside can tie with it.
+    fn nearest_in_cells(
+        &self,
+        cells: &MortonCells,
+        i: usize,
+        k: usize,
+        mut radius: f64,
+        out: &mut Vec<u32>,
+    ) {
+        let p = self.points[i];
+        let mut found: Vec<(bool, u64, u32, u32)> = Vec::new();
+        loop {
+            found.clear();
+            cells.within(self.points, p, radius, |j| {
+                let d2 = crate::cloud::dist2(p, self.points[j as usize]);
+                found.push((j as usize != i, tie_key(d2), self.rank(j), j));
+            });
+            let everything = found.len() == self.points.len();
+            if found.len() >= k {
+                found.select_nth_unstable(k - 1);
+                if everything || found[k - 1].1 < tie_key(radius * radius) {
+                    break;
+                }
+            }
+            radius *= 2.0;
+        }
+        found[..k].sort_unstable();
+        out.extend(found[..k].iter().map(|n| n.3));
     }
 }
 
@@ -171,7 +247,9 @@ impl NeighbourIndex<'_> {
             let reach = (gather - from_centre - slack).min(d_k + from_centre + slack);
             let guess = GUESS_MARGIN * previous_d_k;
             if !self.select_nearest(pp, from_centre, reach * reach, guess * guess, k, s, out) {
-                self.nearest(p, k, &mut s.single);
+                // c's k nearest lie within d_k(c) + |p − c| of p.
+                let holding = d_k + from_centre;
+                self.nearest_given(p, k, holding + 2.0 * slack, &mut s.single);
                 out.copy_from_slice(&s.single);
             }
             previous_d_k = dist(pp, self.points[out[k - 1] as usize]);
@@ -181,12 +259,17 @@ impl NeighbourIndex<'_> {
     /// Gathers the points within `radius` of `centre` as candidates.
     fn gather(&self, centre: Point3, radius: f64, s: &mut RunScratch) {
         s.candidates.clear();
-        self.tree
-            .query(&centre)
-            .within::<SquaredEuclidean<f64>>(radius * radius)
-            .unsorted()
-            .without_distances()
-            .visit(|found| s.candidates.push(found.item));
+        match &self.search {
+            Search::Tree(tree) => tree
+                .query(&centre)
+                .within::<SquaredEuclidean<f64>>(radius * radius)
+                .unsorted()
+                .without_distances()
+                .visit(|found| s.candidates.push(found.item)),
+            Search::Morton(cells) => {
+                cells.within(self.points, centre, radius, |j| s.candidates.push(j))
+            }
+        }
         s.rank_and_index.clear();
         s.rank_and_index.extend(
             s.candidates
@@ -519,6 +602,69 @@ mod tests {
             .collect();
         let index = NeighbourIndex::new(&pts);
         assert_runs_match(&index, 32, |p| nearest_brute_force(&pts, p, 30));
+    }
+
+    /// The index over points in Morton order ([`crate::morton`]) gives the
+    /// brute force's answers on the original points, ties cut by input
+    /// index: by runs (gathers, and the fallbacks given a radius) and by
+    /// single queries (which find their own radius).
+    fn assert_morton_matches_brute_force(raw: &[Point3]) {
+        use crate::morton::{spatial_order, MortonCells, MortonGrid};
+        let grid = MortonGrid::of(raw);
+        let (order, keys) = spatial_order(raw, &grid);
+        let points: Vec<Point3> = order.iter().map(|&i| raw[i as usize]).collect();
+        let mut position_of = vec![0u32; raw.len()];
+        for (position, &i) in order.iter().enumerate() {
+            position_of[i as usize] = position as u32;
+        }
+        let index = NeighbourIndex::in_morton_order(&points, MortonCells::new(grid, &keys))
+            .with_ranks(&order);
+        let reference = |p: usize| -> Vec<u32> {
+            nearest_brute_force(raw, order[p] as usize, 30)
+                .into_iter()
+                .map(|i| position_of[i as usize])
+                .collect()
+        };
+        for run_len in [1, 16, 32] {
+            assert_runs_match(&index, run_len, reference);
+        }
+        let mut single = Vec::new();
+        for p in (0..points.len()).step_by(13) {
+            index.nearest(p, 30, &mut single);
+            assert_eq!(single, reference(p), "single query at {p}");
+        }
+    }
+
+    #[test]
+    fn morton_index_matches_brute_force() {
+        // The sheet, the grid full of ties, and far outliers.
+        let mut pts = sheet_and_grid(11, 1500);
+        pts.extend((0..5).map(|i| [10.0 + i as f64, -3.0, 7.0]));
+        assert_morton_matches_brute_force(&pts);
+    }
+
+    #[test]
+    fn morton_index_matches_brute_force_far_from_the_origin() {
+        let pts: Vec<Point3> = sheet_and_grid(12, 1200)
+            .into_iter()
+            .map(|p| [p[0] * 1e-3 + 1e5, p[1] * 1e-3 - 1e5, p[2] * 1e-3 + 1e5])
+            .collect();
+        assert_morton_matches_brute_force(&pts);
+    }
+
+    /// Density varying a thousandfold, and fewer points than a cell of the
+    /// coarsest useful level.
+    #[test]
+    fn morton_index_matches_brute_force_on_uneven_and_tiny_clouds() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(13);
+        let uneven: Vec<Point3> = (0..2000)
+            .map(|i| {
+                let s = [1.0, 0.03, 0.001][i % 3];
+                [rng.random::<f64>() * s, rng.random::<f64>() * s, 0.0]
+            })
+            .collect();
+        assert_morton_matches_brute_force(&uneven);
+        assert_morton_matches_brute_force(&uneven[..31]);
     }
 
     /// Quantised scanner data puts thousands of points on one coordinate

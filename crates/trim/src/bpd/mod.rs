@@ -26,6 +26,7 @@ use crate::anisotropy::{
 use crate::cloud::{check_finite, check_not_degenerate, cross, merge_duplicates, Point3, Sites};
 use crate::error::CloudError;
 use crate::frame::{fit_plane, project, Frame, Point2};
+use crate::morton::{spatial_order, MortonCells, MortonGrid};
 use crate::neighbours::{NeighbourIndex, RunScratch};
 use crate::resolution::{beta_of, nearest_distances, Columns};
 
@@ -193,6 +194,7 @@ struct SpatialOrder {
     points: Vec<Point3>,
     order: Vec<u32>,
     keys: Vec<u64>,
+    grid: MortonGrid,
 }
 
 impl SpatialOrder {
@@ -203,12 +205,14 @@ impl SpatialOrder {
 
     /// The sites' Morton order, and their copy in that order.
     fn of(sites: &[Point3]) -> Self {
-        let (order, keys) = spatial_order(sites);
+        let grid = MortonGrid::of(sites);
+        let (order, keys) = spatial_order(sites, &grid);
         let points = order.par_iter().map(|&i| sites[i as usize]).collect();
         Self {
             points,
             order,
             keys,
+            grid,
         }
     }
 }
@@ -282,10 +286,12 @@ fn neighbourhoods(
         points,
         order,
         keys,
+        grid,
     } = spatial;
     // Ties are broken by site index (input order), which, unlike the
     // spatial order, does not change when the cloud is moved.
-    let index = NeighbourIndex::new(&points).with_ranks(&order);
+    let index =
+        NeighbourIndex::in_morton_order(&points, MortonCells::new(grid, &keys)).with_ranks(&order);
     let mut lists = vec![0u32; points.len() * k];
     let mut sampling = options.anisotropy.then(|| {
         let unset = Sampling::default();
@@ -579,50 +585,6 @@ fn analyse_point(
     }
 }
 
-/// Indices of `points` sorted along a Morton (Z-order) curve, so that
-/// consecutive queries touch the same part of the tree, and their Morton
-/// keys in that order.
-fn spatial_order(points: &[Point3]) -> (Vec<u32>, Vec<u64>) {
-    // Minima and maxima are exact whatever the split, and the keys are
-    // computed point by point: the parallel passes give the serial result.
-    let (lo, hi) = points
-        .par_iter()
-        .fold(
-            || ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
-            |(lo, hi), p| (min3(lo, *p), max3(hi, *p)),
-        )
-        .reduce(
-            || ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
-            |(lo_a, hi_a), (lo_b, hi_b)| (min3(lo_a, lo_b), max3(hi_a, hi_b)),
-        );
-    let extent = (0..3)
-        .map(|a| hi[a] - lo[a])
-        .fold(0.0, f64::max)
-        .max(f64::MIN_POSITIVE);
-    let scale = ((1u64 << 21) - 1) as f64 / extent;
-    let mut keyed: Vec<(u64, u32)> = points
-        .par_iter()
-        .enumerate()
-        .map(|(i, p)| {
-            let cell = |a: usize| ((p[a] - lo[a]) * scale) as u64;
-            (
-                spread_bits(cell(0)) | spread_bits(cell(1)) << 1 | spread_bits(cell(2)) << 2,
-                i as u32,
-            )
-        })
-        .collect();
-    keyed.par_sort_unstable();
-    keyed.into_par_iter().map(|(key, i)| (i, key)).unzip()
-}
-
-fn min3(a: Point3, b: Point3) -> Point3 {
-    [0, 1, 2].map(|i| a[i].min(b[i]))
-}
-
-fn max3(a: Point3, b: Point3) -> Point3 {
-    [0, 1, 2].map(|i| a[i].max(b[i]))
-}
-
 /// Splits sorted Morton `keys` into runs of at most `max` consecutive
 /// points that each lie in one octree cell: a cell with more points is
 /// split into its eight children, and neighbouring children are merged
@@ -669,17 +631,6 @@ fn split_cell(
     }
 }
 
-/// Spreads the low 21 bits of `x` so they occupy every third bit.
-fn spread_bits(x: u64) -> u64 {
-    let mut x = x & 0x1f_ffff;
-    x = (x | x << 32) & 0x001f_0000_0000_ffff;
-    x = (x | x << 16) & 0x001f_0000_ff00_00ff;
-    x = (x | x << 8) & 0x100f_00f0_0f00_f00f;
-    x = (x | x << 4) & 0x10c3_0c30_c30c_30c3;
-    x = (x | x << 2) & 0x1249_2492_4924_9249;
-    x
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -709,7 +660,7 @@ mod tests {
     #[test]
     fn octree_runs_are_whole_sibling_cells() {
         let points = random_sheet(4, 50, 0.3, 1.0);
-        let (_, keys) = spatial_order(&points);
+        let (_, keys) = spatial_order(&points, &MortonGrid::of(&points));
         let whole_siblings = |run: &std::ops::Range<usize>, level: u32| {
             let cell = |i: usize| keys[i] >> level;
             let parent = |i: usize| keys[i] >> (level + 3);

@@ -1,0 +1,252 @@
+//! Morton (Z-order) keys, and neighbour search over points sorted by them.
+//!
+//! Not from the paper: how BPD's step 1 (k-NN, section 2) finds
+//! neighbourhoods fast. The points are cut into a grid of 2²¹ cells per axis
+//! over their bounding cube, and each point gets its cell's Morton key (the
+//! cell's three coordinates, bits interleaved). Sorted by key, points in one
+//! cell of any coarser level of the octree (a key prefix) are one range of
+//! the sorted list. So the sorted keys are themselves a search tree: the
+//! points near a centre are found by binary searches for the few cells
+//! that cover the ball, with nothing built. BPD sorts by Morton key anyway
+//! (queries in spatial order share the cache), and a k-d tree built on top
+//! cost a serial 0.5 ms at 12k points, 70–90 ms at 1M.
+
+use rayon::prelude::*;
+
+use crate::cloud::{dist2, Point3};
+
+/// Bits per axis of a cell coordinate.
+const BITS: u32 = 21;
+const MAX_CELL: u64 = (1 << BITS) - 1;
+
+/// The grid of a cloud's Morton keys.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MortonGrid {
+    lo: Point3,
+    /// Cells per unit of length.
+    scale: f64,
+}
+
+impl MortonGrid {
+    /// The grid over `points`' bounding cube. Minima and maxima are exact
+    /// whatever the split, so the parallel pass gives the serial result.
+    pub fn of(points: &[Point3]) -> Self {
+        let (lo, hi) = points
+            .par_iter()
+            .fold(
+                || ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
+                |(lo, hi), p| (min3(lo, *p), max3(hi, *p)),
+            )
+            .reduce(
+                || ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
+                |(lo_a, hi_a), (lo_b, hi_b)| (min3(lo_a, lo_b), max3(hi_a, hi_b)),
+            );
+        let extent = (0..3)
+            .map(|a| hi[a] - lo[a])
+            .fold(0.0, f64::max)
+            .max(f64::MIN_POSITIVE);
+        Self {
+            lo,
+            scale: MAX_CELL as f64 / extent,
+        }
+    }
+
+    /// The Morton key of `p`'s cell. Copies of a point share it, and so do
+    /// −0.0 and +0.0.
+    pub fn key(&self, p: Point3) -> u64 {
+        interleave([0, 1, 2].map(|a| self.cell(p[a], a)))
+    }
+
+    /// The cell coordinate of `x` along `axis`, clamped to the grid (`as`
+    /// saturates below zero). Monotone in `x`: every operation on the way
+    /// rounds monotonically.
+    fn cell(&self, x: f64, axis: usize) -> u64 {
+        (((x - self.lo[axis]) * self.scale) as u64).min(MAX_CELL)
+    }
+}
+
+/// Indices of `points` sorted by Morton key, and the keys in that order.
+pub fn spatial_order(points: &[Point3], grid: &MortonGrid) -> (Vec<u32>, Vec<u64>) {
+    let mut keyed: Vec<(u64, u32)> = points
+        .par_iter()
+        .enumerate()
+        .map(|(i, p)| (grid.key(*p), i as u32))
+        .collect();
+    keyed.par_sort_unstable();
+    keyed.into_par_iter().map(|(key, i)| (i, key)).unzip()
+}
+
+/// Points sorted by Morton key, searched through their keys.
+#[derive(Debug, Clone, Copy)]
+pub struct MortonCells<'a> {
+    grid: MortonGrid,
+    keys: &'a [u64],
+}
+
+impl<'a> MortonCells<'a> {
+    /// `keys` must be sorted, each the key (on `grid`) of the point at its
+    /// position.
+    pub fn new(grid: MortonGrid, keys: &'a [u64]) -> Self {
+        debug_assert!(keys.is_sorted());
+        Self { grid, keys }
+    }
+
+    /// Calls `visit(position)` for every point of `points` (the sorted
+    /// points) within `radius` of `centre`: `dist2 ≤ radius²`, exactly.
+    ///
+    /// The ball lies in the box of cells from `centre − radius` to
+    /// `centre + radius` on each axis (rounding is monotone, so a point
+    /// inside never falls outside). At the level where a cell is wider than
+    /// that box, the box meets at most two cells per axis: at most eight
+    /// key ranges, each found by binary search. Splitting big cells further
+    /// to skip their parts outside the box measured fewer points but cost
+    /// more (+1.2M instructions at the 12k benchmark).
+    pub fn within(
+        &self,
+        points: &[Point3],
+        centre: Point3,
+        radius: f64,
+        mut visit: impl FnMut(u32),
+    ) {
+        let low = [0, 1, 2].map(|a| self.grid.cell(centre[a] - radius, a));
+        let high = [0, 1, 2].map(|a| self.grid.cell(centre[a] + radius, a));
+        let span = (0..3).map(|a| high[a] - low[a]).max().unwrap_or(0);
+        // Cells of side 2^shift > span.
+        let shift = (u64::BITS - span.leading_zeros()).min(BITS);
+        let (low, high) = (low.map(|c| c >> shift), high.map(|c| c >> shift));
+        let r2 = radius * radius;
+        for z in low[2]..=high[2] {
+            for y in low[1]..=high[1] {
+                for x in low[0]..=high[0] {
+                    for position in self.cell_range(interleave([x, y, z]), shift) {
+                        if dist2(points[position], centre) <= r2 {
+                            visit(position as u32);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Positions of the points in the cell with Morton key `cell` at the
+    /// level of cells of side 2^shift.
+    fn cell_range(&self, cell: u64, shift: u32) -> std::ops::Range<usize> {
+        let level = 3 * shift;
+        // At the top level (shift = BITS) the only cell is the whole grid;
+        // keys have 3·BITS = 63 bits, so the shifts stay below 64.
+        let start = self.keys.partition_point(|&k| k >> level < cell);
+        let len = self.keys[start..].partition_point(|&k| k >> level == cell);
+        start..start + len
+    }
+
+    /// A radius around the point at `position` that holds at least `k`
+    /// points (or all of them): the diagonal of the smallest cell around it
+    /// with `k` points, widened for rounding.
+    pub fn radius_holding(&self, position: usize, k: usize) -> f64 {
+        let key = self.keys[position];
+        let shift = (0..=BITS)
+            .find(|&s| self.cell_range(key >> (3 * s), s).len() >= k)
+            .unwrap_or(BITS);
+        let side = (1u64 << shift) as f64 / self.grid.scale;
+        // A cell's points differ by less than its side on each axis, up to
+        // the rounding of (x − lo)·scale.
+        side * 3f64.sqrt() * (1.0 + 1e-6) + 1e-12 * (side + magnitude(self.grid.lo))
+    }
+}
+
+fn magnitude(p: Point3) -> f64 {
+    p.iter().fold(0.0, |m, c| m.max(c.abs()))
+}
+
+/// The Morton key of cell coordinates (each below 2²¹).
+fn interleave(cell: [u64; 3]) -> u64 {
+    spread_bits(cell[0]) | spread_bits(cell[1]) << 1 | spread_bits(cell[2]) << 2
+}
+
+/// Spreads the low 21 bits of `x` so they occupy every third bit.
+fn spread_bits(x: u64) -> u64 {
+    let mut x = x & 0x1f_ffff;
+    x = (x | x << 32) & 0x001f_0000_0000_ffff;
+    x = (x | x << 16) & 0x001f_0000_ff00_00ff;
+    x = (x | x << 8) & 0x100f_00f0_0f00_f00f;
+    x = (x | x << 4) & 0x10c3_0c30_c30c_30c3;
+    x = (x | x << 2) & 0x1249_2492_4924_9249;
+    x
+}
+
+fn min3(a: Point3, b: Point3) -> Point3 {
+    [0, 1, 2].map(|i| a[i].min(b[i]))
+}
+
+fn max3(a: Point3, b: Point3) -> Point3 {
+    [0, 1, 2].map(|i| a[i].max(b[i]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{RngExt, SeedableRng};
+
+    fn sorted(points: &[Point3]) -> (Vec<Point3>, Vec<u64>, MortonGrid) {
+        let grid = MortonGrid::of(points);
+        let (order, keys) = spatial_order(points, &grid);
+        (
+            order.iter().map(|&i| points[i as usize]).collect(),
+            keys,
+            grid,
+        )
+    }
+
+    /// Balls of every size, from inside one cell to the whole cloud and
+    /// beyond it, on a sheet whose density varies a hundredfold.
+    #[test]
+    fn within_finds_exactly_the_points_in_the_ball() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(4);
+        let raw: Vec<Point3> = (0..3000)
+            .map(|i| {
+                let s = if i % 2 == 0 { 1.0 } else { 0.01 };
+                [
+                    rng.random::<f64>() * s,
+                    rng.random::<f64>() * s,
+                    rng.random::<f64>() * 0.01,
+                ]
+            })
+            .collect();
+        let (points, keys, grid) = sorted(&raw);
+        let cells = MortonCells::new(grid, &keys);
+        for case in 0..300 {
+            let centre = points[rng.random_range(0..points.len())];
+            let radius = 10f64.powf(rng.random_range(-4.0..0.5));
+            let centre = if case % 5 == 0 {
+                [centre[0] + 2.0, centre[1] - 1.0, centre[2]] // outside the grid
+            } else {
+                centre
+            };
+            let mut got = Vec::new();
+            cells.within(&points, centre, radius, |p| got.push(p));
+            got.sort_unstable();
+            let want: Vec<u32> = (0..points.len() as u32)
+                .filter(|&p| dist2(points[p as usize], centre) <= radius * radius)
+                .collect();
+            assert_eq!(got, want, "centre {centre:?}, radius {radius}");
+        }
+    }
+
+    #[test]
+    fn radius_holding_holds_k_points() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let raw: Vec<Point3> = (0..2000)
+            .map(|_| [rng.random::<f64>() * 1e-3 + 1e5, rng.random(), 0.5])
+            .collect();
+        let (points, keys, grid) = sorted(&raw);
+        let cells = MortonCells::new(grid, &keys);
+        for position in (0..points.len()).step_by(37) {
+            for k in [1, 30, 500, 2000] {
+                let r = cells.radius_holding(position, k);
+                let mut count = 0;
+                cells.within(&points, points[position], r, |_| count += 1);
+                assert!(count >= k, "position {position}, k {k}: {count}");
+            }
+        }
+    }
+}
