@@ -7,7 +7,8 @@
 //! value, as quantised scanner data does and kiddo's mutable tree fails
 //! on), and the points' own Morton order ([`NeighbourIndex::in_morton_order`],
 //! [`crate::morton`]), which BPD sorts its points into anyway and which
-//! needs nothing built. The neighbourhood of a point includes the point itself, first.
+//! needs nothing built. The neighbourhood of a point includes the point
+//! itself, first.
 //! Ties in distance are broken by index so the result never depends on the
 //! tree's internal layout.
 
@@ -154,6 +155,11 @@ impl<'a> NeighbourIndex<'a> {
         out: &mut Vec<u32>,
     ) {
         let p = self.points[i];
+        // A radius of 0 would never grow (k = 1 at the run's centre).
+        if radius.is_nan() || radius <= 0.0 {
+            radius = cells.radius_holding(i, k);
+        }
+        // Allocated per call: these queries are the rare fallbacks.
         let mut found: Vec<(bool, u64, u32, u32)> = Vec::new();
         loop {
             found.clear();
@@ -596,10 +602,7 @@ mod tests {
     /// hold every point within reach (ties on the quantised grid included).
     #[test]
     fn run_queries_match_brute_force_far_from_the_origin() {
-        let pts: Vec<Point3> = sheet_and_grid(9, 1200)
-            .into_iter()
-            .map(|p| [p[0] * 1e-3 + 1e5, p[1] * 1e-3 - 1e5, p[2] * 1e-3 + 1e5])
-            .collect();
+        let pts = far_from_the_origin(sheet_and_grid(9, 1200));
         let index = NeighbourIndex::new(&pts);
         assert_runs_match(&index, 32, |p| nearest_brute_force(&pts, p, 30));
     }
@@ -645,15 +648,39 @@ mod tests {
 
     #[test]
     fn morton_index_matches_brute_force_far_from_the_origin() {
-        let pts: Vec<Point3> = sheet_and_grid(12, 1200)
-            .into_iter()
-            .map(|p| [p[0] * 1e-3 + 1e5, p[1] * 1e-3 - 1e5, p[2] * 1e-3 + 1e5])
-            .collect();
-        assert_morton_matches_brute_force(&pts);
+        assert_morton_matches_brute_force(&far_from_the_origin(sheet_and_grid(12, 1200)));
     }
 
-    /// Density varying a thousandfold, and fewer points than a cell of the
-    /// coarsest useful level.
+    /// With k = 1 a point's k-th distance is 0, a radius that doubling
+    /// cannot grow; the query must still end, with the point itself.
+    #[test]
+    fn morton_index_answers_k_1() {
+        use crate::morton::{spatial_order, MortonCells, MortonGrid};
+        let pts = sheet_and_grid(14, 300);
+        let grid = MortonGrid::of(&pts);
+        let (order, keys) = spatial_order(&pts, &grid);
+        let sorted: Vec<Point3> = order.iter().map(|&i| pts[i as usize]).collect();
+        let index = NeighbourIndex::in_morton_order(&sorted, MortonCells::new(grid, &keys));
+        let mut out = vec![0u32; 8];
+        index.nearest_of_run(0..8, 1, &mut out, &mut RunScratch::default());
+        assert_eq!(out, (0..8).collect::<Vec<u32>>());
+        let mut single = Vec::new();
+        index.nearest(5, 1, &mut single);
+        assert_eq!(single, vec![5]);
+        // The fallback given the run's radius d_k + |p − c| = 0 + 0.
+        index.nearest_given(5, 1, 0.0, &mut single);
+        assert_eq!(single, vec![5]);
+    }
+
+    /// `pts` scaled by 10⁻³ and moved 10⁵ from the origin.
+    fn far_from_the_origin(pts: Vec<Point3>) -> Vec<Point3> {
+        pts.into_iter()
+            .map(|p| [p[0] * 1e-3 + 1e5, p[1] * 1e-3 - 1e5, p[2] * 1e-3 + 1e5])
+            .collect()
+    }
+
+    /// Density varying a thousandfold, and a cloud of 31 points (one more
+    /// than k, so every query needs nearly all of them).
     #[test]
     fn morton_index_matches_brute_force_on_uneven_and_tiny_clouds() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(13);
