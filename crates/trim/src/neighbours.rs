@@ -87,18 +87,38 @@ impl<'a> NeighbourIndex<'a> {
     /// depends on the tree; so the query asks for one more than needed and
     /// widens until the tie is enclosed, then cuts by rank.
     pub fn nearest(&self, i: usize, k: usize, out: &mut Vec<u32>) {
+        self.nearest_holding(i, k, None, out);
+    }
+
+    /// [`Self::nearest`], given when known a radius round point `i` that
+    /// holds at least k points: with Morton cells the search starts there
+    /// (else at a radius found from the cells); the tree does not need it.
+    fn nearest_holding(&self, i: usize, k: usize, holding: Option<f64>, out: &mut Vec<u32>) {
         out.clear();
         let k = k.min(self.points.len());
         if k == 0 {
             return;
         }
-        let tree = match &self.search {
-            Search::Tree(tree) => tree,
+        match &self.search {
+            Search::Tree(tree) => self.nearest_in_tree(tree, i, k, out),
             Search::Morton(cells) => {
-                let radius = cells.radius_holding(i, k);
-                return self.nearest_in_cells(cells, i, k, radius, out);
+                // A radius of 0 would never grow (k = 1 at a run's centre).
+                let radius = holding
+                    .filter(|&r| r > 0.0)
+                    .unwrap_or_else(|| cells.radius_holding(i, k));
+                self.nearest_in_cells(cells, i, k, radius, out);
             }
-        };
+        }
+    }
+
+    /// [`Self::nearest`] through kiddo's tree, for 1 ≤ k ≤ n.
+    fn nearest_in_tree(
+        &self,
+        tree: &ImmutableKdTree<f64, 3>,
+        i: usize,
+        k: usize,
+        out: &mut Vec<u32>,
+    ) {
         let p = self.points[i];
         let mut ask = (k + 1).min(self.points.len());
         let found = loop {
@@ -129,23 +149,10 @@ impl<'a> NeighbourIndex<'a> {
         out.extend(found.iter().map(|n| n.3));
     }
 
-    /// [`Self::nearest`] when a ball of radius `holding` around point `i`
-    /// is known to hold its k nearest: with Morton cells, the search starts
-    /// there; the tree does not need it.
-    fn nearest_given(&self, i: usize, k: usize, holding: f64, out: &mut Vec<u32>) {
-        match &self.search {
-            Search::Morton(cells) if k > 0 => {
-                out.clear();
-                self.nearest_in_cells(cells, i, k.min(self.points.len()), holding, out)
-            }
-            _ => self.nearest(i, k, out),
-        }
-    }
-
-    /// [`Self::nearest`] through Morton cells, starting from a `radius`
-    /// that holds at least k points: the points within it, sorted as the
-    /// tree's answer is. The radius doubles until the k-th is strictly
-    /// inside its tie bin, so that no point outside can tie with it.
+    /// [`Self::nearest`] through Morton cells, for 1 ≤ k ≤ n, starting from
+    /// a `radius` > 0 that holds at least k points: the points within it,
+    /// sorted as the tree's answer is. The radius doubles until the k-th is
+    /// strictly inside its tie bin, so that no point outside can tie with it.
     fn nearest_in_cells(
         &self,
         cells: &MortonCells,
@@ -155,10 +162,6 @@ impl<'a> NeighbourIndex<'a> {
         out: &mut Vec<u32>,
     ) {
         let p = self.points[i];
-        // A radius of 0 would never grow (k = 1 at the run's centre).
-        if radius.is_nan() || radius <= 0.0 {
-            radius = cells.radius_holding(i, k);
-        }
         // Allocated per call: these queries are the rare fallbacks.
         let mut found: Vec<(bool, u64, u32, u32)> = Vec::new();
         loop {
@@ -187,7 +190,7 @@ impl NeighbourIndex<'_> {
     /// `k` per point into `out` in the order of [`Self::nearest`], with the
     /// same result.
     ///
-    /// One tree query serves the whole run: the points within a radius G of
+    /// One range query serves the whole run: the points within a radius G of
     /// the run's central point c are gathered once. For a point p of the
     /// run they include every point within G − |p − c| of p; when at least
     /// k do, p's k nearest (ties included) are among them, exactly. G is
@@ -196,8 +199,8 @@ impl NeighbourIndex<'_> {
     /// previous run's (consecutive runs are neighbours in space, and a tree
     /// query for c cost more than the guess at a million points) and
     /// checked: c's k nearest must lie within G; if not, c gets its own
-    /// tree query. A point for which the gathered set cannot prove its
-    /// answer gets its own tree query too.
+    /// k-NN query. A point for which the gathered set cannot prove its
+    /// answer gets its own k-NN query too.
     pub fn nearest_of_run(&self, run: Range<usize>, k: usize, out: &mut [u32], s: &mut RunScratch) {
         let k = k.min(self.points.len());
         debug_assert_eq!(out.len(), run.len() * k);
@@ -255,7 +258,7 @@ impl NeighbourIndex<'_> {
             if !self.select_nearest(pp, from_centre, reach * reach, guess * guess, k, s, out) {
                 // c's k nearest lie within d_k(c) + |p − c| of p.
                 let holding = d_k + from_centre;
-                self.nearest_given(p, k, holding + 2.0 * slack, &mut s.single);
+                self.nearest_holding(p, k, Some(holding + 2.0 * slack), &mut s.single);
                 out.copy_from_slice(&s.single);
             }
             previous_d_k = dist(pp, self.points[out[k - 1] as usize]);
@@ -668,7 +671,7 @@ mod tests {
         index.nearest(5, 1, &mut single);
         assert_eq!(single, vec![5]);
         // The fallback given the run's radius d_k + |p − c| = 0 + 0.
-        index.nearest_given(5, 1, 0.0, &mut single);
+        index.nearest_holding(5, 1, Some(0.0), &mut single);
         assert_eq!(single, vec![5]);
     }
 

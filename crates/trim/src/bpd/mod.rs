@@ -26,7 +26,7 @@ use crate::anisotropy::{
 use crate::cloud::{check_finite, check_not_degenerate, cross, merge_duplicates, Point3, Sites};
 use crate::error::CloudError;
 use crate::frame::{fit_plane, project, Frame, Point2};
-use crate::morton::{spatial_order, MortonCells, MortonGrid};
+use crate::morton::{octree_runs, spatial_order, MortonCells, MortonGrid};
 use crate::neighbours::{NeighbourIndex, RunScratch};
 use crate::resolution::{beta_of, nearest_distances, Columns};
 
@@ -387,7 +387,7 @@ fn sampling_at(points: &[Point3], members: &[u32], projected: &mut Vec<Point2>) 
 }
 
 /// Most points per k-NN run (see [`NeighbourIndex::nearest_of_run`] and
-/// [`octree_runs`]): enough to share one tree query among them, few
+/// [`octree_runs`]): enough to share one range query among them, few
 /// enough that the run stays small next to a neighbourhood. 32 against 16:
 /// the same time at 12k points, 2 % less at 1M (fewer tree queries where
 /// the tree no longer fits in the cache).
@@ -585,52 +585,6 @@ fn analyse_point(
     }
 }
 
-/// Splits sorted Morton `keys` into runs of at most `max` consecutive
-/// points that each lie in one octree cell: a cell with more points is
-/// split into its eight children, and neighbouring children are merged
-/// back while they fit. Unlike fixed-length stretches of the curve, which
-/// jump between distant cells, every run is compact in space.
-fn octree_runs(keys: &[u64], max: usize) -> Vec<std::ops::Range<usize>> {
-    let mut runs = Vec::with_capacity(2 * keys.len() / max.max(1) + 1);
-    split_cell(keys, 0..keys.len(), 63, max, &mut runs);
-    runs
-}
-
-fn split_cell(
-    keys: &[u64],
-    cell: std::ops::Range<usize>,
-    shift: u32,
-    max: usize,
-    runs: &mut Vec<std::ops::Range<usize>>,
-) {
-    // A cell (or merged siblings) that fits is a run.
-    if cell.len() <= max || shift == 0 {
-        runs.push(cell);
-        return;
-    }
-    let child_shift = shift - 3;
-    let child_of = |i: usize| (keys[i] >> child_shift) & 7;
-    let mut pending: Option<std::ops::Range<usize>> = None;
-    let mut start = cell.start;
-    while start < cell.end {
-        let child = child_of(start);
-        let end =
-            start + keys[start..cell.end].partition_point(|&key| (key >> child_shift) & 7 == child);
-        match pending.take() {
-            Some(p) if p.len() + (end - start) <= max => pending = Some(p.start..end),
-            Some(p) => {
-                split_cell(keys, p, child_shift, max, runs);
-                pending = Some(start..end);
-            }
-            None => pending = Some(start..end),
-        }
-        start = end;
-    }
-    if let Some(p) = pending {
-        split_cell(keys, p, child_shift, max, runs);
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -651,39 +605,6 @@ mod tests {
                 assert_eq!(full, alone, "seed {seed}, anisotropy {anisotropy}");
             }
         }
-    }
-
-    /// Runs cover the Morton order in sequence, hold at most `max` points,
-    /// and each is made of whole octree cells that are siblings: at some
-    /// level, the run's cells share one parent and no cell of that level is
-    /// cut by the run's ends (fixed-length stretches of the curve fail this).
-    #[test]
-    fn octree_runs_are_whole_sibling_cells() {
-        let points = random_sheet(4, 50, 0.3, 1.0);
-        let (_, keys) = spatial_order(&points, &MortonGrid::of(&points));
-        let whole_siblings = |run: &std::ops::Range<usize>, level: u32| {
-            let cell = |i: usize| keys[i] >> level;
-            let parent = |i: usize| keys[i] >> (level + 3);
-            parent(run.start) == parent(run.end - 1)
-                && (run.start == 0 || cell(run.start - 1) != cell(run.start))
-                && (run.end == keys.len() || cell(run.end) != cell(run.end - 1))
-        };
-        for max in [1, 5, 16, 40] {
-            let runs = octree_runs(&keys, max);
-            let mut next = 0;
-            for run in &runs {
-                assert_eq!(run.start, next);
-                assert!(!run.is_empty() && run.len() <= max, "{run:?}");
-                assert!(
-                    (0..61).step_by(3).any(|level| whole_siblings(run, level)),
-                    "max {max}: {run:?} cuts a cell"
-                );
-                next = run.end;
-            }
-            assert_eq!(next, keys.len());
-        }
-        let mut fixed = (0..keys.len() / 16).map(|i| i * 16..i * 16 + 16);
-        assert!(fixed.any(|run| !(0..61).step_by(3).any(|level| whole_siblings(&run, level))));
     }
 
     /// A wavy jittered sheet with a hole and a notch, plus uniform noise.
