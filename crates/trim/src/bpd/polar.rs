@@ -43,10 +43,7 @@ use crate::frame::Point2;
 pub struct PolarScratch {
     theta: Vec<f64>,
     r: Vec<f64>,
-    /// Smallest and largest angle in each of n equal sectors.
-    buckets: Vec<(f64, f64)>,
-    /// The gaps between buckets: (gap, angle where it ends).
-    gaps: Vec<(f64, f64)>,
+    sector: SectorScratch,
     /// 0 for neighbours still free, +∞ for linked ones.
     blocked: Vec<f64>,
     cost: Vec<f64>,
@@ -62,7 +59,7 @@ pub fn surrounding_path_is_open(nb: &[Point2], s: &mut PolarScratch) -> bool {
     }
     s.theta.clear();
     s.theta.extend(nb.iter().map(|p| atan2(p[1], p[0])));
-    let (theta_min, width) = occupied_sector(&s.theta, &mut s.buckets, &mut s.gaps);
+    let (theta_min, width) = occupied_sector(&s.theta, &mut s.sector);
     if width <= 0.0 {
         return true;
     }
@@ -156,44 +153,48 @@ const TIE: f64 = 1e-9;
 /// rounding or the ±π seam of the angles. The same result as
 /// [`occupied_sector_sorted`] except where a gap inside a bucket ties with
 /// the largest (all gaps within [`TIE`] of 2π/n).
-fn occupied_sector(
-    theta: &[f64],
-    buckets: &mut Vec<(f64, f64)>,
-    gaps: &mut Vec<(f64, f64)>,
-) -> (f64, f64) {
+///
+/// Each pass is a plain loop over fixed-length arrays: the gap before every
+/// bucket is written (−∞ for an empty one), so no pass branches on which
+/// buckets are filled, and only the rare tie goes through [`choose_gap`].
+#[inline(never)]
+fn occupied_sector(theta: &[f64], s: &mut SectorScratch) -> (f64, f64) {
     let n = theta.len();
     if n == 0 {
         // No angles: no sector, which the caller reads as open.
         return (0.0, 0.0);
     }
-    buckets.clear();
-    buckets.resize(n, (f64::INFINITY, f64::NEG_INFINITY));
     let per_bucket = n as f64 / TAU;
+    let bucket = |t: f64| ((((t + PI) * per_bucket) as u32) as usize).min(n - 1);
+    s.lows.clear();
+    s.lows.resize(n, f64::INFINITY);
+    s.highs.clear();
+    s.highs.resize(n, f64::NEG_INFINITY);
+    s.gaps.clear();
+    s.gaps.resize(n, f64::NEG_INFINITY);
+    // Slices of length n: `bucket` is below n, so no bounds checks.
+    let (lows, highs, gaps) = (&mut s.lows[..n], &mut s.highs[..n], &mut s.gaps[..n]);
     let (mut smallest, mut largest) = (f64::INFINITY, f64::NEG_INFINITY);
     for &t in theta {
-        // `as u32`: the same bucket as `as usize` for these small,
-        // non-negative values, in fewer instructions.
-        let b = ((((t + PI) * per_bucket) as u32) as usize).min(n - 1);
-        let (lo, hi) = &mut buckets[b];
+        let b = bucket(t);
         // Comparisons, not `f64::min`/`max`, whose NaN handling costs
         // more (the angles are finite).
-        *lo = if t < *lo { t } else { *lo };
-        *hi = if t > *hi { t } else { *hi };
+        lows[b] = if t < lows[b] { t } else { lows[b] };
+        highs[b] = if t > highs[b] { t } else { highs[b] };
         smallest = if t < smallest { t } else { smallest };
         largest = if t > largest { t } else { largest };
     }
-    // The gap before each filled bucket, in bucket order, written for
-    // every bucket and kept (the count advanced) only for filled ones: no
-    // branch on which buckets are filled, a coin flip that the processor
-    // often mispredicts.
-    gaps.clear();
-    gaps.resize(n, (0.0, 0.0));
-    let (mut filled, mut previous_high) = (0, f64::NEG_INFINITY);
-    for &(lo, hi) in buckets.iter() {
-        gaps[filled] = (lo - previous_high, lo);
-        filled += usize::from(lo <= hi);
-        // A filled bucket's angles lie above the previous ones, an empty
-        // one's `hi` is −∞: the maximum is the last filled bucket's.
+    // The gap before each bucket: from the largest angle of the buckets
+    // below (an empty one's `hi` is −∞, so a running maximum) to its
+    // smallest.
+    let mut previous_high = f64::NEG_INFINITY;
+    for b in 0..n {
+        let (lo, hi) = (lows[b], highs[b]);
+        gaps[b] = if lo <= hi {
+            lo - previous_high
+        } else {
+            f64::NEG_INFINITY
+        };
         previous_high = if hi > previous_high {
             hi
         } else {
@@ -202,8 +203,35 @@ fn occupied_sector(
     }
     // The first filled bucket starts at the smallest angle; its gap wraps
     // round from the largest.
-    gaps[0] = (smallest + TAU - largest, smallest);
-    choose_gap(&gaps[..filled], theta[0])
+    gaps[bucket(smallest)] = smallest + TAU - largest;
+    let widest = gaps
+        .iter()
+        .fold(f64::NEG_INFINITY, |m, &g| if g > m { g } else { m });
+    let mut contenders = (0..n).filter(|&b| gaps[b] >= widest - TIE);
+    if let (Some(b), None) = (contenders.next(), contenders.next()) {
+        return (lows[b], TAU - gaps[b]);
+    }
+    // Ties: the filled buckets' gaps, in bucket order, for `choose_gap`.
+    s.pairs.clear();
+    s.pairs.extend(
+        gaps.iter()
+            .zip(lows.iter())
+            .filter(|(&g, _)| g > f64::NEG_INFINITY)
+            .map(|(&g, &lo)| (g, lo)),
+    );
+    choose_gap(&s.pairs, theta[0])
+}
+
+/// Reusable buffers for [`occupied_sector`], one slot per bucket.
+#[derive(Default, Debug, Clone)]
+struct SectorScratch {
+    /// Smallest and largest angle in each bucket (±∞ when empty).
+    lows: Vec<f64>,
+    highs: Vec<f64>,
+    /// The gap before each bucket, −∞ for empty ones.
+    gaps: Vec<f64>,
+    /// Ties only: (gap, angle where it ends) of the filled buckets.
+    pairs: Vec<(f64, f64)>,
 }
 
 /// The sector left by the largest of `gaps` (gap, angle where it ends),
@@ -366,7 +394,7 @@ mod tests {
     fn bucketed_sector_matches_sorting_on_random_angles() {
         use rand::{RngExt, SeedableRng};
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
-        let (mut buckets, mut gaps) = (Vec::new(), Vec::new());
+        let mut sector = SectorScratch::default();
         for case in 0..2000 {
             let n = 1 + case % 40;
             // Clustered angles (a sector), spread ones, and the ends ±π.
@@ -383,7 +411,7 @@ mod tests {
                 theta[n - 1] = -PI;
             }
             assert_eq!(
-                occupied_sector(&theta, &mut buckets, &mut gaps),
+                occupied_sector(&theta, &mut sector),
                 occupied_sector_sorted(&theta),
                 "{theta:?}"
             );
@@ -420,5 +448,37 @@ mod tests {
         assert!((circular_difference(3.0, -3.0) - (6.0 - TAU)).abs() < 1e-12);
         assert!((circular_difference(-3.0, 3.0) - (TAU - 6.0)).abs() < 1e-12);
         assert_eq!(circular_difference(PI, 0.0), PI);
+    }
+
+    /// Quantised angles (multiples of π/4, as quantised clouds give) tie
+    /// for the largest gap; the tie rule picks the same sector either way.
+    #[test]
+    fn bucketed_sector_breaks_ties_as_sorting_does() {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let mut sector = SectorScratch::default();
+        let mut tied = 0;
+        for case in 0..2000 {
+            let n = 2 + case % 30;
+            let theta: Vec<f64> = (0..n)
+                .map(|_| circular_difference(f64::from(rng.random_range(-4..4)) * FRAC_PI_4, 0.0))
+                .collect();
+            let (_, width) = occupied_sector_sorted(&theta);
+            let gap = TAU - width;
+            let mut sorted = theta.clone();
+            sorted.sort_by(f64::total_cmp);
+            let ties = sorted
+                .windows(2)
+                .filter(|w| (w[1] - w[0] - gap).abs() <= TIE)
+                .count()
+                + usize::from((sorted[0] + TAU - sorted[n - 1] - gap).abs() <= TIE);
+            tied += usize::from(ties > 1);
+            assert_eq!(
+                occupied_sector(&theta, &mut sector),
+                occupied_sector_sorted(&theta),
+                "{theta:?}"
+            );
+        }
+        assert!(tied > 100, "only {tied} cases with tied gaps");
     }
 }
