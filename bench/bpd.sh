@@ -26,7 +26,7 @@ if [ ! -x bench-venv/bin/python ] || ! bench-venv/bin/python -c "import open3d" 
     python3 -m venv bench-venv
     bench-venv/bin/pip install -q open3d-cpu==0.20.0
 fi
-cargo build --release -q -p meshtrim-trim --example bench_bpd
+cargo build --release -q --example bench_bpd
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 

@@ -11,7 +11,9 @@
 //! - [`clean_cmd`] is `meshtrim clean`.
 //! - [`batch`] is `meshtrim batch`: many meshes at once.
 //! - [`console`] prints summaries to stdout; a closed pipe is not an error.
+//! - [`alloc`] tunes the memory allocator for repeated large buffers.
 
+pub mod alloc;
 pub mod batch;
 pub mod clean_cmd;
 pub mod cli;

@@ -7,6 +7,7 @@ use clap::Parser;
 use meshtrim::cli::{run, Cli};
 
 fn main() -> ExitCode {
+    meshtrim::alloc::keep_freed_memory();
     // Usage errors exit with 2 inside `parse`.
     let cli = Cli::parse();
     match run(cli) {
