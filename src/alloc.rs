@@ -13,11 +13,15 @@
 //! in one process and gains the same way; a single run still touches its
 //! pages once.
 
-/// Keeps freed blocks for reuse: blocks up to 32 MiB (glibc's largest
-/// threshold) come from the heap rather than their own mappings, and the
-/// heap keeps up to 1 GiB of free memory instead of returning it. Blocks
-/// above 32 MiB (a cloud of some 250k points and more) are mapped as
-/// before. Call it first in `main`, before any other thread exists.
+/// Keeps freed blocks for reuse: blocks up to 32 MiB come from the heap
+/// rather than their own mappings, and the heap keeps up to 1 GiB of free
+/// memory instead of returning it. Blocks above 32 MiB (a cloud of some
+/// 250k points and more) are mapped as before. Call it first in `main`,
+/// before any other thread exists. Elsewhere than glibc on Linux it does
+/// nothing. No unit test: the thresholds are process-wide, and glibc's
+/// own threshold moves with what the process has freed before, so a test
+/// in the test binary cannot tell the settings' effect from the default's;
+/// `bench/bpd.sh` and the page-fault counts in `docs/results.md` measure it.
 pub fn keep_freed_memory() {
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
     // SAFETY: `mallopt` only sets glibc's allocation thresholds; it takes
