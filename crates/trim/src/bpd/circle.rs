@@ -28,6 +28,9 @@
 //!   the box means the cell is unbounded (P_i on the hull) or has a vertex
 //!   beyond L ≥ β: both are boundary cases of the reference, so the answer
 //!   is "some vertex at distance ≥ β". O(k · cell size), no allocation.
+//! - [`boundary_links`] gives a boundary point's neighbours along the
+//!   boundary from its cell in a box wide enough not to depend on the
+//!   plane's axes.
 
 use crate::frame::Point2;
 
@@ -109,9 +112,7 @@ pub struct CellScratch {
 /// Fast circle test: is some vertex of P_i's Voronoi cell (clipped to a box
 /// of half-size `max(2·max|q|, 2β)`) at least `beta` from P_i?
 ///
-/// `nb` are the neighbours relative to P_i, nearest first. When the answer
-/// is true the cell in `s` is complete, and [`boundary_neighbours`] can read
-/// it.
+/// `nb` are the neighbours relative to P_i, nearest first.
 // Baseline and AVX2 variants, chosen at run time (crate doc, "Vector kernels").
 #[multiversion::multiversion(targets("x86_64+avx2"))]
 pub fn largest_empty_circle_exceeds(nb: &[Point2], beta: f64, s: &mut CellScratch) -> bool {
@@ -153,13 +154,28 @@ pub fn largest_empty_circle_exceeds(nb: &[Point2], beta: f64, s: &mut CellScratc
     far2 >= beta2
 }
 
-/// After [`largest_empty_circle_exceeds`] returned true: the neighbours
-/// (indices into its `nb`) joined to P_i by an empty circle of radius
-/// ≥ `beta` — those whose Voronoi edge with P_i reaches `beta` from P_i.
-/// They are P_i's neighbours *along the boundary* (the edges of the
+/// The neighbours (indices into `nb`, relative to P_i as for
+/// [`largest_empty_circle_exceeds`]) joined to P_i by an empty circle of
+/// radius ≥ `beta` — those whose Voronoi edge with P_i reaches `beta` from
+/// P_i. They are P_i's neighbours *along the boundary* (the edges of the
 /// α-shape with α = β), which edge reconstruction uses to cluster and
 /// order boundary points. Sorted, without repeats.
-pub fn boundary_neighbours(s: &CellScratch, beta: f64, out: &mut Vec<u32>) {
+///
+/// `s` must hold the cell of a true answer of
+/// [`largest_empty_circle_exceeds`] for the same `nb` and `beta` (such a
+/// cell is complete: every neighbour has clipped it). When no edge of it
+/// lies on the test's box, it is P_i's whole cell and is read as it is.
+/// Otherwise it is clipped afresh from a box [`LINK_BOX`] times wider: for
+/// a point on the hull the cell is unbounded, and its edges that lie
+/// between the test's box and that box's corners (all farther than β)
+/// were kept or lost with the box's turn in the plane, so the links turned
+/// with the plane's axes. In the wide box only edges more than 2²⁰
+/// neighbourhood radii away could still be, which needs three neighbours
+/// collinear to within a millionth of the radius without being collinear.
+pub fn boundary_links(nb: &[Point2], beta: f64, s: &mut CellScratch, out: &mut Vec<u32>) {
+    if s.poly.iter().any(|&(_, label)| label == BOX_EDGE) {
+        clip_wide(nb, beta, s);
+    }
     out.clear();
     let beta2 = beta * beta;
     let norm2 = |v: Point2| v[0] * v[0] + v[1] * v[1];
@@ -174,6 +190,45 @@ pub fn boundary_neighbours(s: &CellScratch, beta: f64, out: &mut Vec<u32>) {
     out.sort_unstable();
     out.dedup();
 }
+
+/// P_i's cell clipped by all neighbours from the box of [`LINK_BOX`] ×
+/// max(reach, β).
+fn clip_wide(nb: &[Point2], beta: f64, s: &mut CellScratch) {
+    let reach = nb
+        .iter()
+        .map(|q| q[0] * q[0] + q[1] * q[1])
+        .fold(0.0, f64::max)
+        .sqrt();
+    let l = LINK_BOX * reach.max(beta);
+    s.poly.clear();
+    s.poly.extend_from_slice(&[
+        ([-l, -l], BOX_EDGE),
+        ([l, -l], BOX_EDGE),
+        ([l, l], BOX_EDGE),
+        ([-l, l], BOX_EDGE),
+    ]);
+    let mut far2 = 2.0 * l * l;
+    for (j, &q) in nb.iter().enumerate() {
+        let q2 = q[0] * q[0] + q[1] * q[1];
+        // The bisector x·q = |q|²/2 cannot cut a cell within radius |q|/2.
+        if 0.25 * q2 >= far2 {
+            continue;
+        }
+        clip(&s.poly, q, 0.5 * q2, j as u32, &mut s.next);
+        std::mem::swap(&mut s.poly, &mut s.next);
+        far2 = s
+            .poly
+            .iter()
+            .map(|(v, _)| v[0] * v[0] + v[1] * v[1])
+            .fold(0.0, f64::max);
+    }
+}
+
+/// How much wider than the neighbourhood [`boundary_links`]' box is: 2²⁰,
+/// far beyond any Voronoi vertex of a noisy neighbourhood, and close
+/// enough that the vertices near P_i keep about 10⁻⁹ of their precision
+/// relative to the neighbourhood's radius.
+const LINK_BOX: f64 = 1_048_576.0;
 
 /// Keeps the part of convex polygon `poly` where x·n <= h
 /// (Sutherland–Hodgman); the new edge along x·n = h gets `label`.
@@ -200,6 +255,7 @@ fn clip(poly: &[(Point2, u32)], n: Point2, h: f64, label: u32, out: &mut Vec<(Po
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::{PI, TAU};
 
     fn grid_around(skip: impl Fn(f64, f64) -> bool) -> Vec<Point2> {
         let mut pts = vec![[0.0, 0.0]];
@@ -233,14 +289,14 @@ mod tests {
     }
 
     #[test]
-    fn boundary_neighbours_run_along_the_border() {
+    fn boundary_links_run_along_the_border() {
         // Straight border y = 0 with the cloud below: P_i's neighbours along
         // the border are (±1, 0).
         let pts = grid_around(|_, y| y > 0.0);
         let mut s = CellScratch::default();
         assert!(largest_empty_circle_exceeds(&pts[1..], 1.0, &mut s));
         let mut out = Vec::new();
-        boundary_neighbours(&s, 1.0, &mut out);
+        boundary_links(&pts[1..], 1.0, &mut s, &mut out);
         let found: Vec<Point2> = out.iter().map(|&j| pts[1 + j as usize]).collect();
         assert_eq!(found.len(), 2, "{found:?}");
         assert!(found.contains(&[1.0, 0.0]) && found.contains(&[-1.0, 0.0]));
@@ -253,5 +309,44 @@ mod tests {
         assert!(on_hull_reference(&pts[1..]));
         assert!(empty_circle_reference(&pts, 1.0));
         assert!(largest_empty_circle_exceeds(&pts[1..], 1.0, &mut s));
+    }
+
+    /// The links do not depend on how the plane's axes turn: the same
+    /// neighbourhood turned by any angle has the same boundary neighbours.
+    #[test]
+    fn links_do_not_turn_with_the_axes() {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(21);
+        let mut s = CellScratch::default();
+        let (mut first, mut turned) = (Vec::new(), Vec::new());
+        let mut checked = 0;
+        for case in 0..3000 {
+            // A border point: neighbours on one side of a wavy border,
+            // nearest first.
+            let mut nb: Vec<Point2> = (0..29)
+                .map(|_| {
+                    let r = rng.random_range(0.1..1.0f64).sqrt();
+                    let t = rng.random_range(-PI..0.0);
+                    [r * t.cos(), r * t.sin() + 0.15 * (3.0 * r * t.cos()).sin()]
+                })
+                .collect();
+            nb.sort_by(|a, b| (a[0].hypot(a[1])).total_cmp(&b[0].hypot(b[1])));
+            let beta = [0.2, 0.35, 0.5][case % 3];
+            if !largest_empty_circle_exceeds(&nb, beta, &mut s) {
+                continue;
+            }
+            boundary_links(&nb, beta, &mut s, &mut first);
+            let angle = rng.random_range(0.0..TAU);
+            let (c, sn) = (angle.cos(), angle.sin());
+            let rotated: Vec<Point2> = nb
+                .iter()
+                .map(|p| [c * p[0] - sn * p[1], sn * p[0] + c * p[1]])
+                .collect();
+            assert!(largest_empty_circle_exceeds(&rotated, beta, &mut s));
+            boundary_links(&rotated, beta, &mut s, &mut turned);
+            assert_eq!(first, turned, "case {case}, turned by {angle}");
+            checked += 1;
+        }
+        assert!(checked > 1000, "only {checked} border points");
     }
 }

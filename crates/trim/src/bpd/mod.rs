@@ -82,7 +82,7 @@ pub struct Detection {
     /// Pairs of boundary points (input indices, smaller first, sorted)
     /// joined by an empty circle of radius ≥ β: neighbours along the
     /// boundary, the edges of the α-shape with α = β (see
-    /// [`circle::boundary_neighbours`]). A duplicate point is represented by
+    /// [`circle::boundary_links`]). A duplicate point is represented by
     /// its first copy. Edge reconstruction clusters and orders with them.
     pub links: Vec<[u32; 2]>,
 }
@@ -564,7 +564,7 @@ fn analyse_point(
     };
     let mut links = Vec::new();
     if by_circle && cell_says {
-        circle::boundary_neighbours(&s.cell, beta, &mut s.along);
+        circle::boundary_links(&s.neighbours, beta, &mut s.cell, &mut s.along);
         links.extend(
             s.along
                 .iter()
