@@ -34,6 +34,32 @@ pub struct Frame {
 // Baseline and AVX2 variants, chosen at run time (crate doc, "Vector kernels").
 #[multiversion::multiversion(targets("x86_64+avx2"))]
 pub fn fit_plane(points: &[Point3], members: &[u32]) -> Frame {
+    let (_, [normal, _, u]) = symmetric_eigen3(&covariance(points, members));
+    let u = canonical_sign(u);
+    let normal = canonical_sign(normal);
+    let v = crate::cloud::cross(normal, u);
+    Frame { u, v, normal }
+}
+
+/// [`fit_plane`]'s normal (the same bits) with in-plane axes that follow
+/// from the normal alone, not from the spread within the plane: for
+/// callers whose use of the plane does not depend on how its axes turn
+/// in it, as none of BPD's tests does (distances, angles between members,
+/// the sampling tensor and its map all turn with the axes). It skips the
+/// eigenvector of the middle eigenvalue, and in the usual case (a flat
+/// neighbourhood, whose smallest eigenvalue stands apart) the largest
+/// eigenvalue's cosine.
+// Baseline and AVX2 variants, chosen at run time (crate doc, "Vector kernels").
+#[multiversion::multiversion(targets("x86_64+avx2"))]
+pub fn fit_plane_normal(points: &[Point3], members: &[u32]) -> Frame {
+    let normal = canonical_sign(smallest_eigenvector(&covariance(points, members)));
+    let (u, v) = orthogonal_complement(normal);
+    Frame { u, v, normal }
+}
+
+/// The covariance of `members`' positions (unnormalised).
+#[inline(always)]
+fn covariance(points: &[Point3], members: &[u32]) -> Matrix3<f64> {
     let n = members.len() as f64;
     let origin = points[members[0] as usize];
     // Centre on the first member before summing: keeps precision for clouds
@@ -57,12 +83,7 @@ pub fn fit_plane(points: &[Point3], members: &[u32]) -> Frame {
         c[4] += d[1] * d[2];
         c[5] += d[2] * d[2];
     }
-    let cov = Matrix3::new(c[0], c[1], c[2], c[1], c[3], c[4], c[2], c[4], c[5]);
-    let (_, [normal, _, u]) = symmetric_eigen3(&cov);
-    let u = canonical_sign(u);
-    let normal = canonical_sign(normal);
-    let v = crate::cloud::cross(normal, u);
-    Frame { u, v, normal }
+    Matrix3::new(c[0], c[1], c[2], c[1], c[3], c[4], c[2], c[4], c[5])
 }
 
 /// Eigenvalues (ascending) and unit eigenvectors of a symmetric 3×3 matrix,
@@ -78,12 +99,87 @@ pub fn fit_plane(points: &[Point3], members: &[u32]) -> Frame {
 /// was a tenth of its time; [`symmetric_eigen3`] agrees with it (see the
 /// tests) in about a third of the time.
 pub fn symmetric_eigen3(a: &Matrix3<f64>) -> ([f64; 3], [Point3; 3]) {
+    let (rows, shape) = match spectrum(a) {
+        Spectrum::Zero => return ([0.0; 3], AXES),
+        Spectrum::Diagonal(d, scale) => return diagonal_eigen(d, scale),
+        Spectrum::General(rows, shape) => (rows, shape),
+    };
+    let values = shape.values();
+    let vectors = if shape.half_det >= 0.0 {
+        let v2 = eigenvector_of_simple(rows, values[2]);
+        let v1 = eigenvector_in_complement(rows, v2, values[1]);
+        [unit_cross(v1, v2), v1, v2]
+    } else {
+        let v0 = eigenvector_of_simple(rows, values[0]);
+        let v1 = eigenvector_in_complement(rows, v0, values[1]);
+        [v0, v1, unit_cross(v0, v1)]
+    };
+    (values.map(|l| l * shape.max_abs), vectors)
+}
+
+/// The unit eigenvector of the smallest eigenvalue: [`symmetric_eigen3`]'s
+/// first vector, the same bits, without the others when the smallest
+/// eigenvalue is the best separated.
+pub fn smallest_eigenvector(a: &Matrix3<f64>) -> Point3 {
+    match spectrum(a) {
+        Spectrum::Zero => AXES[0],
+        Spectrum::Diagonal(d, scale) => diagonal_eigen(d, scale).1[0],
+        Spectrum::General(rows, shape) if shape.half_det < 0.0 => {
+            eigenvector_of_simple(rows, shape.smallest())
+        }
+        Spectrum::General(..) => symmetric_eigen3(a).1[0],
+    }
+}
+
+const AXES: [Point3; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+
+/// A symmetric matrix's spectrum as [`symmetric_eigen3`] solves it.
+enum Spectrum {
+    /// All zero (or not finite): any axes.
+    Zero,
+    /// Diagonal entries, scaled to [−1, 1], and the scale.
+    Diagonal([f64; 3], f64),
+    /// The scaled rows, and the cubic's solution.
+    General([Point3; 3], Cubic),
+}
+
+/// The trigonometric solution of the characteristic cubic of the scaled
+/// matrix: eigenvalue q + p·2cos(angle + 2πj/3).
+#[derive(Clone, Copy)]
+struct Cubic {
+    q: f64,
+    p: f64,
+    angle: f64,
+    half_det: f64,
+    max_abs: f64,
+}
+
+impl Cubic {
+    const TWO_THIRDS_PI: f64 = 2.0 * std::f64::consts::FRAC_PI_3;
+
+    /// The smallest eigenvalue of the scaled matrix.
+    fn smallest(&self) -> f64 {
+        self.q + self.p * (2.0 * (self.angle + Self::TWO_THIRDS_PI).cos())
+    }
+
+    /// The eigenvalues of the scaled matrix, ascending.
+    fn values(&self) -> [f64; 3] {
+        let beta2 = 2.0 * self.angle.cos();
+        let beta0 = 2.0 * (self.angle + Self::TWO_THIRDS_PI).cos();
+        let beta1 = -(beta0 + beta2);
+        [
+            self.q + self.p * beta0,
+            self.q + self.p * beta1,
+            self.q + self.p * beta2,
+        ]
+    }
+}
+
+/// Scales `a` to entries in [−1, 1] and solves its characteristic cubic.
+fn spectrum(a: &Matrix3<f64>) -> Spectrum {
     let max_abs = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     if max_abs == 0.0 || !max_abs.is_finite() {
-        return (
-            [0.0; 3],
-            [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
-        );
+        return Spectrum::Zero;
     }
     // Scaled to entries in [−1, 1] against overflow and underflow.
     let s = 1.0 / max_abs;
@@ -91,7 +187,7 @@ pub fn symmetric_eigen3(a: &Matrix3<f64>) -> ([f64; 3], [Point3; 3]) {
     let (a11, a12, a22) = (a[(1, 1)] * s, a[(1, 2)] * s, a[(2, 2)] * s);
     let off_diagonal = a01 * a01 + a02 * a02 + a12 * a12;
     if off_diagonal == 0.0 {
-        return diagonal_eigen([a00, a11, a22], max_abs);
+        return Spectrum::Diagonal([a00, a11, a22], max_abs);
     }
     let q = (a00 + a11 + a22) / 3.0;
     let (b00, b11, b22) = (a00 - q, a11 - q, a22 - q);
@@ -102,22 +198,17 @@ pub fn symmetric_eigen3(a: &Matrix3<f64>) -> ([f64; 3], [Point3; 3]) {
     let det = (b00 * c00 - a01 * c01 + a02 * c02) / (p * p * p);
     let half_det = (0.5 * det).clamp(-1.0, 1.0);
     let angle = half_det.acos() / 3.0;
-    const TWO_THIRDS_PI: f64 = 2.0 * std::f64::consts::FRAC_PI_3;
-    let beta2 = 2.0 * angle.cos();
-    let beta0 = 2.0 * (angle + TWO_THIRDS_PI).cos();
-    let beta1 = -(beta0 + beta2);
-    let values = [q + p * beta0, q + p * beta1, q + p * beta2];
     let rows = [[a00, a01, a02], [a01, a11, a12], [a02, a12, a22]];
-    let vectors = if half_det >= 0.0 {
-        let v2 = eigenvector_of_simple(rows, values[2]);
-        let v1 = eigenvector_in_complement(rows, v2, values[1]);
-        [unit_cross(v1, v2), v1, v2]
-    } else {
-        let v0 = eigenvector_of_simple(rows, values[0]);
-        let v1 = eigenvector_in_complement(rows, v0, values[1]);
-        [v0, v1, unit_cross(v0, v1)]
-    };
-    (values.map(|l| l * max_abs), vectors)
+    Spectrum::General(
+        rows,
+        Cubic {
+            q,
+            p,
+            angle,
+            half_det,
+            max_abs,
+        },
+    )
 }
 
 /// a × b for orthonormal a and b, renormalised so that rounding does not
@@ -322,6 +413,59 @@ mod tests {
     }
 
     /// Edge cases: zero, diagonal, non-finite input gives no NaN vectors.
+    /// The smallest eigenvector alone is the full solver's first vector,
+    /// bit for bit, on the awkward matrices, zero and diagonal ones.
+    #[test]
+    fn smallest_eigenvector_is_the_solvers_first() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
+        let mut cases: Vec<Matrix3<f64>> = (0..20_000).map(|_| awkward_matrix(&mut rng)).collect();
+        cases.push(Matrix3::zeros());
+        cases.push(Matrix3::from_diagonal(&Vector3::new(3.0, 1.0, 2.0)));
+        for (case, a) in cases.iter().enumerate() {
+            let want = symmetric_eigen3(a).1[0];
+            assert_eq!(
+                smallest_eigenvector(a).map(f64::to_bits),
+                want.map(f64::to_bits),
+                "case {case}"
+            );
+        }
+    }
+
+    /// BPD's frame has fit_plane's normal, bit for bit, and orthonormal
+    /// in-plane axes with v = n × u.
+    #[test]
+    fn normal_frame_shares_the_normal() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(10);
+        for case in 0..2_000 {
+            let points: Vec<Point3> = (0..30)
+                .map(|_| {
+                    let (x, y) = (rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0));
+                    let z = [0.0, 0.01, 0.3][case % 3] * rng.random_range(-1.0..1.0);
+                    [x + 0.2 * y, y - 0.5 * z, z + 0.4 * x]
+                })
+                .collect();
+            let members: Vec<u32> = (0..30).collect();
+            let full = fit_plane(&points, &members);
+            let frame = fit_plane_normal(&points, &members);
+            assert_eq!(frame.normal, full.normal, "case {case}");
+            let n = frame.normal;
+            for (a, b, want) in [
+                (frame.u, frame.u, 1.0),
+                (frame.v, frame.v, 1.0),
+                (frame.u, frame.v, 0.0),
+                (frame.u, n, 0.0),
+                (frame.v, n, 0.0),
+            ] {
+                assert!((dot(a, b) - want).abs() < 1e-12, "case {case}");
+            }
+            let n_cross_u = crate::cloud::cross(n, frame.u);
+            assert!(
+                (0..3).all(|i| (n_cross_u[i] - frame.v[i]).abs() < 1e-12),
+                "case {case}"
+            );
+        }
+    }
+
     #[test]
     fn closed_form_eigen_edge_cases() {
         let (values, vectors) = symmetric_eigen3(&Matrix3::zeros());

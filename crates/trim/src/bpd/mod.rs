@@ -25,7 +25,7 @@ use crate::anisotropy::{
 };
 use crate::cloud::{check_finite, check_not_degenerate, cross, merge_duplicates, Point3, Sites};
 use crate::error::CloudError;
-use crate::frame::{fit_plane, project, Frame, Point2};
+use crate::frame::{fit_plane_normal, project, Frame, Point2};
 use crate::morton::{octree_runs, spatial_order, MortonCells, MortonGrid};
 use crate::neighbours::{NeighbourIndex, RunScratch};
 use crate::resolution::{beta_of, nearest_distances, Columns};
@@ -356,7 +356,8 @@ fn neighbourhoods(
 
 /// A point's sampling moment and the plane of its neighbourhood, kept from
 /// the k-NN pass for the tests. The plane's v axis is not stored: it is
-/// n × u, as [`fit_plane`] computes it (96 bytes per point, not 120).
+/// n × u, as [`fit_plane_normal`] computes it (96 bytes per point, not
+/// 120).
 #[derive(Debug, Clone, Copy, Default)]
 struct Sampling {
     moment: SamplingMoment,
@@ -377,7 +378,7 @@ impl Sampling {
 /// The plane of a neighbourhood (`members`, the point first) and the
 /// point's own sampling moment in it ([`crate::anisotropy`]).
 fn sampling_at(points: &[Point3], members: &[u32], projected: &mut Vec<Point2>) -> Sampling {
-    let frame = fit_plane(points, members);
+    let frame = fit_plane_normal(points, members);
     project(points, members, &frame, projected);
     Sampling {
         moment: sampling_moment(&own_sampling_vectors(projected, &frame)),
@@ -517,7 +518,10 @@ fn projected_beta(
 ) -> f64 {
     let members = hoods.at(p);
     // The first pass already fitted this neighbourhood's plane.
-    let frame = vectors.map_or_else(|| fit_plane(&hoods.points, members), |v| v[p].frame());
+    let frame = vectors.map_or_else(
+        || fit_plane_normal(&hoods.points, members),
+        |v| v[p].frame(),
+    );
     project(&hoods.points, members, &frame, &mut s.projected);
     if let Some(vectors) = vectors {
         let tensor = sampling_tensor_of_moments(
