@@ -19,7 +19,8 @@ pub type Point2 = [f64; 2];
 /// default: a placeholder, not a frame).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Frame {
-    /// First tangent axis (largest spread).
+    /// First tangent axis: the direction of largest spread from
+    /// [`fit_plane`], one fixed by the normal alone from [`fit_plane_normal`].
     pub u: Point3,
     /// Second tangent axis.
     pub v: Point3,
