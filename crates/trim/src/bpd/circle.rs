@@ -116,21 +116,9 @@ pub struct CellScratch {
 // Baseline and AVX2 variants, chosen at run time (crate doc, "Vector kernels").
 #[multiversion::multiversion(targets("x86_64+avx2"))]
 pub fn largest_empty_circle_exceeds(nb: &[Point2], beta: f64, s: &mut CellScratch) -> bool {
-    let reach = nb
-        .iter()
-        .map(|q| q[0] * q[0] + q[1] * q[1])
-        .fold(0.0, f64::max)
-        .sqrt();
-    let l = (2.0 * reach).max(2.0 * beta);
-    s.poly.clear();
-    s.poly.extend_from_slice(&[
-        ([-l, -l], BOX_EDGE),
-        ([l, -l], BOX_EDGE),
-        ([l, l], BOX_EDGE),
-        ([-l, l], BOX_EDGE),
-    ]);
     let beta2 = beta * beta;
-    let mut far2 = 2.0 * l * l; // largest squared vertex distance so far
+    // The largest squared vertex distance so far.
+    let mut far2 = s.start_at_box((2.0 * reach(nb)).max(2.0 * beta));
     let near2 = NEAR * beta2;
     for near_pass in [true, false] {
         for (j, &q) in nb.iter().enumerate() {
@@ -139,13 +127,7 @@ pub fn largest_empty_circle_exceeds(nb: &[Point2], beta: f64, s: &mut CellScratc
             if (q2 <= near2) != near_pass || 0.25 * q2 >= far2 {
                 continue;
             }
-            clip(&s.poly, q, 0.5 * q2, j as u32, &mut s.next);
-            std::mem::swap(&mut s.poly, &mut s.next);
-            far2 = s
-                .poly
-                .iter()
-                .map(|(v, _)| v[0] * v[0] + v[1] * v[1])
-                .fold(0.0, f64::max);
+            far2 = s.clip_by(q, q2, j);
             if far2 < beta2 {
                 return false;
             }
@@ -194,33 +176,50 @@ pub fn boundary_links(nb: &[Point2], beta: f64, s: &mut CellScratch, out: &mut V
 /// P_i's cell clipped by all neighbours from the box of [`LINK_BOX`] ×
 /// max(reach, β).
 fn clip_wide(nb: &[Point2], beta: f64, s: &mut CellScratch) {
-    let reach = nb
-        .iter()
-        .map(|q| q[0] * q[0] + q[1] * q[1])
-        .fold(0.0, f64::max)
-        .sqrt();
-    let l = LINK_BOX * reach.max(beta);
-    s.poly.clear();
-    s.poly.extend_from_slice(&[
-        ([-l, -l], BOX_EDGE),
-        ([l, -l], BOX_EDGE),
-        ([l, l], BOX_EDGE),
-        ([-l, l], BOX_EDGE),
-    ]);
-    let mut far2 = 2.0 * l * l;
+    let mut far2 = s.start_at_box(LINK_BOX * reach(nb).max(beta));
     for (j, &q) in nb.iter().enumerate() {
         let q2 = q[0] * q[0] + q[1] * q[1];
         // The bisector x·q = |q|²/2 cannot cut a cell within radius |q|/2.
-        if 0.25 * q2 >= far2 {
-            continue;
+        if 0.25 * q2 < far2 {
+            far2 = s.clip_by(q, q2, j);
         }
-        clip(&s.poly, q, 0.5 * q2, j as u32, &mut s.next);
-        std::mem::swap(&mut s.poly, &mut s.next);
-        far2 = s
-            .poly
+    }
+}
+
+/// The largest distance of the neighbours from P_i.
+fn reach(nb: &[Point2]) -> f64 {
+    nb.iter()
+        .map(|q| q[0] * q[0] + q[1] * q[1])
+        .fold(0.0, f64::max)
+        .sqrt()
+}
+
+impl CellScratch {
+    /// The cell set to the square of half-size `l` round P_i, all its edges
+    /// on the box; returns its largest squared vertex distance.
+    fn start_at_box(&mut self, l: f64) -> f64 {
+        self.poly.clear();
+        self.poly.extend_from_slice(&[
+            ([-l, -l], BOX_EDGE),
+            ([l, -l], BOX_EDGE),
+            ([l, l], BOX_EDGE),
+            ([-l, l], BOX_EDGE),
+        ]);
+        2.0 * l * l
+    }
+
+    /// The cell clipped by the bisector with neighbour `j` at `q` (|q|² =
+    /// `q2`); returns its largest squared vertex distance.
+    // Always inlined: as a call it cost the 12k benchmark 1.5M
+    // instructions (341.5M against 339.9M).
+    #[inline(always)]
+    fn clip_by(&mut self, q: Point2, q2: f64, j: usize) -> f64 {
+        clip(&self.poly, q, 0.5 * q2, j as u32, &mut self.next);
+        std::mem::swap(&mut self.poly, &mut self.next);
+        self.poly
             .iter()
             .map(|(v, _)| v[0] * v[0] + v[1] * v[1])
-            .fold(0.0, f64::max);
+            .fold(0.0, f64::max)
     }
 }
 
