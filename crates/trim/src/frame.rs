@@ -106,7 +106,17 @@ pub fn symmetric_eigen3(a: &Matrix3<f64>) -> ([f64; 3], [Point3; 3]) {
         Spectrum::General(rows, shape) => (rows, shape),
     };
     let values = shape.values();
-    let vectors = if shape.half_det >= 0.0 {
+    (
+        values.map(|l| l * shape.max_abs),
+        eigenvectors(rows, &shape, values),
+    )
+}
+
+/// The unit eigenvectors of the scaled `rows` with eigenvalues `values`:
+/// the best-separated eigenvalue's from cross products, the middle one in
+/// its orthogonal complement, the third by a cross product.
+fn eigenvectors(rows: [Point3; 3], shape: &Cubic, values: [f64; 3]) -> [Point3; 3] {
+    if shape.half_det >= 0.0 {
         let v2 = eigenvector_of_simple(rows, values[2]);
         let v1 = eigenvector_in_complement(rows, v2, values[1]);
         [unit_cross(v1, v2), v1, v2]
@@ -114,8 +124,7 @@ pub fn symmetric_eigen3(a: &Matrix3<f64>) -> ([f64; 3], [Point3; 3]) {
         let v0 = eigenvector_of_simple(rows, values[0]);
         let v1 = eigenvector_in_complement(rows, v0, values[1]);
         [v0, v1, unit_cross(v0, v1)]
-    };
-    (values.map(|l| l * shape.max_abs), vectors)
+    }
 }
 
 /// The unit eigenvector of the smallest eigenvalue: [`symmetric_eigen3`]'s
@@ -128,7 +137,7 @@ pub fn smallest_eigenvector(a: &Matrix3<f64>) -> Point3 {
         Spectrum::General(rows, shape) if shape.half_det < 0.0 => {
             eigenvector_of_simple(rows, shape.smallest())
         }
-        Spectrum::General(..) => symmetric_eigen3(a).1[0],
+        Spectrum::General(rows, shape) => eigenvectors(rows, &shape, shape.values())[0],
     }
 }
 
@@ -158,15 +167,20 @@ struct Cubic {
 impl Cubic {
     const TWO_THIRDS_PI: f64 = 2.0 * std::f64::consts::FRAC_PI_3;
 
+    /// The smallest root of the shifted, scaled cubic.
+    fn beta0(&self) -> f64 {
+        2.0 * (self.angle + Self::TWO_THIRDS_PI).cos()
+    }
+
     /// The smallest eigenvalue of the scaled matrix.
     fn smallest(&self) -> f64 {
-        self.q + self.p * (2.0 * (self.angle + Self::TWO_THIRDS_PI).cos())
+        self.q + self.p * self.beta0()
     }
 
     /// The eigenvalues of the scaled matrix, ascending.
     fn values(&self) -> [f64; 3] {
         let beta2 = 2.0 * self.angle.cos();
-        let beta0 = 2.0 * (self.angle + Self::TWO_THIRDS_PI).cos();
+        let beta0 = self.beta0();
         let beta1 = -(beta0 + beta2);
         [
             self.q + self.p * beta0,
