@@ -10,7 +10,6 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result};
 use serde::Serialize;
 use trim::clean::{clean_mesh, CleanOptions, CleanReport};
-use trim::BpdOptions;
 
 use crate::cli::CleanArgs;
 use crate::detect::millis;
@@ -117,10 +116,7 @@ fn clean(input: &Path, output: &Path, settings: &CleanSettings) -> Result<Report
     let mesh = read_mesh_with_faces(input, "`clean` smooths the border of a mesh")?;
     let read_time = started.elapsed();
     let started = Instant::now();
-    let options = BpdOptions {
-        k: settings.k,
-        anisotropy: !settings.no_anisotropy,
-    };
+    let options = settings.bpd_options();
     // Only β is needed: the mesh knows its border (BPD's labels would be
     // thrown away), and β alone takes about half the time.
     let beta = trim::bpd::local_resolution(&mesh.vertices, &options)

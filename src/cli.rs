@@ -8,6 +8,8 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
+use trim::bpd::View;
+use trim::BpdOptions;
 
 /// Boundary detection, edge smoothing and trimming of meshes from 3D scans.
 ///
@@ -124,6 +126,86 @@ pub struct Stages {
     /// estimated physical edge half a row beyond them.
     #[arg(long)]
     pub no_offset: bool,
+    /// Where a range scanner saw the cloud from.
+    #[command(flatten)]
+    pub view: ViewArgs,
+}
+
+impl Stages {
+    /// Boundary detection's options.
+    pub fn bpd_options(&self) -> BpdOptions {
+        bpd_options(self.k, self.no_anisotropy, &self.view)
+    }
+}
+
+/// Where a range scanner (a depth camera, a laser line or structured-light
+/// scanner) saw the cloud from, when it is known. Such scanners err along
+/// their line of sight; with it, detection projects each neighbourhood
+/// along it instead of along the neighbourhood's normal, so that depth
+/// noise and the terraces of a quantised depth do not open gaps where the
+/// surface is inclined to the scanner (docs/bpd.md, "Scanner's line of
+/// sight").
+#[derive(Debug, Clone, Copy, PartialEq, Default, Args)]
+pub struct ViewArgs {
+    /// The scanner's line of sight as a direction X,Y,Z in the cloud's
+    /// frame (either sense), for a distant scanner or a frame whose axis it
+    /// looked along, e.g. 0,0,1.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_direction, allow_hyphen_values = true, conflicts_with = "view_from")]
+    pub view_along: Option<[f64; 3]>,
+    /// The scanner's position X,Y,Z in the cloud's frame (a depth camera's
+    /// centre: 0,0,0 for a cloud in the camera's own frame); the line of
+    /// sight to each point runs from there.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_position, allow_hyphen_values = true)]
+    pub view_from: Option<[f64; 3]>,
+}
+
+impl ViewArgs {
+    /// The view, if one was given.
+    pub fn view(&self) -> Option<View> {
+        self.view_along
+            .map(View::Along)
+            .or(self.view_from.map(View::From))
+    }
+}
+
+/// Boundary detection's options from the command line's.
+fn bpd_options(k: usize, no_anisotropy: bool, view: &ViewArgs) -> BpdOptions {
+    BpdOptions {
+        k,
+        anisotropy: !no_anisotropy,
+        view: view.view(),
+    }
+}
+
+/// Three finite numbers separated by commas.
+fn parse_vector(text: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    let [x, y, z] = parts.as_slice() else {
+        return Err(format!(
+            "expected three numbers X,Y,Z separated by commas, got {} part(s)",
+            parts.len()
+        ));
+    };
+    let number = |s: &str| match s.parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(_) => Err(format!("`{s}` is not a finite number")),
+        Err(_) => Err(format!("`{s}` is not a number")),
+    };
+    Ok([number(x)?, number(y)?, number(z)?])
+}
+
+/// A line of sight: [`parse_vector`], not zero.
+fn parse_direction(text: &str) -> Result<[f64; 3], String> {
+    let v = parse_vector(text)?;
+    if v == [0.0; 3] {
+        return Err("a direction cannot be 0,0,0".into());
+    }
+    Ok(v)
+}
+
+/// A scanner position: [`parse_vector`].
+fn parse_position(text: &str) -> Result<[f64; 3], String> {
+    parse_vector(text)
 }
 
 /// Arguments of `meshtrim mesh`.
@@ -172,6 +254,12 @@ pub struct TrimArgs {
     /// estimated physical edge half a row beyond them.
     #[arg(long)]
     pub no_offset: bool,
+    /// The scanner's line of sight X,Y,Z (see `meshtrim detect --help`).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_direction, allow_hyphen_values = true, conflicts_with = "view_from")]
+    pub view_along: Option<[f64; 3]>,
+    /// The scanner's position X,Y,Z (see `meshtrim detect --help`).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_position, allow_hyphen_values = true)]
+    pub view_from: Option<[f64; 3]>,
     /// Print the report as one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -186,6 +274,10 @@ impl TrimArgs {
             k: self.k,
             no_anisotropy: self.no_anisotropy,
             no_offset: self.no_offset,
+            view: ViewArgs {
+                view_along: self.view_along,
+                view_from: self.view_from,
+            },
         }
     }
 }
@@ -205,9 +297,19 @@ pub struct DetectArgs {
     /// Use the paper's isotropic tests, without the sampling-tensor map.
     #[arg(long)]
     pub no_anisotropy: bool,
+    /// Where a range scanner saw the cloud from.
+    #[command(flatten)]
+    pub view: ViewArgs,
     /// Print the summary as one JSON object.
     #[arg(long)]
     pub json: bool,
+}
+
+impl DetectArgs {
+    /// Boundary detection's options.
+    pub fn bpd_options(&self) -> BpdOptions {
+        bpd_options(self.k, self.no_anisotropy, &self.view)
+    }
 }
 
 /// Arguments of `meshtrim edges`.

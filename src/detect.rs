@@ -46,6 +46,12 @@ pub struct Summary {
     pub k: usize,
     /// Whether the anisotropy map was on.
     pub anisotropy: bool,
+    /// The scanner's line of sight, when given (`--view-along`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub view_along: Option<[f64; 3]>,
+    /// The scanner's position, when given (`--view-from`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub view_from: Option<[f64; 3]>,
 }
 
 /// Runs `meshtrim detect`.
@@ -61,7 +67,7 @@ pub fn run(args: &DetectArgs) -> Result<()> {
         detection,
         read_time,
         detect_time,
-    } = read_and_detect(&args.cloud, args.k, args.no_anisotropy)?;
+    } = read_and_detect(&args.cloud, &args.bpd_options())?;
     if let Some((path, format)) = &output {
         write_labels(path, *format, &cloud.points, &detection)?;
     }
@@ -158,6 +164,8 @@ impl Summary {
             detect_ms: millis(detect_time),
             k: args.k,
             anisotropy: !args.no_anisotropy,
+            view_along: args.view.view_along,
+            view_from: args.view.view_from,
         }
     }
 
@@ -181,12 +189,26 @@ impl Summary {
             ("beta std", format!("{:.6}", self.beta_std)),
             ("k", self.k.to_string()),
             ("anisotropy", on_off.to_string()),
+            ("projection", self.projection()),
             ("read time", format!("{:.1} ms", self.read_ms)),
             ("detect time", format!("{:.1} ms", self.detect_ms)),
         ];
         rows.iter()
             .map(|(label, value)| format!("{label:<20} {value}\n"))
             .collect()
+    }
+}
+
+impl Summary {
+    /// How neighbourhoods were projected: along their normals (the
+    /// paper's), or along the scanner's line of sight.
+    fn projection(&self) -> String {
+        let xyz = |v: [f64; 3]| format!("{},{},{}", v[0], v[1], v[2]);
+        match (self.view_along, self.view_from) {
+            (Some(d), _) => format!("along the line of sight {}", xyz(d)),
+            (None, Some(o)) => format!("along lines of sight from {}", xyz(o)),
+            (None, None) => "along each neighbourhood's normal".to_string(),
+        }
     }
 }
 
@@ -212,8 +234,8 @@ pub(crate) struct Detected {
 
 /// Reads the cloud at `path` and runs BPD on it (with the progress bar),
 /// errors naming the file.
-pub(crate) fn read_and_detect(path: &Path, k: usize, no_anisotropy: bool) -> Result<Detected> {
-    read_and_detect_with(path, k, no_anisotropy, true)
+pub(crate) fn read_and_detect(path: &Path, options: &BpdOptions) -> Result<Detected> {
+    read_and_detect_with(path, options, true)
 }
 
 /// [`read_and_detect`], with or without the detection's progress bar:
@@ -221,22 +243,17 @@ pub(crate) fn read_and_detect(path: &Path, k: usize, no_anisotropy: bool) -> Res
 /// its files' detections show none.
 pub(crate) fn read_and_detect_with(
     path: &Path,
-    k: usize,
-    no_anisotropy: bool,
+    options: &BpdOptions,
     progress: bool,
 ) -> Result<Detected> {
     let started = Instant::now();
     let cloud = read_cloud(path)?;
     let read_time = started.elapsed();
-    let options = BpdOptions {
-        k,
-        anisotropy: !no_anisotropy,
-    };
     let started = Instant::now();
     let detection = if progress {
-        detect_with_progress(&cloud.points, &options)
+        detect_with_progress(&cloud.points, options)
     } else {
-        trim::bpd::detect_boundary(&cloud.points, &options)
+        trim::bpd::detect_boundary(&cloud.points, options)
     }
     .with_context(|| path.display().to_string())?;
     Ok(Detected {

@@ -55,7 +55,7 @@ pub fn run(args: &EdgesArgs) -> Result<()> {
         detection,
         read_time,
         detect_time,
-    } = read_and_detect(&args.cloud, args.stages.k, args.stages.no_anisotropy)?;
+    } = read_and_detect(&args.cloud, &args.stages.bpd_options())?;
     let started = Instant::now();
     let edge_options = EdgeOptions {
         offset: !args.stages.no_offset,

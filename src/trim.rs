@@ -10,6 +10,7 @@ use anyhow::{Context, Result};
 use serde::Serialize;
 use trim::edges::{reconstruct_edges, EdgeOptions};
 use trim::trimming::{trim_mesh, LoopFit, TrimReport};
+use trim::BpdOptions;
 
 use crate::cli::TrimArgs;
 use crate::detect::{millis, read_and_detect_with, Detected};
@@ -77,12 +78,10 @@ pub struct BorderFit {
 /// What trimming one mesh is told, beside its paths.
 #[derive(Debug, Clone)]
 pub struct TrimSettings {
-    /// Neighbourhood size of boundary detection, the point itself included.
-    pub k: usize,
+    /// Boundary detection's options.
+    pub detection: BpdOptions,
     /// Cut along the smoothed boundary points instead of the estimated edge.
     pub no_offset: bool,
-    /// The paper's isotropic detection, without the sampling-tensor map.
-    pub no_anisotropy: bool,
     /// Whether detection may show its own progress bar (not in a batch,
     /// which has one bar for all files).
     pub progress: bool,
@@ -92,9 +91,8 @@ pub struct TrimSettings {
 pub fn run(args: &TrimArgs) -> Result<()> {
     check_paths(args)?;
     let settings = TrimSettings {
-        k: args.stages().k,
+        detection: args.stages().bpd_options(),
         no_offset: args.stages().no_offset,
-        no_anisotropy: args.stages().no_anisotropy,
         progress: true,
     };
     let report = trim_file(&args.mesh, &args.cloud, &args.output, &settings)?;
@@ -119,12 +117,7 @@ pub fn trim_file(
         detection,
         read_time,
         detect_time,
-    } = read_and_detect_with(
-        cloud_path,
-        settings.k,
-        settings.no_anisotropy,
-        settings.progress,
-    )?;
+    } = read_and_detect_with(cloud_path, &settings.detection, settings.progress)?;
     let read_time = mesh_read_time + read_time;
     let started = Instant::now();
     let edges = reconstruct_edges(

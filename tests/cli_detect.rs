@@ -323,6 +323,54 @@ fn bad_output_extension_is_refused_before_reading() {
     assert!(!Path::new("labels.txt").exists());
 }
 
+/// A scanner's line of sight or position changes the projection, is
+/// reported (table and JSON), and bad values are usage errors naming the
+/// problem.
+#[test]
+fn scanner_view_is_used_reported_and_checked() {
+    let json = |extra: &[&str]| {
+        let mut args = vec!["detect", FIXTURE, "--json"];
+        args.extend(extra);
+        let run = meshtrim(&args);
+        assert!(run.status.success(), "{}", stderr(&run));
+        serde_json::from_slice::<serde_json::Value>(&run.stdout).unwrap()
+    };
+    let paper = json(&[]);
+    assert!(paper.get("view_along").is_none() && paper.get("view_from").is_none());
+    let along = json(&["--view-along", "0.3,-0.2,1"]);
+    assert_eq!(along["view_along"], serde_json::json!([0.3, -0.2, 1.0]));
+    let from = json(&["--view-from=-50,20,300"]);
+    assert_eq!(from["view_from"], serde_json::json!([-50.0, 20.0, 300.0]));
+    // The fixture is a curved panel: a slanted line of sight moves some labels.
+    assert_ne!(paper["beta_mean"], along["beta_mean"]);
+    let table = meshtrim(&["detect", FIXTURE, "--view-along", "0,0,1"]);
+    assert!(String::from_utf8_lossy(&table.stdout)
+        .contains("projection           along the line of sight 0,0,1"));
+    for (args, expected) in [
+        (vec!["--view-along", "0,0,0"], "a direction cannot be 0,0,0"),
+        (vec!["--view-along", "1,2"], "expected three numbers X,Y,Z"),
+        (vec!["--view-from", "1,2,x"], "`x` is not a number"),
+        (
+            vec!["--view-from", "1,inf,2"],
+            "`inf` is not a finite number",
+        ),
+        (
+            vec!["--view-along", "0,0,1", "--view-from", "0,0,0"],
+            "cannot be used with",
+        ),
+    ] {
+        let mut all = vec!["detect", FIXTURE];
+        all.extend(&args);
+        let run = meshtrim(&all);
+        assert_eq!(run.status.code(), Some(2), "{args:?}");
+        assert!(
+            stderr(&run).contains(expected),
+            "{args:?}: {}",
+            stderr(&run)
+        );
+    }
+}
+
 #[test]
 fn usage_errors_exit_2() {
     assert_eq!(meshtrim(&["detect"]).status.code(), Some(2));

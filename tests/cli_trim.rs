@@ -210,6 +210,8 @@ fn the_main_job_takes_the_stage_options() {
             "--no-offset",
             "--k",
             "20",
+            "--view-along",
+            "0.1,0,1",
             "--json",
         ],
         None,
@@ -220,6 +222,19 @@ fn the_main_job_takes_the_stage_options() {
         String::from_utf8_lossy(&run.stderr)
     );
     assert!(out.exists());
+    let both = meshtrim(
+        &[
+            MESH,
+            CLOUD,
+            out.to_str().unwrap(),
+            "--view-along",
+            "0,0,1",
+            "--view-from",
+            "0,0,0",
+        ],
+        None,
+    );
+    assert_eq!(both.status.code(), Some(2));
 }
 
 #[test]

@@ -22,7 +22,7 @@ use anyhow::{anyhow, bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
-use crate::clean_cmd::{clean_file, CleanSettings};
+use crate::clean_cmd::clean_file;
 use crate::cli::BatchArgs;
 use crate::console;
 use crate::detect::millis;
@@ -157,12 +157,7 @@ fn process(job: &Job, args: &BatchArgs) -> Row {
 fn work(job: &Job, args: &BatchArgs) -> Result<Outcome> {
     match &job.cloud {
         CloudMatch::None => {
-            let settings = CleanSettings {
-                k: args.stages.k,
-                no_offset: args.stages.no_offset,
-                no_anisotropy: args.stages.no_anisotropy,
-            };
-            let o = clean_file(&job.input, &job.output, &settings)?;
+            let o = clean_file(&job.input, &job.output, &args.stages)?;
             Ok(Outcome {
                 loops: o.loops,
                 faces_in: o.faces_in,
@@ -174,9 +169,8 @@ fn work(job: &Job, args: &BatchArgs) -> Result<Outcome> {
         }
         CloudMatch::One(cloud) => {
             let settings = TrimSettings {
-                k: args.stages.k,
+                detection: args.stages.bpd_options(),
                 no_offset: args.stages.no_offset,
-                no_anisotropy: args.stages.no_anisotropy,
                 progress: false,
             };
             let r = trim_file(&job.input, cloud, &job.output, &settings)?;

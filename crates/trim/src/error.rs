@@ -37,6 +37,21 @@ pub enum CloudError {
         /// Smallest accepted value.
         min: usize,
     },
+    /// A scanner view direction that is zero or not finite, or a scanner
+    /// position that is not finite.
+    #[error("the scanner view {what} ({x}, {y}, {z}) is not usable: {why}")]
+    BadView {
+        /// "direction" or "position".
+        what: &'static str,
+        /// Its components.
+        x: f64,
+        /// Its components.
+        y: f64,
+        /// Its components.
+        z: f64,
+        /// What is wrong with it.
+        why: &'static str,
+    },
     /// Fewer distinct points than one neighbourhood holds.
     #[error("the cloud has {distinct} distinct points ({total} in all), fewer than the neighbourhood size k = {k}; lower --k or use a denser cloud")]
     TooFewPoints {

@@ -464,6 +464,60 @@ impl SyntheticCloud {
             })
             .collect()
     }
+
+    /// The points as a range scanner looking along `direction` would
+    /// report them with its depth rounded to multiples of `step` (3D
+    /// units), as depth cameras quantise it: each point moves along the
+    /// line of sight to the nearest depth level, by at most `step`/2.
+    /// Where the surface is inclined to the line of sight the points form
+    /// terraces, one per level.
+    pub fn with_quantised_depth(&self, direction: P3, step: f64) -> Vec<P3> {
+        let d = normalised(direction);
+        self.points
+            .iter()
+            .map(|x| {
+                let depth = dot(*x, d);
+                let moved = (depth / step).round() * step - depth;
+                [
+                    x[0] + moved * d[0],
+                    x[1] + moved * d[1],
+                    x[2] + moved * d[2],
+                ]
+            })
+            .collect()
+    }
+
+    /// The points as a depth camera at `origin` would report them with
+    /// its range (distance from `origin`) rounded to multiples of `step`:
+    /// each point moves along its own line of sight from `origin`.
+    pub fn with_quantised_range(&self, origin: P3, step: f64) -> Vec<P3> {
+        self.points
+            .iter()
+            .map(|x| {
+                let ray = [x[0] - origin[0], x[1] - origin[1], x[2] - origin[2]];
+                let range = dot(ray, ray).sqrt();
+                let scale = (range / step).round() * step / range;
+                [0, 1, 2].map(|a| origin[a] + scale * ray[a])
+            })
+            .collect()
+    }
+
+    /// The points moved along a line of sight `direction` (a range
+    /// scanner's depth noise) by uniform(−p, p) times their intended
+    /// spacing; [`SyntheticCloud::with_noise`] moves them along their
+    /// normals instead, with the same draws for the same seed.
+    pub fn with_depth_noise(&self, direction: P3, p: f64, seed: u64) -> Vec<P3> {
+        let d = normalised(direction);
+        let mut rng = SplitMix64::new(seed ^ 0x6e6f_6973_655f_5f5f);
+        self.points
+            .iter()
+            .zip(&self.spacing)
+            .map(|(x, h)| {
+                let m = rng.range(-1.0, 1.0) * p * h;
+                [x[0] + m * d[0], x[1] + m * d[1], x[2] + m * d[2]]
+            })
+            .collect()
+    }
 }
 
 /// Jittered-grid samples of `region` with pitch `field` (see the module

@@ -169,7 +169,7 @@ proptest! {
         for i in 0..duplicates {
             cloud.push(cloud[(i * 7919) % n]);
         }
-        let options = BpdOptions { k, anisotropy };
+        let options = BpdOptions { k, anisotropy, view: None };
         let fast = detect_boundary(&cloud, &options).unwrap();
         let plain = detect_boundary_reference(&cloud, &options).unwrap();
         prop_assert_eq!(&fast.boundary, &plain.boundary);

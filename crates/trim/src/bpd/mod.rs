@@ -23,9 +23,11 @@ use crate::anisotropy::{
     apply, own_sampling_vectors, sampling_moment, sampling_tensor_of_moments, whitening_map,
     SamplingMoment,
 };
-use crate::cloud::{check_finite, check_not_degenerate, cross, merge_duplicates, Point3, Sites};
+use crate::cloud::{
+    check_finite, check_not_degenerate, cross, merge_duplicates, sub, Point3, Sites,
+};
 use crate::error::CloudError;
-use crate::frame::{fit_plane_normal, project, Frame, Point2};
+use crate::frame::{fit_plane_normal, project_sheared, ray_shear, Frame, Point2};
 use crate::morton::{octree_runs, spatial_order, MortonCells, MortonGrid};
 use crate::neighbours::{NeighbourIndex, RunScratch};
 use crate::resolution::{beta_of, nearest_distances, Columns};
@@ -40,6 +42,12 @@ pub struct BpdOptions {
     /// tests (meshtrim's extension for line scans; see [`crate::anisotropy`]).
     /// Off gives the paper's isotropic behaviour.
     pub anisotropy: bool,
+    /// Where a range scanner saw the cloud from, when known: each
+    /// neighbourhood is then projected onto its plane along the scanner's
+    /// line of sight instead of along the plane's normal (meshtrim's
+    /// extension for range scans; see [`View`]). `None` is the paper's
+    /// projection.
+    pub view: Option<View>,
 }
 
 impl BpdOptions {
@@ -52,7 +60,58 @@ impl Default for BpdOptions {
         Self {
             k: 30,
             anisotropy: true,
+            view: None,
         }
+    }
+}
+
+/// Where a range scanner (a depth camera, a laser line or structured-light
+/// scanner) saw the cloud from.
+///
+/// A range scanner errs along its line of sight: depth noise, and the
+/// terraces of a quantised depth, move points along the ray, not along
+/// the surface's normal. Where the surface is inclined to the ray, the
+/// paper's projection along the normal turns part of each such move into a
+/// shift within the plane, and the terraces of a quantised depth open gaps
+/// of a spacing or more between their rows: interior points turn boundary
+/// all over the scan. Projected along the ray (see
+/// [`crate::frame::ray_shear`]), a point moved along its ray lands where
+/// it would have without the move.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum View {
+    /// Every line of sight has this direction (either sense): a distant or
+    /// orthographic scanner, or a cloud in a frame whose axis the scanner
+    /// looked along.
+    Along(Point3),
+    /// The scanner stood here (a depth camera's centre): the line of sight
+    /// to a point runs from here to it.
+    From(Point3),
+}
+
+impl View {
+    /// The line of sight to `p` (not normalised; zero for `p` at the
+    /// scanner, which then gets the paper's projection).
+    fn ray_to(&self, p: Point3) -> Point3 {
+        match *self {
+            View::Along(direction) => direction,
+            View::From(origin) => sub(p, origin),
+        }
+    }
+
+    /// Rejects a zero or non-finite direction and a non-finite position.
+    fn check(&self) -> Result<(), CloudError> {
+        let (what, [x, y, z]) = match *self {
+            View::Along(d) => ("direction", d),
+            View::From(o) => ("position", o),
+        };
+        let bad = |why| Err(CloudError::BadView { what, x, y, z, why });
+        if ![x, y, z].iter().all(|c| c.is_finite()) {
+            return bad("a component is not finite");
+        }
+        if matches!(self, View::Along(_)) && [x, y, z] == [0.0; 3] {
+            return bad("a direction cannot be zero");
+        }
+        Ok(())
     }
 }
 
@@ -132,6 +191,8 @@ struct Neighbourhoods {
     lists: Vec<u32>,
     /// Each position's sampling moment and plane, with anisotropy on.
     sampling: Option<Vec<Sampling>>,
+    /// The scanner's view, when given: projections follow its rays.
+    view: Option<View>,
 }
 
 impl Neighbourhoods {
@@ -231,6 +292,9 @@ fn prepare(points: &[Point3], options: &BpdOptions) -> Result<Prepared, CloudErr
             min: BpdOptions::MIN_K,
         });
     }
+    if let Some(view) = &options.view {
+        view.check()?;
+    }
     check_finite(points)?;
     let in_order = SpatialOrder::of(points);
     if !in_order.keys_repeat() {
@@ -282,6 +346,7 @@ fn neighbourhoods(
     progress: &(dyn Fn(usize) + Sync),
 ) -> Neighbourhoods {
     let k = options.k;
+    let view = options.view.as_ref();
     let SpatialOrder {
         points,
         order,
@@ -320,7 +385,7 @@ fn neighbourhoods(
                     |(scratch, projected), (run, out, out_sampling)| {
                         index.nearest_of_run(run.clone(), k, out, scratch);
                         for (members, o) in out.chunks_exact(k).zip(out_sampling.iter_mut()) {
-                            *o = sampling_at(&points, members, projected);
+                            *o = sampling_at(&points, members, view, projected);
                         }
                     },
                 );
@@ -340,7 +405,7 @@ fn neighbourhoods(
             }
             let mut projected = Vec::new();
             for (members, o) in lists.chunks_exact(k).zip(sampling.iter_mut().flatten()) {
-                *o = sampling_at(&points, members, &mut projected);
+                *o = sampling_at(&points, members, view, &mut projected);
             }
         }
     }
@@ -351,6 +416,7 @@ fn neighbourhoods(
         k,
         lists,
         sampling,
+        view: options.view,
     }
 }
 
@@ -377,14 +443,26 @@ impl Sampling {
 
 /// The plane of a neighbourhood (`members`, the point first) and the
 /// point's own sampling moment in it ([`crate::anisotropy`]).
-fn sampling_at(points: &[Point3], members: &[u32], projected: &mut Vec<Point2>) -> Sampling {
+fn sampling_at(
+    points: &[Point3],
+    members: &[u32],
+    view: Option<&View>,
+    projected: &mut Vec<Point2>,
+) -> Sampling {
     let frame = fit_plane_normal(points, members);
-    project(points, members, &frame, projected);
+    let shear = shear_towards(view, &frame, points[members[0] as usize]);
+    project_sheared(points, members, &frame, shear, projected);
     Sampling {
         moment: sampling_moment(&own_sampling_vectors(projected, &frame)),
         u: frame.u,
         normal: frame.normal,
     }
+}
+
+/// The shear that projects the neighbourhood of the point at `at` onto
+/// `frame`'s plane along the scanner's line of sight; none without a view.
+fn shear_towards(view: Option<&View>, frame: &Frame, at: Point3) -> [f64; 2] {
+    view.map_or([0.0, 0.0], |v| ray_shear(frame, v.ray_to(at)))
 }
 
 /// Most points per k-NN run (see [`NeighbourIndex::nearest_of_run`] and
@@ -522,7 +600,12 @@ fn projected_beta(
         || fit_plane_normal(&hoods.points, members),
         |v| v[p].frame(),
     );
-    project(&hoods.points, members, &frame, &mut s.projected);
+    let shear = shear_towards(
+        hoods.view.as_ref(),
+        &frame,
+        hoods.points[members[0] as usize],
+    );
+    project_sheared(&hoods.points, members, &frame, shear, &mut s.projected);
     if let Some(vectors) = vectors {
         let tensor = sampling_tensor_of_moments(
             &frame,
@@ -603,7 +686,11 @@ mod tests {
             let mut points = random_sheet(seed, 24, 0.05, stretch);
             points.extend_from_within(..10);
             for anisotropy in [true, false] {
-                let options = BpdOptions { k: 30, anisotropy };
+                let options = BpdOptions {
+                    k: 30,
+                    anisotropy,
+                    view: None,
+                };
                 let full = detect_boundary(&points, &options).unwrap().beta;
                 let alone = local_resolution(&points, &options).unwrap();
                 assert_eq!(full, alone, "seed {seed}, anisotropy {anisotropy}");
@@ -639,17 +726,29 @@ mod tests {
             let noise = [0.0, 0.1, 0.4][seed as usize % 3];
             let stretch = [1.0, 3.0][seed as usize % 2];
             let pts = random_sheet(seed, 40, noise, stretch);
-            for anisotropy in [false, true] {
-                let opts = BpdOptions { k: 30, anisotropy };
+            let views = [
+                None,
+                Some(View::Along([0.3, -0.5, 1.0])),
+                Some(View::From([-20.0, 10.0, 30.0])),
+            ];
+            for (anisotropy, view) in [false, true]
+                .into_iter()
+                .flat_map(|a| views.map(|v| (a, v)))
+            {
+                let opts = BpdOptions {
+                    k: 30,
+                    anisotropy,
+                    view,
+                };
                 let fast = detect_boundary(&pts, &opts).unwrap();
                 let slow = detect_boundary_reference(&pts, &opts).unwrap();
-                assert_eq!(fast.beta, slow.beta, "seed {seed}");
+                assert_eq!(fast.beta, slow.beta, "seed {seed} {view:?}");
                 let differ: Vec<usize> = (0..pts.len())
                     .filter(|&i| fast.boundary[i] != slow.boundary[i])
                     .collect();
                 assert!(
                     differ.is_empty(),
-                    "seed {seed} anisotropy {anisotropy}: labels differ at {differ:?}"
+                    "seed {seed} anisotropy {anisotropy} {view:?}: labels differ at {differ:?}"
                 );
             }
         }
@@ -730,5 +829,63 @@ mod tests {
             detect_boundary(&few, &k3),
             Err(CloudError::KTooSmall { .. })
         ));
+    }
+
+    /// A view turns and moves with the cloud: the same labels and links
+    /// after a rotation and a translation of both; a view along the normal
+    /// of an exactly flat cloud is the paper's projection.
+    #[test]
+    fn the_view_moves_with_the_cloud() {
+        let pts = random_sheet(7, 30, 0.3, 1.0);
+        let (s, c) = 0.8f64.sin_cos();
+        let turn = |p: Point3| [c * p[0] - s * p[2] + 5e3, p[1] - 2e3, s * p[0] + c * p[2]];
+        let turn_direction = |d: Point3| [c * d[0] - s * d[2], d[1], s * d[0] + c * d[2]];
+        let moved: Vec<Point3> = pts.iter().map(|&p| turn(p)).collect();
+        for (view, moved_view) in [
+            (
+                View::Along([0.4, 0.1, 1.0]),
+                View::Along(turn_direction([0.4, 0.1, 1.0])),
+            ),
+            (
+                View::From([10.0, -5.0, 40.0]),
+                View::From(turn([10.0, -5.0, 40.0])),
+            ),
+        ] {
+            let at = |view| BpdOptions {
+                view: Some(view),
+                ..BpdOptions::default()
+            };
+            let before = detect_boundary(&pts, &at(view)).unwrap();
+            let after = detect_boundary(&moved, &at(moved_view)).unwrap();
+            assert_eq!(before.boundary, after.boundary, "{view:?}");
+            assert_eq!(before.links, after.links, "{view:?}");
+        }
+        let flat: Vec<Point3> = pts.iter().map(|p| [p[0], p[1], 0.0]).collect();
+        let paper = detect_boundary(&flat, &BpdOptions::default()).unwrap();
+        let along_z = BpdOptions {
+            view: Some(View::Along([0.0, 0.0, -2.0])),
+            ..BpdOptions::default()
+        };
+        assert_eq!(paper, detect_boundary(&flat, &along_z).unwrap());
+    }
+
+    #[test]
+    fn unusable_views_are_refused() {
+        let pts = random_sheet(8, 10, 0.0, 1.0);
+        for view in [
+            View::Along([0.0, 0.0, 0.0]),
+            View::Along([f64::NAN, 0.0, 1.0]),
+            View::From([0.0, f64::INFINITY, 0.0]),
+        ] {
+            let options = BpdOptions {
+                view: Some(view),
+                ..BpdOptions::default()
+            };
+            let error = detect_boundary(&pts, &options).unwrap_err();
+            assert!(
+                matches!(error, CloudError::BadView { .. }),
+                "{view:?}: {error}"
+            );
+        }
     }
 }
