@@ -6,6 +6,7 @@
 use std::path::Path;
 use std::time::Instant;
 
+use trim::bpd::View as Scanner;
 use trim::edges::{reconstruct_edges, EdgeOptions, Edges};
 use trim::{detect_boundary, BpdOptions, Point3};
 
@@ -19,29 +20,55 @@ enum View {
     Axis(usize, bool),
 }
 
-const SCANS: &[(&str, &str, View)] = &[
+/// Each scan: its picture's name, its file, how to look at it, and the
+/// scanner's line of sight when the detection is to use it (BPD's
+/// `view`; `None` is the paper's projection along each normal).
+const SCANS: &[(&str, &str, View, Option<Scanner>)] = &[
     (
         "bunny_zipper",
         "stanford_bunny/bun_zipper.ply",
         View::Axis(1, true),
+        None,
     ),
     (
         "bunny_bun000",
         "stanford_bunny/bun000.ply",
         View::Axis(2, false),
+        None,
     ),
     (
         "blade_scan1",
         "blade_scan_kinect/BladeScan1.csv",
         View::Plane,
+        None,
+    ),
+    (
+        "blade_scan1_view",
+        "blade_scan_kinect/BladeScan1.csv",
+        View::Plane,
+        // The robot frame's z, which the panel faces.
+        Some(Scanner::Along([0.0, 0.0, 1.0])),
     ),
     (
         "blade_scan2",
         "blade_scan_kinect/BladeScan2.csv",
         View::Plane,
+        None,
     ),
-    ("milk", "pcl_test/milk.pcd", View::Plane),
-    ("face000", "meshlab_scans/face000.ply", View::Axis(2, false)),
+    ("milk", "pcl_test/milk.pcd", View::Plane, None),
+    (
+        "milk_view",
+        "pcl_test/milk.pcd",
+        View::Plane,
+        // A cloud in the depth camera's own frame.
+        Some(Scanner::From([0.0, 0.0, 0.0])),
+    ),
+    (
+        "face000",
+        "meshlab_scans/face000.ply",
+        View::Axis(2, false),
+        None,
+    ),
 ];
 
 fn main() -> anyhow::Result<()> {
@@ -50,10 +77,14 @@ fn main() -> anyhow::Result<()> {
     std::fs::create_dir_all(&out)?;
     println!("| scan | points | boundary points | loops | corners | dropped groups | β mean | detect ms | edges ms | picture |");
     println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|---|");
-    for &(name, file, view) in SCANS {
+    for &(name, file, view, scanner) in SCANS {
         let cloud = meshtrim::io::read_cloud(&data.join(file))?;
+        let options = BpdOptions {
+            view: scanner,
+            ..BpdOptions::default()
+        };
         let start = Instant::now();
-        let found = detect_boundary(&cloud.points, &BpdOptions::default())?;
+        let found = detect_boundary(&cloud.points, &options)?;
         let ms = start.elapsed().as_secs_f64() * 1e3;
         let start = Instant::now();
         let edges = reconstruct_edges(&cloud.points, &found, &EdgeOptions::default());
@@ -63,7 +94,8 @@ fn main() -> anyhow::Result<()> {
         let png = out.join(format!("{name}.png"));
         draw(&cloud.points, &found.boundary, &edges, view, &png)?;
         println!(
-            "| {file} | {} | {} | {} | {corners} | {} | {beta:.4} | {ms:.0} | {edges_ms:.0} | ![{name}](img/{name}.png) |",
+            "| {file}{} | {} | {} | {} | {corners} | {} | {beta:.4} | {ms:.0} | {edges_ms:.0} | ![{name}](img/{name}.png) |",
+            scanner.map_or(String::new(), |s| format!(" ({s:?})")),
             cloud.points.len(),
             found.boundary_count(),
             edges.loops.len(),
