@@ -146,6 +146,11 @@ fn known_bad_files() -> Vec<(&'static str, Vec<u8>, &'static str)> {
             pcd("1 1 18446744073709551615", "binary", &[b'x'; 100]),
             "line 2: COUNT 18446744073709551615",
         ),
+        (
+            "wh.pcd",
+            b"FIELDS x y z\nWIDTH 4294967296\nHEIGHT 4294967296\nDATA ascii\n1 2 3\n".to_vec(),
+            "line 4: WIDTH 4294967296 × HEIGHT 4294967296 is too many points",
+        ),
     ]
 }
 

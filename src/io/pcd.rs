@@ -138,8 +138,10 @@ fn parse_header(bytes: &[u8]) -> Result<Header> {
             "POINTS" => points = Some(number(values).map_err(at)?),
             "DATA" => {
                 let data = parse_data(values).map_err(at)?;
-                let points = points.or(width.zip(height).map(|(w, h)| w * h));
-                let points = points.ok_or_else(|| at("no POINTS, WIDTH or HEIGHT".into()))?;
+                let points = match points {
+                    Some(points) => points,
+                    None => points_of(width, height).map_err(at)?,
+                };
                 let fields = fill_fields(fields, sizes, types, counts).map_err(at)?;
                 let (fields, point_bytes) = check_counts(fields)
                     .map_err(|e| anyhow!("malformed PCD header: line {count_line}: {e}"))?;
@@ -156,6 +158,17 @@ fn parse_header(bytes: &[u8]) -> Result<Header> {
         }
     }
     bail!("malformed PCD header: no DATA line")
+}
+
+/// POINTS' default, WIDTH × HEIGHT; a product that overflows would wrap
+/// to a small count and misread the file.
+fn points_of(width: Option<usize>, height: Option<usize>) -> Result<usize, String> {
+    let (w, h) = width
+        .zip(height)
+        .ok_or("no POINTS, WIDTH or HEIGHT".to_string())?;
+    w.checked_mul(h).ok_or(format!(
+        "WIDTH {w} × HEIGHT {h} is too many points (and no POINTS)"
+    ))
 }
 
 /// Drops the fields of COUNT 0, which hold no data (PCL drops them too),
@@ -565,6 +578,16 @@ mod tests {
         assert_eq!(
             read_pcd(text.as_bytes()).unwrap().points,
             vec![[1.0, 2.0, 3.0]]
+        );
+    }
+
+    #[test]
+    fn width_times_height_must_not_wrap() {
+        let file = "FIELDS x y z\nWIDTH 4294967296\nHEIGHT 4294967296\nDATA ascii\n1 2 3\n";
+        assert_eq!(
+            err(file.as_bytes()),
+            "malformed PCD header: line 4: WIDTH 4294967296 × HEIGHT 4294967296 \
+             is too many points (and no POINTS)"
         );
     }
 
