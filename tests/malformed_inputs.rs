@@ -132,7 +132,12 @@ fn known_bad_files() -> Vec<(&'static str, Vec<u8>, &'static str)> {
     lzf_block.push(15);
     lzf_block.extend(&floats);
     let z0 = "line 2: COUNT 0 for field 'z'";
+    // An element without properties and a huge count, then vertices
+    // with a bad number: reaching that error needs the element skipped.
+    let hang = "ply\nformat ascii 1.0\nelement junk 18446744073709551615\nelement vertex 2\n\
+        property float x\nproperty float y\nproperty float z\nend_header\n1 2 3\n4 x 6\n";
     vec![
+        ("hang.ply", hang.into(), "line 10: 'x' is not a number"),
         ("c0.pcd", pcd("1 1 0", "ascii", b"1 2\n3 4\n"), z0),
         ("c0b.pcd", pcd("1 1 0", "binary", &floats), z0),
         ("c0c.pcd", pcd("1 1 0", "binary_compressed", &lzf_block), z0),

@@ -394,7 +394,7 @@ fn read_body(header: &Header, values: &mut dyn Values, grid: bool) -> Result<Mes
                 }
                 range_grid = Some(read_range_grid(element, values, list)?);
             }
-            Role::Skip => read_element(element, values, None, |_, _| Ok(()))?,
+            Role::Skip => skip_element(element, values)?,
         }
     }
     let vertex_count = vertex_count.ok_or_else(|| anyhow!("the file has no vertex element"))?;
@@ -407,6 +407,16 @@ fn read_body(header: &Header, values: &mut dyn Values, grid: bool) -> Result<Mes
         }
     }
     Ok(mesh)
+}
+
+/// Reads past an element the caller does not use. One without properties
+/// holds no data, so there is nothing to read: walking its records would
+/// consume nothing, and a header can claim 2^64 of them.
+fn skip_element(element: &Element, values: &mut dyn Values) -> Result<()> {
+    if element.properties.is_empty() {
+        return Ok(());
+    }
+    read_element(element, values, None, |_, _| Ok(()))
 }
 
 fn role_of(element: &Element, grid: bool) -> Result<Role> {
@@ -938,6 +948,34 @@ mod tests {
             read_ply_mesh(text.as_bytes()).unwrap().faces,
             Some(vec![[0, 1, 2]])
         );
+    }
+
+    /// An element without properties and a huge count, before and after
+    /// the vertices, in both encodings: it used to loop 2^64 times.
+    #[test]
+    fn elements_without_properties_are_skipped_at_once() {
+        let junk = "element junk 18446744073709551615\n";
+        let vertex = "element vertex 2\nproperty float x\nproperty float y\nproperty float z\n";
+        let mut binary_body = Vec::new();
+        [1f32, 2.0, 3.0, 4.0, 5.0, 6.0]
+            .iter()
+            .for_each(|c| binary_body.extend(c.to_le_bytes()));
+        for elements in [format!("{vertex}{junk}"), format!("{junk}{vertex}")] {
+            let ascii = format!("ply\nformat ascii 1.0\n{elements}end_header\n1 2 3\n4 5 6\n");
+            let mut binary =
+                format!("ply\nformat binary_little_endian 1.0\n{elements}end_header\n")
+                    .into_bytes();
+            binary.extend(&binary_body);
+            for bytes in [ascii.into_bytes(), binary] {
+                // On a thread with a deadline, so a regression fails
+                // instead of hanging the test run.
+                let (send, receive) = std::sync::mpsc::channel();
+                std::thread::spawn(move || send.send(read_ply(&bytes).map(|m| m.vertices)));
+                let read = receive.recv_timeout(std::time::Duration::from_secs(20));
+                let vertices = read.expect("read in 20 s").unwrap();
+                assert_eq!(vertices, vec![[1., 2., 3.], [4., 5., 6.]]);
+            }
+        }
     }
 
     #[test]
