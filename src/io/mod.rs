@@ -3,6 +3,8 @@
 //! [`read_cloud`] picks the reader from the file's content when the content
 //! is unambiguous (a PLY or PCD header, OBJ `v` lines) and from its
 //! extension otherwise, so a PLY file named `.txt` still reads as PLY.
+//! Files named `.stl`, `.glb` or `.gltf` follow the mesh reader's rules
+//! ([`MeshInput`]) instead: an STL header is free text and proves nothing.
 //!
 //! Every error names the file, then where in it (a line for text, an
 //! element index for binary data) and what is wrong. Readers never panic on
@@ -131,14 +133,7 @@ pub fn read_mesh_with_faces(path: &Path, hint: &str) -> Result<trim::mesh::Mesh>
 
 fn read_cloud_inner(path: &Path) -> Result<Cloud> {
     let bytes = std::fs::read(path).context("cannot read")?;
-    let format = match detect_format(path, &bytes) {
-        Ok(format) => format,
-        // A triangulated scan (STL, glTF) is a cloud too: its vertices.
-        Err(error) => match MeshInput::detect(path, &bytes) {
-            Ok(MeshInput::Stl | MeshInput::Gltf) => Format::MeshVertices,
-            _ => return Err(error),
-        },
-    };
+    let format = cloud_format(path, &bytes)?;
     let cloud = match format {
         Format::MeshVertices => from_mesh(parse_mesh(path, &bytes)?, format),
         Format::Ply => from_mesh(ply::read_ply(&bytes)?, format),
@@ -150,6 +145,30 @@ fn read_cloud_inner(path: &Path) -> Result<Cloud> {
         bail!("no points in the file ({} format)", format.name());
     }
     Ok(cloud)
+}
+
+/// The reader for a cloud: [`detect_format`], except that the mesh-only
+/// extensions `.stl`, `.glb` and `.gltf` go to the mesh reader's rules, as
+/// in [`read_mesh`]. A binary STL's 80-byte header is free text, so one
+/// starting `v ` or `VERSION` would otherwise be sniffed as OBJ or PCD.
+fn cloud_format(path: &Path, bytes: &[u8]) -> Result<Format> {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+    if ["stl", "glb", "gltf"].contains(&ext.to_ascii_lowercase().as_str()) {
+        return Ok(match MeshInput::detect(path, bytes)? {
+            MeshInput::Ply => Format::Ply,
+            MeshInput::Obj => Format::Obj,
+            MeshInput::Stl | MeshInput::Gltf => Format::MeshVertices,
+        });
+    }
+    let error = match detect_format(path, bytes) {
+        Ok(format) => return Ok(format),
+        Err(error) => error,
+    };
+    // A triangulated scan (STL, glTF) is a cloud too: its vertices.
+    match MeshInput::detect(path, bytes) {
+        Ok(MeshInput::Stl | MeshInput::Gltf) => Ok(Format::MeshVertices),
+        _ => Err(error),
+    }
 }
 
 fn read_mesh_inner(path: &Path) -> Result<Mesh> {
