@@ -284,6 +284,7 @@ pub fn detect_format(path: &Path, bytes: &[u8]) -> Result<Format> {
 
 /// Recognises a format from the start of the file, if it is unambiguous.
 fn sniff(bytes: &[u8]) -> Option<Format> {
+    let bytes = strip_bom(bytes);
     if bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n") {
         return Some(Format::Ply);
     }
@@ -331,6 +332,24 @@ pub(crate) fn capacity(count: usize) -> usize {
     count.min(1 << 20)
 }
 
+/// `bytes` without a leading UTF-8 byte order mark, which Windows editors
+/// write and which would otherwise stick to the first word (`\u{feff}1`).
+pub(crate) fn strip_bom(bytes: &[u8]) -> &[u8] {
+    bytes.strip_prefix(b"\xef\xbb\xbf").unwrap_or(bytes)
+}
+
+/// The file as UTF-8 text, without a leading byte order mark; the mark is
+/// dropped after decoding so that byte offsets in messages stay the file's.
+pub(crate) fn text_of(bytes: &[u8]) -> Result<&str> {
+    let text = std::str::from_utf8(bytes).map_err(|e| {
+        anyhow::anyhow!(
+            "not a text file (invalid UTF-8 at byte {})",
+            e.valid_up_to()
+        )
+    })?;
+    Ok(text.strip_prefix('\u{feff}').unwrap_or(text))
+}
+
 /// Formats a point for messages, keeping NaN and inf readable.
 pub(crate) fn show(p: &Point3) -> String {
     format!("({}, {}, {})", p[0], p[1], p[2])
@@ -369,6 +388,17 @@ mod tests {
         );
         let err = detect_format(Path::new("a.dat"), b"hello world\n").unwrap_err();
         assert!(err.to_string().contains("unknown format"), "{err}");
+    }
+
+    #[test]
+    fn a_byte_order_mark_does_not_hide_the_content() {
+        let dat = Path::new("a.dat");
+        let bom = |s: &str| format!("\u{feff}{s}").into_bytes();
+        let format = |s: &str| detect_format(dat, &bom(s)).unwrap();
+        assert_eq!(format("ply\nformat ascii 1.0\n"), Format::Ply);
+        assert_eq!(format("# .PCD v0.7\nVERSION 0.7\n"), Format::Pcd);
+        assert_eq!(format("v 1 2 3\n"), Format::Obj);
+        assert_eq!(format("1 2 3\n"), Format::Text);
     }
 
     #[test]

@@ -9,16 +9,11 @@
 
 use anyhow::{anyhow, bail, Result};
 
-use super::{show, Mesh, Point3};
+use super::{show, text_of, Mesh, Point3};
 
 /// Reads the vertices and faces of an OBJ file.
 pub fn read_obj(bytes: &[u8]) -> Result<Mesh> {
-    let text = std::str::from_utf8(bytes).map_err(|e| {
-        anyhow!(
-            "not a text file (invalid UTF-8 at byte {})",
-            e.valid_up_to()
-        )
-    })?;
+    let text = text_of(bytes)?;
     let mut mesh = Mesh::default();
     for (i, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();
@@ -115,6 +110,12 @@ mod tests {
         let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1/1 2//3 3/4/5 -1\nf 1 2 3\n";
         let mesh = read_obj(text.as_bytes()).unwrap();
         assert_eq!(mesh.faces.unwrap(), vec![[0, 1, 2], [0, 2, 3], [0, 1, 2]]);
+    }
+
+    #[test]
+    fn a_byte_order_mark_is_skipped() {
+        let mesh = read_obj("\u{feff}v 1 2 3\nv 4 5 6\n".as_bytes()).unwrap();
+        assert_eq!(mesh.vertices, vec![[1., 2., 3.], [4., 5., 6.]]);
     }
 
     #[test]

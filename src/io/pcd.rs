@@ -15,7 +15,7 @@
 
 use anyhow::{anyhow, bail, Result};
 
-use super::{capacity, truncated, Cloud, Format, Point3};
+use super::{capacity, strip_bom, truncated, Cloud, Format, Point3};
 
 /// One field of a PCD point.
 #[derive(Debug, Clone, PartialEq)]
@@ -81,6 +81,7 @@ struct Wanted {
 
 /// Reads a PCD file, dropping (and counting) non-finite points.
 pub fn read_pcd(bytes: &[u8]) -> Result<Cloud> {
+    let bytes = strip_bom(bytes);
     let header = parse_header(bytes)?;
     let wanted = wanted_fields(&header)?;
     let body = &bytes[header.body_start..];
@@ -494,6 +495,11 @@ mod tests {
         check(read_pcd(ascii().as_bytes()).unwrap());
         check(read_pcd(&binary()).unwrap());
         check(read_pcd(&compressed()).unwrap());
+    }
+
+    #[test]
+    fn a_byte_order_mark_is_skipped() {
+        check(read_pcd(format!("\u{feff}{}", ascii()).as_bytes()).unwrap());
     }
 
     #[test]

@@ -37,7 +37,7 @@ use std::io::Write;
 use anyhow::{anyhow, bail, Result};
 use byteorder::{BigEndian, ByteOrder, LittleEndian, WriteBytesExt};
 
-use super::{capacity, show, truncated, Mesh, Point3};
+use super::{capacity, show, strip_bom, truncated, Mesh, Point3};
 
 /// A PLY scalar type.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -163,6 +163,7 @@ pub fn read_ply_mesh(bytes: &[u8]) -> Result<Mesh> {
 }
 
 fn read(bytes: &[u8], grid: bool) -> Result<Mesh> {
+    let bytes = strip_bom(bytes);
     let header = parse_header(bytes)?;
     let body = &bytes[header.body_start..];
     match header.encoding {
@@ -976,6 +977,15 @@ mod tests {
                 assert_eq!(vertices, vec![[1., 2., 3.], [4., 5., 6.]]);
             }
         }
+    }
+
+    #[test]
+    fn a_byte_order_mark_is_skipped() {
+        let text = format!("\u{feff}{ASCII}");
+        assert_eq!(
+            read_ply(text.as_bytes()).unwrap(),
+            read_ply(ASCII.as_bytes()).unwrap()
+        );
     }
 
     #[test]

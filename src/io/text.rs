@@ -8,16 +8,11 @@
 
 use anyhow::{bail, Result};
 
-use super::{show, Mesh, Point3};
+use super::{show, strip_bom, text_of, Mesh, Point3};
 
 /// Reads a text point list.
 pub fn read_text(bytes: &[u8]) -> Result<Mesh> {
-    let text = std::str::from_utf8(bytes).map_err(|e| {
-        anyhow::anyhow!(
-            "not a text file (invalid UTF-8 at byte {})",
-            e.valid_up_to()
-        )
-    })?;
+    let text = text_of(bytes)?;
     let mut vertices = Vec::new();
     let mut first = true;
     for (i, line) in data_lines(text) {
@@ -36,6 +31,7 @@ pub fn read_text(bytes: &[u8]) -> Result<Mesh> {
 /// True if the first data line of `bytes` holds at least three numbers, so
 /// that a file with an unknown extension can still be read as text.
 pub fn looks_numeric(bytes: &[u8]) -> bool {
+    let bytes = strip_bom(bytes);
     let head = String::from_utf8_lossy(&bytes[..bytes.len().min(4096)]);
     let first = data_lines(&head).next();
     first.is_some_and(|(_, line)| {
@@ -115,6 +111,17 @@ mod tests {
         assert_eq!(e, "line 2: non-finite coordinate (4, NaN, 6)");
         let e = read("x y z\na b c\n").unwrap_err().to_string();
         assert_eq!(e, "line 2: 'a' is not a number");
+    }
+
+    #[test]
+    fn a_byte_order_mark_is_not_part_of_the_first_field() {
+        let points = read("\u{feff}1,2,3\n4,5,6\n").unwrap();
+        assert_eq!(points, vec![[1., 2., 3.], [4., 5., 6.]]);
+        assert_eq!(read("\u{feff}x,y,z\n1,2,3\n").unwrap(), vec![[1., 2., 3.]]);
+        assert!(looks_numeric("\u{feff}1 2 3\n".as_bytes()));
+        // Offsets in messages stay the file's, mark included.
+        let e = read_text(b"\xef\xbb\xbf1 2 \xff").unwrap_err().to_string();
+        assert_eq!(e, "not a text file (invalid UTF-8 at byte 7)");
     }
 
     #[test]
