@@ -4,7 +4,8 @@
 //! fields (colour, intensity, normals) are ignored. Fields are separated by
 //! whitespace, commas or semicolons. Blank lines and lines starting with `#`
 //! are skipped, and the first data line is taken as a header when none of
-//! its first three fields is a number.
+//! its first three fields is a number; a header with no data line after it
+//! is an error naming it.
 
 use anyhow::{bail, Result};
 
@@ -15,12 +16,22 @@ pub fn read_text(bytes: &[u8]) -> Result<Mesh> {
     let text = text_of(bytes)?;
     let mut vertices = Vec::new();
     let mut first = true;
+    let mut header = None;
     for (i, line) in data_lines(text) {
         let fields: Vec<&str> = fields(line).collect();
         if std::mem::take(&mut first) && is_header(&fields) {
+            header = Some(i);
             continue;
         }
         vertices.push(parse_point(&fields).map_err(|e| anyhow::anyhow!("line {i}: {e}"))?);
+    }
+    // Otherwise a file of words reads as a header alone and the error,
+    // "no points", hides that its one line was not numbers.
+    if let Some(i) = header.filter(|_| vertices.is_empty()) {
+        bail!(
+            "line {i} looks like a header (none of its first three fields is a number) \
+             and no line of numbers follows"
+        );
     }
     Ok(Mesh {
         vertices,
@@ -111,6 +122,12 @@ mod tests {
         assert_eq!(e, "line 2: non-finite coordinate (4, NaN, 6)");
         let e = read("x y z\na b c\n").unwrap_err().to_string();
         assert_eq!(e, "line 2: 'a' is not a number");
+        let e = read("# notes\nhello world foo\n").unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "line 2 looks like a header (none of its first three fields is a number) \
+             and no line of numbers follows"
+        );
     }
 
     #[test]
