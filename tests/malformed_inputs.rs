@@ -136,7 +136,14 @@ fn known_bad_files() -> Vec<(&'static str, Vec<u8>, &'static str)> {
     // with a bad number: reaching that error needs the element skipped.
     let hang = "ply\nformat ascii 1.0\nelement junk 18446744073709551615\nelement vertex 2\n\
         property float x\nproperty float y\nproperty float z\nend_header\n1 2 3\n4 x 6\n";
+    let shifted = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\n\
+        property float y\nproperty float z\nend_header\n1 2 3 4\n5 6 7\n";
     vec![
+        (
+            "shifted.ply",
+            shifted.into(),
+            "line 8: vertex 0 has 4 values, expected 3",
+        ),
         ("hang.ply", hang.into(), "line 10: 'x' is not a number"),
         ("c0.pcd", pcd("1 1 0", "ascii", b"1 2\n3 4\n"), z0),
         ("c0b.pcd", pcd("1 1 0", "binary", &floats), z0),

@@ -274,13 +274,30 @@ trait Values {
     fn next(&mut self, ty: Scalar) -> Result<Option<f64>>;
     /// "line N: " for ASCII data, empty for binary data.
     fn line_prefix(&self) -> String;
+    /// Marks the start of a record.
+    fn begin_record(&mut self) {}
+    /// Checks where record `i` of `element`, just read, ended.
+    fn end_record(&mut self, _element: &str, _i: usize) -> Result<()> {
+        Ok(())
+    }
 }
 
 /// Whitespace-separated values, numbered by line for messages.
+///
+/// Values are a stream, so a record may run over several lines, but it
+/// must end where a line ends: a record that ends inside a line has a
+/// value too many or too few (a line of 4 values for 3 properties would
+/// otherwise shift every later vertex by one value, silently).
 struct AsciiValues<'a> {
     lines: std::str::Lines<'a>,
     tokens: std::str::SplitAsciiWhitespace<'a>,
     line: usize,
+    /// The current line's text, for counting its values in messages.
+    text: &'a str,
+    /// Values taken since `begin_record`.
+    taken: usize,
+    /// The first line of the current record and its text.
+    first: (usize, &'a str),
 }
 
 impl<'a> AsciiValues<'a> {
@@ -289,6 +306,9 @@ impl<'a> AsciiValues<'a> {
             lines: text.lines(),
             tokens: "".split_ascii_whitespace(),
             line: header_lines,
+            text: "",
+            taken: 0,
+            first: (header_lines, ""),
         }
     }
 }
@@ -300,18 +320,42 @@ impl Values for AsciiValues<'_> {
                 let value = token
                     .parse::<f64>()
                     .map_err(|_| anyhow!("line {}: '{token}' is not a number", self.line))?;
+                if self.taken == 0 {
+                    self.first = (self.line, self.text);
+                }
+                self.taken += 1;
                 return Ok(Some(value));
             }
             let Some(line) = self.lines.next() else {
                 return Ok(None);
             };
             self.line += 1;
+            self.text = line;
             self.tokens = line.split_ascii_whitespace();
         }
     }
 
     fn line_prefix(&self) -> String {
         format!("line {}: ", self.line)
+    }
+
+    fn begin_record(&mut self) {
+        self.taken = 0;
+    }
+
+    fn end_record(&mut self, element: &str, i: usize) -> Result<()> {
+        if self.tokens.clone().next().is_none() {
+            return Ok(());
+        }
+        // Records start where a line starts (the one before ended with its
+        // line), so the first line's values are all this record's: more
+        // than it took on one line, or fewer on a line it ran past.
+        let (line, text) = self.first;
+        let found = text.split_ascii_whitespace().count();
+        bail!(
+            "line {line}: {element} {i} has {found} values, expected {}",
+            self.taken
+        )
     }
 }
 
@@ -626,9 +670,11 @@ fn read_element(
 ) -> Result<()> {
     let mut record = Record::default();
     for i in 0..element.count {
+        values.begin_record();
         if !read_record(element, values, wanted_list, &mut record)? {
             return Err(truncated(element.count, &element.name, i));
         }
+        values.end_record(&element.name, i)?;
         keep(i, &record).map_err(|e| anyhow!("{}{e}", values.line_prefix()))?;
     }
     Ok(())
@@ -977,6 +1023,41 @@ mod tests {
                 assert_eq!(vertices, vec![[1., 2., 3.], [4., 5., 6.]]);
             }
         }
+    }
+
+    #[test]
+    fn a_record_must_end_where_its_line_ends() {
+        // One value too many, or too few: every later vertex used to shift.
+        let extra = ASCII.replace("1 0 0 0 0 1 0\n", "1 0 0 0 0 1 0 5\n");
+        assert_eq!(
+            err(extra.as_bytes()),
+            "line 23: vertex 1 has 8 values, expected 7"
+        );
+        let short = ASCII.replace("1 0 0 0 0 1 0\n", "1 0 0 0 0 1\n");
+        assert_eq!(
+            err(short.as_bytes()),
+            "line 23: vertex 1 has 6 values, expected 7"
+        );
+        let face = ASCII.replace("3 0 1 2\n", "3 0 1 2 3\n");
+        assert_eq!(
+            err(face.as_bytes()),
+            "line 20: face 0 has 5 values, expected 4"
+        );
+        // Values on the last record's line are checked too.
+        let last = ASCII.replace("0 1 0.25 0 0 1 0\n", "0 1 0.25 0 0 1 0 9\n");
+        assert_eq!(
+            err(last.as_bytes()),
+            "line 25: vertex 3 has 8 values, expected 7"
+        );
+    }
+
+    #[test]
+    fn records_split_over_lines_still_read() {
+        let split = ASCII
+            .replace("4 0 1 2 3\n", "4 0 1\n2 3\n")
+            .replace("1 1 0 0 0 1 0\n", "1\n1 0\n\n0 0 1 0\n");
+        let (a, b) = (read_ply(split.as_bytes()), read_ply(ASCII.as_bytes()));
+        assert_eq!(a.unwrap(), b.unwrap());
     }
 
     #[test]
