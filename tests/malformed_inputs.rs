@@ -85,6 +85,87 @@ fn mutated_files_give_errors_not_panics() {
     );
 }
 
+/// Files that once panicked, hung or were misread, with what the error
+/// must say. Each is read as a cloud on a thread with a deadline, so a
+/// hang fails the test instead of stalling it.
+#[test]
+fn known_bad_files_give_clear_errors() {
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let mut failures = Vec::new();
+    for (name, bytes, expected) in known_bad_files() {
+        let path = dir.path().join(name);
+        std::fs::write(&path, &bytes).expect("write a bad file");
+        let (send, receive) = std::sync::mpsc::channel();
+        let read_path = path.clone();
+        std::thread::spawn(move || send.send(read_as_cloud(&read_path)));
+        let problem = match receive.recv_timeout(std::time::Duration::from_secs(20)) {
+            Err(_) => "no answer in 20 s".to_string(),
+            Ok(Outcome::Read) => "read without an error".to_string(),
+            Ok(Outcome::Panic(message)) => format!("panic: {message}"),
+            Ok(Outcome::Error(message)) => {
+                let named = message.starts_with(&*path.to_string_lossy());
+                if named && message.contains(expected) {
+                    continue;
+                }
+                format!("error {message:?} does not name the file or say {expected:?}")
+            }
+        };
+        failures.push(format!("{name}: {problem}"));
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// The bad files of [`known_bad_files_give_clear_errors`]: name, bytes and
+/// a part of the expected message.
+fn known_bad_files() -> Vec<(&'static str, Vec<u8>, &'static str)> {
+    let pcd = |counts: &str, data: &str, body: &[u8]| {
+        let mut out = format!("FIELDS x y z\nCOUNT {counts}\nPOINTS 2\nDATA {data}\n").into_bytes();
+        out.extend(body);
+        out
+    };
+    let floats: Vec<u8> = [1f32, 2.0, 3.0, 4.0]
+        .iter()
+        .flat_map(|c| c.to_le_bytes())
+        .collect();
+    // The same 16 bytes LZF-packed as one literal run, behind the sizes.
+    let mut lzf_block = [17u32, 16].map(u32::to_le_bytes).concat();
+    lzf_block.push(15);
+    lzf_block.extend(&floats);
+    let z0 = "line 2: COUNT 0 for field 'z'";
+    // An element without properties and a huge count, then vertices
+    // with a bad number: reaching that error needs the element skipped.
+    let hang = "ply\nformat ascii 1.0\nelement junk 18446744073709551615\nelement vertex 2\n\
+        property float x\nproperty float y\nproperty float z\nend_header\n1 2 3\n4 x 6\n";
+    let shifted = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\n\
+        property float y\nproperty float z\nend_header\n1 2 3 4\n5 6 7\n";
+    vec![
+        (
+            "shifted.ply",
+            shifted.into(),
+            "line 8: vertex 0 has 4 values, expected 3",
+        ),
+        ("hang.ply", hang.into(), "line 10: 'x' is not a number"),
+        ("c0.pcd", pcd("1 1 0", "ascii", b"1 2\n3 4\n"), z0),
+        ("c0b.pcd", pcd("1 1 0", "binary", &floats), z0),
+        ("c0c.pcd", pcd("1 1 0", "binary_compressed", &lzf_block), z0),
+        (
+            "c00.pcd",
+            pcd("0 0 0", "binary", b"abcdefgh"),
+            "COUNT 0 for field 'x'",
+        ),
+        (
+            "cbig.pcd",
+            pcd("1 1 18446744073709551615", "binary", &[b'x'; 100]),
+            "line 2: COUNT 18446744073709551615",
+        ),
+        (
+            "wh.pcd",
+            b"FIELDS x y z\nWIDTH 4294967296\nHEIGHT 4294967296\nDATA ascii\n1 2 3\n".to_vec(),
+            "line 4: WIDTH 4294967296 × HEIGHT 4294967296 is too many points",
+        ),
+    ]
+}
+
 enum Outcome {
     Read,
     Error(String),

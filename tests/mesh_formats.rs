@@ -7,7 +7,7 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use base64::Engine;
-use meshtrim::io::{read_mesh, write_mesh, Mesh, MeshInput, Point3};
+use meshtrim::io::{read_cloud, read_mesh, write_mesh, Format, Mesh, MeshInput, Point3};
 
 /// A 6 × 5 grid of vertices with one cell missing (a hole), coordinates
 /// that no short decimal or f32 holds exactly, and a little relief.
@@ -111,6 +111,32 @@ fn stl_and_gltf_are_recognised_by_content_under_other_names() {
         };
         assert_eq!(MeshInput::detect(&other, &bytes).unwrap(), want);
         assert_eq!(read_mesh(&other).unwrap(), read_mesh(&path).unwrap());
+    }
+}
+
+/// A binary STL's 80-byte header is free text: one that starts like an
+/// OBJ or PCD file must still read as STL, as a cloud as well as a mesh
+/// (it was sniffed as OBJ or PCD and refused).
+#[test]
+fn stl_headers_that_look_like_other_formats_read_as_stl() {
+    let dir = tempfile::tempdir().unwrap();
+    let (vertices, triangles) = grid_with_hole();
+    let path = dir.path().join("grid.stl");
+    write_mesh(&path, &vertices, &triangles).unwrap();
+    let written = std::fs::read(&path).unwrap();
+    for banner in [
+        "v 2. ScanTool",
+        "VERSION 2 ScanTool",
+        "FIELDS x y z",
+        "# .PCD v0.7",
+    ] {
+        let mut bytes = format!("{banner:<80}").into_bytes();
+        bytes.extend(&written[80..]);
+        let path = dir.path().join("banner.STL");
+        std::fs::write(&path, &bytes).unwrap();
+        let cloud = read_cloud(&path).unwrap_or_else(|e| panic!("{banner}: {e:#}"));
+        assert_eq!(cloud.format, Format::MeshVertices, "{banner}");
+        assert_eq!(cloud.points, read_mesh(&path).unwrap().vertices, "{banner}");
     }
 }
 

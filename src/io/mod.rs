@@ -3,6 +3,8 @@
 //! [`read_cloud`] picks the reader from the file's content when the content
 //! is unambiguous (a PLY or PCD header, OBJ `v` lines) and from its
 //! extension otherwise, so a PLY file named `.txt` still reads as PLY.
+//! Files named `.stl`, `.glb` or `.gltf` follow the mesh reader's rules
+//! ([`MeshInput`]) instead: an STL header is free text and proves nothing.
 //!
 //! Every error names the file, then where in it (a line for text, an
 //! element index for binary data) and what is wrong. Readers never panic on
@@ -131,14 +133,7 @@ pub fn read_mesh_with_faces(path: &Path, hint: &str) -> Result<trim::mesh::Mesh>
 
 fn read_cloud_inner(path: &Path) -> Result<Cloud> {
     let bytes = std::fs::read(path).context("cannot read")?;
-    let format = match detect_format(path, &bytes) {
-        Ok(format) => format,
-        // A triangulated scan (STL, glTF) is a cloud too: its vertices.
-        Err(error) => match MeshInput::detect(path, &bytes) {
-            Ok(MeshInput::Stl | MeshInput::Gltf) => Format::MeshVertices,
-            _ => return Err(error),
-        },
-    };
+    let format = cloud_format(path, &bytes)?;
     let cloud = match format {
         Format::MeshVertices => from_mesh(parse_mesh(path, &bytes)?, format),
         Format::Ply => from_mesh(ply::read_ply(&bytes)?, format),
@@ -150,6 +145,30 @@ fn read_cloud_inner(path: &Path) -> Result<Cloud> {
         bail!("no points in the file ({} format)", format.name());
     }
     Ok(cloud)
+}
+
+/// The reader for a cloud: [`detect_format`], except that the mesh-only
+/// extensions `.stl`, `.glb` and `.gltf` go to the mesh reader's rules, as
+/// in [`read_mesh`]. A binary STL's 80-byte header is free text, so one
+/// starting `v ` or `VERSION` would otherwise be sniffed as OBJ or PCD.
+fn cloud_format(path: &Path, bytes: &[u8]) -> Result<Format> {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("");
+    if ["stl", "glb", "gltf"].contains(&ext.to_ascii_lowercase().as_str()) {
+        return Ok(match MeshInput::detect(path, bytes)? {
+            MeshInput::Ply => Format::Ply,
+            MeshInput::Obj => Format::Obj,
+            MeshInput::Stl | MeshInput::Gltf => Format::MeshVertices,
+        });
+    }
+    let error = match detect_format(path, bytes) {
+        Ok(format) => return Ok(format),
+        Err(error) => error,
+    };
+    // A triangulated scan (STL, glTF) is a cloud too: its vertices.
+    match MeshInput::detect(path, bytes) {
+        Ok(MeshInput::Stl | MeshInput::Gltf) => Ok(Format::MeshVertices),
+        _ => Err(error),
+    }
 }
 
 fn read_mesh_inner(path: &Path) -> Result<Mesh> {
@@ -265,6 +284,7 @@ pub fn detect_format(path: &Path, bytes: &[u8]) -> Result<Format> {
 
 /// Recognises a format from the start of the file, if it is unambiguous.
 fn sniff(bytes: &[u8]) -> Option<Format> {
+    let bytes = strip_bom(bytes);
     if bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n") {
         return Some(Format::Ply);
     }
@@ -312,6 +332,24 @@ pub(crate) fn capacity(count: usize) -> usize {
     count.min(1 << 20)
 }
 
+/// `bytes` without a leading UTF-8 byte order mark, which Windows editors
+/// write and which would otherwise stick to the first word (`\u{feff}1`).
+pub(crate) fn strip_bom(bytes: &[u8]) -> &[u8] {
+    bytes.strip_prefix(b"\xef\xbb\xbf").unwrap_or(bytes)
+}
+
+/// The file as UTF-8 text, without a leading byte order mark; the mark is
+/// dropped after decoding so that byte offsets in messages stay the file's.
+pub(crate) fn text_of(bytes: &[u8]) -> Result<&str> {
+    let text = std::str::from_utf8(bytes).map_err(|e| {
+        anyhow::anyhow!(
+            "not a text file (invalid UTF-8 at byte {})",
+            e.valid_up_to()
+        )
+    })?;
+    Ok(text.strip_prefix('\u{feff}').unwrap_or(text))
+}
+
 /// Formats a point for messages, keeping NaN and inf readable.
 pub(crate) fn show(p: &Point3) -> String {
     format!("({}, {}, {})", p[0], p[1], p[2])
@@ -350,6 +388,17 @@ mod tests {
         );
         let err = detect_format(Path::new("a.dat"), b"hello world\n").unwrap_err();
         assert!(err.to_string().contains("unknown format"), "{err}");
+    }
+
+    #[test]
+    fn a_byte_order_mark_does_not_hide_the_content() {
+        let dat = Path::new("a.dat");
+        let bom = |s: &str| format!("\u{feff}{s}").into_bytes();
+        let format = |s: &str| detect_format(dat, &bom(s)).unwrap();
+        assert_eq!(format("ply\nformat ascii 1.0\n"), Format::Ply);
+        assert_eq!(format("# .PCD v0.7\nVERSION 0.7\n"), Format::Pcd);
+        assert_eq!(format("v 1 2 3\n"), Format::Obj);
+        assert_eq!(format("1 2 3\n"), Format::Text);
     }
 
     #[test]

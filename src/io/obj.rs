@@ -9,16 +9,11 @@
 
 use anyhow::{anyhow, bail, Result};
 
-use super::{show, Mesh, Point3};
+use super::{show, text_of, Mesh, Point3};
 
 /// Reads the vertices and faces of an OBJ file.
 pub fn read_obj(bytes: &[u8]) -> Result<Mesh> {
-    let text = std::str::from_utf8(bytes).map_err(|e| {
-        anyhow!(
-            "not a text file (invalid UTF-8 at byte {})",
-            e.valid_up_to()
-        )
-    })?;
+    let text = text_of(bytes)?;
     let mut mesh = Mesh::default();
     for (i, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();
@@ -32,22 +27,38 @@ pub fn read_obj(bytes: &[u8]) -> Result<Mesh> {
             _ => {}
         }
     }
-    check_indices(&mesh)?;
+    check_indices(&mesh, text)?;
     Ok(mesh)
 }
 
 /// Positive references may point forward, so they are checked at the end.
-fn check_indices(mesh: &Mesh) -> Result<()> {
+fn check_indices(mesh: &Mesh, text: &str) -> Result<()> {
     let n = mesh.vertices.len();
     for (t, face) in mesh.faces.as_deref().unwrap_or_default().iter().enumerate() {
         if let Some(&v) = face.iter().find(|&&v| v as usize >= n) {
-            bail!(
-                "triangle {t} refers to vertex {}, but there are only {n} vertices",
-                v + 1
-            );
+            // As written: 1-based, and in u64, where u32::MAX + 1 fits.
+            let written = u64::from(v) + 1;
+            let at = line_of_triangle(text, t).map_or(String::new(), |l| format!("line {l}: "));
+            bail!("{at}triangle {t} refers to vertex {written}, but there are only {n} vertices");
         }
     }
     Ok(())
+}
+
+/// The line of the `f` line that gave triangle `t`, found again by counting
+/// each face's fan (only on this error path, so nothing is kept per face).
+fn line_of_triangle(text: &str, t: usize) -> Option<usize> {
+    let mut before = 0;
+    for (i, line) in text.lines().enumerate() {
+        let mut words = line.split_whitespace();
+        if words.next() == Some("f") {
+            before += words.count().saturating_sub(2);
+            if before > t {
+                return Some(i + 1);
+            }
+        }
+    }
+    None
 }
 
 /// `v x y z [w | r g b]`: the first three numbers.
@@ -118,6 +129,23 @@ mod tests {
     }
 
     #[test]
+    fn a_byte_order_mark_is_skipped() {
+        let mesh = read_obj("\u{feff}v 1 2 3\nv 4 5 6\n".as_bytes()).unwrap();
+        assert_eq!(mesh.vertices, vec![[1., 2., 3.], [4., 5., 6.]]);
+    }
+
+    #[test]
+    fn a_reference_past_u32_is_named_as_written() {
+        let e = |t: &str| read_obj(t.as_bytes()).unwrap_err().to_string();
+        // The reference as written, though it does not fit in u32 once
+        // 1-based (it used to wrap to "vertex 0"); the line of a later fan.
+        assert_eq!(
+            e("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 1\n# c\nf 1 2 4294967296\n"),
+            "line 6: triangle 2 refers to vertex 4294967296, but there are only 3 vertices"
+        );
+    }
+
+    #[test]
     fn errors_name_the_line() {
         let e = |t: &str| read_obj(t.as_bytes()).unwrap_err().to_string();
         assert_eq!(e("v 1 2 3\nv 1 x 3\n"), "line 2: 'x' is not a number");
@@ -131,7 +159,7 @@ mod tests {
         );
         assert_eq!(
             e("v 1 2 3\nf 1 2 3\n"),
-            "triangle 0 refers to vertex 2, but there are only 1 vertices"
+            "line 2: triangle 0 refers to vertex 2, but there are only 1 vertices"
         );
         assert_eq!(
             e("v 1 2 3\nf 1 -2 1\n"),

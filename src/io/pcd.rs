@@ -15,7 +15,7 @@
 
 use anyhow::{anyhow, bail, Result};
 
-use super::{capacity, truncated, Cloud, Format, Point3};
+use super::{capacity, strip_bom, truncated, Cloud, Format, Point3};
 
 /// One field of a PCD point.
 #[derive(Debug, Clone, PartialEq)]
@@ -63,16 +63,13 @@ struct Header {
     data: Data,
     body_start: usize,
     lines: usize,
+    /// Bytes per point, checked not to overflow.
+    point_bytes: usize,
 }
 
 impl Header {
     fn field(&self, name: &str) -> Option<usize> {
         self.fields.iter().position(|f| f.name == name)
-    }
-
-    /// Bytes per point.
-    fn point_bytes(&self) -> usize {
-        self.fields.iter().map(Field::bytes).sum()
     }
 }
 
@@ -84,6 +81,7 @@ struct Wanted {
 
 /// Reads a PCD file, dropping (and counting) non-finite points.
 pub fn read_pcd(bytes: &[u8]) -> Result<Cloud> {
+    let bytes = strip_bom(bytes);
     let header = parse_header(bytes)?;
     let wanted = wanted_fields(&header)?;
     let body = &bytes[header.body_start..];
@@ -114,6 +112,7 @@ fn parse_header(bytes: &[u8]) -> Result<Header> {
     let (mut width, mut height, mut points) = (None, None, None);
     let mut start = 0;
     let mut line_no = 0;
+    let mut count_line = 0;
     while start < bytes.len() {
         line_no += 1;
         let len = bytes[start..].iter().position(|&b| b == b'\n');
@@ -131,27 +130,75 @@ fn parse_header(bytes: &[u8]) -> Result<Header> {
             "FIELDS" | "COLUMNS" => fields = values.iter().map(|n| new_field(n)).collect(),
             "SIZE" => sizes = Some(numbers(values).map_err(at)?),
             "TYPE" => types = Some(values.iter().map(|t| t.to_string()).collect::<Vec<_>>()),
-            "COUNT" => counts = Some(numbers(values).map_err(at)?),
+            "COUNT" => {
+                counts = Some(numbers(values).map_err(at)?);
+                count_line = line_no;
+            }
             "WIDTH" => width = Some(number(values).map_err(at)?),
             "HEIGHT" => height = Some(number(values).map_err(at)?),
             "POINTS" => points = Some(number(values).map_err(at)?),
             "DATA" => {
                 let data = parse_data(values).map_err(at)?;
-                let points = points.or(width.zip(height).map(|(w, h)| w * h));
-                let points = points.ok_or_else(|| at("no POINTS, WIDTH or HEIGHT".into()))?;
+                let points = match points {
+                    Some(points) => points,
+                    None => points_of(width, height).map_err(at)?,
+                };
                 let fields = fill_fields(fields, sizes, types, counts).map_err(at)?;
+                let (fields, point_bytes) = check_counts(fields)
+                    .map_err(|e| anyhow!("malformed PCD header: line {count_line}: {e}"))?;
                 return Ok(Header {
                     fields,
                     points,
                     data,
                     body_start: start,
                     lines: line_no,
+                    point_bytes,
                 });
             }
             other => return Err(at(format!("unknown header line '{other}'"))),
         }
     }
     bail!("malformed PCD header: no DATA line")
+}
+
+/// POINTS' default, WIDTH × HEIGHT; a product that overflows would wrap
+/// to a small count and misread the file.
+fn points_of(width: Option<usize>, height: Option<usize>) -> Result<usize, String> {
+    let (w, h) = width
+        .zip(height)
+        .ok_or("no POINTS, WIDTH or HEIGHT".to_string())?;
+    w.checked_mul(h).ok_or(format!(
+        "WIDTH {w} × HEIGHT {h} is too many points (and no POINTS)"
+    ))
+}
+
+/// Drops the fields of COUNT 0, which hold no data (PCL drops them too),
+/// and returns the fields left with the bytes a point takes. x, y and z
+/// must keep at least one element; a record size that overflows is an
+/// error rather than a wrapped, wrong stride.
+fn check_counts(fields: Vec<Field>) -> Result<(Vec<Field>, usize), String> {
+    if let Some(f) = fields
+        .iter()
+        .find(|f| f.count == 0 && ["x", "y", "z"].contains(&f.name.as_str()))
+    {
+        return Err(format!(
+            "COUNT 0 for field '{}': x, y and z need a COUNT of at least 1",
+            f.name
+        ));
+    }
+    let fields: Vec<Field> = fields.into_iter().filter(|f| f.count > 0).collect();
+    let mut total = 0usize;
+    for f in &fields {
+        total = f
+            .size
+            .checked_mul(f.count)
+            .and_then(|bytes| total.checked_add(bytes))
+            .ok_or(format!(
+                "COUNT {} for field '{}' makes a point larger than memory can hold",
+                f.count, f.name
+            ))?;
+    }
+    Ok((fields, total))
 }
 
 fn new_field(name: &str) -> Field {
@@ -280,8 +327,8 @@ fn read_ascii(header: &Header, wanted: &Wanted, body: &[u8]) -> Result<Raw> {
 }
 
 fn read_binary(header: &Header, wanted: &Wanted, body: &[u8]) -> Result<Raw> {
-    let stride = header.point_bytes();
-    let available = body.len() / stride.max(1);
+    let stride = header.point_bytes;
+    let available = body.len() / stride;
     if available < header.points {
         return Err(truncated(header.points, "point", available));
     }
@@ -301,7 +348,7 @@ fn read_compressed(header: &Header, wanted: &Wanted, body: &[u8]) -> Result<Raw>
     }
     let expected = header
         .points
-        .checked_mul(header.point_bytes())
+        .checked_mul(header.point_bytes)
         .filter(|&e| e <= u32::MAX as usize)
         .ok_or_else(|| {
             anyhow!(
@@ -451,6 +498,11 @@ mod tests {
     }
 
     #[test]
+    fn a_byte_order_mark_is_skipped() {
+        check(read_pcd(format!("\u{feff}{}", ascii()).as_bytes()).unwrap());
+    }
+
+    #[test]
     fn integer_fields_and_counts() {
         let text =
             "FIELDS j x y z\nSIZE 2 1 2 8\nTYPE I I U I\nCOUNT 2 1 1 1\nPOINTS 1\nDATA binary\n";
@@ -485,6 +537,64 @@ mod tests {
         assert!(err(format!("{huge} binary\n").as_bytes()).contains("file ends after 0"));
         assert!(err(format!("{huge} ascii\n").as_bytes()).contains("file ends after 0"));
         assert!(err(format!("{huge} binary_compressed\n").as_bytes()).contains("too many"));
+    }
+
+    #[test]
+    fn zero_or_huge_xyz_counts_are_header_errors() {
+        // Each encoding once: COUNT 0 used to index past the tokens
+        // (ascii), decode from an empty slice (binary) or make a zero
+        // stride (COUNT 0 0 0); a huge COUNT overflowed SIZE × COUNT.
+        for data in [
+            "ascii\n1 2\n3 4\n",
+            "binary\nabcdefgh",
+            "binary_compressed\n",
+        ] {
+            for counts in ["1 1 0", "0 0 0"] {
+                let file = format!("FIELDS x y z\nCOUNT {counts}\nPOINTS 2\nDATA {data}");
+                assert_eq!(
+                    err(file.as_bytes()),
+                    format!(
+                        "malformed PCD header: line 2: COUNT 0 for field '{}': \
+                         x, y and z need a COUNT of at least 1",
+                        if counts == "0 0 0" { "x" } else { "z" }
+                    )
+                );
+            }
+            let file = format!(
+                "FIELDS x y z\nCOUNT 1 1 {}\nPOINTS 2\nDATA {data}",
+                usize::MAX
+            );
+            assert!(
+                err(file.as_bytes()).starts_with("malformed PCD header: line 2: COUNT 1844"),
+                "{}",
+                err(file.as_bytes())
+            );
+        }
+    }
+
+    #[test]
+    fn fields_of_count_zero_hold_no_data() {
+        let text = "FIELDS x pad y z\nCOUNT 1 0 1 1\nPOINTS 1\nDATA binary\n";
+        let mut bytes = text.as_bytes().to_vec();
+        [1f32, 2.0, 3.0]
+            .iter()
+            .for_each(|c| bytes.extend(c.to_le_bytes()));
+        assert_eq!(read_pcd(&bytes).unwrap().points, vec![[1.0, 2.0, 3.0]]);
+        let text = "FIELDS x pad y z\nCOUNT 1 0 1 1\nPOINTS 1\nDATA ascii\n1 2 3\n";
+        assert_eq!(
+            read_pcd(text.as_bytes()).unwrap().points,
+            vec![[1.0, 2.0, 3.0]]
+        );
+    }
+
+    #[test]
+    fn width_times_height_must_not_wrap() {
+        let file = "FIELDS x y z\nWIDTH 4294967296\nHEIGHT 4294967296\nDATA ascii\n1 2 3\n";
+        assert_eq!(
+            err(file.as_bytes()),
+            "malformed PCD header: line 4: WIDTH 4294967296 × HEIGHT 4294967296 \
+             is too many points (and no POINTS)"
+        );
     }
 
     #[test]

@@ -37,7 +37,7 @@ use std::io::Write;
 use anyhow::{anyhow, bail, Result};
 use byteorder::{BigEndian, ByteOrder, LittleEndian, WriteBytesExt};
 
-use super::{capacity, show, truncated, Mesh, Point3};
+use super::{capacity, show, strip_bom, truncated, Mesh, Point3};
 
 /// A PLY scalar type.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -163,6 +163,7 @@ pub fn read_ply_mesh(bytes: &[u8]) -> Result<Mesh> {
 }
 
 fn read(bytes: &[u8], grid: bool) -> Result<Mesh> {
+    let bytes = strip_bom(bytes);
     let header = parse_header(bytes)?;
     let body = &bytes[header.body_start..];
     match header.encoding {
@@ -273,13 +274,30 @@ trait Values {
     fn next(&mut self, ty: Scalar) -> Result<Option<f64>>;
     /// "line N: " for ASCII data, empty for binary data.
     fn line_prefix(&self) -> String;
+    /// Marks the start of a record.
+    fn begin_record(&mut self) {}
+    /// Checks where record `i` of `element`, just read, ended.
+    fn end_record(&mut self, _element: &str, _i: usize) -> Result<()> {
+        Ok(())
+    }
 }
 
 /// Whitespace-separated values, numbered by line for messages.
+///
+/// Values are a stream, so a record may run over several lines, but it
+/// must end where a line ends: a record that ends inside a line has a
+/// value too many or too few (a line of 4 values for 3 properties would
+/// otherwise shift every later vertex by one value, silently).
 struct AsciiValues<'a> {
     lines: std::str::Lines<'a>,
     tokens: std::str::SplitAsciiWhitespace<'a>,
     line: usize,
+    /// The current line's text, for counting its values in messages.
+    text: &'a str,
+    /// Values taken since `begin_record`.
+    taken: usize,
+    /// The first line of the current record and its text.
+    first: (usize, &'a str),
 }
 
 impl<'a> AsciiValues<'a> {
@@ -288,6 +306,9 @@ impl<'a> AsciiValues<'a> {
             lines: text.lines(),
             tokens: "".split_ascii_whitespace(),
             line: header_lines,
+            text: "",
+            taken: 0,
+            first: (header_lines, ""),
         }
     }
 }
@@ -299,18 +320,42 @@ impl Values for AsciiValues<'_> {
                 let value = token
                     .parse::<f64>()
                     .map_err(|_| anyhow!("line {}: '{token}' is not a number", self.line))?;
+                if self.taken == 0 {
+                    self.first = (self.line, self.text);
+                }
+                self.taken += 1;
                 return Ok(Some(value));
             }
             let Some(line) = self.lines.next() else {
                 return Ok(None);
             };
             self.line += 1;
+            self.text = line;
             self.tokens = line.split_ascii_whitespace();
         }
     }
 
     fn line_prefix(&self) -> String {
         format!("line {}: ", self.line)
+    }
+
+    fn begin_record(&mut self) {
+        self.taken = 0;
+    }
+
+    fn end_record(&mut self, element: &str, i: usize) -> Result<()> {
+        if self.tokens.clone().next().is_none() {
+            return Ok(());
+        }
+        // Records start where a line starts (the one before ended with its
+        // line), so the first line's values are all this record's: more
+        // than it took on one line, or fewer on a line it ran past.
+        let (line, text) = self.first;
+        let found = text.split_ascii_whitespace().count();
+        bail!(
+            "line {line}: {element} {i} has {found} values, expected {}",
+            self.taken
+        )
     }
 }
 
@@ -394,7 +439,7 @@ fn read_body(header: &Header, values: &mut dyn Values, grid: bool) -> Result<Mes
                 }
                 range_grid = Some(read_range_grid(element, values, list)?);
             }
-            Role::Skip => read_element(element, values, None, |_, _| Ok(()))?,
+            Role::Skip => skip_element(element, values)?,
         }
     }
     let vertex_count = vertex_count.ok_or_else(|| anyhow!("the file has no vertex element"))?;
@@ -407,6 +452,16 @@ fn read_body(header: &Header, values: &mut dyn Values, grid: bool) -> Result<Mes
         }
     }
     Ok(mesh)
+}
+
+/// Reads past an element the caller does not use. One without properties
+/// holds no data, so there is nothing to read: walking its records would
+/// consume nothing, and a header can claim 2^64 of them.
+fn skip_element(element: &Element, values: &mut dyn Values) -> Result<()> {
+    if element.properties.is_empty() {
+        return Ok(());
+    }
+    read_element(element, values, None, |_, _| Ok(()))
 }
 
 fn role_of(element: &Element, grid: bool) -> Result<Role> {
@@ -615,9 +670,11 @@ fn read_element(
 ) -> Result<()> {
     let mut record = Record::default();
     for i in 0..element.count {
+        values.begin_record();
         if !read_record(element, values, wanted_list, &mut record)? {
             return Err(truncated(element.count, &element.name, i));
         }
+        values.end_record(&element.name, i)?;
         keep(i, &record).map_err(|e| anyhow!("{}{e}", values.line_prefix()))?;
     }
     Ok(())
@@ -937,6 +994,78 @@ mod tests {
         assert_eq!(
             read_ply_mesh(text.as_bytes()).unwrap().faces,
             Some(vec![[0, 1, 2]])
+        );
+    }
+
+    /// An element without properties and a huge count, before and after
+    /// the vertices, in both encodings: it used to loop 2^64 times.
+    #[test]
+    fn elements_without_properties_are_skipped_at_once() {
+        let junk = "element junk 18446744073709551615\n";
+        let vertex = "element vertex 2\nproperty float x\nproperty float y\nproperty float z\n";
+        let mut binary_body = Vec::new();
+        [1f32, 2.0, 3.0, 4.0, 5.0, 6.0]
+            .iter()
+            .for_each(|c| binary_body.extend(c.to_le_bytes()));
+        for elements in [format!("{vertex}{junk}"), format!("{junk}{vertex}")] {
+            let ascii = format!("ply\nformat ascii 1.0\n{elements}end_header\n1 2 3\n4 5 6\n");
+            let mut binary =
+                format!("ply\nformat binary_little_endian 1.0\n{elements}end_header\n")
+                    .into_bytes();
+            binary.extend(&binary_body);
+            for bytes in [ascii.into_bytes(), binary] {
+                // On a thread with a deadline, so a regression fails
+                // instead of hanging the test run.
+                let (send, receive) = std::sync::mpsc::channel();
+                std::thread::spawn(move || send.send(read_ply(&bytes).map(|m| m.vertices)));
+                let read = receive.recv_timeout(std::time::Duration::from_secs(20));
+                let vertices = read.expect("read in 20 s").unwrap();
+                assert_eq!(vertices, vec![[1., 2., 3.], [4., 5., 6.]]);
+            }
+        }
+    }
+
+    #[test]
+    fn a_record_must_end_where_its_line_ends() {
+        // One value too many, or too few: every later vertex used to shift.
+        let extra = ASCII.replace("1 0 0 0 0 1 0\n", "1 0 0 0 0 1 0 5\n");
+        assert_eq!(
+            err(extra.as_bytes()),
+            "line 23: vertex 1 has 8 values, expected 7"
+        );
+        let short = ASCII.replace("1 0 0 0 0 1 0\n", "1 0 0 0 0 1\n");
+        assert_eq!(
+            err(short.as_bytes()),
+            "line 23: vertex 1 has 6 values, expected 7"
+        );
+        let face = ASCII.replace("3 0 1 2\n", "3 0 1 2 3\n");
+        assert_eq!(
+            err(face.as_bytes()),
+            "line 20: face 0 has 5 values, expected 4"
+        );
+        // Values on the last record's line are checked too.
+        let last = ASCII.replace("0 1 0.25 0 0 1 0\n", "0 1 0.25 0 0 1 0 9\n");
+        assert_eq!(
+            err(last.as_bytes()),
+            "line 25: vertex 3 has 8 values, expected 7"
+        );
+    }
+
+    #[test]
+    fn records_split_over_lines_still_read() {
+        let split = ASCII
+            .replace("4 0 1 2 3\n", "4 0 1\n2 3\n")
+            .replace("1 1 0 0 0 1 0\n", "1\n1 0\n\n0 0 1 0\n");
+        let (a, b) = (read_ply(split.as_bytes()), read_ply(ASCII.as_bytes()));
+        assert_eq!(a.unwrap(), b.unwrap());
+    }
+
+    #[test]
+    fn a_byte_order_mark_is_skipped() {
+        let text = format!("\u{feff}{ASCII}");
+        assert_eq!(
+            read_ply(text.as_bytes()).unwrap(),
+            read_ply(ASCII.as_bytes()).unwrap()
         );
     }
 

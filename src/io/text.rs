@@ -4,28 +4,34 @@
 //! fields (colour, intensity, normals) are ignored. Fields are separated by
 //! whitespace, commas or semicolons. Blank lines and lines starting with `#`
 //! are skipped, and the first data line is taken as a header when none of
-//! its first three fields is a number.
+//! its first three fields is a number; a header with no data line after it
+//! is an error naming it.
 
 use anyhow::{bail, Result};
 
-use super::{show, Mesh, Point3};
+use super::{show, strip_bom, text_of, Mesh, Point3};
 
 /// Reads a text point list.
 pub fn read_text(bytes: &[u8]) -> Result<Mesh> {
-    let text = std::str::from_utf8(bytes).map_err(|e| {
-        anyhow::anyhow!(
-            "not a text file (invalid UTF-8 at byte {})",
-            e.valid_up_to()
-        )
-    })?;
+    let text = text_of(bytes)?;
     let mut vertices = Vec::new();
     let mut first = true;
+    let mut header = None;
     for (i, line) in data_lines(text) {
         let fields: Vec<&str> = fields(line).collect();
         if std::mem::take(&mut first) && is_header(&fields) {
+            header = Some(i);
             continue;
         }
         vertices.push(parse_point(&fields).map_err(|e| anyhow::anyhow!("line {i}: {e}"))?);
+    }
+    // Otherwise a file of words reads as a header alone and the error,
+    // "no points", hides that its one line was not numbers.
+    if let Some(i) = header.filter(|_| vertices.is_empty()) {
+        bail!(
+            "line {i} looks like a header (none of its first three fields is a number) \
+             and no line of numbers follows"
+        );
     }
     Ok(Mesh {
         vertices,
@@ -36,6 +42,7 @@ pub fn read_text(bytes: &[u8]) -> Result<Mesh> {
 /// True if the first data line of `bytes` holds at least three numbers, so
 /// that a file with an unknown extension can still be read as text.
 pub fn looks_numeric(bytes: &[u8]) -> bool {
+    let bytes = strip_bom(bytes);
     let head = String::from_utf8_lossy(&bytes[..bytes.len().min(4096)]);
     let first = data_lines(&head).next();
     first.is_some_and(|(_, line)| {
@@ -115,6 +122,23 @@ mod tests {
         assert_eq!(e, "line 2: non-finite coordinate (4, NaN, 6)");
         let e = read("x y z\na b c\n").unwrap_err().to_string();
         assert_eq!(e, "line 2: 'a' is not a number");
+        let e = read("# notes\nhello world foo\n").unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "line 2 looks like a header (none of its first three fields is a number) \
+             and no line of numbers follows"
+        );
+    }
+
+    #[test]
+    fn a_byte_order_mark_is_not_part_of_the_first_field() {
+        let points = read("\u{feff}1,2,3\n4,5,6\n").unwrap();
+        assert_eq!(points, vec![[1., 2., 3.], [4., 5., 6.]]);
+        assert_eq!(read("\u{feff}x,y,z\n1,2,3\n").unwrap(), vec![[1., 2., 3.]]);
+        assert!(looks_numeric("\u{feff}1 2 3\n".as_bytes()));
+        // Offsets in messages stay the file's, mark included.
+        let e = read_text(b"\xef\xbb\xbf1 2 \xff").unwrap_err().to_string();
+        assert_eq!(e, "not a text file (invalid UTF-8 at byte 7)");
     }
 
     #[test]
