@@ -167,6 +167,36 @@ fn an_output_naming_an_input_is_refused() {
     assert_eq!(std::fs::read(&mesh).unwrap(), before);
 }
 
+/// `meshtrim mesh` refuses, before reading, an output or a report that
+/// would replace its cloud, and a report not named .json.
+#[test]
+fn the_delaunay_path_never_overwrites_its_cloud() {
+    let dir = temp_dir();
+    let cloud = path(dir.path(), "c.ply");
+    std::fs::copy(CLOUD, &cloud).unwrap();
+    // A text cloud may have any extension, .json included.
+    let json_cloud = path(dir.path(), "c.json");
+    std::fs::write(&json_cloud, "0 0 0\n1 0 0\n0 1 0\n").unwrap();
+    let out = path(dir.path(), "o.ply");
+    let (c, j, o) = (
+        cloud.to_str().unwrap(),
+        json_cloud.to_str().unwrap(),
+        out.to_str().unwrap(),
+    );
+    let runs: [(&[&str], &str); 4] = [
+        (&["mesh", c, c], "c.ply: an output would overwrite this input"),
+        (&["mesh", c, o, "--report", c], "name it .json"),
+        (&["mesh", j, o, "--report", j], "c.json: an output would overwrite"),
+        (&["mesh", c, o, "--report", "r.txt"], "name it .json"),
+    ];
+    for (args, message) in runs {
+        assert_clean_failure(&meshtrim(args, None), message);
+    }
+    assert_eq!(std::fs::read(&cloud).unwrap(), std::fs::read(CLOUD).unwrap());
+    assert_eq!(std::fs::read(&json_cloud).unwrap(), b"0 0 0\n1 0 0\n0 1 0\n");
+    assert!(!out.exists());
+}
+
 #[test]
 fn the_delaunay_path_meshes_the_cloud_and_refuses_a_folded_surface() {
     let dir = temp_dir();
