@@ -133,8 +133,12 @@ pub fn merge_duplicates(points: &[Point3]) -> Result<Sites, CloudError> {
 /// Rejects clouds whose distinct points all coincide or are collinear.
 ///
 /// Collinearity is judged relative to the cloud's extent, so the verdict does
-/// not depend on units or position.
+/// not depend on units or position within the supported range; beyond it
+/// the squares below overflow or underflow (300 random points at 1e160
+/// were "one line", at 1e-300 "one point"), so such clouds are refused as
+/// out of range ([`check_range`]), the same error detection gives.
 pub fn check_not_degenerate(points: &[Point3]) -> Result<(), CloudError> {
+    check_range(points)?;
     let distinct = points.len();
     let Some(&a) = points.first() else {
         return Err(CloudError::Degenerate {
@@ -319,5 +323,35 @@ mod tests {
         assert!(message.contains("between 1e-30 and 1e50"), "{message}");
         // A cloud at the origin is one point, not out of range.
         assert!(check_range(&[[0.0; 3], [-0.0; 3]]).is_ok());
+    }
+
+    /// Within the supported range the verdict does not depend on units;
+    /// beyond it the cloud is out of range, not a line or a point.
+    #[test]
+    fn the_verdict_does_not_depend_on_units() {
+        for scale in [1.5e-30, 1e-20, 1.0, 1e20, 1e49] {
+            assert!(check_not_degenerate(&random_slab(scale)).is_ok(), "{scale}");
+            let line: Vec<Point3> = (1..=50)
+                .map(|i| [i as f64 / 50.0 * scale, 0.5 * scale, -scale])
+                .collect();
+            let verdict = check_not_degenerate(&line);
+            assert!(
+                matches!(
+                    verdict,
+                    Err(CloudError::Degenerate {
+                        what: "one line",
+                        ..
+                    })
+                ),
+                "{scale}: {verdict:?}"
+            );
+        }
+        for scale in [1e160, 1e-300] {
+            let refused = check_not_degenerate(&random_slab(scale)).unwrap_err();
+            assert!(
+                matches!(refused, CloudError::OutOfRange { .. }),
+                "{refused}"
+            );
+        }
     }
 }
