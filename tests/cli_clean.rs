@@ -102,6 +102,23 @@ fn unknown_output_formats_and_reports_are_refused() {
     assert!(!out.exists());
 }
 
+/// `--report R.JSON` is a JSON report like `r.json`: the extension's case
+/// does not matter, as for the mesh output.
+#[test]
+fn an_upper_case_report_extension_is_accepted() {
+    let dir = tempfile::tempdir().unwrap();
+    let (out, report) = (dir.path().join("OUT.STL"), dir.path().join("R.JSON"));
+    let run = meshtrim(&["clean", JAGGED, s(&out), "--report", s(&report)], None);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(json["faces_in"], 5768);
+}
+
 #[test]
 fn a_non_manifold_mesh_is_a_clear_error() {
     let dir = tempfile::tempdir().unwrap();
