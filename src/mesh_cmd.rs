@@ -4,14 +4,14 @@
 
 use std::time::{Duration, Instant};
 
-use anyhow::{bail, Context, Result};
+use anyhow::{Context, Result};
 use serde::Serialize;
 use trim::delaunay::{delaunay_mesh_with_report, DelaunayReport};
 use trim::edges::{reconstruct_edges, EdgeOptions};
 
 use crate::cli::MeshArgs;
 use crate::detect::{millis, read_and_detect, Detected};
-use crate::io::mesh_out::{write_mesh, MeshFormat};
+use crate::io::mesh_out::write_mesh;
 
 /// What `mesh` prints and `--report` writes.
 #[derive(Debug, Clone, Serialize)]
@@ -53,12 +53,9 @@ pub struct Report {
 
 /// Runs `meshtrim mesh`.
 pub fn run(args: &MeshArgs) -> Result<()> {
-    if MeshFormat::from_path(&args.output).is_none() {
-        bail!(
-            "{}: unsupported output format: use .obj, .ply, .stl, .gltf or .glb",
-            args.output.display()
-        );
-    }
+    // Before the (possibly long) work: the output format, the report's
+    // name, and neither may overwrite the cloud.
+    crate::report::check_outputs(&args.output, args.report.as_deref(), &[&args.cloud])?;
     let Detected {
         cloud,
         detection,

@@ -37,7 +37,7 @@ pub fn rows(rows: &[(&str, String)]) -> String {
 }
 
 /// Refuses, before any work, an unknown mesh output format, a report not
-/// named `.json`, and an output or report that would overwrite one of the
+/// named `.json` (any case), and an output or report that would overwrite one of the
 /// `inputs`.
 pub fn check_outputs(output: &Path, report: Option<&Path>, inputs: &[&Path]) -> Result<()> {
     use anyhow::bail;
@@ -48,7 +48,9 @@ pub fn check_outputs(output: &Path, report: Option<&Path>, inputs: &[&Path]) -> 
         );
     }
     if let Some(report) = report {
-        if report.extension().and_then(|e| e.to_str()) != Some("json") {
+        // Any case, as mesh outputs, -o and batch reports accept.
+        let json = report.extension().and_then(|e| e.to_str());
+        if !json.is_some_and(|e| e.eq_ignore_ascii_case("json")) {
             bail!("{}: the report is JSON: name it .json", report.display());
         }
     }
@@ -59,4 +61,21 @@ pub fn check_outputs(output: &Path, report: Option<&Path>, inputs: &[&Path]) -> 
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_report_extension_is_json_in_any_case() {
+        let (out, input) = (Path::new("o.ply"), Path::new("Cargo.toml"));
+        for name in ["r.json", "r.JSON", "R.Json"] {
+            assert!(check_outputs(out, Some(Path::new(name)), &[input]).is_ok());
+        }
+        for name in ["r.txt", "r", "r.jsonl"] {
+            let refused = check_outputs(out, Some(Path::new(name)), &[input]);
+            assert!(refused.unwrap_err().to_string().contains("name it .json"));
+        }
+    }
 }

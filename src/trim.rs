@@ -111,6 +111,10 @@ pub fn trim_file(
 ) -> Result<Report> {
     let started = Instant::now();
     let mesh = read_mesh_with_faces(mesh_path, "give a mesh (the cloud goes second)")?;
+    // Checked here, before detection, so the error names the mesh: the
+    // library's own check reports "MESH with CLOUD".
+    trim::mesh::check_vertex_range(&mesh.vertices)
+        .with_context(|| mesh_path.display().to_string())?;
     let mesh_read_time = started.elapsed();
     let Detected {
         cloud,

@@ -243,10 +243,36 @@ fn an_output_over_an_input_is_refused() {
     let stderr = text(&run.stderr);
     assert_eq!(run.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("would overwrite the input"), "{stderr}");
+    assert!(stderr.contains("choose another --out-dir"), "{stderr}");
     assert_eq!(
         std::fs::read(d.join("scans/a.ply")).unwrap(),
         std::fs::read(MESH).unwrap()
     );
+}
+
+/// A report over a cloud is refused, and the advice names --report, the
+/// option at fault, not --out-dir.
+#[test]
+fn a_report_over_a_cloud_names_the_report() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::create_dir_all(d.join("scans")).unwrap();
+    std::fs::copy(JAGGED, d.join("scans/a.stl")).unwrap();
+    std::fs::write(d.join("scans/a.csv"), "0,0,0\n1,0,0\n0,1,0\n").unwrap();
+    let run = batch(d, &["scans", "--out-dir", "out", "--report", "scans/a.csv"]);
+    let stderr = text(&run.stderr);
+    assert_eq!(run.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("scans/a.csv: the report would overwrite the input scans/a.csv"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("choose another --report"), "{stderr}");
+    assert!(!stderr.contains("--out-dir"), "{stderr}");
+    assert_eq!(
+        std::fs::read(d.join("scans/a.csv")).unwrap(),
+        b"0,0,0\n1,0,0\n0,1,0\n"
+    );
+    assert!(!d.join("out").exists(), "nothing processed");
 }
 
 #[test]

@@ -3,7 +3,7 @@
 use std::path::Path;
 
 mod common;
-use common::{assert_clean_failure, meshtrim};
+use common::{assert_clean_failure, grid_obj, meshtrim};
 
 const JAGGED: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -102,6 +102,23 @@ fn unknown_output_formats_and_reports_are_refused() {
     assert!(!out.exists());
 }
 
+/// `--report R.JSON` is a JSON report like `r.json`: the extension's case
+/// does not matter, as for the mesh output.
+#[test]
+fn an_upper_case_report_extension_is_accepted() {
+    let dir = tempfile::tempdir().unwrap();
+    let (out, report) = (dir.path().join("OUT.STL"), dir.path().join("R.JSON"));
+    let run = meshtrim(&["clean", JAGGED, s(&out), "--report", s(&report)], None);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(json["faces_in"], 5768);
+}
+
 #[test]
 fn a_non_manifold_mesh_is_a_clear_error() {
     let dir = tempfile::tempdir().unwrap();
@@ -132,4 +149,34 @@ fn a_truncated_file_is_a_clear_error() {
     let run = meshtrim(&["clean", s(&input), s(&out)], None);
     assert_clean_failure(&run, "cut.stl");
     assert!(!out.exists());
+}
+
+/// Coordinates beyond the supported range (|coordinate| up to 1e50, the
+/// largest at least 1e-30) are refused with the range, not a panic in
+/// spade (1e90) or a wrong verdict; inside it the scale changes nothing.
+#[test]
+fn coordinates_out_of_range_are_a_clear_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let run_at = |scale: f64| {
+        let input = dir.path().join(format!("grid{scale:e}.obj"));
+        std::fs::write(&input, grid_obj(20, scale, true)).unwrap();
+        let out = dir.path().join(format!("out{scale:e}.obj"));
+        (
+            meshtrim(&["clean", s(&input), s(&out), "--json"], None),
+            out,
+        )
+    };
+    for scale in [1e90, 1e60, 1e-35, 1e-60] {
+        let (run, out) = run_at(scale);
+        assert_clean_failure(&run, "the largest |coordinate| is");
+        assert_clean_failure(&run, "between 1e-30 and 1e50");
+        assert!(!out.exists());
+    }
+    let faces = |scale| {
+        let (run, _) = run_at(scale);
+        let json: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+        (json["faces_out"].clone(), json["loops_smoothed"].clone())
+    };
+    assert_eq!(faces(1e45), faces(1.0));
+    assert_eq!(faces(1e-28), faces(1.0));
 }

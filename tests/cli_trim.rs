@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 
 mod common;
-use common::{assert_clean_failure, meshtrim};
+use common::{assert_clean_failure, grid_obj, meshtrim};
 
 const MESH: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -167,6 +167,48 @@ fn an_output_naming_an_input_is_refused() {
     assert_eq!(std::fs::read(&mesh).unwrap(), before);
 }
 
+/// `meshtrim mesh` refuses, before reading, an output or a report that
+/// would replace its cloud, and a report not named .json.
+#[test]
+fn the_delaunay_path_never_overwrites_its_cloud() {
+    let dir = temp_dir();
+    let cloud = path(dir.path(), "c.ply");
+    std::fs::copy(CLOUD, &cloud).unwrap();
+    // A text cloud may have any extension, .json included.
+    let json_cloud = path(dir.path(), "c.json");
+    std::fs::write(&json_cloud, "0 0 0\n1 0 0\n0 1 0\n").unwrap();
+    let out = path(dir.path(), "o.ply");
+    let (c, j, o) = (
+        cloud.to_str().unwrap(),
+        json_cloud.to_str().unwrap(),
+        out.to_str().unwrap(),
+    );
+    let runs: [(&[&str], &str); 4] = [
+        (
+            &["mesh", c, c],
+            "c.ply: an output would overwrite this input",
+        ),
+        (&["mesh", c, o, "--report", c], "name it .json"),
+        (
+            &["mesh", j, o, "--report", j],
+            "c.json: an output would overwrite",
+        ),
+        (&["mesh", c, o, "--report", "r.txt"], "name it .json"),
+    ];
+    for (args, message) in runs {
+        assert_clean_failure(&meshtrim(args, None), message);
+    }
+    assert_eq!(
+        std::fs::read(&cloud).unwrap(),
+        std::fs::read(CLOUD).unwrap()
+    );
+    assert_eq!(
+        std::fs::read(&json_cloud).unwrap(),
+        b"0 0 0\n1 0 0\n0 1 0\n"
+    );
+    assert!(!out.exists());
+}
+
 #[test]
 fn the_delaunay_path_meshes_the_cloud_and_refuses_a_folded_surface() {
     let dir = temp_dir();
@@ -280,4 +322,55 @@ fn the_delaunay_path_gives_the_same_faces_for_a_moved_quantised_cloud() {
             "{a:?} {b:?}"
         );
     }
+}
+
+/// The Delaunay path and detection refuse clouds beyond the supported
+/// coordinate range by naming it, instead of "the mesh has no faces" (1e60,
+/// beyond spade's range), a folded surface (1e-60, flushed to zero by
+/// spade) or a line or point (1e160, 1e-300: squares overflow or
+/// underflow); inside it the scale changes nothing.
+#[test]
+fn clouds_out_of_range_are_a_clear_error() {
+    let dir = temp_dir();
+    let run_at = |command: &str, scale: f64| {
+        let cloud = path(dir.path(), &format!("grid{scale:e}.obj"));
+        std::fs::write(&cloud, grid_obj(20, scale, false)).unwrap();
+        let out = path(dir.path(), "out.ply");
+        let out = out.to_str().unwrap();
+        let args = match command {
+            "mesh" => vec!["mesh", cloud.to_str().unwrap(), out, "--json"],
+            _ => vec!["detect", cloud.to_str().unwrap(), "--json"],
+        };
+        meshtrim(&args, None)
+    };
+    for (command, scale) in [
+        ("mesh", 1e60),
+        ("mesh", 1e-60),
+        ("detect", 1e160),
+        ("detect", 1e-300),
+    ] {
+        let run = run_at(command, scale);
+        assert_clean_failure(&run, "the largest |coordinate| is");
+        assert_clean_failure(&run, "between 1e-30 and 1e50");
+    }
+    // A mesh out of range for an in-range cloud: the error names the mesh.
+    let mesh = path(dir.path(), "far.obj");
+    std::fs::write(&mesh, grid_obj(20, 1e60, true)).unwrap();
+    let out = path(dir.path(), "out.ply");
+    let run = meshtrim(
+        &[mesh.to_str().unwrap(), CLOUD, out.to_str().unwrap()],
+        None,
+    );
+    assert_clean_failure(
+        &run,
+        "far.obj: the coordinates are out of the supported range",
+    );
+    assert!(!out.exists());
+    let faces = |scale| {
+        let json: serde_json::Value =
+            serde_json::from_slice(&run_at("mesh", scale).stdout).unwrap();
+        json["faces"].clone()
+    };
+    assert_eq!(faces(1e45), faces(1.0));
+    assert_eq!(faces(1e-28), faces(1.0));
 }

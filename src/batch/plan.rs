@@ -426,11 +426,15 @@ fn check_overwrites(jobs: &[Job], report: Option<&Path>) -> Result<()> {
             }
         }
     }
-    let outputs = jobs.iter().map(|j| j.output.as_path()).chain(report);
-    for out in outputs {
+    // The advice names the option that chose the path at fault.
+    let outputs = jobs
+        .iter()
+        .map(|j| (j.output.as_path(), "output", "--out-dir"));
+    let report = report.map(|r| (r, "report", "--report"));
+    for (out, what, option) in outputs.chain(report) {
         if let Some(input) = canonical(out).and_then(|c| inputs.get(&c)) {
             bail!(
-                "{}: the output would overwrite the input {}: choose another --out-dir",
+                "{}: the {what} would overwrite the input {}: choose another {option}",
                 out.display(),
                 input.display()
             );

@@ -78,7 +78,8 @@ impl MeshFormat {
 ///
 /// Fails, naming the file, before anything is written if the extension is
 /// unknown, a face refers to a missing vertex, a coordinate is not finite
-/// (or does not fit in `f32` for STL and glTF), or the format cannot hold
+/// (or, for STL and glTF, does not fit in `f32`, or the whole mesh is below
+/// f32's normal range and would be written as zeros), or the format cannot hold
 /// the mesh (PLY's `int` indices, STL's `u32` triangle count, glTF's
 /// non-empty accessors).
 pub fn write_mesh(path: &Path, vertices: &[Point3], faces: &[[u32; 3]]) -> Result<()> {
@@ -110,6 +111,9 @@ pub fn check_mesh(format: MeshFormat, vertices: &[Point3], faces: &[[u32; 3]]) -
             );
         }
     }
+    if format.is_f32() {
+        check_f32_underflow(format, vertices)?;
+    }
     for (t, face) in faces.iter().enumerate() {
         if let Some(&v) = face.iter().find(|&&v| v as usize >= vertices.len()) {
             bail!(
@@ -130,6 +134,34 @@ pub fn check_mesh(format: MeshFormat, vertices: &[Point3], faces: &[[u32; 3]]) -
         }
         _ => Ok(()),
     }
+}
+
+/// Refuses a mesh too small for `f32`: when its largest |coordinate| is
+/// below f32's smallest normal number, every coordinate becomes 0 or a
+/// subnormal with a few bits, so the file would hold a point or a
+/// distorted shape (a mesh at 1e-50 was written as all (0, 0, 0)). Single
+/// tiny coordinates in a larger mesh are fine: their rounding stays below
+/// f32's precision at the mesh's size.
+fn check_f32_underflow(format: MeshFormat, vertices: &[Point3]) -> Result<()> {
+    let largest = |p: &Point3| p.iter().fold(0.0, |m: f64, c| m.max(c.abs()));
+    let Some((i, p)) = vertices
+        .iter()
+        .enumerate()
+        .max_by(|(_, p), (_, q)| largest(p).total_cmp(&largest(q)))
+    else {
+        return Ok(());
+    };
+    let m = largest(p);
+    if m > 0.0 && m < f64::from(f32::MIN_POSITIVE) {
+        bail!(
+            "the mesh's largest |coordinate| is {m:e} (vertex {i}), below f32's smallest \
+             normal number ({:e}), so {} would store its vertices as 0 or with a few bits: \
+             write .ply or .obj (f64) instead",
+            f32::MIN_POSITIVE,
+            format_name(format)
+        );
+    }
+    Ok(())
 }
 
 fn format_name(format: MeshFormat) -> &'static str {
@@ -251,6 +283,20 @@ mod tests {
         );
         assert!(check_mesh(MeshFormat::Ply, &v, &[[0, 1, 2]]).is_ok());
         assert!(e(MeshFormat::Glb, &v[..2], &[]).contains("at least one"));
+        // A mesh below f32's normal range would be written as zeros.
+        let tiny = v.map(|p| p.map(|c| c * 1e-50));
+        for format in [MeshFormat::Stl, MeshFormat::Glb, MeshFormat::Gltf] {
+            let msg = e(format, &tiny[..2], &[[0, 1, 1]]);
+            assert!(
+                msg.contains("largest |coordinate| is 1e-50 (vertex 1)"),
+                "{msg}"
+            );
+            assert!(msg.contains("write .ply or .obj"), "{msg}");
+        }
+        assert!(check_mesh(MeshFormat::Obj, &tiny[..2], &[[0, 1, 1]]).is_ok());
+        // A tiny coordinate in a mesh of ordinary size is only rounded.
+        let small = [[1e-50, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+        assert!(check_mesh(MeshFormat::Stl, &small, &[[0, 1, 2]]).is_ok());
         let nan = [[0.0, f64::NAN, 0.0]];
         assert_eq!(
             e(MeshFormat::Ply, &nan, &[]),

@@ -42,3 +42,34 @@ pub fn assert_clean_failure(out: &std::process::Output, mentions: &str) {
     assert!(stderr.contains(mentions), "{stderr} should name {mentions}");
     assert!(!stderr.contains("panicked"), "{stderr}");
 }
+
+/// An n × n grid of jittered points at `scale` (a slightly bumpy square
+/// panel, deterministic) as OBJ text: `v` lines, then two triangles per
+/// cell when `faces`.
+#[allow(dead_code)]
+pub fn grid_obj(n: usize, scale: f64, faces: bool) -> String {
+    // A fixed hash as the jitter, so every scale holds the same shape.
+    let jitter = |i: usize, salt: usize| ((i * 7919 + salt * 104_729) % 1000) as f64 / 1000.0;
+    let mut text = String::new();
+    for j in 0..n {
+        for i in 0..n {
+            let at = j * n + i;
+            let x = (i as f64 + 0.2 * jitter(at, 1) - 0.1) * scale;
+            let y = (j as f64 + 0.2 * jitter(at, 2) - 0.1) * scale;
+            text += &format!("v {x:e} {y:e} {:e}\n", 0.01 * jitter(at, 3) * scale);
+        }
+    }
+    for j in (0..n - 1).filter(|_| faces) {
+        for i in 0..n - 1 {
+            let a = j * n + i + 1;
+            text += &format!(
+                "f {a} {} {}\nf {a} {} {}\n",
+                a + 1,
+                a + n + 1,
+                a + n + 1,
+                a + n
+            );
+        }
+    }
+    text
+}

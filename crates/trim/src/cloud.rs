@@ -31,7 +31,47 @@ impl Sites {
     }
 }
 
-/// Checks that the cloud fits u32 indices and every coordinate is finite.
+/// The largest |coordinate| meshtrim accepts. The geometry squares
+/// distances (f64 overflows near 1e154), multiplies two squares (cross
+/// products' norms, circle tests: overflow near 1e77), and spade refuses
+/// plane coordinates beyond 2^201 ≈ 3.2e60; 1e50 stays ten orders of
+/// magnitude below the first of these, with the cloud anywhere in that box.
+pub const MAX_COORDINATE: f64 = 1e50;
+
+/// The smallest largest |coordinate| meshtrim accepts (except 0: points all
+/// at the origin are one point). Spade flushes plane coordinates below
+/// 2^-142 ≈ 1.8e-43 to zero, and products of two squared distances
+/// underflow near 1e-77; from 1e-30 up the flush moves a point by less than
+/// 1e-12 of the cloud's size, below the rounding of the plane fit.
+pub const MIN_LARGEST_COORDINATE: f64 = 1e-30;
+
+/// The largest |coordinate| of finite `points`, when it lies outside the
+/// supported range ([`MIN_LARGEST_COORDINATE`] to [`MAX_COORDINATE`]).
+pub fn out_of_range(points: &[Point3]) -> Option<f64> {
+    let largest = points
+        .par_iter()
+        .map(|p| p.iter().fold(0.0, |m: f64, c| m.max(c.abs())))
+        .reduce(|| 0.0, f64::max);
+    let tiny = largest > 0.0 && largest < MIN_LARGEST_COORDINATE;
+    (tiny || largest > MAX_COORDINATE).then_some(largest)
+}
+
+/// Refuses finite `points` outside the supported range, where squared
+/// distances and spade's predicates would overflow or underflow and give
+/// wrong verdicts or panics instead of errors.
+pub fn check_range(points: &[Point3]) -> Result<(), CloudError> {
+    match out_of_range(points) {
+        Some(largest) => Err(CloudError::OutOfRange {
+            largest,
+            min: MIN_LARGEST_COORDINATE,
+            max: MAX_COORDINATE,
+        }),
+        None => Ok(()),
+    }
+}
+
+/// Checks that the cloud fits u32 indices and every coordinate is finite
+/// and within the supported range ([`check_range`]).
 pub fn check_finite(points: &[Point3]) -> Result<(), CloudError> {
     // Sites, neighbour lists and k-d tree items are u32 indices.
     let max = u32::MAX as usize;
@@ -53,7 +93,7 @@ pub fn check_finite(points: &[Point3]) -> Result<(), CloudError> {
             z: p[2],
         });
     }
-    Ok(())
+    check_range(points)
 }
 
 /// Checks that every coordinate is finite and merges exact duplicates.
@@ -93,8 +133,12 @@ pub fn merge_duplicates(points: &[Point3]) -> Result<Sites, CloudError> {
 /// Rejects clouds whose distinct points all coincide or are collinear.
 ///
 /// Collinearity is judged relative to the cloud's extent, so the verdict does
-/// not depend on units or position.
+/// not depend on units or position within the supported range; beyond it
+/// the squares below overflow or underflow (300 random points at 1e160
+/// were "one line", at 1e-300 "one point"), so such clouds are refused as
+/// out of range ([`check_range`]), the same error detection gives.
 pub fn check_not_degenerate(points: &[Point3]) -> Result<(), CloudError> {
+    check_range(points)?;
     let distinct = points.len();
     let Some(&a) = points.first() else {
         return Err(CloudError::Degenerate {
@@ -245,5 +289,69 @@ mod tests {
             .map(|i| [(i % 7) as f64, (i / 7) as f64, 0.0])
             .collect();
         assert!(check_not_degenerate(&plane).is_ok());
+    }
+
+    /// 300 random points of a slightly thick square, at `scale`.
+    fn random_slab(scale: f64) -> Vec<Point3> {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
+        (0..300)
+            .map(|_| [1.0, 1.0, 0.01].map(|f: f64| f * rng.random::<f64>() * scale))
+            .collect()
+    }
+
+    /// Beyond the supported range (squares overflow from 1e154, underflow
+    /// below 1e-154, spade fails from 3.2e60) a cloud is refused by naming
+    /// the range, before anything squares its coordinates.
+    #[test]
+    fn out_of_range_clouds_are_refused() {
+        for scale in [1e160, 1e-300, 1e51, 1e-31] {
+            let refused = merge_duplicates(&random_slab(scale)).unwrap_err();
+            assert!(
+                matches!(refused, CloudError::OutOfRange { .. }),
+                "{refused}"
+            );
+        }
+        for scale in [1.5e-30, 1e49] {
+            assert!(merge_duplicates(&random_slab(scale)).is_ok(), "{scale}");
+        }
+        let message = check_range(&[[0.0, -2e160, 1.0]]).unwrap_err().to_string();
+        assert!(
+            message.contains("largest |coordinate| is 2.00e160"),
+            "{message}"
+        );
+        assert!(message.contains("between 1e-30 and 1e50"), "{message}");
+        // A cloud at the origin is one point, not out of range.
+        assert!(check_range(&[[0.0; 3], [-0.0; 3]]).is_ok());
+    }
+
+    /// Within the supported range the verdict does not depend on units;
+    /// beyond it the cloud is out of range, not a line or a point.
+    #[test]
+    fn the_verdict_does_not_depend_on_units() {
+        for scale in [1.5e-30, 1e-20, 1.0, 1e20, 1e49] {
+            assert!(check_not_degenerate(&random_slab(scale)).is_ok(), "{scale}");
+            let line: Vec<Point3> = (1..=50)
+                .map(|i| [i as f64 / 50.0 * scale, 0.5 * scale, -scale])
+                .collect();
+            let verdict = check_not_degenerate(&line);
+            assert!(
+                matches!(
+                    verdict,
+                    Err(CloudError::Degenerate {
+                        what: "one line",
+                        ..
+                    })
+                ),
+                "{scale}: {verdict:?}"
+            );
+        }
+        for scale in [1e160, 1e-300] {
+            let refused = check_not_degenerate(&random_slab(scale)).unwrap_err();
+            assert!(
+                matches!(refused, CloudError::OutOfRange { .. }),
+                "{refused}"
+            );
+        }
     }
 }

@@ -158,6 +158,8 @@ pub fn delaunay_mesh_with_report(
     if let Some(index) = cloud.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
         return Err(MeshError::NonFinite { index });
     }
+    // Before spade, which panics or refuses points beyond its range.
+    crate::mesh::check_vertex_range(cloud)?;
     if n < 3 || detection.beta.len() != n {
         return Err(MeshError::NoFaces);
     }

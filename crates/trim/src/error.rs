@@ -62,6 +62,17 @@ pub enum CloudError {
         /// Requested neighbourhood size.
         k: usize,
     },
+    /// The coordinates are too large or too small for the geometry's f64
+    /// arithmetic (see `cloud::MAX_COORDINATE`).
+    #[error("the coordinates are out of the supported range: the largest |coordinate| is {largest:.2e}, and meshtrim needs it between {min:e} and {max:e} (beyond, squared distances and the triangulation overflow or underflow); change the units")]
+    OutOfRange {
+        /// The largest |coordinate|.
+        largest: f64,
+        /// Smallest accepted largest |coordinate| (0 aside).
+        min: f64,
+        /// Largest accepted |coordinate|.
+        max: f64,
+    },
     /// All points coincide or lie on one line: there is no surface.
     #[error("the cloud is degenerate: all {distinct} distinct points lie on {what}, so it has no surface and no boundary")]
     Degenerate {
@@ -90,6 +101,17 @@ pub enum MeshError {
     NonFinite {
         /// Index of the vertex.
         index: usize,
+    },
+    /// The coordinates are too large or too small for the geometry's f64
+    /// arithmetic and spade (see `cloud::MAX_COORDINATE`).
+    #[error("the coordinates are out of the supported range: the largest |coordinate| is {largest:.2e}, and meshtrim needs it between {min:e} and {max:e} (beyond, squared distances and the triangulation overflow or underflow); change the units")]
+    OutOfRange {
+        /// The largest |coordinate|.
+        largest: f64,
+        /// Smallest accepted largest |coordinate| (0 aside).
+        min: f64,
+        /// Largest accepted |coordinate|.
+        max: f64,
     },
     /// The mesh has no faces.
     #[error("the mesh has no faces")]

@@ -3,7 +3,8 @@
 
 use std::collections::HashMap;
 
-use crate::cloud::{cross, norm2, sub, Point3};
+use crate::cloud::{cross, norm2, out_of_range, sub, Point3};
+use crate::cloud::{MAX_COORDINATE, MIN_LARGEST_COORDINATE};
 use crate::error::MeshError;
 
 /// An indexed triangle mesh.
@@ -16,8 +17,23 @@ pub struct Mesh {
     pub faces: Vec<[u32; 3]>,
 }
 
+/// Refuses finite vertices outside the supported coordinate range
+/// ([`crate::cloud::check_range`]): beyond it spade panics or fails and
+/// the geometry's squares overflow or underflow.
+pub fn check_vertex_range(vertices: &[Point3]) -> Result<(), MeshError> {
+    match out_of_range(vertices) {
+        Some(largest) => Err(MeshError::OutOfRange {
+            largest,
+            min: MIN_LARGEST_COORDINATE,
+            max: MAX_COORDINATE,
+        }),
+        None => Ok(()),
+    }
+}
+
 impl Mesh {
-    /// Checks indices and coordinates.
+    /// Checks indices and coordinates (finite, and within the supported
+    /// range: [`check_vertex_range`]).
     pub fn validate(&self) -> Result<(), MeshError> {
         if self.faces.is_empty() {
             return Err(MeshError::NoFaces);
@@ -29,6 +45,7 @@ impl Mesh {
         {
             return Err(MeshError::NonFinite { index });
         }
+        check_vertex_range(&self.vertices)?;
         for (face, f) in self.faces.iter().enumerate() {
             if let Some(&vertex) = f.iter().find(|&&v| v as usize >= self.vertices.len()) {
                 return Err(MeshError::IndexOutOfRange {
@@ -266,6 +283,12 @@ mod tests {
         let mut m = grid(1);
         m.vertices[2][0] = f64::NAN;
         assert_eq!(m.validate(), Err(MeshError::NonFinite { index: 2 }));
+        // Beyond the supported range, spade panics and squares overflow.
+        for scale in [1e90, 1e-60] {
+            let mut m = grid(2);
+            m.vertices.iter_mut().flatten().for_each(|c| *c *= scale);
+            assert!(matches!(m.validate(), Err(MeshError::OutOfRange { .. })));
+        }
     }
 
     #[test]
