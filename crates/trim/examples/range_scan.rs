@@ -9,7 +9,7 @@
 
 use trim::bpd::View;
 use trim::evaluate::precision_recall;
-use trim::synthetic::{blade_with_jitter, SyntheticCloud, P3};
+use trim::synthetic::{blade_with_jitter, tilted, SyntheticCloud, P3};
 use trim::{detect_boundary, BpdOptions};
 
 fn main() {
@@ -22,7 +22,7 @@ fn main() {
         (8.0, 0.15, 11),
     ] {
         let truth = blade_with_jitter(h, jitter, seed);
-        let normal = mean_normal(&truth);
+        let normal = truth.mean_normal();
         for incidence in [0.0f64, 20.0, 40.0, 60.0] {
             let sight = tilted(normal, incidence.to_radians());
             for (label, points) in disturbed(&truth, sight, h) {
@@ -63,33 +63,4 @@ fn disturbed(truth: &SyntheticCloud, sight: P3, h: f64) -> Vec<(String, Vec<P3>)
         ),
         ("noise ±0.5 h".into(), truth.with_depth_noise(sight, 0.5, 7)),
     ]
-}
-
-/// The normalised mean of the true normals.
-fn mean_normal(truth: &SyntheticCloud) -> P3 {
-    let mut sum = [0.0; 3];
-    for n in &truth.normals {
-        for a in 0..3 {
-            sum[a] += n[a];
-        }
-    }
-    let len = (sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]).sqrt();
-    sum.map(|c| c / len)
-}
-
-/// `normal` turned by `angle` towards a direction perpendicular to it.
-fn tilted(normal: P3, angle: f64) -> P3 {
-    let helper = if normal[0].abs() < 0.9 {
-        [1.0, 0.0, 0.0]
-    } else {
-        [0.0, 1.0, 0.0]
-    };
-    let along = helper[0] * normal[0] + helper[1] * normal[1] + helper[2] * normal[2];
-    let mut e = [0.0; 3];
-    for a in 0..3 {
-        e[a] = helper[a] - along * normal[a];
-    }
-    let len = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
-    let (c, s) = (angle.cos(), angle.sin());
-    [0, 1, 2].map(|a| c * normal[a] + s * e[a] / len)
 }

@@ -502,6 +502,16 @@ impl SyntheticCloud {
             .collect()
     }
 
+    /// The normalised mean of the true normals: where a scanner facing
+    /// the whole cloud would look from.
+    pub fn mean_normal(&self) -> P3 {
+        let sum = self
+            .normals
+            .iter()
+            .fold([0.0; 3], |s, n| [s[0] + n[0], s[1] + n[1], s[2] + n[2]]);
+        normalised(sum)
+    }
+
     /// The points moved along a line of sight `direction` (a range
     /// scanner's depth noise) by uniform(−p, p) times their intended
     /// spacing; [`SyntheticCloud::with_noise`] moves them along their
@@ -518,6 +528,21 @@ impl SyntheticCloud {
             })
             .collect()
     }
+}
+
+/// The unit vector `normal` turned by `angle` (radians) towards the x
+/// axis, or the y axis when `normal` is nearly along x: a line of sight
+/// inclined to a surface whose mean normal is `normal`.
+pub fn tilted(normal: P3, angle: f64) -> P3 {
+    let helper = if normal[0].abs() < 0.9 {
+        [1.0, 0.0, 0.0]
+    } else {
+        [0.0, 1.0, 0.0]
+    };
+    let along = dot(helper, normal);
+    let e = normalised([0, 1, 2].map(|a| helper[a] - along * normal[a]));
+    let (s, c) = angle.sin_cos();
+    [0, 1, 2].map(|a| c * normal[a] + s * e[a])
 }
 
 /// Jittered-grid samples of `region` with pitch `field` (see the module

@@ -143,7 +143,7 @@ fn range_scans_with_quantised_depth_seen_along_the_line_of_sight() {
     let mut failures = Vec::new();
     for (h, jitter, seed) in [(4.0, 0.05, 40), (8.0, synthetic::JITTER, 41)] {
         let truth = synthetic::blade_with_jitter(h, jitter, seed);
-        let sight = tilted(mean_normal(&truth), 40f64.to_radians());
+        let sight = synthetic::tilted(truth.mean_normal(), 40f64.to_radians());
         let camera: P3 = std::array::from_fn(|a| centroid(&truth)[a] - 3000.0 * sight[a]);
         let cases = [
             (
@@ -189,16 +189,6 @@ fn range_scans_with_quantised_depth_seen_along_the_line_of_sight() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
-/// The normalised mean of the true normals.
-fn mean_normal(truth: &SyntheticCloud) -> P3 {
-    let sum = truth
-        .normals
-        .iter()
-        .fold([0.0; 3], |s, n| [s[0] + n[0], s[1] + n[1], s[2] + n[2]]);
-    let len = (sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]).sqrt();
-    sum.map(|c| c / len)
-}
-
 /// The mean of the points.
 fn centroid(truth: &SyntheticCloud) -> P3 {
     let sum = truth
@@ -206,21 +196,6 @@ fn centroid(truth: &SyntheticCloud) -> P3 {
         .iter()
         .fold([0.0; 3], |s, p| [s[0] + p[0], s[1] + p[1], s[2] + p[2]]);
     sum.map(|c| c / truth.len() as f64)
-}
-
-/// `normal` (a unit vector) turned by `angle` towards the x axis, or the y
-/// axis when it is nearly along x.
-fn tilted(normal: P3, angle: f64) -> P3 {
-    let helper = if normal[0].abs() < 0.9 {
-        [1.0, 0.0, 0.0]
-    } else {
-        [0.0, 1.0, 0.0]
-    };
-    let along = helper[0] * normal[0] + helper[1] * normal[1] + helper[2] * normal[2];
-    let e: P3 = std::array::from_fn(|a| helper[a] - along * normal[a]);
-    let len = (e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt();
-    let (s, c) = angle.sin_cos();
-    std::array::from_fn(|a| c * normal[a] + s * e[a] / len)
 }
 
 /// Rotation about a generic axis, translation, uniform scale.
