@@ -41,8 +41,11 @@ pub struct Report {
     /// Input faces removed whole.
     pub faces_removed: usize,
     /// Pieces of the cut mesh dropped for lack of cloud support (e.g. the
-    /// far side of a Poisson envelope).
+    /// far side of a Poisson envelope, the caps over holes).
     pub pieces_dropped: usize,
+    /// Pieces beyond the cut kept because the cloud supports them (on a
+    /// closed scan, surface behind the walls of small loops).
+    pub pieces_restored: usize,
     /// Vertices snapped onto the cut to avoid slivers.
     pub vertices_snapped: usize,
     /// Area of the input mesh.
@@ -184,6 +187,7 @@ impl Report {
             faces_split: r.faces_split,
             faces_removed: r.faces_removed,
             pieces_dropped: r.pieces_dropped,
+            pieces_restored: r.pieces_restored,
             vertices_snapped: r.vertices_snapped,
             area_in: r.area_in,
             area_out: r.area_out,
@@ -221,6 +225,7 @@ impl crate::report::Table for Report {
             ("faces split", self.faces_split.to_string()),
             ("faces removed", self.faces_removed.to_string()),
             ("pieces dropped", self.pieces_dropped.to_string()),
+            ("pieces restored", self.pieces_restored.to_string()),
             (
                 "area in / out",
                 format!("{:.6} / {:.6}", self.area_in, self.area_out),

@@ -80,6 +80,7 @@ fn trims_the_fixture_and_reports() {
         "write_ms",
         "faces_split",
         "pieces_dropped",
+        "pieces_restored",
     ] {
         assert!(json.get(key).is_some(), "missing {key}");
     }
