@@ -93,8 +93,8 @@ fn an_overshooting_capped_mesh_is_cut_to_the_notched_plate() {
         let normal_z = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
         assert!(normal_z > 0.0, "face {f} flipped");
     }
-    assert_eq!(
-        report.pieces_dropped,
-        1 + report.pieces_dropped.saturating_sub(1)
-    );
+    // The far sheet and the cap over the hole go as pieces of their own;
+    // nothing on this open plate lies behind a wall and is covered.
+    assert!(report.pieces_dropped >= 2, "{report:?}");
+    assert_eq!(report.pieces_restored, 0, "{report:?}");
 }
