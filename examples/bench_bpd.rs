@@ -18,7 +18,7 @@ use std::time::Instant;
 
 use trim::{detect_boundary, BpdOptions, Point3};
 
-fn main() {
+fn main() -> anyhow::Result<()> {
     // As the `meshtrim` binary does, so that the benchmark times the library
     // as the binary runs it.
     meshtrim::alloc::keep_freed_memory();
@@ -30,7 +30,7 @@ fn main() {
         _ => twisted_sheet(n, 1.0, 7),
     };
     if let Some(path) = args.get(3).filter(|p| !p.is_empty()) {
-        write_ply(path, &cloud).expect("write the cloud");
+        write_ply(path, &cloud)?;
     }
     let default_repeat = if cloud.len() <= 1_500_000 { 3 } else { 1 };
     let repeat = std::env::var("BENCH_REPEAT")
@@ -44,7 +44,7 @@ fn main() {
     for _ in 0..repeat.max(1) {
         drop(found.take()); // not two results in the peak memory
         let start = Instant::now();
-        found = Some(detect_boundary(&cloud, &BpdOptions::default()).expect("detect"));
+        found = Some(detect_boundary(&cloud, &BpdOptions::default())?);
         let run_ms = start.elapsed().as_secs_f64() * 1e3;
         // The process's first run, cold: code, caches and thread pool.
         first_ms.get_or_insert(run_ms);
@@ -52,7 +52,7 @@ fn main() {
         // The first run's peak: later runs add the allocator's leftovers.
         peak_mb.get_or_insert_with(peak_rss_mb);
     }
-    let found = found.expect("ran at least once");
+    let found = found.ok_or_else(|| anyhow::anyhow!("no detection ran"))?;
     let start = Instant::now();
     let edges =
         trim::edges::reconstruct_edges(&cloud, &found, &trim::edges::EdgeOptions::default());
@@ -70,6 +70,7 @@ fn main() {
         edges.loops.len(),
         peak_mb.unwrap_or(f64::NAN)
     );
+    Ok(())
 }
 
 /// A twisted, cambered sheet (about 600 × 200 units) with three round holes,

@@ -155,7 +155,7 @@ pub struct ViewArgs {
     /// The scanner's position X,Y,Z in the cloud's frame (a depth camera's
     /// centre: 0,0,0 for a cloud in the camera's own frame); the line of
     /// sight to each point runs from there.
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_position, allow_hyphen_values = true)]
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vector, allow_hyphen_values = true)]
     pub view_from: Option<[f64; 3]>,
 }
 
@@ -201,11 +201,6 @@ fn parse_direction(text: &str) -> Result<[f64; 3], String> {
         return Err("a direction cannot be 0,0,0".into());
     }
     Ok(v)
-}
-
-/// A scanner position: [`parse_vector`].
-fn parse_position(text: &str) -> Result<[f64; 3], String> {
-    parse_vector(text)
 }
 
 /// Arguments of `meshtrim mesh`.
@@ -258,7 +253,7 @@ pub struct TrimArgs {
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_direction, allow_hyphen_values = true, conflicts_with = "view_from")]
     pub view_along: Option<[f64; 3]>,
     /// The scanner's position X,Y,Z (see `meshtrim detect --help`).
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_position, allow_hyphen_values = true)]
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vector, allow_hyphen_values = true)]
     pub view_from: Option<[f64; 3]>,
     /// Print the report as one JSON object.
     #[arg(long)]

@@ -50,17 +50,31 @@ pub const MIN_LARGEST_COORDINATE: f64 = 1e-30;
 pub fn out_of_range(points: &[Point3]) -> Option<f64> {
     let largest = points
         .par_iter()
-        .map(|p| p.iter().fold(0.0, |m: f64, c| m.max(c.abs())))
+        .map(largest_coordinate)
         .reduce(|| 0.0, f64::max);
+    beyond_range(largest)
+}
+
+/// `largest` (a largest |coordinate|) when it lies outside the supported
+/// range.
+fn beyond_range(largest: f64) -> Option<f64> {
     let tiny = largest > 0.0 && largest < MIN_LARGEST_COORDINATE;
     (tiny || largest > MAX_COORDINATE).then_some(largest)
+}
+
+fn largest_coordinate(p: &Point3) -> f64 {
+    p.iter().fold(0.0, |m: f64, c| m.max(c.abs()))
 }
 
 /// Refuses finite `points` outside the supported range, where squared
 /// distances and spade's predicates would overflow or underflow and give
 /// wrong verdicts or panics instead of errors.
 pub fn check_range(points: &[Point3]) -> Result<(), CloudError> {
-    match out_of_range(points) {
+    beyond_range_error(out_of_range(points))
+}
+
+fn beyond_range_error(largest: Option<f64>) -> Result<(), CloudError> {
+    match largest {
         Some(largest) => Err(CloudError::OutOfRange {
             largest,
             min: MIN_LARGEST_COORDINATE,
@@ -81,19 +95,25 @@ pub fn check_finite(points: &[Point3]) -> Result<(), CloudError> {
             max,
         });
     }
-    if let Some((index, p)) = points
-        .iter()
+    // One pass for both checks: the first non-finite point (the smallest
+    // index, whatever the threads) and the largest |coordinate|.
+    let (first_bad, largest) = points
+        .par_iter()
         .enumerate()
-        .find(|(_, p)| p.iter().any(|c| !c.is_finite()))
-    {
+        .map(|(i, p)| {
+            let finite = p.iter().all(|c| c.is_finite());
+            (if finite { usize::MAX } else { i }, largest_coordinate(p))
+        })
+        .reduce(|| (usize::MAX, 0.0), |a, b| (a.0.min(b.0), a.1.max(b.1)));
+    if let Some(p) = points.get(first_bad) {
         return Err(CloudError::NonFinite {
-            index,
+            index: first_bad,
             x: p[0],
             y: p[1],
             z: p[2],
         });
     }
-    check_range(points)
+    beyond_range_error(beyond_range(largest))
 }
 
 /// Checks that every coordinate is finite and merges exact duplicates.
