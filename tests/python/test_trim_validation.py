@@ -147,8 +147,11 @@ def test_bunny_base_holes(tmp_path):
     ov, of = synthetic.read_ply(out_path)
     out_v = np.stack([ov["x"], ov["y"], ov["z"]], axis=1)
     assert len(poisson.boundary_loops(of)) > len(poisson.boundary_loops(f))
-    spacing = float(np.median(poisson.cKDTree(pts).query(pts, k=2)[0][:, 1]))
-    assert poisson.max_distance_to_cloud(out_v, pts) <= 2.0 * spacing
+    # Within 1.5 local spacings of the cloud (measured 1.24): no envelope
+    # is left. The bound is local because the base is sampled about twice
+    # as sparsely as the median; in median spacings the cut through a base
+    # gap lies 1.95-2.13 away (docs/results.md, "Range scans").
+    assert poisson.max_distance_in_local_spacings(out_v, pts) <= 1.5
     assert poisson.is_edge_manifold(of)
     # The rest of the scanned surface stays: the zippered mesh's own area
     # (holes and all). Until stop 17 the walls of small loops round sparse

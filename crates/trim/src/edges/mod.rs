@@ -152,8 +152,9 @@ struct CanonicalBoundary {
 
 impl CanonicalBoundary {
     fn new(points: &[Point3], detection: &Detection) -> Self {
+        let fillers = gap_fillers(detection);
         let mut input: Vec<u32> = (0..points.len() as u32)
-            .filter(|&i| detection.boundary[i as usize])
+            .filter(|&i| detection.boundary[i as usize] || fillers[i as usize])
             .collect();
         let n = input.len().max(1) as f64;
         let mut centre = [0.0; 3];
@@ -184,6 +185,46 @@ impl CanonicalBoundary {
             links,
         }
     }
+}
+
+/// Interior-labelled points that close an open chain of the border (true
+/// at their index).
+///
+/// BPD links a boundary point to the neighbours that its empty circles of
+/// radius ≥ β touch. Each boundary point has at least two such links, but
+/// a linked neighbour is sometimes labelled interior: its own test, in its
+/// own plane and with its own β, found no circle as large. The chain of
+/// links between boundary points then stops there, and clustering, which
+/// keeps only closed chains, drops the whole border (on clean single-row
+/// borders, e.g. a range scan's, nearly every chain end is such a link).
+/// A neighbour that an open end links to and that at least one more
+/// boundary point links to lies on the border as its neighbours see it: it
+/// joins the boundary for edge reconstruction. Where no chain is open,
+/// nothing changes.
+fn gap_fillers(detection: &Detection) -> Vec<bool> {
+    let boundary = &detection.boundary;
+    let mut boundary_degree = vec![0u32; boundary.len()];
+    for &[a, b] in &detection.links {
+        if boundary[a as usize] && boundary[b as usize] {
+            boundary_degree[a as usize] += 1;
+            boundary_degree[b as usize] += 1;
+        }
+    }
+    let mut linked_from_boundary = vec![0u32; boundary.len()];
+    let mut closes_an_end = vec![false; boundary.len()];
+    for &[a, b] in &detection.links {
+        for (from, to) in [(a as usize, b as usize), (b as usize, a as usize)] {
+            if boundary[from] && !boundary[to] {
+                linked_from_boundary[to] += 1;
+                closes_an_end[to] |= boundary_degree[from] == 1;
+            }
+        }
+    }
+    closes_an_end
+        .iter()
+        .zip(&linked_from_boundary)
+        .map(|(&end, &links)| end && links >= 2)
+        .collect()
 }
 
 /// Corners, smoothed edges and (with `index`, the cloud's neighbour index)
@@ -279,5 +320,67 @@ fn move_edges_outward(edges: &mut [Edge], corners: &[usize], sides: &[offset::Ed
         edges[k].points[0] = moved;
         let last = edges[previous].points.len() - 1;
         edges[previous].points[last] = moved;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bpd::Decision;
+
+    /// A ring of 16 boundary points linked to their neighbours, one of
+    /// them labelled interior (`gap`, when given): its two neighbours
+    /// still link to it, as BPD does when their circles touch it.
+    fn ring(gap: Option<usize>) -> (Vec<Point3>, Detection) {
+        let n = 16;
+        let points: Vec<Point3> = (0..n)
+            .map(|i| {
+                let a = std::f64::consts::TAU * i as f64 / n as f64;
+                [10.0 * a.cos(), 10.0 * a.sin(), 0.0]
+            })
+            .collect();
+        let boundary: Vec<bool> = (0..n).map(|i| Some(i) != gap).collect();
+        let links = (0..n as u32)
+            .map(|i| [i, (i + 1) % n as u32])
+            .map(|[a, b]| [a.min(b), a.max(b)])
+            .collect();
+        let detection = Detection {
+            decision: boundary
+                .iter()
+                .map(|&b| {
+                    if b {
+                        Decision::EmptyCircle
+                    } else {
+                        Decision::Interior
+                    }
+                })
+                .collect(),
+            boundary,
+            beta: vec![3.0; n],
+            duplicates: 0,
+            links,
+        };
+        (points, detection)
+    }
+
+    /// One interior-labelled point in a border's chain of links closes it
+    /// again instead of losing the whole border; a closed border gets no
+    /// filler.
+    #[test]
+    fn an_interior_point_linked_from_an_open_end_closes_the_border() {
+        let options = EdgeOptions { offset: false };
+        let (points, whole) = ring(None);
+        assert!(gap_fillers(&whole).iter().all(|&f| !f));
+        let closed = reconstruct_edges(&points, &whole, &options);
+        assert_eq!(closed.loops.len(), 1);
+        assert_eq!(closed.loops[0].boundary_points.len(), 16);
+        let (points, broken) = ring(Some(5));
+        let fillers = gap_fillers(&broken);
+        assert_eq!(fillers.iter().filter(|&&f| f).count(), 1);
+        assert!(fillers[5]);
+        let healed = reconstruct_edges(&points, &broken, &options);
+        assert_eq!(healed.loops.len(), 1, "{healed:?}");
+        assert_eq!(healed.loops[0].boundary_points.len(), 16);
+        assert!(healed.loops[0].boundary_points.contains(&5));
     }
 }
