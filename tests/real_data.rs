@@ -142,3 +142,30 @@ fn edge_tours_on_range_scans_do_not_jump() {
         assert!(jumps <= max_jumps, "{rel}: {jumps} jumps");
     }
 }
+
+/// milk.pcd is a Kinect cloud in its camera's frame. Seen from the camera
+/// (`--view-from 0,0,0`) its boundary is one clean row round the carton,
+/// and the edges close it as one loop. Measured: 5 loops, the largest of
+/// 525 points. Without the gap fillers (`trim::edges`, points labelled
+/// interior that close an open border chain) the border fell apart into
+/// 64 loops of at most 16 points.
+#[test]
+fn a_range_scan_seen_from_its_camera_has_one_outer_loop() {
+    use trim::bpd::View;
+    use trim::edges::{reconstruct_edges, EdgeOptions};
+    let cloud = read_cloud(&data("pcl_test/milk.pcd")).unwrap_or_else(|e| panic!("{e:#}"));
+    let options = trim::BpdOptions {
+        view: Some(View::From([0.0; 3])),
+        ..trim::BpdOptions::default()
+    };
+    let found = trim::detect_boundary(&cloud.points, &options).unwrap();
+    let edges = reconstruct_edges(&cloud.points, &found, &EdgeOptions::default());
+    let largest = edges
+        .loops
+        .iter()
+        .map(|l| l.boundary_points.len())
+        .max()
+        .unwrap_or(0);
+    assert!(edges.loops.len() <= 10, "{} loops", edges.loops.len());
+    assert!(largest >= 450, "largest loop {largest} points");
+}
