@@ -530,6 +530,41 @@ impl SyntheticCloud {
     }
 }
 
+/// A range scan of `truth` as the tests see it, with depth quantised in
+/// terraces 1.5 spacings apart: what the scanner was, the points it
+/// reports, and the view it was seen along.
+pub struct RangeScan {
+    /// "orthographic" or "from a camera".
+    pub scanner: &'static str,
+    /// The reported points (each moved along its line of sight).
+    pub points: Vec<P3>,
+    /// The scanner's line of sight.
+    pub view: crate::bpd::View,
+}
+
+/// Two range scans of `truth` whose line of sight is inclined 40° to its
+/// mean normal: an orthographic scanner (depth quantised along the sight)
+/// and a camera 3,000 units back along it (range quantised from the
+/// camera), with terraces 1.5 spacings (`spacing`) apart.
+pub fn range_scans(truth: &SyntheticCloud, spacing: f64) -> [RangeScan; 2] {
+    let sight = tilted(truth.mean_normal(), 40f64.to_radians());
+    let n = truth.len() as f64;
+    let centre: P3 = std::array::from_fn(|a| truth.points.iter().map(|p| p[a]).sum::<f64>() / n);
+    let camera: P3 = std::array::from_fn(|a| centre[a] - 3000.0 * sight[a]);
+    [
+        RangeScan {
+            scanner: "orthographic",
+            points: truth.with_quantised_depth(sight, 1.5 * spacing),
+            view: crate::bpd::View::Along(sight),
+        },
+        RangeScan {
+            scanner: "from a camera",
+            points: truth.with_quantised_range(camera, 1.5 * spacing),
+            view: crate::bpd::View::From(camera),
+        },
+    ]
+}
+
 /// The unit vector `normal` turned by `angle` (radians) towards the x
 /// axis, or the y axis when `normal` is nearly along x: a line of sight
 /// inclined to a surface whose mean normal is `normal`.

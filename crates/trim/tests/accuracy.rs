@@ -2,9 +2,8 @@
 //! (`trim::synthetic`, scored by `trim::evaluate`). Run with `--nocapture`
 //! to see the measured numbers.
 
-use trim::bpd::View;
 use trim::evaluate::{ideal_first_layer, noise_robustness, percent_sweep, precision_recall};
-use trim::synthetic::{self, SyntheticCloud, P3};
+use trim::synthetic::{self, SyntheticCloud};
 use trim::{detect_boundary, BpdOptions};
 
 const TARGET: f64 = 0.98;
@@ -143,27 +142,14 @@ fn range_scans_with_quantised_depth_seen_along_the_line_of_sight() {
     let mut failures = Vec::new();
     for (h, jitter, seed) in [(4.0, 0.05, 40), (8.0, synthetic::JITTER, 41)] {
         let truth = synthetic::blade_with_jitter(h, jitter, seed);
-        let sight = synthetic::tilted(truth.mean_normal(), 40f64.to_radians());
-        let camera: P3 = std::array::from_fn(|a| centroid(&truth)[a] - 3000.0 * sight[a]);
-        let cases = [
-            (
-                "orthographic",
-                truth.with_quantised_depth(sight, 1.5 * h),
-                View::Along(sight),
-            ),
-            (
-                "from a camera",
-                truth.with_quantised_range(camera, 1.5 * h),
-                View::From(camera),
-            ),
-        ];
-        for (what, points, view) in cases {
-            let [normal, along_sight] = [None, Some(view)].map(|view| {
+        for scan in synthetic::range_scans(&truth, h) {
+            let (what, points) = (scan.scanner, &scan.points);
+            let [normal, along_sight] = [None, Some(scan.view)].map(|view| {
                 let options = BpdOptions {
                     view,
                     ..BpdOptions::default()
                 };
-                let found = detect_boundary(&points, &options).unwrap();
+                let found = detect_boundary(points, &options).unwrap();
                 precision_recall(&truth.points, &found.boundary, &truth)
             });
             eprintln!(
@@ -187,15 +173,6 @@ fn range_scans_with_quantised_depth_seen_along_the_line_of_sight() {
         }
     }
     assert!(failures.is_empty(), "{failures:#?}");
-}
-
-/// The mean of the points.
-fn centroid(truth: &SyntheticCloud) -> P3 {
-    let sum = truth
-        .points
-        .iter()
-        .fold([0.0; 3], |s, p| [s[0] + p[0], s[1] + p[1], s[2] + p[2]]);
-    sum.map(|c| c / truth.len() as f64)
 }
 
 /// Rotation about a generic axis, translation, uniform scale.

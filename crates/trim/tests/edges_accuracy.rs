@@ -167,33 +167,17 @@ fn edges_follow_rigid_motions_and_units() {
 /// off the true surface too.
 #[test]
 fn range_scans_seen_along_the_line_of_sight_close_every_border() {
-    use trim::bpd::View;
     let mut failures = Vec::new();
     for (h, jitter, seed) in [(4.0, 0.05, 40), (8.0, synthetic::JITTER, 41)] {
         let truth = synthetic::blade_with_jitter(h, jitter, seed);
-        let sight = synthetic::tilted(truth.mean_normal(), 40f64.to_radians());
-        let n = truth.points.len() as f64;
-        let centre: Point3 =
-            std::array::from_fn(|a| truth.points.iter().map(|p| p[a]).sum::<f64>() / n);
-        let camera: Point3 = std::array::from_fn(|a| centre[a] - 3000.0 * sight[a]);
-        for (what, points, view) in [
-            (
-                "orthographic",
-                truth.with_quantised_depth(sight, 1.5 * h),
-                View::Along(sight),
-            ),
-            (
-                "from a camera",
-                truth.with_quantised_range(camera, 1.5 * h),
-                View::From(camera),
-            ),
-        ] {
+        for scan in synthetic::range_scans(&truth, h) {
+            let (what, points) = (scan.scanner, &scan.points);
             let options = BpdOptions {
-                view: Some(view),
+                view: Some(scan.view),
                 ..BpdOptions::default()
             };
-            let detection = detect_boundary(&points, &options).unwrap();
-            let edges = reconstruct_edges(&points, &detection, &EdgeOptions::default());
+            let detection = detect_boundary(points, &options).unwrap();
+            let edges = reconstruct_edges(points, &detection, &EdgeOptions::default());
             let name = format!("{} {what}", truth.name);
             let (mean, max) = distance_to_truth(&truth, &edges);
             eprintln!(
