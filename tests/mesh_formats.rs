@@ -301,6 +301,34 @@ fn gltf_buffer_beside_the_file() {
     assert!(e.contains("tri angle.bin"), "{e}");
 }
 
+/// A buffer URI may name any file, not only a regular one: a FIFO (whose
+/// opening waits for a writer forever), a device that never ends such as
+/// `/dev/zero` (reached by an absolute or `..` path; the read used to fill
+/// the memory) or a directory must each give an error at once.
+#[cfg(unix)]
+#[test]
+fn gltf_buffer_that_is_not_a_regular_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("fifo.bin");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    assert!(made.unwrap().success(), "mkfifo");
+    let text = transformed_gltf(4);
+    let uri_start = text.find("data:").unwrap();
+    let uri_end = uri_start + text[uri_start..].find('"').unwrap();
+    for uri in ["fifo.bin", "."] {
+        let path = dir.path().join("device.gltf");
+        let doc = format!("{}{uri}{}", &text[..uri_start], &text[uri_end..]);
+        std::fs::write(&path, doc).unwrap();
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || tx.send(error(&path)));
+        let e = rx
+            .recv_timeout(std::time::Duration::from_secs(20))
+            .unwrap_or_else(|_| panic!("reading buffer '{uri}' does not end"));
+        assert!(e.contains("buffer 0: cannot read"), "{e}");
+        assert!(e.ends_with("not a regular file"), "{e}");
+    }
+}
+
 #[test]
 fn gltf_errors() {
     let dir = tempfile::tempdir().unwrap();
