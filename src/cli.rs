@@ -117,7 +117,7 @@ pub struct CleanArgs {
 #[derive(Debug, Clone, PartialEq, Args)]
 pub struct Stages {
     /// Neighbourhood size of boundary detection, the point itself included.
-    #[arg(long, default_value_t = 30)]
+    #[arg(long, default_value_t = 30, value_parser = parse_k)]
     pub k: usize,
     /// Use the paper's isotropic detection, without the sampling-tensor map.
     #[arg(long)]
@@ -175,6 +175,22 @@ fn bpd_options(k: usize, no_anisotropy: bool, view: &ViewArgs) -> BpdOptions {
         anisotropy: !no_anisotropy,
         view: view.view(),
     }
+}
+
+/// `--k`: a whole number of at least [`BpdOptions::MIN_K`]. Checked here,
+/// not only by detection, so that a value it would refuse is a usage error
+/// before any file is read: a batch used to read and fail every file on it.
+fn parse_k(text: &str) -> Result<usize, String> {
+    let k: usize = text.parse().map_err(|e| format!("{e}"))?;
+    let min = BpdOptions::MIN_K;
+    if k < min {
+        return Err(format!(
+            "k = {k} is too small: boundary detection needs k >= {min} \
+             (the point itself and at least {} neighbours)",
+            min - 1
+        ));
+    }
+    Ok(k)
 }
 
 /// Three finite numbers separated by commas.
@@ -240,7 +256,7 @@ pub struct TrimArgs {
     #[arg(long, value_name = "FILE.json")]
     pub report: Option<PathBuf>,
     /// Neighbourhood size of boundary detection, the point itself included.
-    #[arg(long, default_value_t = 30)]
+    #[arg(long, default_value_t = 30, value_parser = parse_k)]
     pub k: usize,
     /// Use the paper's isotropic detection, without the sampling-tensor map.
     #[arg(long)]
@@ -287,7 +303,7 @@ pub struct DetectArgs {
     #[arg(short, long, value_name = "OUT")]
     pub output: Option<PathBuf>,
     /// Neighbourhood size, the point itself included.
-    #[arg(long, default_value_t = 30)]
+    #[arg(long, default_value_t = 30, value_parser = parse_k)]
     pub k: usize,
     /// Use the paper's isotropic tests, without the sampling-tensor map.
     #[arg(long)]

@@ -310,9 +310,31 @@ fn all_points_identical() {
     fails(&path, &[], "degenerate");
 }
 
+/// A `--k` below 4 is a usage error (exit 2) before any file is read, in
+/// every command: it used to be found by detection after reading the
+/// input (exit 1), and a batch read and failed every file on it.
 #[test]
-fn k_too_small() {
-    fails(Path::new(FIXTURE), &["--k", "2"], "k = 2 is too small");
+fn k_too_small_is_a_usage_error() {
+    let missing = "no-such-input.ply";
+    for args in [
+        vec!["detect", missing, "--k", "3"],
+        vec!["edges", missing, "-o", "e.json", "--k", "0"],
+        vec!["trim", missing, missing, "t.ply", "--k", "2"],
+        vec![missing, missing, "t.ply", "--k", "1"],
+        vec!["mesh", missing, "m.ply", "--k", "3"],
+        vec!["clean", missing, "c.ply", "--k", "3"],
+        vec!["batch", missing, "--out-dir", "out", "--k", "3"],
+    ] {
+        let run = meshtrim(&args);
+        let err = stderr(&run);
+        assert_eq!(run.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains("is too small: boundary detection needs k >= 4"),
+            "{err}"
+        );
+    }
+    let run = meshtrim(&["detect", FIXTURE, "--k", "4", "--json"]);
+    assert!(run.status.success(), "{}", stderr(&run));
 }
 
 #[test]

@@ -301,6 +301,34 @@ fn gltf_buffer_beside_the_file() {
     assert!(e.contains("tri angle.bin"), "{e}");
 }
 
+/// A buffer URI may name any file, not only a regular one: a FIFO (whose
+/// opening waits for a writer forever), a device that never ends such as
+/// `/dev/zero` (reached by an absolute or `..` path; the read used to fill
+/// the memory) or a directory must each give an error at once.
+#[cfg(unix)]
+#[test]
+fn gltf_buffer_that_is_not_a_regular_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("fifo.bin");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    assert!(made.unwrap().success(), "mkfifo");
+    let text = transformed_gltf(4);
+    let uri_start = text.find("data:").unwrap();
+    let uri_end = uri_start + text[uri_start..].find('"').unwrap();
+    for uri in ["fifo.bin", "."] {
+        let path = dir.path().join("device.gltf");
+        let doc = format!("{}{uri}{}", &text[..uri_start], &text[uri_end..]);
+        std::fs::write(&path, doc).unwrap();
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || tx.send(error(&path)));
+        let e = rx
+            .recv_timeout(std::time::Duration::from_secs(20))
+            .unwrap_or_else(|_| panic!("reading buffer '{uri}' does not end"));
+        assert!(e.contains("buffer 0: cannot read"), "{e}");
+        assert!(e.ends_with("not a regular file"), "{e}");
+    }
+}
+
 #[test]
 fn gltf_errors() {
     let dir = tempfile::tempdir().unwrap();
@@ -331,6 +359,71 @@ fn gltf_errors() {
     let path = dir.path().join("broken.glb");
     std::fs::write(&path, b"glTF\x02\0\0\0junk").unwrap();
     assert!(error(&path).contains("malformed glTF"));
+}
+
+/// Lines ended by a lone carriage return (classic Mac OS, Excel for Mac's
+/// "CSV (Macintosh)") read like lines ended by a newline. They used to read
+/// as one long line: an OBJ mesh became one vertex and no faces, a text
+/// cloud one point (the other values ignored as extra fields), an ASCII
+/// STL "ends inside a solid".
+#[test]
+fn lone_carriage_returns_end_lines() {
+    let dir = tempfile::tempdir().unwrap();
+    let (v, f) = grid_with_hole();
+    let obj: String = v
+        .iter()
+        .map(|p| format!("v {} {} {}\n", p[0], p[1], p[2]))
+        .chain(
+            f.iter()
+                .map(|t| format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1)),
+        )
+        .collect();
+    let csv: String = v
+        .iter()
+        .map(|p| format!("{},{},{}\n", p[0], p[1], p[2]))
+        .collect();
+    let stl_path = dir.path().join("lf.stl");
+    write_mesh(&stl_path, &v, &f).unwrap();
+    let stl: String = std::iter::once("solid cr\n".to_string())
+        .chain(f.iter().map(|t| {
+            let corner = |i: u32| {
+                let p = to_f32(&v[i as usize]);
+                format!("vertex {} {} {}\n", p[0], p[1], p[2])
+            };
+            format!(
+                "facet normal 0 0 0\nouter loop\n{}{}{}endloop\nendfacet\n",
+                corner(t[0]),
+                corner(t[1]),
+                corner(t[2])
+            )
+        }))
+        .chain(std::iter::once("endsolid cr\n".to_string()))
+        .collect();
+    for (name, text) in [
+        ("m.obj", obj),
+        ("c.csv", format!("x,y,z\n{csv}")),
+        ("c.xyz", csv.replace(',', " ")),
+        ("m.stl", stl),
+    ] {
+        let lf = dir.path().join(format!("lf_{name}"));
+        let cr = dir.path().join(format!("cr_{name}"));
+        std::fs::write(&lf, &text).unwrap();
+        std::fs::write(&cr, text.replace('\n', "\r")).unwrap();
+        let lf_cloud = read_cloud(&lf).unwrap().points;
+        assert_eq!(lf_cloud.len(), 30, "{name}");
+        assert_eq!(read_cloud(&cr).unwrap().points, lf_cloud, "{name}");
+        if name.starts_with("m.") {
+            assert_eq!(read_mesh(&cr).unwrap(), read_mesh(&lf).unwrap(), "{name}");
+        }
+    }
+    // Line numbers count lone carriage returns too.
+    let bad = dir.path().join("bad.obj");
+    std::fs::write(&bad, "v 1 2 3\r\nv 4 5 6\rv 1 x 3\r").unwrap();
+    assert!(
+        error(&bad).ends_with("line 3: 'x' is not a number"),
+        "{}",
+        error(&bad)
+    );
 }
 
 #[test]

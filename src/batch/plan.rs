@@ -302,9 +302,11 @@ fn has_faces(path: &Path, ext: &str) -> bool {
     };
     let mut lines = BufReader::new(file).split(b'\n');
     if ext == "obj" {
+        // The OBJ reader's rule: a line whose first word is `f`, lines
+        // ended by \n, \r\n or a lone \r.
         return lines
             .map_while(std::result::Result::ok)
-            .any(|l| l.starts_with(b"f ") || l.starts_with(b"f\t"));
+            .any(|l| l.split(|&b| b == b'\r').any(is_face_line));
     }
     for line in lines
         .by_ref()
@@ -324,6 +326,11 @@ fn has_faces(path: &Path, ext: &str) -> bool {
         }
     }
     true
+}
+
+/// An OBJ line whose first word is `f`, indented or not.
+fn is_face_line(line: &[u8]) -> bool {
+    line.split(u8::is_ascii_whitespace).find(|w| !w.is_empty()) == Some(b"f")
 }
 
 /// The clouds of each directory looked in, listed once (a batch of
@@ -476,5 +483,26 @@ mod tests {
         assert!(is_mesh_input(Path::new("blade.cloud.stl")));
         assert!(!is_mesh_input(Path::new("blade.cloud.ply")));
         assert!(!is_mesh_input(Path::new("blade.xyz")));
+    }
+
+    /// An OBJ beside a mesh of its stem is that mesh's cloud only if the
+    /// OBJ reader finds no face in it. Face lines that are indented, or
+    /// ended by a lone \r, were missed: the mesh was taken for a cloud,
+    /// not processed, and its sibling trimmed by it instead of cleaned.
+    #[test]
+    fn obj_faces_are_found_as_the_reader_finds_them() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("part.stl"), b"").unwrap();
+        let obj = dir.path().join("part.obj");
+        for (text, cloud) in [
+            ("v 0 0 0\nv 1 0 0\nv 0 1 0\n", true),
+            ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", false),
+            ("v 0 0 0\nv 1 0 0\nv 0 1 0\n  f 1 2 3\n", false),
+            ("v 0 0 0\rv 1 0 0\rv 0 1 0\rf 1 2 3\r", false),
+            ("v 0 0 0\nv 1 0 0\nv 0 1 0\n# f 1 2 3\nfo 1\n", true),
+        ] {
+            std::fs::write(&obj, text).unwrap();
+            assert_eq!(paired_cloud(&obj), cloud, "{text:?}");
+        }
     }
 }

@@ -140,7 +140,7 @@ fn load_buffers<'a>(gltf: &'a gltf::Gltf, dir: &Path) -> Result<Vec<Cow<'a, [u8]
                 }
                 let path = dir.join(percent_decode(uri));
                 Cow::Owned(
-                    std::fs::read(&path)
+                    read_buffer_file(&path, buffer.length())
                         .with_context(|| format!("buffer {i}: cannot read '{}'", path.display()))?,
                 )
             }
@@ -155,6 +155,24 @@ fn load_buffers<'a>(gltf: &'a gltf::Gltf, dir: &Path) -> Result<Vec<Cow<'a, [u8]
         out.push(data);
     }
     Ok(out)
+}
+
+/// The first `length` bytes of an external buffer file, which must be a
+/// regular file. The URI comes from the document and may name anything: a
+/// FIFO's opening waits for a writer forever, and a device such as
+/// `/dev/zero` (an absolute or `..` path) never ends, so a whole-file read
+/// would hang or fill the memory. Bytes past `length` are not needed.
+fn read_buffer_file(path: &Path, length: usize) -> Result<Vec<u8>> {
+    use std::io::Read;
+    // Checked before opening: opening a FIFO blocks.
+    if !std::fs::metadata(path)?.is_file() {
+        bail!("not a regular file");
+    }
+    let mut data = Vec::new();
+    std::fs::File::open(path)?
+        .take(length as u64)
+        .read_to_end(&mut data)?;
+    Ok(data)
 }
 
 fn decode_data_uri(uri: &str) -> Result<Vec<u8>> {

@@ -292,12 +292,12 @@ fn sniff(bytes: &[u8]) -> Option<Format> {
     let head = String::from_utf8_lossy(&bytes[..bytes.len().min(4096)]);
     // The PCD banner is a comment line, but a telling one.
     let telling = |l: &&str| !l.is_empty() && (!l.starts_with('#') || is_pcd_banner(l));
-    let first = head.lines().map(str::trim).find(telling)?;
+    let first = lines(&head).map(str::trim).find(telling)?;
     if is_pcd_banner(first) || first.starts_with("VERSION") || first.starts_with("FIELDS") {
         return Some(Format::Pcd);
     }
     let obj_line = |l: &str| l.starts_with("v ") || l.starts_with("v\t");
-    if head.lines().map(str::trim_start).any(obj_line) {
+    if lines(&head).map(str::trim_start).any(obj_line) {
         return Some(Format::Obj);
     }
     None
@@ -350,6 +350,27 @@ pub(crate) fn text_of(bytes: &[u8]) -> Result<&str> {
     Ok(text.strip_prefix('\u{feff}').unwrap_or(text))
 }
 
+/// The lines of a text, ended by `\n`, `\r\n` or a lone `\r`, without their
+/// ends. `str::lines` does not end a line at a lone `\r` (classic Mac OS,
+/// Excel for Mac's "CSV (Macintosh)"), so such a file would read as one
+/// line: an OBJ as one vertex, a point list as one point with the rest
+/// taken for extra fields. Otherwise the same as `str::lines`.
+pub(crate) fn lines(text: &str) -> impl Iterator<Item = &str> {
+    let mut rest = text;
+    std::iter::from_fn(move || {
+        if rest.is_empty() {
+            return None;
+        }
+        let (line, after) = match rest.find(['\n', '\r']) {
+            Some(i) if rest[i..].starts_with("\r\n") => (&rest[..i], &rest[i + 2..]),
+            Some(i) => (&rest[..i], &rest[i + 1..]),
+            None => (rest, ""),
+        };
+        rest = after;
+        Some(line)
+    })
+}
+
 /// Formats a point for messages, keeping NaN and inf readable.
 pub(crate) fn show(p: &Point3) -> String {
     format!("({}, {}, {})", p[0], p[1], p[2])
@@ -399,6 +420,18 @@ mod tests {
         assert_eq!(format("# .PCD v0.7\nVERSION 0.7\n"), Format::Pcd);
         assert_eq!(format("v 1 2 3\n"), Format::Obj);
         assert_eq!(format("1 2 3\n"), Format::Text);
+    }
+
+    #[test]
+    fn lines_end_at_any_line_ending() {
+        fn all(t: &str) -> Vec<&str> {
+            lines(t).collect()
+        }
+        // Without a lone \r, the same as str::lines.
+        for t in ["", "a", "a\n", "a\r\nb", "\n\nb\n", "a\r\n\r\n"] {
+            assert_eq!(all(t), t.lines().collect::<Vec<_>>(), "{t:?}");
+        }
+        assert_eq!(all("a\rb\r\rc\r\nd\n"), ["a", "b", "", "c", "d"]);
     }
 
     #[test]

@@ -9,13 +9,13 @@
 
 use anyhow::{anyhow, bail, Result};
 
-use super::{show, text_of, Mesh, Point3};
+use super::{lines, show, text_of, Mesh, Point3};
 
 /// Reads the vertices and faces of an OBJ file.
 pub fn read_obj(bytes: &[u8]) -> Result<Mesh> {
     let text = text_of(bytes)?;
     let mut mesh = Mesh::default();
-    for (i, line) in text.lines().enumerate() {
+    for (i, line) in lines(text).enumerate() {
         let mut words = line.split_whitespace();
         let at = |e: anyhow::Error| anyhow!("line {}: {e}", i + 1);
         match words.next() {
@@ -49,7 +49,7 @@ fn check_indices(mesh: &Mesh, text: &str) -> Result<()> {
 /// each face's fan (only on this error path, so nothing is kept per face).
 fn line_of_triangle(text: &str, t: usize) -> Option<usize> {
     let mut before = 0;
-    for (i, line) in text.lines().enumerate() {
+    for (i, line) in lines(text).enumerate() {
         let mut words = line.split_whitespace();
         if words.next() == Some("f") {
             before += words.count().saturating_sub(2);

@@ -18,7 +18,7 @@ use std::io::Write;
 use anyhow::{anyhow, bail, Result};
 use byteorder::{ByteOrder, LittleEndian, WriteBytesExt};
 
-use super::{capacity, show, Mesh, Point3};
+use super::{capacity, lines, show, Mesh, Point3};
 
 /// Size of a binary STL's header: 80 bytes of text, a u32 triangle count.
 const HEADER: usize = 84;
@@ -37,8 +37,7 @@ pub fn looks_ascii(bytes: &[u8]) -> bool {
     let head = String::from_utf8_lossy(&bytes[..bytes.len().min(1024)]);
     let mut words = head.split_whitespace();
     words.next() == Some("solid")
-        && head
-            .lines()
+        && lines(&head)
             .skip(1)
             .map(str::trim_start)
             .any(|l| l.starts_with("facet") || l.starts_with("endsolid"))
@@ -175,7 +174,7 @@ fn read_ascii(bytes: &[u8]) -> Result<Mesh> {
     let mut corners: Vec<Point3> = Vec::with_capacity(3);
     let mut facets = 0usize;
     let mut last = 0;
-    for (i, line) in text.lines().enumerate() {
+    for (i, line) in lines(text).enumerate() {
         last = i + 1;
         let at = |e: String| anyhow!("line {}: {e}", i + 1);
         let mut words = line.split_whitespace();

@@ -9,7 +9,7 @@
 
 use anyhow::{bail, Result};
 
-use super::{show, strip_bom, text_of, Mesh, Point3};
+use super::{lines, show, strip_bom, text_of, Mesh, Point3};
 
 /// Reads a text point list.
 pub fn read_text(bytes: &[u8]) -> Result<Mesh> {
@@ -53,7 +53,7 @@ pub fn looks_numeric(bytes: &[u8]) -> bool {
 
 /// Non-blank, non-comment lines with their 1-based line numbers.
 fn data_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
-    text.lines()
+    lines(text)
         .enumerate()
         .map(|(i, l)| (i + 1, l.trim()))
         .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'))

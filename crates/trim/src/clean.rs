@@ -915,8 +915,11 @@ fn smallest_angle(vertices: &[Point3], face: [u32; 3]) -> f64 {
 }
 
 /// Edge-manifold with consistent orientation: every undirected edge used
-/// at most twice, every directed edge at most once.
+/// at most twice, every directed edge at most once. A face that names a
+/// vertex twice is reported as such first: it would count its one real
+/// edge twice and be taken for a non-manifold edge.
 fn check_manifold(mesh: &Mesh) -> Result<(), MeshError> {
+    check_distinct_corners(mesh)?;
     let mut directed: HashMap<(u32, u32), u32> = HashMap::new();
     for f in &mesh.faces {
         for k in 0..3 {
@@ -932,6 +935,22 @@ fn check_manifold(mesh: &Mesh) -> Result<(), MeshError> {
         return Err(MeshError::Misoriented { edges: misoriented });
     }
     Ok(())
+}
+
+/// Every face has three different vertices.
+fn check_distinct_corners(mesh: &Mesh) -> Result<(), MeshError> {
+    let repeats = |f: &&[u32; 3]| f[0] == f[1] || f[1] == f[2] || f[2] == f[0];
+    let Some(first) = mesh.faces.iter().position(|f| repeats(&f)) else {
+        return Ok(());
+    };
+    let [a, b, c] = mesh.faces[first];
+    Err(MeshError::RepeatedCorner {
+        faces: mesh.faces.iter().filter(repeats).count(),
+        first,
+        a,
+        b,
+        c,
+    })
 }
 
 /// The faces around each vertex (compressed rows).
@@ -1215,5 +1234,26 @@ mod tests {
             ),
             Err(MeshError::NonManifold { .. })
         ));
+    }
+
+    /// A face with two equal corners (a binary STL's sliver, merged) is
+    /// named as such; it used to be reported as a non-manifold edge.
+    #[test]
+    fn a_face_with_a_repeated_vertex_is_named() {
+        let mut mesh = jagged_annulus(8.0, 3.0, 3);
+        let beta = vec![1.0; mesh.vertices.len()];
+        let [a, b, _] = mesh.faces[5];
+        mesh.faces.push([a, b, a]);
+        let last = mesh.faces.len() - 1;
+        assert_eq!(
+            clean_mesh(&mesh, &beta, &CleanOptions::default()).unwrap_err(),
+            MeshError::RepeatedCorner {
+                faces: 1,
+                first: last,
+                a,
+                b,
+                c: a
+            }
+        );
     }
 }

@@ -360,6 +360,7 @@ pub const MAX_INCIDENCE_DEGREES: f64 = 70.0;
 /// (0, 0) when the ray is the normal; its length tan θ (θ the incidence)
 /// is capped at tan [`MAX_INCIDENCE_DEGREES`], keeping its direction.
 pub fn ray_shear(frame: &Frame, ray: Point3) -> [f64; 2] {
+    let ray = moderate(ray);
     let (along_u, along_v, along_n) =
         (dot(ray, frame.u), dot(ray, frame.v), dot(ray, frame.normal));
     let tangential = along_u.hypot(along_v);
@@ -379,6 +380,25 @@ pub fn ray_shear(frame: &Frame, ray: Point3) -> [f64; 2] {
         sense * length * along_u / tangential,
         sense * length * along_v / tangential,
     ]
+}
+
+/// `v` scaled by powers of two until its largest |component| lies in
+/// [2⁻⁶⁴, 2⁶⁴). Only the ray's direction matters, and the user gives its
+/// length (`--view-along 1e308,1e308,1e308`, or a `--view-from` far away):
+/// at 1e308 the shear's `length * along_u` overflowed to infinity, and
+/// subnormal components lose their bits in the products. A power of two
+/// scales exactly, so a ray already in range is left as it is and any
+/// other gets the shear of the same direction at unit size, bit for bit.
+fn moderate(mut v: Point3) -> Point3 {
+    const BIG: f64 = 18_446_744_073_709_551_616.0; // 2^64
+    let largest = |v: &Point3| v.iter().fold(0.0f64, |m, c| m.max(c.abs()));
+    while largest(&v) >= BIG && largest(&v).is_finite() {
+        v = v.map(|c| c / BIG);
+    }
+    while largest(&v) > 0.0 && largest(&v) < 1.0 / BIG {
+        v = v.map(|c| c * BIG);
+    }
+    v
 }
 
 /// [`project`] along a scanner's ray: `shear` from [`ray_shear`]. With a
@@ -505,6 +525,39 @@ mod tests {
                 want.map(f64::to_bits),
                 "case {case}"
             );
+        }
+    }
+
+    /// The shear depends on the ray's direction only, not its length, bit
+    /// for bit: `--view-along 1e308,1e308,1e308` used to overflow the
+    /// shear to infinity (1012 boundary points on the blade fixture
+    /// instead of 311 along 1,1,1), and a ray of subnormal components lost
+    /// its bits.
+    #[test]
+    fn the_shear_ignores_the_length_of_the_ray() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        for case in 0..200 {
+            let points: Vec<Point3> = (0..12)
+                .map(|_| std::array::from_fn(|a| rng.random_range(-1.0..1.0) * [1.0, 1.0, 0.1][a]))
+                .collect();
+            let frame = fit_plane_normal(&points, &(0..12).collect::<Vec<u32>>());
+            let ray: Point3 = std::array::from_fn(|_| f64::from(rng.random_range(-8i8..=8)));
+            if ray == [0.0; 3] {
+                continue;
+            }
+            let want = ray_shear(&frame, ray).map(f64::to_bits);
+            for scale in [
+                2f64.powi(1020),
+                2f64.powi(-1066),
+                2f64.powi(-1000) * 2f64.powi(-70),
+            ] {
+                let got = ray_shear(&frame, ray.map(|c| c * scale));
+                assert_eq!(
+                    got.map(f64::to_bits),
+                    want,
+                    "case {case}: {ray:?} × {scale:e}"
+                );
+            }
         }
     }
 

@@ -149,11 +149,17 @@ impl Mesh {
     /// The border: directed edges (as the faces run) used by one face only,
     /// chained into loops of vertex indices. At a vertex where several
     /// border loops touch, the chaining takes the edges in index order.
+    /// The "edge" from a vertex to itself of a face that names it twice
+    /// (a zero-area sliver) is no border: it would be a loop of one
+    /// vertex, anywhere on the surface.
     pub fn boundary_loops(&self) -> Vec<Vec<u32>> {
         let edges = self.sorted_edges();
         let mut next: HashMap<u32, Vec<u32>> = HashMap::new();
         for on_edge in edges.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
             if let [(low, high, face)] = on_edge {
+                if low == high {
+                    continue;
+                }
                 let (a, b) = directed_edge(self.faces[*face as usize], *low, *high);
                 next.entry(a).or_default().push(b);
             }
@@ -170,7 +176,7 @@ impl Mesh {
         for f in &self.faces {
             for k in 0..3 {
                 let (a, b) = (f[k], f[(k + 1) % 3]);
-                if uses[&(a.min(b), a.max(b))] == 1 {
+                if a != b && uses[&(a.min(b), a.max(b))] == 1 {
                     next.entry(a).or_default().push(b);
                 }
             }
@@ -266,6 +272,21 @@ mod tests {
         let loops = m.boundary_loops();
         assert_eq!(loops.len(), 1);
         assert_eq!(loops[0].len(), 16);
+    }
+
+    /// A face that names a vertex twice has an "edge" from that vertex to
+    /// itself, used once: it is no border. It used to become a loop of one
+    /// interior vertex, which the trim report measured as a border vertex
+    /// far from every smoothed edge.
+    #[test]
+    fn an_edge_from_a_vertex_to_itself_is_no_border() {
+        let inner = 2 * 5 + 2;
+        for extra in [[inner, inner, inner + 1], [inner + 1, inner, inner]] {
+            let mut m = grid(4);
+            m.faces.push(extra);
+            assert_eq!(m.boundary_loops(), grid(4).boundary_loops());
+            assert_eq!(m.boundary_loops_reference(), grid(4).boundary_loops());
+        }
     }
 
     #[test]
