@@ -64,7 +64,7 @@ pub struct Report {
     pub faces_out: usize,
     /// New vertices (on the smoothed border).
     pub vertices_added: usize,
-    /// Smallest angle of the new faces, degrees.
+    /// Smallest angle of the new faces, degrees; 0 when no face was added.
     pub min_angle_new: f64,
     /// Area of the input.
     pub area_in: f64,
@@ -180,6 +180,18 @@ impl Report {
     }
 }
 
+impl Report {
+    /// The smallest angle of the new faces, or "none" when there are none
+    /// (the number is then 0, which would read as a degenerate face).
+    fn smallest_new_angle(&self) -> String {
+        if self.faces_added == 0 {
+            "none (no new faces)".to_string()
+        } else {
+            format!("{:.1}°", self.min_angle_new)
+        }
+    }
+}
+
 impl crate::report::Table for Report {
     fn table(&self) -> String {
         let left: usize = self.loops_left.iter().map(|l| l.loops.len()).sum();
@@ -203,7 +215,7 @@ impl crate::report::Table for Report {
                 "faces replaced",
                 format!("{} removed, {} new", self.faces_removed, self.faces_added),
             ),
-            ("smallest new angle", format!("{:.1}°", self.min_angle_new)),
+            ("smallest new angle", self.smallest_new_angle()),
             (
                 "area in / out",
                 format!("{:.6} / {:.6}", self.area_in, self.area_out),

@@ -180,3 +180,43 @@ fn coordinates_out_of_range_are_a_clear_error() {
     assert_eq!(faces(1e45), faces(1.0));
     assert_eq!(faces(1e-28), faces(1.0));
 }
+
+/// A closed mesh has no border to clean: nothing is replaced, and the
+/// report says there is no new face instead of a smallest angle of 0°.
+#[test]
+fn a_closed_mesh_is_written_unchanged_and_reports_no_new_angle() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, out) = (dir.path().join("cylinder.obj"), dir.path().join("out.obj"));
+    // A closed cylinder: 24 sides, 8 rings, both ends capped by a fan.
+    let (sides, rings) = (24u32, 8u32);
+    let mut text = String::new();
+    for r in 0..rings {
+        for k in 0..sides {
+            let a = std::f64::consts::TAU * f64::from(k) / f64::from(sides);
+            text += &format!("v {} {} {}\n", a.cos(), a.sin(), 0.3 * f64::from(r));
+        }
+    }
+    let (bottom, top) = (rings * sides + 1, rings * sides + 2);
+    text += &format!("v 0 0 0\nv 0 0 {}\n", 0.3 * f64::from(rings - 1));
+    let at = |r: u32, k: u32| r * sides + k % sides + 1;
+    for r in 0..rings - 1 {
+        for k in 0..sides {
+            text += &format!("f {} {} {}\n", at(r, k), at(r, k + 1), at(r + 1, k + 1));
+            text += &format!("f {} {} {}\n", at(r, k), at(r + 1, k + 1), at(r + 1, k));
+        }
+    }
+    for k in 0..sides {
+        text += &format!("f {bottom} {} {}\n", at(0, k + 1), at(0, k));
+        text += &format!("f {top} {} {}\n", at(rings - 1, k), at(rings - 1, k + 1));
+    }
+    std::fs::write(&input, text).unwrap();
+    let run = meshtrim(&["clean", s(&input), s(&out)], None);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(stdout.contains("0 removed, 0 new"), "{stdout}");
+    assert!(stdout.contains("none (no new faces)"), "{stdout}");
+}

@@ -147,7 +147,8 @@ pub struct CleanReport {
     pub area_in: f64,
     /// Area of the output.
     pub area_out: f64,
-    /// Smallest angle of the new faces, in degrees.
+    /// Smallest angle of the new faces, in degrees; 0 when no face was
+    /// added (`faces_added` is 0).
     pub min_angle_new: f64,
 }
 
