@@ -135,22 +135,29 @@ def mesh_area(vertices, faces):
     return 0.5 * float(np.linalg.norm(np.cross(a, b), axis=1).sum())
 
 
+def poisson_trimmed(points, cloud, tmp_path, *options):
+    """PyMeshLab's screened-Poisson mesh of ``points`` (depth 8), trimmed
+    by meshtrim with ``cloud`` and ``options``: the Poisson faces, and the
+    output's vertices and faces."""
+    v, f, _ = poisson.reconstruct(points, depth=8)
+    mesh_path = tmp_path / "poisson.ply"
+    out_path = tmp_path / "trimmed.ply"
+    synthetic.write_mesh_ply(mesh_path, v, f)
+    run_meshtrim("trim", mesh_path, cloud, out_path, *options)
+    ov, of = synthetic.read_ply(out_path)
+    return f, np.stack([ov["x"], ov["y"], ov["z"]], axis=1), of
+
+
 def test_bunny_base_holes(tmp_path):
     bunny = shared_data("stanford_bunny/bun_zipper.ply")
     verts, scan_faces = synthetic.read_ply(bunny)
     pts = np.stack([verts["x"], verts["y"], verts["z"]], axis=1)
-    v, f, _ = poisson.reconstruct(pts, depth=8)
-    mesh_path = tmp_path / "bunny_poisson.ply"
-    out_path = tmp_path / "bunny_trimmed.ply"
-    synthetic.write_mesh_ply(mesh_path, v, f)
-    run_meshtrim(mesh_path, bunny, out_path)
-    ov, of = synthetic.read_ply(out_path)
-    out_v = np.stack([ov["x"], ov["y"], ov["z"]], axis=1)
+    f, out_v, of = poisson_trimmed(pts, bunny, tmp_path)
     assert len(poisson.boundary_loops(of)) > len(poisson.boundary_loops(f))
     # Within 1.5 local spacings of the cloud (measured 1.24): no envelope
     # is left. The bound is local because the base is sampled about twice
     # as sparsely as the median; in median spacings the cut through a base
-    # gap lies 1.95-2.13 away (docs/results.md, "Range scans").
+    # gap lies 1.95-2.13 away (docs/edges.md, "Gap fillers").
     assert poisson.max_distance_in_local_spacings(out_v, pts) <= 1.5
     assert poisson.is_edge_manifold(of)
     # The rest of the scanned surface stays: the zippered mesh's own area
@@ -172,13 +179,7 @@ def test_range_scan_trimmed_along_the_line_of_sight(tmp_path):
     run_meshtrim("detect", milk, "-o", points_path)
     verts, _ = synthetic.read_ply(points_path)
     pts = np.stack([verts["x"], verts["y"], verts["z"]], axis=1)
-    v, f, _ = poisson.reconstruct(pts, depth=8)
-    mesh_path = tmp_path / "milk_poisson.ply"
-    out_path = tmp_path / "milk_trimmed.ply"
-    synthetic.write_mesh_ply(mesh_path, v, f)
-    run_meshtrim("trim", mesh_path, milk, out_path, "--view-from", "0,0,0")
-    ov, of = synthetic.read_ply(out_path)
-    out_v = np.stack([ov["x"], ov["y"], ov["z"]], axis=1)
+    _, out_v, of = poisson_trimmed(pts, milk, tmp_path, "--view-from", "0,0,0")
     assert poisson.max_distance_in_local_spacings(out_v, pts) <= 4.0
     # The carton's faces stay: 0.0468 m² of the envelope's 0.1118 (measured).
     kept = mesh_area(out_v, np.asarray(of))
