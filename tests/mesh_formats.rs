@@ -361,6 +361,28 @@ fn gltf_errors() {
     assert!(error(&path).contains("malformed glTF"));
 }
 
+/// `"uri": ""` in a `.gltf` names no buffer. It used to be joined to the
+/// file's directory and read: `cannot read '…/': not a regular file`, or
+/// `cannot read '': No such file or directory` for a file in the current
+/// directory, which hid that the URI was empty.
+#[test]
+fn gltf_buffer_with_an_empty_uri() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = transformed_gltf(4);
+    let uri_start = text.find("data:").unwrap();
+    let uri_end = uri_start + text[uri_start..].find('"').unwrap();
+    let path = dir.path().join("empty-uri.gltf");
+    std::fs::write(&path, format!("{}{}", &text[..uri_start], &text[uri_end..])).unwrap();
+    let e = error(&path);
+    assert!(
+        e.ends_with(
+            "buffer 0 has an empty URI: it needs the name of a file beside the document or a \
+             base64 data: URI"
+        ),
+        "{e}"
+    );
+}
+
 /// Lines ended by a lone carriage return (classic Mac OS, Excel for Mac's
 /// "CSV (Macintosh)") read like lines ended by a newline. They used to read
 /// as one long line: an OBJ mesh became one vertex and no faces, a text

@@ -131,6 +131,12 @@ fn load_buffers<'a>(gltf: &'a gltf::Gltf, dir: &Path) -> Result<Vec<Cow<'a, [u8]
             gltf::buffer::Source::Bin => Cow::Borrowed(gltf.blob.as_deref().ok_or_else(|| {
                 anyhow!("buffer {i} refers to a GLB binary chunk, and there is none")
             })?),
+            // An empty relative reference names the document itself (here
+            // its directory), which is never the buffer: say what is wrong.
+            gltf::buffer::Source::Uri("") => bail!(
+                "buffer {i} has an empty URI: it needs the name of a file beside the \
+                 document or a base64 data: URI"
+            ),
             gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
                 Cow::Owned(decode_data_uri(uri).with_context(|| format!("buffer {i}"))?)
             }
