@@ -361,6 +361,82 @@ fn gltf_errors() {
     assert!(error(&path).contains("malformed glTF"));
 }
 
+/// A `.gltf` whose one mesh, `vertices` positions with `indices` u8
+/// indices (cycling 0, 1, 2) or none, is placed by `nodes` nodes.
+fn instanced_gltf(vertices: usize, indices: Option<usize>, nodes: usize) -> String {
+    let mut bin: Vec<u8> = (0..vertices)
+        .flat_map(|i| [i as f32, 0.0, 0.0])
+        .flat_map(f32::to_le_bytes)
+        .collect();
+    let positions_len = bin.len();
+    bin.extend((0..indices.unwrap_or(0)).map(|i| (i % 3) as u8));
+    let (indices_key, index_accessor, index_view) = match indices {
+        Some(n) => (
+            r#", "indices": 1"#.to_string(),
+            format!(
+                r#", {{"bufferView": 1, "componentType": 5121, "count": {n}, "type": "SCALAR"}}"#
+            ),
+            format!(r#", {{"buffer": 0, "byteOffset": {positions_len}, "byteLength": {n}}}"#),
+        ),
+        None => (String::new(), String::new(), String::new()),
+    };
+    let data = base64::engine::general_purpose::STANDARD.encode(&bin);
+    format!(
+        r#"{{
+  "asset": {{"version": "2.0"}},
+  "nodes": [{nodes}],
+  "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}{indices_key}}}]}}],
+  "accessors": [
+    {{"bufferView": 0, "componentType": 5126, "count": {vertices}, "type": "VEC3",
+     "min": [0, 0, 0], "max": [{last}, 0, 0]}}{index_accessor}
+  ],
+  "bufferViews": [
+    {{"buffer": 0, "byteOffset": 0, "byteLength": {positions_len}}}{index_view}
+  ],
+  "buffers": [{{"byteLength": {len}, "uri": "data:application/octet-stream;base64,{data}"}}]
+}}"#,
+        nodes = vec![r#"{"mesh": 0}"#; nodes].join(", "),
+        last = vertices - 1,
+        len = bin.len(),
+    )
+}
+
+/// Every node that uses a mesh gets its own copy of the mesh's vertices,
+/// so a file of a few hundred kilobytes could ask for gigabytes: 10,002
+/// nodes each placing one 9,999-vertex accessor made 100 million vertices
+/// (2.4 GB), and 10,001 nodes each placing 20,000 triangles of one-byte
+/// indices 200 million triangles, allocated as they were read. The totals
+/// are now counted first and refused above the documented limits.
+#[test]
+fn gltf_instancing_beyond_the_limit_is_refused_before_allocating() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("instances.gltf");
+    std::fs::write(&path, instanced_gltf(9_999, None, 3)).unwrap();
+    assert_eq!(read_mesh(&path).unwrap().vertices.len(), 3 * 9_999);
+
+    std::fs::write(&path, instanced_gltf(9_999, None, 10_002)).unwrap();
+    let e = error(&path);
+    assert!(
+        e.ends_with(
+            "the 10002 nodes that use meshes would make 100009998 vertices (the file stores \
+             9999), more than the limit of 100000000 (2.4 GB in memory) for instanced meshes; \
+             use fewer nodes per mesh, or save the scene flattened (a copy per instance) as PLY \
+             or OBJ, which have no such limit"
+        ),
+        "{e}"
+    );
+
+    std::fs::write(&path, instanced_gltf(3, Some(60_000), 10_001)).unwrap();
+    let e = error(&path);
+    assert!(
+        e.contains(
+            "the 10001 nodes that use meshes would make 200020000 triangles (the file stores \
+             20000), more than the limit of 200000000 (2.4 GB in memory)"
+        ),
+        "{e}"
+    );
+}
+
 /// `"uri": ""` in a `.gltf` names no buffer. It used to be joined to the
 /// file's directory and read: `cannot read '…/': not a regular file`, or
 /// `cannot read '': No such file or directory` for a file in the current
