@@ -459,6 +459,31 @@ fn gltf_buffer_with_an_empty_uri() {
     );
 }
 
+/// A glTF whose meshes no node uses, or with no meshes at all, has nothing
+/// to read; both used to say `no vertices in the file`, which read like a
+/// mesh without vertices.
+#[test]
+fn gltf_without_mesh_instances_says_why() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("unused.gltf");
+    let unused =
+        instanced_gltf(3, None, 1).replace(r#""nodes": [{"mesh": 0}]"#, r#""nodes": [{}]"#);
+    std::fs::write(&path, unused).unwrap();
+    let e = error(&path);
+    assert!(
+        e.ends_with(
+            "no node uses a mesh (the file has 1 mesh): glTF places a mesh only through a node \
+             that uses it, and meshes that no node uses are not read"
+        ),
+        "{e}"
+    );
+    assert!(format!("{:#}", read_cloud(&path).unwrap_err()).ends_with("are not read"));
+
+    let path = dir.path().join("empty.gltf");
+    std::fs::write(&path, r#"{"asset": {"version": "2.0"}}"#).unwrap();
+    assert!(error(&path).ends_with("the file has no meshes"));
+}
+
 /// Lines ended by a lone carriage return (classic Mac OS, Excel for Mac's
 /// "CSV (Macintosh)") read like lines ended by a newline. They used to read
 /// as one long line: an OBJ mesh became one vertex and no faces, a text

@@ -52,6 +52,9 @@ pub fn read_gltf(bytes: &[u8], dir: &Path) -> Result<Mesh> {
     let gltf = parse(bytes)?;
     let buffers = load_buffers(&gltf, dir)?;
     let instances = instances(&gltf.document)?;
+    if instances.is_empty() {
+        return Err(no_instances(gltf.document.meshes().len()));
+    }
     check_expansion(&instances, &buffers)?;
     let mut mesh = Mesh {
         faces: Some(Vec::new()),
@@ -77,6 +80,22 @@ pub fn read_gltf(bytes: &[u8], dir: &Path) -> Result<Mesh> {
         }
     }
     Ok(mesh)
+}
+
+/// Why a file without mesh instances has no vertices. Meshes that no node
+/// uses are not read: a mesh has no place of its own (its positions are
+/// in the frame of the node that uses it), and files keep unused meshes
+/// as spares, so reading them where they stand could add geometry that is
+/// in no scene.
+fn no_instances(meshes: usize) -> anyhow::Error {
+    match meshes {
+        0 => anyhow!("the file has no meshes"),
+        n => anyhow!(
+            "no node uses a mesh (the file has {n} mesh{}): glTF places a mesh only \
+             through a node that uses it, and meshes that no node uses are not read",
+            if n == 1 { "" } else { "es" }
+        ),
+    }
 }
 
 /// A node that places a mesh, and its world matrix.
