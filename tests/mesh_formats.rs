@@ -484,6 +484,72 @@ fn gltf_without_mesh_instances_says_why() {
     assert!(error(&path).ends_with("the file has no meshes"));
 }
 
+/// PLY and PCD headers whose lines end with a lone carriage return
+/// (classic Mac OS) used to fail: `no 'end_header' line`, `no DATA line`,
+/// and a PLY under another extension was not recognised at all. Binary
+/// data follows a header and may start with a `\n` byte (here the first
+/// byte of x), which must not be taken for the end of a `\r\n`.
+#[test]
+fn ply_and_pcd_headers_with_lone_carriage_returns() {
+    let dir = tempfile::tempdir().unwrap();
+    let read = |name: &str, bytes: &[u8]| {
+        let path = dir.path().join(name);
+        std::fs::write(&path, bytes).unwrap();
+        read_cloud(&path)
+    };
+    // x's little-endian bytes start with 0x0a, a '\n'.
+    let x = f32::from_bits(0x3f80_000a);
+    let points = [[f64::from(x), 2.0, 3.0], [4.0, 5.0, 6.0], [7.0, 8.0, 0.5]];
+    let ply_header = |format: &str| {
+        format!(
+            "ply\nformat {format} 1.0\ncomment lone CR\nelement vertex 3\nproperty float x\n\
+             property float y\nproperty float z\nend_header\n"
+        )
+    };
+    let pcd_header = |data: &str| {
+        format!(
+            "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n\
+             WIDTH 3\nHEIGHT 1\nPOINTS 3\nDATA {data}\n"
+        )
+    };
+    let ascii: String = points
+        .iter()
+        .map(|p| format!("{} {} {}\n", p[0], p[1], p[2]))
+        .collect();
+    let binary: Vec<u8> = points
+        .iter()
+        .flatten()
+        .flat_map(|&c| (c as f32).to_le_bytes())
+        .collect();
+    assert_eq!(binary[0], b'\n');
+    for (eol, tag) in [("\n", "lf"), ("\r\n", "crlf"), ("\r", "cr")] {
+        // ASCII bodies end their lines alike; binary bodies are bytes.
+        let text = ascii.replace('\n', eol).into_bytes();
+        let files = [
+            ("ply", ply_header("ascii"), &text),
+            ("ply", ply_header("binary_little_endian"), &binary),
+            ("pcd", pcd_header("ascii"), &text),
+            ("pcd", pcd_header("binary"), &binary),
+        ];
+        for (i, (ext, header, body)) in files.into_iter().enumerate() {
+            let mut bytes = header.replace('\n', eol).into_bytes();
+            bytes.extend(body);
+            // A .dat name: the format is recognised by content.
+            let cloud = read(&format!("{tag}_{i}.dat"), &bytes);
+            let cloud = cloud.unwrap_or_else(|e| panic!("{tag} {i}: {e:#}"));
+            assert_eq!(cloud.format.name(), ext, "{tag} {i}");
+            assert_eq!(cloud.points, points, "{tag} {i}");
+        }
+    }
+    // Line numbers count lone carriage returns, in the header and after.
+    let bad = ply_header("ascii").replace('\n', "\r") + "1 2 3\r4 x 6\r7 8 9\r";
+    let e = format!("{:#}", read("bad.ply", bad.as_bytes()).unwrap_err());
+    assert!(e.ends_with("line 10: 'x' is not a number"), "{e}");
+    let bad = pcd_header("ascii").replace('\n', "\r") + "1 2 3\r4 x 6\r7 8 9\r";
+    let e = format!("{:#}", read("bad.pcd", bad.as_bytes()).unwrap_err());
+    assert!(e.ends_with("line 12: 'x' is not a number"), "{e}");
+}
+
 /// Lines ended by a lone carriage return (classic Mac OS, Excel for Mac's
 /// "CSV (Macintosh)") read like lines ended by a newline. They used to read
 /// as one long line: an OBJ mesh became one vertex and no faces, a text
