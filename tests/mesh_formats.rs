@@ -550,6 +550,31 @@ fn ply_and_pcd_headers_with_lone_carriage_returns() {
     assert!(e.ends_with("line 12: 'x' is not a number"), "{e}");
 }
 
+/// A PLY or PCD header whose first line ends with `\n` and a later one
+/// with a lone `\r` ran that line into the next: a PCD `FIELDS` line took
+/// the `SIZE` and `TYPE` lines' words for 11 field names and failed on the
+/// data (`line 7: expected 11 values, found 3`). The header line is now
+/// named. A lone `\r` in a comment is left alone.
+#[test]
+fn ply_and_pcd_headers_with_mixed_line_endings() {
+    let dir = tempfile::tempdir().unwrap();
+    let message = "a lone carriage return inside the line: every header line must end as the \
+                   first does, and the first ends with a newline";
+    let pcd = "VERSION .7\n# a\rcomment\nFIELDS x y z\rSIZE 4 4 4\rTYPE F F F\nWIDTH 1\n\
+               HEIGHT 1\nDATA ascii\n1 2 3\n";
+    let ply = "ply\r\nformat ascii 1.0\r\ncomment a\rcomment\r\nelement vertex 1\r\
+               property float x\r\nproperty float y\r\nproperty float z\r\nend_header\r\n1 2 3\r\n";
+    for (name, text, line) in [("mixed.pcd", pcd, 3), ("mixed.ply", ply, 4)] {
+        let path = dir.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        let e = format!("{:#}", read_cloud(&path).unwrap_err());
+        assert!(
+            e.ends_with(&format!("header: line {line}: {message}")),
+            "{e}"
+        );
+    }
+}
+
 /// Lines ended by a lone carriage return (classic Mac OS, Excel for Mac's
 /// "CSV (Macintosh)") read like lines ended by a newline. They used to read
 /// as one long line: an OBJ mesh became one vertex and no faces, a text

@@ -419,6 +419,18 @@ impl HeaderEol {
     }
 }
 
+/// Whether a PLY or PCD header line holds a `\r` that ends no line: the
+/// header's first line ended with `\n`, so a later line ended by a lone
+/// `\r` ran into the next one, which would be misread (a PCD `FIELDS`
+/// line taking the `SIZE` line's words for field names).
+pub(crate) fn mixed_line_ending(line: &str) -> Option<String> {
+    line.trim_end_matches('\r').contains('\r').then(|| {
+        "a lone carriage return inside the line: every header line must end as the \
+         first does, and the first ends with a newline"
+            .to_string()
+    })
+}
+
 /// Formats a point for messages, keeping NaN and inf readable.
 pub(crate) fn show(p: &Point3) -> String {
     format!("({}, {}, {})", p[0], p[1], p[2])

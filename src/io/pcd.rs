@@ -15,7 +15,9 @@
 
 use anyhow::{anyhow, bail, Result};
 
-use super::{capacity, lines, strip_bom, truncated, Cloud, Format, HeaderEol, Point3};
+use super::{
+    capacity, lines, mixed_line_ending, strip_bom, truncated, Cloud, Format, HeaderEol, Point3,
+};
 
 /// One field of a PCD point.
 #[derive(Debug, Clone, PartialEq)]
@@ -127,6 +129,9 @@ fn parse_header(bytes: &[u8]) -> Result<Header> {
         let Some((key, values)) = words.split_first() else {
             continue;
         };
+        if let Some(e) = mixed_line_ending(&line).filter(|_| !key.starts_with('#')) {
+            return Err(at(e));
+        }
         match *key {
             k if k.starts_with('#') => {}
             "VERSION" | "VIEWPOINT" => {}

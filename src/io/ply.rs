@@ -37,7 +37,9 @@ use std::io::Write;
 use anyhow::{anyhow, bail, Result};
 use byteorder::{BigEndian, ByteOrder, LittleEndian, WriteBytesExt};
 
-use super::{capacity, lines, show, strip_bom, truncated, HeaderEol, Mesh, Point3};
+use super::{
+    capacity, lines, mixed_line_ending, show, strip_bom, truncated, HeaderEol, Mesh, Point3,
+};
 
 /// A PLY scalar type.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -198,6 +200,10 @@ fn parse_header(bytes: &[u8]) -> Result<Header> {
         lines = i + 1;
         let at = |what: String| anyhow!("malformed PLY header: line {}: {what}", i + 1);
         let words: Vec<&str> = line.split_whitespace().collect();
+        let comment = matches!(words.first(), Some(&("comment" | "obj_info")));
+        if let Some(e) = mixed_line_ending(line).filter(|_| !comment) {
+            return Err(at(e));
+        }
         match words.as_slice() {
             ["ply"] if i == 0 => {}
             _ if i == 0 => return Err(at("the file does not start with 'ply'".into())),
