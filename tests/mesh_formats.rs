@@ -361,6 +361,220 @@ fn gltf_errors() {
     assert!(error(&path).contains("malformed glTF"));
 }
 
+/// A `.gltf` whose one mesh, `vertices` positions with `indices` u8
+/// indices (cycling 0, 1, 2) or none, is placed by `nodes` nodes.
+fn instanced_gltf(vertices: usize, indices: Option<usize>, nodes: usize) -> String {
+    let mut bin: Vec<u8> = (0..vertices)
+        .flat_map(|i| [i as f32, 0.0, 0.0])
+        .flat_map(f32::to_le_bytes)
+        .collect();
+    let positions_len = bin.len();
+    bin.extend((0..indices.unwrap_or(0)).map(|i| (i % 3) as u8));
+    let (indices_key, index_accessor, index_view) = match indices {
+        Some(n) => (
+            r#", "indices": 1"#.to_string(),
+            format!(
+                r#", {{"bufferView": 1, "componentType": 5121, "count": {n}, "type": "SCALAR"}}"#
+            ),
+            format!(r#", {{"buffer": 0, "byteOffset": {positions_len}, "byteLength": {n}}}"#),
+        ),
+        None => (String::new(), String::new(), String::new()),
+    };
+    let data = base64::engine::general_purpose::STANDARD.encode(&bin);
+    format!(
+        r#"{{
+  "asset": {{"version": "2.0"}},
+  "nodes": [{nodes}],
+  "meshes": [{{"primitives": [{{"attributes": {{"POSITION": 0}}{indices_key}}}]}}],
+  "accessors": [
+    {{"bufferView": 0, "componentType": 5126, "count": {vertices}, "type": "VEC3",
+     "min": [0, 0, 0], "max": [{last}, 0, 0]}}{index_accessor}
+  ],
+  "bufferViews": [
+    {{"buffer": 0, "byteOffset": 0, "byteLength": {positions_len}}}{index_view}
+  ],
+  "buffers": [{{"byteLength": {len}, "uri": "data:application/octet-stream;base64,{data}"}}]
+}}"#,
+        nodes = vec![r#"{"mesh": 0}"#; nodes].join(", "),
+        last = vertices - 1,
+        len = bin.len(),
+    )
+}
+
+/// Every node that uses a mesh gets its own copy of the mesh's vertices,
+/// so a file of a few hundred kilobytes could ask for gigabytes: 10,002
+/// nodes each placing one 9,999-vertex accessor made 100 million vertices
+/// (2.4 GB), and 10,001 nodes each placing 20,000 triangles of one-byte
+/// indices 200 million triangles, allocated as they were read. The totals
+/// are now counted first and refused above the documented limits.
+#[test]
+fn gltf_instancing_beyond_the_limit_is_refused_before_allocating() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("instances.gltf");
+    std::fs::write(&path, instanced_gltf(9_999, None, 3)).unwrap();
+    assert_eq!(read_mesh(&path).unwrap().vertices.len(), 3 * 9_999);
+
+    std::fs::write(&path, instanced_gltf(9_999, None, 10_002)).unwrap();
+    let e = error(&path);
+    assert!(
+        e.ends_with(
+            "the 10002 nodes that use meshes would make 100009998 vertices (the file stores \
+             9999), more than the limit of 100000000 (2.4 GB in memory) for instanced meshes; \
+             use fewer nodes per mesh, or save the scene flattened (a copy per instance) as PLY \
+             or OBJ, which have no such limit"
+        ),
+        "{e}"
+    );
+
+    std::fs::write(&path, instanced_gltf(3, Some(60_000), 10_001)).unwrap();
+    let e = error(&path);
+    assert!(
+        e.contains(
+            "the 10001 nodes that use meshes would make 200020000 triangles (the file stores \
+             20000), more than the limit of 200000000 (2.4 GB in memory)"
+        ),
+        "{e}"
+    );
+}
+
+/// `"uri": ""` in a `.gltf` names no buffer. It used to be joined to the
+/// file's directory and read: `cannot read '…/': not a regular file`, or
+/// `cannot read '': No such file or directory` for a file in the current
+/// directory, which hid that the URI was empty.
+#[test]
+fn gltf_buffer_with_an_empty_uri() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = transformed_gltf(4);
+    let uri_start = text.find("data:").unwrap();
+    let uri_end = uri_start + text[uri_start..].find('"').unwrap();
+    let path = dir.path().join("empty-uri.gltf");
+    std::fs::write(&path, format!("{}{}", &text[..uri_start], &text[uri_end..])).unwrap();
+    let e = error(&path);
+    assert!(
+        e.ends_with(
+            "buffer 0 has an empty URI: it needs the name of a file beside the document or a \
+             base64 data: URI"
+        ),
+        "{e}"
+    );
+}
+
+/// A glTF whose meshes no node uses, or with no meshes at all, has nothing
+/// to read; both used to say `no vertices in the file`, which read like a
+/// mesh without vertices.
+#[test]
+fn gltf_without_mesh_instances_says_why() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("unused.gltf");
+    let unused =
+        instanced_gltf(3, None, 1).replace(r#""nodes": [{"mesh": 0}]"#, r#""nodes": [{}]"#);
+    std::fs::write(&path, unused).unwrap();
+    let e = error(&path);
+    assert!(
+        e.ends_with(
+            "no node uses a mesh (the file has 1 mesh): glTF places a mesh only through a node \
+             that uses it, and meshes that no node uses are not read"
+        ),
+        "{e}"
+    );
+    assert!(format!("{:#}", read_cloud(&path).unwrap_err()).ends_with("are not read"));
+
+    let path = dir.path().join("empty.gltf");
+    std::fs::write(&path, r#"{"asset": {"version": "2.0"}}"#).unwrap();
+    assert!(error(&path).ends_with("the file has no meshes"));
+}
+
+/// PLY and PCD headers whose lines end with a lone carriage return
+/// (classic Mac OS) used to fail: `no 'end_header' line`, `no DATA line`,
+/// and a PLY under another extension was not recognised at all. Binary
+/// data follows a header and may start with a `\n` byte (here the first
+/// byte of x), which must not be taken for the end of a `\r\n`.
+#[test]
+fn ply_and_pcd_headers_with_lone_carriage_returns() {
+    let dir = tempfile::tempdir().unwrap();
+    let read = |name: &str, bytes: &[u8]| {
+        let path = dir.path().join(name);
+        std::fs::write(&path, bytes).unwrap();
+        read_cloud(&path)
+    };
+    // x's little-endian bytes start with 0x0a, a '\n'.
+    let x = f32::from_bits(0x3f80_000a);
+    let points = [[f64::from(x), 2.0, 3.0], [4.0, 5.0, 6.0], [7.0, 8.0, 0.5]];
+    let ply_header = |format: &str| {
+        format!(
+            "ply\nformat {format} 1.0\ncomment lone CR\nelement vertex 3\nproperty float x\n\
+             property float y\nproperty float z\nend_header\n"
+        )
+    };
+    let pcd_header = |data: &str| {
+        format!(
+            "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n\
+             WIDTH 3\nHEIGHT 1\nPOINTS 3\nDATA {data}\n"
+        )
+    };
+    let ascii: String = points
+        .iter()
+        .map(|p| format!("{} {} {}\n", p[0], p[1], p[2]))
+        .collect();
+    let binary: Vec<u8> = points
+        .iter()
+        .flatten()
+        .flat_map(|&c| (c as f32).to_le_bytes())
+        .collect();
+    assert_eq!(binary[0], b'\n');
+    for (eol, tag) in [("\n", "lf"), ("\r\n", "crlf"), ("\r", "cr")] {
+        // ASCII bodies end their lines alike; binary bodies are bytes.
+        let text = ascii.replace('\n', eol).into_bytes();
+        let files = [
+            ("ply", ply_header("ascii"), &text),
+            ("ply", ply_header("binary_little_endian"), &binary),
+            ("pcd", pcd_header("ascii"), &text),
+            ("pcd", pcd_header("binary"), &binary),
+        ];
+        for (i, (ext, header, body)) in files.into_iter().enumerate() {
+            let mut bytes = header.replace('\n', eol).into_bytes();
+            bytes.extend(body);
+            // A .dat name: the format is recognised by content.
+            let cloud = read(&format!("{tag}_{i}.dat"), &bytes);
+            let cloud = cloud.unwrap_or_else(|e| panic!("{tag} {i}: {e:#}"));
+            assert_eq!(cloud.format.name(), ext, "{tag} {i}");
+            assert_eq!(cloud.points, points, "{tag} {i}");
+        }
+    }
+    // Line numbers count lone carriage returns, in the header and after.
+    let bad = ply_header("ascii").replace('\n', "\r") + "1 2 3\r4 x 6\r7 8 9\r";
+    let e = format!("{:#}", read("bad.ply", bad.as_bytes()).unwrap_err());
+    assert!(e.ends_with("line 10: 'x' is not a number"), "{e}");
+    let bad = pcd_header("ascii").replace('\n', "\r") + "1 2 3\r4 x 6\r7 8 9\r";
+    let e = format!("{:#}", read("bad.pcd", bad.as_bytes()).unwrap_err());
+    assert!(e.ends_with("line 12: 'x' is not a number"), "{e}");
+}
+
+/// A PLY or PCD header whose first line ends with `\n` and a later one
+/// with a lone `\r` ran that line into the next: a PCD `FIELDS` line took
+/// the `SIZE` and `TYPE` lines' words for 11 field names and failed on the
+/// data (`line 7: expected 11 values, found 3`). The header line is now
+/// named. A lone `\r` in a comment is left alone.
+#[test]
+fn ply_and_pcd_headers_with_mixed_line_endings() {
+    let dir = tempfile::tempdir().unwrap();
+    let message = "a lone carriage return inside the line: every header line must end as the \
+                   first does, and the first ends with a newline";
+    let pcd = "VERSION .7\n# a\rcomment\nFIELDS x y z\rSIZE 4 4 4\rTYPE F F F\nWIDTH 1\n\
+               HEIGHT 1\nDATA ascii\n1 2 3\n";
+    let ply = "ply\r\nformat ascii 1.0\r\ncomment a\rcomment\r\nelement vertex 1\r\
+               property float x\r\nproperty float y\r\nproperty float z\r\nend_header\r\n1 2 3\r\n";
+    for (name, text, line) in [("mixed.pcd", pcd, 3), ("mixed.ply", ply, 4)] {
+        let path = dir.path().join(name);
+        std::fs::write(&path, text).unwrap();
+        let e = format!("{:#}", read_cloud(&path).unwrap_err());
+        assert!(
+            e.ends_with(&format!("header: line {line}: {message}")),
+            "{e}"
+        );
+    }
+}
+
 /// Lines ended by a lone carriage return (classic Mac OS, Excel for Mac's
 /// "CSV (Macintosh)") read like lines ended by a newline. They used to read
 /// as one long line: an OBJ mesh became one vertex and no faces, a text

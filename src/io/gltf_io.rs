@@ -14,11 +14,15 @@
 //! the output keeps counter-clockwise front faces. Buffers may be the GLB
 //! binary chunk, `data:` URIs (base64) or files beside the `.gltf`.
 //! Sparse accessors, quantised positions and Draco compression are not read.
+//! Instances are counted before they are read, and a file whose instances
+//! would make more than [`MAX_INSTANCED_VERTICES`] or
+//! [`MAX_INSTANCED_TRIANGLES`] (beyond what it stores) is refused.
 //!
 //! Writing: one mesh with one primitive, `f32` positions with the `min` and
 //! `max` bounds the spec requires, and `u32` indices.
 
 use std::borrow::Cow;
+use std::collections::HashSet;
 use std::io::Write;
 use std::path::Path;
 
@@ -47,9 +51,64 @@ pub fn looks_like_json(bytes: &[u8]) -> bool {
 pub fn read_gltf(bytes: &[u8], dir: &Path) -> Result<Mesh> {
     let gltf = parse(bytes)?;
     let buffers = load_buffers(&gltf, dir)?;
-    let document = &gltf.document;
+    let instances = instances(&gltf.document)?;
+    if instances.is_empty() {
+        return Err(no_instances(gltf.document.meshes().len()));
+    }
+    check_expansion(&instances, &buffers)?;
+    let mut mesh = Mesh {
+        faces: Some(Vec::new()),
+        ..Mesh::default()
+    };
+    for Instance {
+        node,
+        mesh: m,
+        world,
+    } in &instances
+    {
+        for primitive in m.primitives() {
+            let at = || {
+                format!(
+                    "node {}, mesh {}{}, primitive {}",
+                    node.index(),
+                    m.index(),
+                    m.name().map(|n| format!(" '{n}'")).unwrap_or_default(),
+                    primitive.index()
+                )
+            };
+            add_primitive(&primitive, &buffers, world, &mut mesh).with_context(at)?;
+        }
+    }
+    Ok(mesh)
+}
 
-    // World matrices: walk down from the nodes that are nobody's child.
+/// Why a file without mesh instances has no vertices. Meshes that no node
+/// uses are not read: a mesh has no place of its own (its positions are
+/// in the frame of the node that uses it), and files keep unused meshes
+/// as spares, so reading them where they stand could add geometry that is
+/// in no scene.
+fn no_instances(meshes: usize) -> anyhow::Error {
+    match meshes {
+        0 => anyhow!("the file has no meshes"),
+        n => anyhow!(
+            "no node uses a mesh (the file has {n} mesh{}): glTF places a mesh only \
+             through a node that uses it, and meshes that no node uses are not read",
+            if n == 1 { "" } else { "es" }
+        ),
+    }
+}
+
+/// A node that places a mesh, and its world matrix.
+struct Instance<'a> {
+    node: gltf::Node<'a>,
+    mesh: gltf::Mesh<'a>,
+    world: Matrix,
+}
+
+/// The nodes that have a mesh, in depth-first order from the nodes that
+/// are nobody's child, with their world matrices. A node with two parents
+/// or in a cycle is an error.
+fn instances(document: &gltf::Document) -> Result<Vec<Instance<'_>>> {
     let nodes = document.nodes().len();
     let mut has_parent = vec![false; nodes];
     for node in document.nodes() {
@@ -64,38 +123,138 @@ pub fn read_gltf(bytes: &[u8], dir: &Path) -> Result<Mesh> {
         .map(|n| (n, IDENTITY))
         .collect();
     stack.reverse();
-    let mut mesh = Mesh {
-        faces: Some(Vec::new()),
-        ..Mesh::default()
-    };
+    let mut out = Vec::new();
     while let Some((node, parent)) = stack.pop() {
         if std::mem::replace(&mut visited[node.index()], true) {
             bail!("node {} is reached twice: it has two parents", node.index());
         }
         let world = multiply(&parent, &local_matrix(&node));
-        if let Some(m) = node.mesh() {
-            for primitive in m.primitives() {
-                let at = || {
-                    format!(
-                        "node {}, mesh {}{}, primitive {}",
-                        node.index(),
-                        m.index(),
-                        m.name().map(|n| format!(" '{n}'")).unwrap_or_default(),
-                        primitive.index()
-                    )
-                };
-                add_primitive(&primitive, &buffers, &world, &mut mesh).with_context(at)?;
-            }
-        }
         let children: Vec<_> = node.children().collect();
         for child in children.into_iter().rev() {
             stack.push((child, world));
+        }
+        if let Some(mesh) = node.mesh() {
+            out.push(Instance { node, mesh, world });
         }
     }
     if let Some(n) = visited.iter().position(|v| !v) {
         bail!("node {n} is in a cycle of the node hierarchy");
     }
-    Ok(mesh)
+    Ok(out)
+}
+
+/// Most vertices that instancing may make: 100 million, 2.4 GB as the
+/// `f64` x, y, z the reader returns. Every node that uses a mesh gets its
+/// own copy of the mesh's vertices, so a file of a few megabytes (one
+/// large accessor, thousands of nodes) could otherwise ask for tens of
+/// gigabytes. A file that stores more vertices itself is still read whole,
+/// as a PLY of that size would be: then the memory follows the file size.
+pub const MAX_INSTANCED_VERTICES: usize = 100_000_000;
+
+/// Most triangles that instancing may make: 200 million (a closed mesh has
+/// about twice as many triangles as vertices), 2.4 GB as `u32` corners.
+/// The same rule as [`MAX_INSTANCED_VERTICES`]; it matters on its own
+/// because a `u8` index takes one byte in the file and four in memory.
+pub const MAX_INSTANCED_TRIANGLES: usize = 200_000_000;
+
+/// Refuses a file whose instances would make more vertices or triangles
+/// than [`MAX_INSTANCED_VERTICES`] and [`MAX_INSTANCED_TRIANGLES`] allow,
+/// before anything is allocated for them. Only accessors whose data lies
+/// in their buffer count, so the totals are backed by real bytes; a broken
+/// accessor gets its own error when its primitive is read.
+fn check_expansion(instances: &[Instance], buffers: &[Cow<[u8]>]) -> Result<()> {
+    let mut e = Expansion::default();
+    for instance in instances {
+        for primitive in instance.mesh.primitives() {
+            if let Some(counts) = primitive_counts(&primitive, buffers) {
+                e.add(&counts);
+            }
+        }
+    }
+    let limits = [
+        (
+            "vertices",
+            e.made[0],
+            e.stored[0],
+            MAX_INSTANCED_VERTICES,
+            24,
+        ),
+        (
+            "triangles",
+            e.made[1] / 3,
+            e.stored[1] / 3,
+            MAX_INSTANCED_TRIANGLES,
+            12,
+        ),
+    ];
+    for (what, made, stored, cap, bytes) in limits {
+        if made > cap.max(stored) {
+            bail!(
+                "the {} nodes that use meshes would make {made} {what} (the file stores \
+                 {stored}), more than the limit of {cap} ({:.1} GB in memory) for instanced \
+                 meshes; use fewer nodes per mesh, or save the scene flattened (a copy per \
+                 instance) as PLY or OBJ, which have no such limit",
+                instances.len(),
+                (cap * bytes) as f64 / 1e9
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Vertices and triangle corners: those the instances make, and those
+/// the file stores (each accessor once).
+#[derive(Default)]
+struct Expansion {
+    made: [usize; 2],
+    stored: [usize; 2],
+    seen_positions: HashSet<usize>,
+    seen_corners: HashSet<(usize, Option<usize>)>,
+}
+
+impl Expansion {
+    fn add(&mut self, c: &PrimitiveCounts) {
+        let add = |total: &mut usize, n: usize| *total = total.saturating_add(n);
+        add(&mut self.made[0], c.vertices);
+        add(&mut self.made[1], c.corners);
+        if self.seen_positions.insert(c.positions) {
+            add(&mut self.stored[0], c.vertices);
+        }
+        if self.seen_corners.insert(c.corner_source) {
+            add(&mut self.stored[1], c.corners);
+        }
+    }
+}
+
+/// A primitive's vertex and corner counts and the accessors they come from.
+struct PrimitiveCounts {
+    positions: usize,
+    vertices: usize,
+    /// The indices accessor, or `None` for consecutive triples of the
+    /// positions.
+    corner_source: (usize, Option<usize>),
+    corners: usize,
+}
+
+/// `None` when an accessor is missing or its data does not lie in its
+/// buffer: the primitive's reading reports that.
+fn primitive_counts(primitive: &gltf::Primitive, buffers: &[Cow<[u8]>]) -> Option<PrimitiveCounts> {
+    let positions = primitive.get(&gltf::Semantic::Positions)?;
+    accessor_data(&positions, buffers, 12, "POSITION").ok()?;
+    let (corner_source, corners) = match primitive.indices() {
+        Some(indices) => {
+            // The smallest index size: any index takes at least a byte.
+            accessor_data(&indices, buffers, 1, "indices").ok()?;
+            ((positions.index(), Some(indices.index())), indices.count())
+        }
+        None => ((positions.index(), None), positions.count()),
+    };
+    Some(PrimitiveCounts {
+        positions: positions.index(),
+        vertices: positions.count(),
+        corner_source,
+        corners,
+    })
 }
 
 /// Parses and validates the document. The accessor indices of mesh
@@ -131,6 +290,12 @@ fn load_buffers<'a>(gltf: &'a gltf::Gltf, dir: &Path) -> Result<Vec<Cow<'a, [u8]
             gltf::buffer::Source::Bin => Cow::Borrowed(gltf.blob.as_deref().ok_or_else(|| {
                 anyhow!("buffer {i} refers to a GLB binary chunk, and there is none")
             })?),
+            // An empty relative reference names the document itself (here
+            // its directory), which is never the buffer: say what is wrong.
+            gltf::buffer::Source::Uri("") => bail!(
+                "buffer {i} has an empty URI: it needs the name of a file beside the \
+                 document or a base64 data: URI"
+            ),
             gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
                 Cow::Owned(decode_data_uri(uri).with_context(|| format!("buffer {i}"))?)
             }

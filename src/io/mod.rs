@@ -285,7 +285,8 @@ pub fn detect_format(path: &Path, bytes: &[u8]) -> Result<Format> {
 /// Recognises a format from the start of the file, if it is unambiguous.
 fn sniff(bytes: &[u8]) -> Option<Format> {
     let bytes = strip_bom(bytes);
-    if bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n") {
+    // `ply\r` covers `ply\r\n` and a lone `\r` (classic Mac OS).
+    if bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r") {
         return Some(Format::Ply);
     }
     // Only the start matters; a lossy view copes with binary data after it.
@@ -371,6 +372,65 @@ pub(crate) fn lines(text: &str) -> impl Iterator<Item = &str> {
     })
 }
 
+/// How the lines of a PLY or PCD header end, as its first line ends: `\n`
+/// (after an optional `\r`) or a lone `\r` (classic Mac OS).
+///
+/// A header cannot be split like text ([`lines`]): binary data follows it,
+/// and it may start with a `\n` byte, which after a header line ending in
+/// `\r` would be taken for the rest of a `\r\n`. Taking the ending of the
+/// first line for the whole header finds the header's end exactly.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum HeaderEol {
+    /// `\n` or `\r\n`.
+    Newline,
+    /// A lone `\r`.
+    Return,
+}
+
+impl HeaderEol {
+    /// The ending of the first line of `bytes`; `Newline` when there is no
+    /// line ending at all.
+    pub(crate) fn of(bytes: &[u8]) -> HeaderEol {
+        match bytes.iter().position(|&b| b == b'\n' || b == b'\r') {
+            Some(i) if bytes[i] == b'\r' && bytes.get(i + 1) != Some(&b'\n') => HeaderEol::Return,
+            _ => HeaderEol::Newline,
+        }
+    }
+
+    /// The byte that ends a line.
+    pub(crate) fn byte(self) -> u8 {
+        match self {
+            HeaderEol::Newline => b'\n',
+            HeaderEol::Return => b'\r',
+        }
+    }
+
+    /// The next line of `bytes` from `start`: its text, without the ending
+    /// (and a `\r` before a `\n`), and where the line after it starts;
+    /// `None` when the bytes end before a line ending.
+    pub(crate) fn line(self, bytes: &[u8], start: usize) -> Option<(&[u8], usize)> {
+        let len = bytes[start..].iter().position(|&b| b == self.byte())?;
+        let line = &bytes[start..start + len];
+        let line = match self {
+            HeaderEol::Newline => line.strip_suffix(b"\r").unwrap_or(line),
+            HeaderEol::Return => line,
+        };
+        Some((line, start + len + 1))
+    }
+}
+
+/// Whether a PLY or PCD header line holds a `\r` that ends no line: the
+/// header's first line ended with `\n`, so a later line ended by a lone
+/// `\r` ran into the next one, which would be misread (a PCD `FIELDS`
+/// line taking the `SIZE` line's words for field names).
+pub(crate) fn mixed_line_ending(line: &str) -> Option<String> {
+    line.trim_end_matches('\r').contains('\r').then(|| {
+        "a lone carriage return inside the line: every header line must end as the \
+         first does, and the first ends with a newline"
+            .to_string()
+    })
+}
+
 /// Formats a point for messages, keeping NaN and inf readable.
 pub(crate) fn show(p: &Point3) -> String {
     format!("({}, {}, {})", p[0], p[1], p[2])
@@ -432,6 +492,20 @@ mod tests {
             assert_eq!(all(t), t.lines().collect::<Vec<_>>(), "{t:?}");
         }
         assert_eq!(all("a\rb\r\rc\r\nd\n"), ["a", "b", "", "c", "d"]);
+    }
+
+    #[test]
+    fn header_lines_end_as_the_first_does() {
+        use HeaderEol::{Newline, Return};
+        assert_eq!(HeaderEol::of(b"ply\nformat\r"), Newline);
+        assert_eq!(HeaderEol::of(b"ply\r\nformat\r"), Newline);
+        assert_eq!(HeaderEol::of(b"ply\rformat\r\n"), Return);
+        assert_eq!(HeaderEol::of(b"ply"), Newline);
+        // A binary body's first byte may be \n: it is not the line's.
+        let bytes = b"ply\rend_header\r\n\x01";
+        assert_eq!(Return.line(bytes, 4), Some((&b"end_header"[..], 15)));
+        assert_eq!(Newline.line(b"a\r\nb", 0), Some((&b"a"[..], 3)));
+        assert_eq!(Newline.line(b"a\r\nb", 3), None);
     }
 
     #[test]

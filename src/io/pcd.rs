@@ -15,7 +15,9 @@
 
 use anyhow::{anyhow, bail, Result};
 
-use super::{capacity, strip_bom, truncated, Cloud, Format, Point3};
+use super::{
+    capacity, lines, mixed_line_ending, strip_bom, truncated, Cloud, Format, HeaderEol, Point3,
+};
 
 /// One field of a PCD point.
 #[derive(Debug, Clone, PartialEq)]
@@ -113,9 +115,12 @@ fn parse_header(bytes: &[u8]) -> Result<Header> {
     let mut start = 0;
     let mut line_no = 0;
     let mut count_line = 0;
+    // Every header line ends as the first does, so that binary data
+    // starts exactly after the DATA line's own ending.
+    let eol = HeaderEol::of(bytes).byte();
     while start < bytes.len() {
         line_no += 1;
-        let len = bytes[start..].iter().position(|&b| b == b'\n');
+        let len = bytes[start..].iter().position(|&b| b == eol);
         let end = len.map_or(bytes.len(), |l| start + l);
         let line = String::from_utf8_lossy(&bytes[start..end]);
         start = (end + 1).min(bytes.len());
@@ -124,6 +129,9 @@ fn parse_header(bytes: &[u8]) -> Result<Header> {
         let Some((key, values)) = words.split_first() else {
             continue;
         };
+        if let Some(e) = mixed_line_ending(&line).filter(|_| !key.starts_with('#')) {
+            return Err(at(e));
+        }
         match *key {
             k if k.starts_with('#') => {}
             "VERSION" | "VIEWPOINT" => {}
@@ -300,8 +308,7 @@ fn read_ascii(header: &Header, wanted: &Wanted, body: &[u8]) -> Result<Raw> {
         total += f.count;
     }
     let mut raw = Raw::new(wanted, header.points);
-    let lines = text
-        .lines()
+    let lines = lines(text)
         .enumerate()
         .filter(|(_, l)| !l.trim().is_empty());
     for (i, line) in lines.take(header.points) {

@@ -37,7 +37,9 @@ use std::io::Write;
 use anyhow::{anyhow, bail, Result};
 use byteorder::{BigEndian, ByteOrder, LittleEndian, WriteBytesExt};
 
-use super::{capacity, show, strip_bom, truncated, Mesh, Point3};
+use super::{
+    capacity, lines, mixed_line_ending, show, strip_bom, truncated, HeaderEol, Mesh, Point3,
+};
 
 /// A PLY scalar type.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -140,7 +142,7 @@ struct Element {
 struct Header {
     encoding: Encoding,
     elements: Vec<Element>,
-    /// Byte offset of the first byte after `end_header`'s newline.
+    /// Byte offset of the first byte after `end_header`'s line ending.
     body_start: usize,
     /// Number of header lines, so ASCII body lines can be numbered.
     lines: usize,
@@ -181,18 +183,27 @@ fn read(bytes: &[u8], grid: bool) -> Result<Mesh> {
 
 /// Splits off the header and parses it.
 fn parse_header(bytes: &[u8]) -> Result<Header> {
-    let end = find_end_header(bytes)
+    let eol = HeaderEol::of(bytes);
+    let end = find_end_header(bytes, eol)
         .ok_or_else(|| anyhow!("malformed PLY header: no 'end_header' line"))?;
     let text = std::str::from_utf8(&bytes[..end.0])
         .map_err(|_| anyhow!("malformed PLY header: it is not ASCII text"))?;
+    // Split as find_end_header did; a \r before a \n is not part of a line.
+    let header_lines = text
+        .split(char::from(eol.byte()))
+        .map(|l| l.strip_suffix('\r').unwrap_or(l));
     let mut encoding = None;
     let mut elements: Vec<Element> = Vec::new();
     let mut lines = 0;
     let mut grid_size = [None, None];
-    for (i, line) in text.lines().enumerate() {
+    for (i, line) in header_lines.enumerate() {
         lines = i + 1;
         let at = |what: String| anyhow!("malformed PLY header: line {}: {what}", i + 1);
         let words: Vec<&str> = line.split_whitespace().collect();
+        let comment = matches!(words.first(), Some(&("comment" | "obj_info")));
+        if let Some(e) = mixed_line_ending(line).filter(|_| !comment) {
+            return Err(at(e));
+        }
         match words.as_slice() {
             ["ply"] if i == 0 => {}
             _ if i == 0 => return Err(at("the file does not start with 'ply'".into())),
@@ -227,16 +238,15 @@ fn parse_header(bytes: &[u8]) -> Result<Header> {
 }
 
 /// Finds the `end_header` line: (end of its text, start of the body).
-fn find_end_header(bytes: &[u8]) -> Option<(usize, usize)> {
+/// Every header line ends as the first does (see [`HeaderEol`]), so that
+/// the body starts exactly after `end_header`'s own line ending.
+fn find_end_header(bytes: &[u8], eol: HeaderEol) -> Option<(usize, usize)> {
     let mut start = 0;
-    while start < bytes.len() {
-        let len = bytes[start..].iter().position(|&b| b == b'\n')?;
-        let line = &bytes[start..start + len];
-        let line = line.strip_suffix(b"\r").unwrap_or(line);
+    while let Some((line, next)) = eol.line(bytes, start) {
         if line.trim_ascii() == b"end_header" {
-            return Some((start + len, start + len + 1));
+            return Some((start + line.len(), next));
         }
-        start += len + 1;
+        start = next;
     }
     None
 }
@@ -289,7 +299,8 @@ trait Values {
 /// value too many or too few (a line of 4 values for 3 properties would
 /// otherwise shift every later vertex by one value, silently).
 struct AsciiValues<'a> {
-    lines: std::str::Lines<'a>,
+    /// Ended by `\n`, `\r\n` or a lone `\r`, as in the other text readers.
+    lines: Box<dyn Iterator<Item = &'a str> + 'a>,
     tokens: std::str::SplitAsciiWhitespace<'a>,
     line: usize,
     /// The current line's text, for counting its values in messages.
@@ -303,7 +314,7 @@ struct AsciiValues<'a> {
 impl<'a> AsciiValues<'a> {
     fn new(text: &'a str, header_lines: usize) -> Self {
         Self {
-            lines: text.lines(),
+            lines: Box::new(lines(text)),
             tokens: "".split_ascii_whitespace(),
             line: header_lines,
             text: "",
