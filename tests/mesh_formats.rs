@@ -484,6 +484,36 @@ fn gltf_without_mesh_instances_says_why() {
     assert!(error(&path).ends_with("the file has no meshes"));
 }
 
+/// glTF rotations are unit quaternions. One of length 2 used to be read
+/// as it stood, which distorts the mesh instead of turning it (the
+/// rotation formula assumes a unit quaternion); it is now an error naming
+/// the node, while one within rounding of unit length is normalised.
+#[test]
+fn gltf_rotation_must_be_a_unit_quaternion() {
+    let dir = tempfile::tempdir().unwrap();
+    let with_rotation = |q: &str| {
+        instanced_gltf(3, None, 1).replace(
+            r#""nodes": [{"mesh": 0}]"#,
+            &format!(r#""nodes": [{{"mesh": 0, "rotation": [{q}]}}]"#),
+        )
+    };
+    let path = dir.path().join("long.gltf");
+    std::fs::write(&path, with_rotation("0, 0, 0, 2")).unwrap();
+    let e = error(&path);
+    assert!(e.contains("node 0") && e.contains("has length 2"), "{e}");
+    // A quarter turn about z, written with f32 rounding: read as the unit
+    // quaternion, so (2, 0, 0) lands at (0, 2, 0) to within rounding.
+    let path = dir.path().join("turned.gltf");
+    let h = std::f64::consts::FRAC_1_SQRT_2 * 1.0002;
+    std::fs::write(&path, with_rotation(&format!("0, 0, {h}, {h}"))).unwrap();
+    let mesh = read_mesh(&path).unwrap();
+    let p = mesh.vertices[2];
+    assert!(
+        p[0].abs() < 1e-6 && (p[1] - 2.0).abs() < 1e-6 && p[2].abs() < 1e-6,
+        "{p:?}"
+    );
+}
+
 /// PLY and PCD headers whose lines end with a lone carriage return
 /// (classic Mac OS) used to fail: `no 'end_header' line`, `no DATA line`,
 /// and a PLY under another extension was not recognised at all. Binary

@@ -128,7 +128,7 @@ fn instances(document: &gltf::Document) -> Result<Vec<Instance<'_>>> {
         if std::mem::replace(&mut visited[node.index()], true) {
             bail!("node {} is reached twice: it has two parents", node.index());
         }
-        let world = multiply(&parent, &local_matrix(&node));
+        let world = multiply(&parent, &local_matrix(&node)?);
         let children: Vec<_> = node.children().collect();
         for child in children.into_iter().rev() {
             stack.push((child, world));
@@ -379,8 +379,8 @@ const IDENTITY: Matrix = [
     [0.0, 0.0, 0.0, 1.0],
 ];
 
-fn local_matrix(node: &gltf::Node) -> Matrix {
-    match node.transform() {
+fn local_matrix(node: &gltf::Node) -> Result<Matrix> {
+    Ok(match node.transform() {
         gltf::scene::Transform::Matrix { matrix } => matrix.map(|c| c.map(f64::from)),
         gltf::scene::Transform::Decomposed {
             translation,
@@ -388,7 +388,8 @@ fn local_matrix(node: &gltf::Node) -> Matrix {
             scale,
         } => {
             let [t, s] = [translation, scale].map(|v| v.map(f64::from));
-            let [x, y, z, w] = rotation.map(f64::from);
+            let [x, y, z, w] =
+                unit_rotation(rotation).with_context(|| format!("node {}", node.index()))?;
             // The unit quaternion's rotation matrix, columns scaled by s.
             let r = [
                 [
@@ -414,7 +415,30 @@ fn local_matrix(node: &gltf::Node) -> Matrix {
                 [t[0], t[1], t[2], 1.0],
             ]
         }
+    })
+}
+
+/// How far a rotation quaternion's length may be from 1 and still be read
+/// (as the unit quaternion of its direction): the rounding of f32
+/// components written by exporters, with room to spare.
+const QUATERNION_TOLERANCE: f64 = 1e-3;
+
+/// A node's rotation as a unit quaternion (x, y, z, w). glTF requires unit
+/// quaternions; the rotation matrix formula assumes one, and for any other
+/// it distorts the mesh instead of turning it, silently. Lengths within
+/// [`QUATERNION_TOLERANCE`] of 1 are normalised; others are an error.
+fn unit_rotation(rotation: [f32; 4]) -> Result<[f64; 4]> {
+    let q = rotation.map(f64::from);
+    let length = q.iter().map(|c| c * c).sum::<f64>().sqrt();
+    // Written so that a NaN length (an infinite component) fails too.
+    let unit = (length - 1.0).abs() <= QUATERNION_TOLERANCE;
+    if !unit {
+        bail!(
+            "the rotation quaternion {q:?} has length {length}: glTF requires a unit quaternion \
+             (within {QUATERNION_TOLERANCE} here)"
+        );
     }
+    Ok(q.map(|c| c / length))
 }
 
 fn multiply(a: &Matrix, b: &Matrix) -> Matrix {
