@@ -417,6 +417,26 @@ impl HeaderEol {
         };
         Some((line, start + len + 1))
     }
+
+    /// [`HeaderEol::line`], or else the rest of `bytes` as a last line
+    /// without an ending.
+    pub(crate) fn line_or_rest(self, bytes: &[u8], start: usize) -> (&[u8], usize) {
+        self.line(bytes, start)
+            .unwrap_or((&bytes[start..], bytes.len()))
+    }
+
+    /// The lines of a header's text, split as [`HeaderEol::line`] splits
+    /// bytes (the last line needs no ending).
+    pub(crate) fn text_lines(self, text: &str) -> impl Iterator<Item = &str> {
+        let newline = self == HeaderEol::Newline;
+        text.split(char::from(self.byte())).map(move |l| {
+            if newline {
+                l.strip_suffix('\r').unwrap_or(l)
+            } else {
+                l
+            }
+        })
+    }
 }
 
 /// Whether a PLY or PCD header line holds a `\r` that ends no line: the

@@ -117,13 +117,12 @@ fn parse_header(bytes: &[u8]) -> Result<Header> {
     let mut count_line = 0;
     // Every header line ends as the first does, so that binary data
     // starts exactly after the DATA line's own ending.
-    let eol = HeaderEol::of(bytes).byte();
+    let eol = HeaderEol::of(bytes);
     while start < bytes.len() {
         line_no += 1;
-        let len = bytes[start..].iter().position(|&b| b == eol);
-        let end = len.map_or(bytes.len(), |l| start + l);
-        let line = String::from_utf8_lossy(&bytes[start..end]);
-        start = (end + 1).min(bytes.len());
+        let (text, next) = eol.line_or_rest(bytes, start);
+        let line = String::from_utf8_lossy(text);
+        start = next;
         let at = |what: String| anyhow!("malformed PCD header: line {line_no}: {what}");
         let words: Vec<&str> = line.split_whitespace().collect();
         let Some((key, values)) = words.split_first() else {

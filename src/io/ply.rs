@@ -188,10 +188,8 @@ fn parse_header(bytes: &[u8]) -> Result<Header> {
         .ok_or_else(|| anyhow!("malformed PLY header: no 'end_header' line"))?;
     let text = std::str::from_utf8(&bytes[..end.0])
         .map_err(|_| anyhow!("malformed PLY header: it is not ASCII text"))?;
-    // Split as find_end_header did; a \r before a \n is not part of a line.
-    let header_lines = text
-        .split(char::from(eol.byte()))
-        .map(|l| l.strip_suffix('\r').unwrap_or(l));
+    // Split as find_end_header did.
+    let header_lines = eol.text_lines(text);
     let mut encoding = None;
     let mut elements: Vec<Element> = Vec::new();
     let mut lines = 0;

@@ -391,12 +391,16 @@ pub fn ray_shear(frame: &Frame, ray: Point3) -> [f64; 2] {
 /// other gets the shear of the same direction at unit size, bit for bit.
 fn moderate(mut v: Point3) -> Point3 {
     const BIG: f64 = 18_446_744_073_709_551_616.0; // 2^64
-    let largest = |v: &Point3| v.iter().fold(0.0f64, |m, c| m.max(c.abs()));
-    while largest(&v) >= BIG && largest(&v).is_finite() {
+                                                   // Scaled with the vector, exactly (a power of two): the largest
+                                                   // |component| is found once per ray, which runs for every point.
+    let mut largest = v.iter().fold(0.0f64, |m, c| m.max(c.abs()));
+    while largest >= BIG && largest.is_finite() {
         v = v.map(|c| c / BIG);
+        largest /= BIG;
     }
-    while largest(&v) > 0.0 && largest(&v) < 1.0 / BIG {
+    while largest > 0.0 && largest < 1.0 / BIG {
         v = v.map(|c| c * BIG);
+        largest *= BIG;
     }
     v
 }
