@@ -56,6 +56,8 @@ pub struct Report {
     pub loops_left: Vec<LeftLoops>,
     /// Input faces.
     pub faces_in: usize,
+    /// Input faces that named a vertex twice (no area), dropped.
+    pub slivers_dropped: usize,
     /// Input faces removed in the border bands.
     pub faces_removed: usize,
     /// New faces.
@@ -165,6 +167,7 @@ impl Report {
                 })
                 .collect(),
             faces_in: r.faces_in,
+            slivers_dropped: r.slivers_dropped,
             faces_removed: r.faces_removed,
             faces_added: r.faces_added,
             faces_out: r.faces_out,
@@ -226,6 +229,15 @@ impl crate::report::Table for Report {
             ("write time", format!("{:.1} ms", self.write_ms)),
             ("output", self.output.clone()),
         ];
+        if self.slivers_dropped > 0 {
+            rows.insert(
+                3,
+                (
+                    "slivers dropped",
+                    format!("{} (faces naming a vertex twice)", self.slivers_dropped),
+                ),
+            );
+        }
         for l in &self.loops_left {
             rows.push((
                 "left unchanged",

@@ -220,3 +220,38 @@ fn a_closed_mesh_is_written_unchanged_and_reports_no_new_angle() {
     assert!(stdout.contains("0 removed, 0 new"), "{stdout}");
     assert!(stdout.contains("none (no new faces)"), "{stdout}");
 }
+
+/// A binary STL sliver whose two corners coincide (one face naming a vertex
+/// twice once the reader merges them) is dropped and counted; the rest is
+/// cleaned to the same bytes as the file without it.
+#[test]
+fn an_stl_sliver_with_two_equal_corners_is_dropped_and_counted() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut stl = std::fs::read(JAGGED).unwrap();
+    let count = u32::from_le_bytes(stl[80..84].try_into().unwrap());
+    // The first triangle again, its third corner moved onto its second.
+    let mut sliver = stl[84..134].to_vec();
+    let second_corner = sliver[24..36].to_vec();
+    sliver[36..48].copy_from_slice(&second_corner);
+    stl.extend_from_slice(&sliver);
+    stl[80..84].copy_from_slice(&(count + 1).to_le_bytes());
+    let input = dir.path().join("sliver.stl");
+    std::fs::write(&input, &stl).unwrap();
+    let (want, got) = (dir.path().join("want.stl"), dir.path().join("got.stl"));
+    let report = dir.path().join("report.json");
+    for run in [
+        meshtrim(&["clean", JAGGED, s(&want)], None),
+        meshtrim(&["clean", s(&input), s(&got), "--report", s(&report)], None),
+    ] {
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+    }
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
+    assert_eq!(json["slivers_dropped"], 1);
+    assert_eq!(json["faces_in"], u64::from(count) + 1);
+    assert_eq!(std::fs::read(&want).unwrap(), std::fs::read(&got).unwrap());
+}

@@ -58,6 +58,7 @@
 //! non-manifold or same-direction edge is dropped the same way, so the
 //! output is never a broken mesh.
 
+use std::borrow::Cow;
 use std::collections::{BTreeSet, HashMap};
 
 use rayon::prelude::*;
@@ -135,6 +136,9 @@ pub struct CleanReport {
     pub loops_left: Vec<LeftLoops>,
     /// Input faces.
     pub faces_in: usize,
+    /// Input faces that named a vertex twice, dropped before anything else
+    /// (see [`without_slivers`]).
+    pub slivers_dropped: usize,
     /// Input faces removed (in the bands).
     pub faces_removed: usize,
     /// New faces (the bands triangulated again).
@@ -161,6 +165,9 @@ pub fn clean_mesh(
     options: &CleanOptions,
 ) -> Result<(Mesh, CleanReport), MeshError> {
     mesh.validate()?;
+    let faces_in = mesh.faces.len();
+    let (kept, slivers_dropped) = without_slivers(mesh);
+    let mesh: &Mesh = &kept;
     if mesh.faces.is_empty() {
         return Err(MeshError::NoFaces);
     }
@@ -174,7 +181,8 @@ pub fn clean_mesh(
     let borders = mesh.boundary_loops();
     let mut report = CleanReport {
         loops_in: borders.len(),
-        faces_in: mesh.faces.len(),
+        faces_in,
+        slivers_dropped,
         area_in: mesh.area(),
         ..Default::default()
     };
@@ -915,12 +923,30 @@ fn smallest_angle(vertices: &[Point3], face: [u32; 3]) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
+/// `mesh` without its faces that name a vertex twice, and how many there
+/// were. Such a face (a binary STL's sliver whose two corners coincide
+/// becomes one once its vertices are merged) has no area and no border of
+/// its own: the faces on either side of it already share its one real
+/// edge. Kept, that edge would count twice and read as non-manifold; so
+/// they are dropped, as MeshLab's "Remove Zero Area Faces" would, and
+/// counted in the report. Faces of three distinct but collinear vertices
+/// stay: they hold the surface together.
+fn without_slivers(mesh: &Mesh) -> (Cow<'_, Mesh>, usize) {
+    let distinct = |f: &[u32; 3]| f[0] != f[1] && f[1] != f[2] && f[2] != f[0];
+    let slivers = mesh.faces.iter().filter(|f| !distinct(f)).count();
+    if slivers == 0 {
+        return (Cow::Borrowed(mesh), 0);
+    }
+    let kept = Mesh {
+        vertices: mesh.vertices.clone(),
+        faces: mesh.faces.iter().copied().filter(distinct).collect(),
+    };
+    (Cow::Owned(kept), slivers)
+}
+
 /// Edge-manifold with consistent orientation: every undirected edge used
-/// at most twice, every directed edge at most once. A face that names a
-/// vertex twice is reported as such first: it would count its one real
-/// edge twice and be taken for a non-manifold edge.
+/// at most twice, every directed edge at most once.
 fn check_manifold(mesh: &Mesh) -> Result<(), MeshError> {
-    check_distinct_corners(mesh)?;
     let mut directed: HashMap<(u32, u32), u32> = HashMap::new();
     for f in &mesh.faces {
         for k in 0..3 {
@@ -936,22 +962,6 @@ fn check_manifold(mesh: &Mesh) -> Result<(), MeshError> {
         return Err(MeshError::Misoriented { edges: misoriented });
     }
     Ok(())
-}
-
-/// Every face has three different vertices.
-fn check_distinct_corners(mesh: &Mesh) -> Result<(), MeshError> {
-    let repeats = |f: &&[u32; 3]| f[0] == f[1] || f[1] == f[2] || f[2] == f[0];
-    let Some(first) = mesh.faces.iter().position(|f| repeats(&f)) else {
-        return Ok(());
-    };
-    let [a, b, c] = mesh.faces[first];
-    Err(MeshError::RepeatedCorner {
-        faces: mesh.faces.iter().filter(repeats).count(),
-        first,
-        a,
-        b,
-        c,
-    })
 }
 
 /// The faces around each vertex (compressed rows).
@@ -1237,24 +1247,38 @@ mod tests {
         ));
     }
 
-    /// A face with two equal corners (a binary STL's sliver, merged) is
-    /// named as such; it used to be reported as a non-manifold edge.
+    /// Faces with two equal corners (a binary STL's sliver, merged) are
+    /// dropped and counted; they used to stop the cleanup (reported first
+    /// as a non-manifold edge, then as an error of their own). The rest of
+    /// the mesh is cleaned exactly as it would be without them.
     #[test]
-    fn a_face_with_a_repeated_vertex_is_named() {
-        let mut mesh = jagged_annulus(8.0, 3.0, 3);
+    fn faces_naming_a_vertex_twice_are_dropped() {
+        let mesh = jagged_annulus(8.0, 3.0, 3);
         let beta = vec![1.0; mesh.vertices.len()];
+        let options = CleanOptions::default();
+        let (want, _) = clean_mesh(&mesh, &beta, &options).unwrap();
+        let mut with_slivers = mesh.clone();
         let [a, b, _] = mesh.faces[5];
-        mesh.faces.push([a, b, a]);
-        let last = mesh.faces.len() - 1;
+        let [c, d, _] = mesh.faces[9];
+        with_slivers.faces.insert(3, [a, b, a]);
+        with_slivers.faces.push([c, d, d]);
+        with_slivers.faces.push([c, c, c]);
+        let (got, report) = clean_mesh(&with_slivers, &beta, &options).unwrap();
+        assert_eq!(got, want);
+        assert_eq!(report.slivers_dropped, 3);
+        assert_eq!(report.faces_in, mesh.faces.len() + 3);
+    }
+
+    /// A mesh of slivers alone has no faces to clean.
+    #[test]
+    fn a_mesh_of_slivers_alone_has_no_faces() {
+        let mesh = Mesh {
+            vertices: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            faces: vec![[0, 1, 1], [2, 2, 0]],
+        };
         assert_eq!(
-            clean_mesh(&mesh, &beta, &CleanOptions::default()).unwrap_err(),
-            MeshError::RepeatedCorner {
-                faces: 1,
-                first: last,
-                a,
-                b,
-                c: a
-            }
+            clean_mesh(&mesh, &[1.0; 3], &CleanOptions::default()).unwrap_err(),
+            MeshError::NoFaces
         );
     }
 }

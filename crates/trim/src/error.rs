@@ -149,22 +149,6 @@ pub enum MeshError {
         /// Vertices of the mesh.
         vertices: usize,
     },
-    /// Some faces name one vertex twice (an STL sliver whose two corners
-    /// coincide merges into one): they have no area, and their edge,
-    /// counted twice, would be reported as non-manifold.
-    #[error("{faces} faces use a vertex twice (the first is face {first}: vertices {a}, {b}, {c}), so they have no area; remove them first (e.g. MeshLab's \"Remove Zero Area Faces\")")]
-    RepeatedCorner {
-        /// How many such faces.
-        faces: usize,
-        /// Index of the first one.
-        first: usize,
-        /// Its first vertex.
-        a: u32,
-        /// Its second vertex.
-        b: u32,
-        /// Its third vertex.
-        c: u32,
-    },
     /// Some edges are shared by more than two faces.
     #[error("{edges} edges are shared by more than two faces; the mesh must be edge-manifold (repair it first, e.g. MeshLab's \"Repair non Manifold Edges\")")]
     NonManifold {
