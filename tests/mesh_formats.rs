@@ -459,6 +459,55 @@ fn gltf_buffer_with_an_empty_uri() {
     );
 }
 
+/// Buffer URIs are relative references resolved against the document's
+/// directory, `..` included (asset pipelines share buffers that way);
+/// URIs with a scheme other than `data:` are refused, each with its own
+/// message (`file:` used to be called a remote URI, and `http:x` without
+/// `//` was read as a file name).
+#[test]
+fn gltf_buffer_uris_relative_parent_and_schemes() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = transformed_gltf(4);
+    let uri_start = text.find("data:").unwrap();
+    let uri_end = uri_start + text[uri_start..].find('"').unwrap();
+    let bytes = base64::engine::general_purpose::STANDARD
+        .decode(text[uri_start..uri_end].split_once(";base64,").unwrap().1)
+        .unwrap();
+    std::fs::write(dir.path().join("shared.bin"), &bytes).unwrap();
+    std::fs::create_dir(dir.path().join("scene")).unwrap();
+    let with_uri = |name: &str, uri: &str| {
+        let path = dir.path().join("scene").join(name);
+        std::fs::write(
+            &path,
+            format!("{}{uri}{}", &text[..uri_start], &text[uri_end..]),
+        )
+        .unwrap();
+        path
+    };
+    let embedded = meshtrim::io::read_mesh(&with_uri("embedded.gltf", &text[uri_start..uri_end]));
+    let parent = meshtrim::io::read_mesh(&with_uri("parent.gltf", "../shared.bin"));
+    assert_eq!(parent.unwrap(), embedded.unwrap());
+    let e = error(&with_uri("file.gltf", "file:///tmp/shared.bin"));
+    assert!(
+        e.ends_with(
+            "buffer 0: file URI 'file:///tmp/shared.bin' is not supported: name the buffer \
+             relative to the document (e.g. 'mesh.bin' or '../shared/mesh.bin') or embed it as a \
+             base64 data: URI"
+        ),
+        "{e}"
+    );
+    for uri in ["http://example.com/a.bin", "ftp:a.bin"] {
+        let e = error(&with_uri("remote.gltf", uri));
+        assert!(
+            e.ends_with(&format!(
+                "buffer 0: URI '{uri}' is not supported: only files relative to the document \
+                 and base64 data: URIs are read"
+            )),
+            "{e}"
+        );
+    }
+}
+
 /// A glTF whose meshes no node uses, or with no meshes at all, has nothing
 /// to read; both used to say `no vertices in the file`, which read like a
 /// mesh without vertices.

@@ -300,9 +300,12 @@ fn load_buffers<'a>(gltf: &'a gltf::Gltf, dir: &Path) -> Result<Vec<Cow<'a, [u8]
                 Cow::Owned(decode_data_uri(uri).with_context(|| format!("buffer {i}"))?)
             }
             gltf::buffer::Source::Uri(uri) => {
-                if uri.contains("://") {
-                    bail!("buffer {i}: remote URI '{uri}' is not supported");
-                }
+                refuse_schemes(uri).with_context(|| format!("buffer {i}"))?;
+                // A relative reference, resolved against the document's
+                // directory as RFC 3986 does: `../shared/mesh.bin` (asset
+                // pipelines share buffers that way) and a path-absolute
+                // `/data/mesh.bin` name files on this machine. Only a
+                // regular file is read, and only `byteLength` bytes of it.
                 let path = dir.join(percent_decode(uri));
                 Cow::Owned(
                     read_buffer_file(&path, buffer.length())
@@ -320,6 +323,30 @@ fn load_buffers<'a>(gltf: &'a gltf::Gltf, dir: &Path) -> Result<Vec<Cow<'a, [u8]
         out.push(data);
     }
     Ok(out)
+}
+
+/// A URI with a scheme (RFC 3986: a letter, then letters, digits, `+`,
+/// `-` or `.`, then `:`) other than `data:` is not read: `http:` and its
+/// kind would need the network, and a `file:` URI, absolute by nature, is
+/// refused with the form a portable asset uses instead.
+fn refuse_schemes(uri: &str) -> Result<()> {
+    let Some((scheme, _)) = uri.split_once(':') else {
+        return Ok(());
+    };
+    let is_scheme = scheme.starts_with(|c: char| c.is_ascii_alphabetic())
+        && scheme
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '+' | '-' | '.'));
+    if !is_scheme {
+        return Ok(());
+    }
+    if scheme.eq_ignore_ascii_case("file") {
+        bail!(
+            "file URI '{uri}' is not supported: name the buffer relative to the document \
+             (e.g. 'mesh.bin' or '../shared/mesh.bin') or embed it as a base64 data: URI"
+        );
+    }
+    bail!("URI '{uri}' is not supported: only files relative to the document and base64 data: URIs are read")
 }
 
 /// The first `length` bytes of an external buffer file, which must be a
