@@ -189,34 +189,118 @@ const SVG_MARGIN: f64 = 20.0;
 /// The data is scaled so the larger side is 1000 units plus a margin, and
 /// coordinates are rounded to 0.01 units.
 pub fn write_svg(w: &mut dyn Write, data: EdgeData) -> std::io::Result<()> {
-    let points = data.points;
-    let frame = if points.is_empty() {
-        Frame {
-            u: [1.0, 0.0, 0.0],
-            v: [0.0, 1.0, 0.0],
-            normal: [0.0, 0.0, 1.0],
+    let view = SvgView::new(data);
+    write_svg_header(w, data, &view)?;
+    write_interior_points(w, data, &view)?;
+    write_boundary_points(w, data, &view)?;
+    write_raw_loops(w, data.edges, &view)?;
+    write_smoothed_edges(w, data.edges, &view)?;
+    write_corners(w, data.edges, &view)?;
+    writeln!(w, "</svg>")
+}
+
+/// The cloud's best-fit plane, in which the picture is drawn.
+struct PicturePlane {
+    frame: Frame,
+    origin: Point3,
+}
+
+impl PicturePlane {
+    /// The plane of all the points, relative to the first (any plane for
+    /// no points).
+    fn of(points: &[Point3]) -> Self {
+        let frame = if points.is_empty() {
+            Frame {
+                u: [1.0, 0.0, 0.0],
+                v: [0.0, 1.0, 0.0],
+                normal: [0.0, 0.0, 1.0],
+            }
+        } else {
+            let all: Vec<u32> = (0..points.len() as u32).collect();
+            fit_plane(points, &all)
+        };
+        PicturePlane {
+            frame,
+            origin: points.first().copied().unwrap_or([0.0; 3]),
         }
-    } else {
-        let all: Vec<u32> = (0..points.len() as u32).collect();
-        fit_plane(points, &all)
-    };
-    let origin = points.first().copied().unwrap_or([0.0; 3]);
-    // Plane coordinates with the y axis pointing down, as SVG's does.
-    let plane = |p: &Point3| {
+    }
+
+    /// Plane coordinates with the y axis pointing down, as SVG's does.
+    fn project(&self, p: &Point3) -> [f64; 2] {
+        let origin = self.origin;
         let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
         let dot = |a: &Point3| d[0] * a[0] + d[1] * a[1] + d[2] * a[2];
-        [dot(&frame.u), -dot(&frame.v)]
-    };
-    let projected: Vec<[f64; 2]> = points.iter().map(plane).collect();
-    let edge_points = data
-        .edges
+        [dot(&self.frame.u), -dot(&self.frame.v)]
+    }
+}
+
+/// How the picture sees the cloud: its plane, and the scale and offset
+/// from plane coordinates to picture coordinates.
+struct SvgView {
+    plane: PicturePlane,
+    /// Every input point in plane coordinates.
+    projected: Vec<[f64; 2]>,
+    /// Smallest plane coordinates of the points and edges.
+    lo: [f64; 2],
+    /// Picture units per plane unit.
+    scale: f64,
+    width: f64,
+    height: f64,
+}
+
+impl SvgView {
+    /// Fits the points and the smoothed edges in a picture whose larger
+    /// side is [`SVG_SIZE`], plus the margins.
+    fn new(data: EdgeData) -> Self {
+        let plane = PicturePlane::of(data.points);
+        let projected: Vec<[f64; 2]> = data.points.iter().map(|p| plane.project(p)).collect();
+        let (lo, hi) = bounds(&plane, &projected, data.edges);
+        let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]);
+        let scale = if extent > 0.0 { SVG_SIZE / extent } else { 1.0 };
+        SvgView {
+            plane,
+            projected,
+            lo,
+            scale,
+            width: (hi[0] - lo[0]) * scale + 2.0 * SVG_MARGIN,
+            height: (hi[1] - lo[1]) * scale + 2.0 * SVG_MARGIN,
+        }
+    }
+
+    /// Plane coordinates to picture coordinates.
+    fn to_svg(&self, q: [f64; 2]) -> [f64; 2] {
+        [
+            (q[0] - self.lo[0]) * self.scale + SVG_MARGIN,
+            (q[1] - self.lo[1]) * self.scale + SVG_MARGIN,
+        ]
+    }
+
+    /// Input point `i` in picture coordinates.
+    fn at(&self, i: usize) -> [f64; 2] {
+        self.to_svg(self.projected[i])
+    }
+
+    /// Any point in picture coordinates.
+    fn point(&self, p: &Point3) -> [f64; 2] {
+        self.to_svg(self.plane.project(p))
+    }
+}
+
+/// The bounding box of the `projected` points and the smoothed edges in
+/// the plane; the unit square when there is nothing.
+fn bounds(plane: &PicturePlane, projected: &[[f64; 2]], edges: &Edges) -> ([f64; 2], [f64; 2]) {
+    let edge_points = edges
         .loops
         .iter()
         .flat_map(|l| &l.edges)
         .flat_map(|e| &e.points);
     let mut lo = [f64::INFINITY; 2];
     let mut hi = [f64::NEG_INFINITY; 2];
-    for q in projected.iter().copied().chain(edge_points.map(plane)) {
+    for q in projected
+        .iter()
+        .copied()
+        .chain(edge_points.map(|p| plane.project(p)))
+    {
         for a in 0..2 {
             lo[a] = lo[a].min(q[a]);
             hi[a] = hi[a].max(q[a]);
@@ -225,22 +309,21 @@ pub fn write_svg(w: &mut dyn Write, data: EdgeData) -> std::io::Result<()> {
     if lo[0] > hi[0] {
         (lo, hi) = ([0.0; 2], [1.0; 2]);
     }
-    let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]);
-    let scale = if extent > 0.0 { SVG_SIZE / extent } else { 1.0 };
-    let to_svg = |q: [f64; 2]| {
-        [
-            (q[0] - lo[0]) * scale + SVG_MARGIN,
-            (q[1] - lo[1]) * scale + SVG_MARGIN,
-        ]
-    };
-    let width = (hi[0] - lo[0]) * scale + 2.0 * SVG_MARGIN;
-    let height = (hi[1] - lo[1]) * scale + 2.0 * SVG_MARGIN;
-    let at = |i: u32| to_svg(projected[i as usize]);
+    (lo, hi)
+}
 
+/// Is input point `i` labelled a boundary point?
+fn is_boundary(data: EdgeData, i: usize) -> bool {
+    data.boundary.get(i).copied().unwrap_or(false)
+}
+
+/// The `<svg>` element's opening, a title with the counts, and a white
+/// background.
+fn write_svg_header(w: &mut dyn Write, data: EdgeData, view: &SvgView) -> std::io::Result<()> {
     let loops = &data.edges.loops;
     let edge_count: usize = loops.iter().map(|l| l.edges.len()).sum();
     let corner_count: usize = loops.iter().map(|l| l.corners.len()).sum();
-    let (w_, h_) = (num(width), num(height));
+    let (w_, h_) = (num(view.width), num(view.height));
     writeln!(
         w,
         "<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"0 0 {w_} {h_}\" \
@@ -249,15 +332,18 @@ pub fn write_svg(w: &mut dyn Write, data: EdgeData) -> std::io::Result<()> {
     writeln!(
         w,
         "<title>meshtrim edges: {} points, {} loops, {edge_count} edges, {corner_count} corners</title>",
-        points.len(),
+        data.points.len(),
         loops.len()
     )?;
-    writeln!(w, "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>")?;
+    writeln!(w, "<rect width=\"100%\" height=\"100%\" fill=\"white\"/>")
+}
 
-    // Interior points: zero-length round-capped segments, the most compact
-    // dots SVG has.
-    let interior: Vec<usize> = (0..points.len())
-        .filter(|&i| !data.boundary.get(i).copied().unwrap_or(false))
+/// Every n-th interior point, at most [`SVG_MAX_INTERIOR`], as a grey dot:
+/// zero-length round-capped segments, the most compact dots SVG has, 1000
+/// to a path.
+fn write_interior_points(w: &mut dyn Write, data: EdgeData, view: &SvgView) -> std::io::Result<()> {
+    let interior: Vec<usize> = (0..data.points.len())
+        .filter(|&i| !is_boundary(data, i))
         .collect();
     let step = interior.len().div_ceil(SVG_MAX_INTERIOR).max(1);
     writeln!(
@@ -270,53 +356,73 @@ pub fn write_svg(w: &mut dyn Write, data: EdgeData) -> std::io::Result<()> {
         .collect::<Vec<_>>()
         .chunks(1000)
     {
-        let mut d = String::new();
-        for (n, &&i) in chunk.iter().enumerate() {
-            let [x, y] = to_svg(projected[i]);
-            let sep = if n % 16 == 15 { "\n" } else { "" };
-            let _ = write!(d, "M{} {}h0{sep}", num(x), num(y));
-        }
-        writeln!(w, "<path d=\"{}\"/>", d.trim_end())?;
+        writeln!(w, "<path d=\"{}\"/>", dots(chunk, view).trim_end())?;
     }
-    writeln!(w, "</g>")?;
+    writeln!(w, "</g>")
+}
 
+/// The path data of a dot at each of the `points` (input indices), 16 to
+/// a line.
+fn dots(points: &[&usize], view: &SvgView) -> String {
+    let mut d = String::new();
+    for (n, &&i) in points.iter().enumerate() {
+        let [x, y] = view.at(i);
+        let sep = if n % 16 == 15 { "\n" } else { "" };
+        let _ = write!(d, "M{} {}h0{sep}", num(x), num(y));
+    }
+    d
+}
+
+/// Every boundary point as a red circle.
+fn write_boundary_points(w: &mut dyn Write, data: EdgeData, view: &SvgView) -> std::io::Result<()> {
     writeln!(
         w,
         "<g id=\"boundary-points\" fill=\"none\" stroke=\"#d02020\" stroke-width=\"0.8\">"
     )?;
-    for i in (0..points.len()).filter(|&i| data.boundary.get(i).copied().unwrap_or(false)) {
-        let [x, y] = to_svg(projected[i]);
+    for i in (0..data.points.len()).filter(|&i| is_boundary(data, i)) {
+        let [x, y] = view.at(i);
         writeln!(w, "<circle cx=\"{}\" cy=\"{}\" r=\"2.5\"/>", num(x), num(y))?;
     }
-    writeln!(w, "</g>")?;
+    writeln!(w, "</g>")
+}
 
+/// Each loop's ordered boundary points, closed, as a dashed grey-blue
+/// line.
+fn write_raw_loops(w: &mut dyn Write, edges: &Edges, view: &SvgView) -> std::io::Result<()> {
     writeln!(
         w,
         "<g id=\"raw-loops\" fill=\"none\" stroke=\"#6f8fb0\" stroke-width=\"1\" stroke-dasharray=\"4 3\">"
     )?;
-    for l in loops {
+    for l in &edges.loops {
         let ring = l.boundary_points.iter().chain(l.boundary_points.first());
-        polyline(w, ring.map(|&i| at(i)))?;
+        polyline(w, ring.map(|&i| view.at(i as usize)))?;
     }
-    writeln!(w, "</g>")?;
+    writeln!(w, "</g>")
+}
 
+/// The smoothed edges as solid dark lines, a closed edge back to its first
+/// point.
+fn write_smoothed_edges(w: &mut dyn Write, edges: &Edges, view: &SvgView) -> std::io::Result<()> {
     writeln!(
         w,
         "<g id=\"edges\" fill=\"none\" stroke=\"#202020\" stroke-width=\"1.6\" stroke-linejoin=\"round\">"
     )?;
-    for e in loops.iter().flat_map(|l| &l.edges) {
+    for e in edges.loops.iter().flat_map(|l| &l.edges) {
         let closing = if e.closed { e.points.first() } else { None };
-        polyline(w, e.points.iter().chain(closing).map(|p| to_svg(plane(p))))?;
+        polyline(w, e.points.iter().chain(closing).map(|p| view.point(p)))?;
     }
-    writeln!(w, "</g>")?;
+    writeln!(w, "</g>")
+}
 
+/// The corners as asterisks, at their input points.
+fn write_corners(w: &mut dyn Write, edges: &Edges, view: &SvgView) -> std::io::Result<()> {
     writeln!(
         w,
         "<g id=\"corners\" fill=\"none\" stroke=\"black\" stroke-width=\"1.4\">"
     )?;
-    for l in loops {
+    for l in &edges.loops {
         for &c in &l.corners {
-            let [x, y] = at(l.boundary_points[c]);
+            let [x, y] = view.at(l.boundary_points[c] as usize);
             // A six-pointed asterisk of radius 6, as in the paper.
             writeln!(
                 w,
@@ -330,8 +436,7 @@ pub fn write_svg(w: &mut dyn Write, data: EdgeData) -> std::io::Result<()> {
             )?;
         }
     }
-    writeln!(w, "</g>")?;
-    writeln!(w, "</svg>")
+    writeln!(w, "</g>")
 }
 
 /// One `<polyline>` through `points`, 8 points a line.

@@ -76,7 +76,7 @@ use crate::bpd::Detection;
 use crate::cloud::{cross, dot, norm2, sub, Point3};
 use crate::edges::Edges;
 use crate::error::MeshError;
-use crate::frame::fit_plane;
+use crate::frame::{fit_plane, Frame};
 use crate::mesh::Mesh;
 use crate::neighbours::NeighbourIndex;
 
@@ -148,42 +148,83 @@ pub fn delaunay_mesh(
     delaunay_mesh_with_report(cloud, detection, edges).map(|(mesh, _)| mesh)
 }
 
-/// [`delaunay_mesh`], with what it did.
+/// [`delaunay_mesh`], with what it did. The steps are those of the module
+/// doc.
 pub fn delaunay_mesh_with_report(
     cloud: &[Point3],
     detection: &Detection,
     edges: &Edges,
 ) -> Result<(Mesh, DelaunayReport), MeshError> {
+    check_input(cloud, detection)?;
     let n = cloud.len();
-    if let Some(index) = cloud.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
-        return Err(MeshError::NonFinite { index });
-    }
-    // Before spade, which panics or refuses points beyond its range.
-    crate::mesh::check_vertex_range(cloud)?;
-    if n < 3 || detection.beta.len() != n {
-        return Err(MeshError::NoFaces);
-    }
     let beta = &detection.beta;
     let beta_median = median(beta);
     let mut report = DelaunayReport {
         points_in: n,
         ..Default::default()
     };
+    let plane = Projection::fit(cloud);
+    report.plane_normal = plane.frame.normal;
+    let normals = local_normals(cloud, plane.frame.normal);
+    check_steep_normals(&normals, plane.frame.normal, &mut report)?;
+    if edges.loops.is_empty() {
+        return Err(MeshError::NoFaces);
+    }
+    let (rings, grid) = valid_rings(edges, beta, beta_median, &plane, &mut report)?;
+    let nodes = points_inside(cloud, beta, &plane, &grid, &mut report);
+    let triangulation = LoopCdt::build(nodes, &rings, n, &mut report)?;
+    let (mesh, reference) = triangulation.lift(cloud, &mut report)?;
+    check_triangles(&mesh, &reference, &normals, beta_median, &mut report)?;
+    report.area = mesh.area();
+    Ok((mesh, report))
+}
 
-    // 1. Projection.
-    let all: Vec<u32> = (0..n as u32).collect();
-    let frame = fit_plane(cloud, &all);
-    let plane_normal = frame.normal;
-    report.plane_normal = plane_normal;
-    let origin = cloud[0];
-    let to2 = |p: Point3| {
-        let d = sub(p, origin);
-        [dot(d, frame.u), dot(d, frame.v)]
-    };
+/// Refuses what spade cannot take or no mesh can be made of: non-finite
+/// coordinates, coordinates beyond spade's range (checked before spade,
+/// which panics or refuses points there), fewer than 3 points, or a β
+/// count other than one per point.
+fn check_input(cloud: &[Point3], detection: &Detection) -> Result<(), MeshError> {
+    if let Some(index) = cloud.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+        return Err(MeshError::NonFinite { index });
+    }
+    crate::mesh::check_vertex_range(cloud)?;
+    if cloud.len() < 3 || detection.beta.len() != cloud.len() {
+        return Err(MeshError::NoFaces);
+    }
+    Ok(())
+}
 
-    // 2. Local normals, oriented to the plane normal's side.
+/// Step 1, **projection**: the cloud's best-fit plane, with (u, v)
+/// coordinates relative to the first point, which keeps precision for
+/// clouds far from the origin.
+struct Projection {
+    frame: Frame,
+    origin: Point3,
+}
+
+impl Projection {
+    /// The plane of all the points (PCA, [`fit_plane`]).
+    fn fit(cloud: &[Point3]) -> Self {
+        let all: Vec<u32> = (0..cloud.len() as u32).collect();
+        Projection {
+            frame: fit_plane(cloud, &all),
+            origin: cloud[0],
+        }
+    }
+
+    /// `p` in the plane's (u, v) coordinates.
+    fn to2(&self, p: Point3) -> [f64; 2] {
+        let d = sub(p, self.origin);
+        [dot(d, self.frame.u), dot(d, self.frame.v)]
+    }
+}
+
+/// Step 2, **local normals**: each point's normal fitted to its
+/// [`NORMAL_K`] nearest neighbours, oriented to the side `plane_normal`
+/// points to.
+fn local_normals(cloud: &[Point3], plane_normal: Point3) -> Vec<Point3> {
     let index = NeighbourIndex::new(cloud);
-    let normals: Vec<Point3> = (0..n)
+    (0..cloud.len())
         .into_par_iter()
         .map_init(Vec::new, |nb, i| {
             index.nearest(i, NORMAL_K, nb);
@@ -194,7 +235,20 @@ pub fn delaunay_mesh_with_report(
                 m
             }
         })
-        .collect();
+        .collect()
+}
+
+/// Step 2, **height-field check on the points**: where the surface stands
+/// on edge or folds over its plane, local normals turn perpendicular to
+/// the plane normal; more than [`STEEP_SHARE`] of them below
+/// [`STEEP_COS`] is [`MeshError::NotAHeightField`]. Fills
+/// `steep_normals_percent`.
+fn check_steep_normals(
+    normals: &[Point3],
+    plane_normal: Point3,
+    report: &mut DelaunayReport,
+) -> Result<(), MeshError> {
+    let n = normals.len();
     let steep = normals
         .iter()
         .filter(|m| dot(**m, plane_normal) < STEEP_COS)
@@ -207,170 +261,358 @@ pub fn delaunay_mesh_with_report(
             limit: 100.0 * STEEP_SHARE,
         });
     }
+    Ok(())
+}
 
-    if edges.loops.is_empty() {
-        return Err(MeshError::NoFaces);
-    }
-
-    // 3. Loops as clean 2D rings.
+/// Step 3, **loops made valid**: each smoothed loop as a ring projected
+/// onto the plane, coincident vertices merged, self-crossings untwisted
+/// ([`untwist`]); returns the rings and the grid of their segments. Fills
+/// `loop_vertices_merged` and `loop_vertices_dropped`.
+fn valid_rings(
+    edges: &Edges,
+    beta: &[f64],
+    beta_median: f64,
+    plane: &Projection,
+    report: &mut DelaunayReport,
+) -> Result<(Vec<Ring>, SegmentGrid), MeshError> {
     let mut rings: Vec<Ring> = edges
         .loops
         .iter()
         .map(|lp| Ring::from_loop(lp, beta))
         .collect();
     for ring in rings.iter_mut() {
-        ring.p2 = ring.p3.iter().map(|&p| to2(p)).collect();
+        ring.p2 = ring.p3.iter().map(|&p| plane.to2(p)).collect();
         report.loop_vertices_merged += ring.merge_coincident();
     }
-    let grid = untwist(&mut rings, beta_median, MAX_REPAIR, &mut report)?;
+    let grid = untwist(&mut rings, beta_median, MAX_REPAIR, report)?;
+    Ok((rings, grid))
+}
 
-    // 4. Which cloud points go in.
-    let class: Vec<u8> = (0..n)
+/// Where a cloud point lies relative to the loops (step 4).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum PointClass {
+    /// Inside the loops by parity and away from them: inserted.
+    Inside,
+    /// Within [`EXCLUDE`]·β of a loop: left out, the loop stands for the
+    /// border there.
+    NearLoop,
+    /// Beyond the outer border or in a hole.
+    Outside,
+}
+
+/// Step 4, **which points go in**: the cloud points inside the loops by
+/// parity and farther than [`EXCLUDE`]·βᵢ from every loop, as
+/// triangulation nodes in cloud order. Points next to a loop would only
+/// make slivers, or on it split the constraint and change the border's
+/// vertex sequence. Fills `points_near_loop` and `points_outside`.
+fn points_inside(
+    cloud: &[Point3],
+    beta: &[f64],
+    plane: &Projection,
+    grid: &SegmentGrid,
+    report: &mut DelaunayReport,
+) -> Vec<Node> {
+    let class: Vec<PointClass> = (0..cloud.len())
         .into_par_iter()
         .map(|i| {
-            let p = to2(cloud[i]);
+            let p = plane.to2(cloud[i]);
             if grid.near(p, EXCLUDE * beta[i]) {
-                1
+                PointClass::NearLoop
             } else if grid.parity(p) {
-                0
+                PointClass::Inside
             } else {
-                2
+                PointClass::Outside
             }
         })
         .collect();
-    report.points_near_loop = class.iter().filter(|&&c| c == 1).count();
-    report.points_outside = class.iter().filter(|&&c| c == 2).count();
-    let nodes: Vec<Node> = (0..n)
-        .filter(|&i| class[i] == 0)
-        .map(|i| Node::new(to2(cloud[i]), i as u32))
-        .collect();
-    let inserted = nodes.len();
+    let count = |c: PointClass| class.iter().filter(|&&k| k == c).count();
+    report.points_near_loop = count(PointClass::NearLoop);
+    report.points_outside = count(PointClass::Outside);
+    (0..cloud.len())
+        .filter(|&i| class[i] == PointClass::Inside)
+        .map(|i| Node::new(plane.to2(cloud[i]), i as u32))
+        .collect()
+}
 
-    // 5. Constrained Delaunay triangulation.
-    let mut cdt: Cdt = if nodes.is_empty() {
-        Cdt::new()
-    } else {
-        Cdt::bulk_load(nodes).map_err(|_| MeshError::NoFaces)?
-    };
-    report.points_merged = inserted - cdt.num_vertices();
-    let mut loop_p3: Vec<Point3> = Vec::new();
-    let mut loop_ref: Vec<u32> = Vec::new();
-    let mut loop_of: Vec<u32> = Vec::new();
-    // The outer borders first: the largest loop by area.
-    let mut order: Vec<usize> = (0..rings.len()).collect();
-    order.sort_by(|&a, &b| rings[b].area().abs().total_cmp(&rings[a].area().abs()));
-    let mut ring_handles = vec![Vec::new(); rings.len()];
-    for &l in &order {
-        let ring = &rings[l];
-        let mut hs = Vec::with_capacity(ring.p2.len());
+/// Step 5, the **constrained Delaunay triangulation** (spade, exact
+/// predicates) of the inserted points and the rings, with what its loop
+/// vertices stand for. Node ids: cloud points below n, loop vertex j at
+/// n + j.
+struct LoopCdt {
+    cdt: Cdt,
+    /// Number of cloud points.
+    n: usize,
+    /// Smoothed 3D position of each loop vertex.
+    loop_p3: Vec<Point3>,
+    /// The boundary point each loop vertex was smoothed from.
+    loop_ref: Vec<u32>,
+    /// The ring each loop vertex belongs to, to name it in errors.
+    loop_of: Vec<u32>,
+    /// Each ring's vertex handles, in ring order.
+    ring_handles: Vec<Vec<FixedVertexHandle>>,
+}
+
+impl LoopCdt {
+    /// Bulk-loads the `nodes`, then inserts every ring's vertices and adds
+    /// its segments as constraint edges, outer borders first. A ring vertex
+    /// or segment that meets another ring's (or its own) is an error, never
+    /// a panic in spade. Fills `points_merged` (nodes spade found
+    /// coincident, the first kept).
+    fn build(
+        nodes: Vec<Node>,
+        rings: &[Ring],
+        n: usize,
+        report: &mut DelaunayReport,
+    ) -> Result<Self, MeshError> {
+        let inserted = nodes.len();
+        let cdt: Cdt = if nodes.is_empty() {
+            Cdt::new()
+        } else {
+            Cdt::bulk_load(nodes).map_err(|_| MeshError::NoFaces)?
+        };
+        report.points_merged = inserted - cdt.num_vertices();
+        let mut t = LoopCdt {
+            cdt,
+            n,
+            loop_p3: Vec::new(),
+            loop_ref: Vec::new(),
+            loop_of: Vec::new(),
+            ring_handles: vec![Vec::new(); rings.len()],
+        };
+        for l in largest_first(rings) {
+            let handles = t.insert_ring_vertices(l, &rings[l])?;
+            t.constrain_ring(l, rings[l].len(), &handles)?;
+            t.ring_handles[l] = handles;
+        }
+        Ok(t)
+    }
+
+    /// Inserts the vertices of ring `l`, refusing one that lands on an
+    /// existing vertex or on a constraint edge; returns their handles.
+    fn insert_ring_vertices(
+        &mut self,
+        l: usize,
+        ring: &Ring,
+    ) -> Result<Vec<FixedVertexHandle>, MeshError> {
+        let mut handles = Vec::with_capacity(ring.p2.len());
         for j in 0..ring.p2.len() {
-            let id = (n + loop_p3.len()) as u32;
+            let id = (self.n + self.loop_p3.len()) as u32;
             let position = point(ring.p2[j]);
-            match cdt.locate(position) {
+            match self.cdt.locate(position) {
                 PositionInTriangulation::OnVertex(h) => {
-                    return Err(crossing(
-                        l,
-                        ring.len(),
-                        cdt.vertex(h).data().id,
-                        n,
-                        &loop_of,
-                    ));
+                    let other = self.cdt.vertex(h).data().id;
+                    return Err(self.crossing(l, ring.len(), other));
                 }
-                PositionInTriangulation::OnEdge(e) if cdt.is_constraint_edge(e.as_undirected()) => {
-                    let other = cdt.directed_edge(e).from().data().id;
-                    return Err(crossing(l, ring.len(), other, n, &loop_of));
+                PositionInTriangulation::OnEdge(e)
+                    if self.cdt.is_constraint_edge(e.as_undirected()) =>
+                {
+                    let other = self.cdt.directed_edge(e).from().data().id;
+                    return Err(self.crossing(l, ring.len(), other));
                 }
                 _ => {}
             }
-            let h = cdt
+            let h = self
+                .cdt
                 .insert(Node::new(ring.p2[j], id))
                 .map_err(|_| MeshError::NonFinite { index: 0 })?;
-            loop_p3.push(ring.p3[j]);
-            loop_ref.push(ring.reference[j]);
-            loop_of.push(l as u32);
-            hs.push(h);
+            self.loop_p3.push(ring.p3[j]);
+            self.loop_ref.push(ring.reference[j]);
+            self.loop_of.push(l as u32);
+            handles.push(h);
         }
-        let m = hs.len();
-        for j in 0..m {
-            let (a, b) = (hs[j], hs[(j + 1) % m]);
-            if let Some(other) = obstacle(&cdt, a, b) {
-                return Err(crossing(l, ring.len(), other, n, &loop_of));
-            }
-            cdt.add_constraint(a, b);
-        }
-        ring_handles[l] = hs;
+        Ok(handles)
     }
 
-    // 6. Kept faces, co-circular quads made canonical, lifted.
-    let kept = inside_faces(&cdt);
-    let mut out_index = vec![u32::MAX; n + loop_p3.len()];
-    let mut faces_ids: Vec<[u32; 3]> = Vec::with_capacity(kept.len());
-    let mut positions = HashMap::new();
-    for f in kept {
-        let face = cdt.face(f);
-        let vs = face.vertices();
-        let mut ids = vs.map(|v| v.data().id);
-        let p = vs.map(|v| v.position());
-        let orient = (p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[1].y - p[0].y) * (p[2].x - p[0].x);
-        if orient < 0.0 {
-            ids.swap(1, 2);
+    /// Adds the closed polyline through `handles` (ring `l`, of `vertices`
+    /// vertices) as constraint edges, checking each first with exact
+    /// predicates: spade panics on crossing constraints.
+    fn constrain_ring(
+        &mut self,
+        l: usize,
+        vertices: usize,
+        handles: &[FixedVertexHandle],
+    ) -> Result<(), MeshError> {
+        let m = handles.len();
+        for j in 0..m {
+            let (a, b) = (handles[j], handles[(j + 1) % m]);
+            if let Some(other) = obstacle(&self.cdt, a, b) {
+                return Err(self.crossing(l, vertices, other));
+            }
+            self.cdt.add_constraint(a, b);
         }
-        faces_ids.push(ids);
-        for (id, p) in vs.map(|v| v.data().id).into_iter().zip(p) {
-            out_index[id as usize] = 0;
-            positions.insert(id, [p.x, p.y]);
+        Ok(())
+    }
+
+    /// The error for ring `l` meeting the vertex `other` ([`crossing`]).
+    fn crossing(&self, l: usize, vertices: usize, other: u32) -> MeshError {
+        crossing(l, vertices, other, self.n, &self.loop_of)
+    }
+
+    /// Step 6, **kept faces, lifted**: the odd faces ([`inside_faces`]),
+    /// counter-clockwise seen from the plane normal's side, co-circular
+    /// quads given their canonical diagonal ([`diagonals`]) and listed in
+    /// the order of their ids, so that moving the cloud, which rounds its
+    /// coordinates, changes nothing. Lifted back to 3D: cloud points keep
+    /// their exact coordinates, loop vertices take their smoothed 3D
+    /// positions. Returns the mesh and, per vertex, the cloud point it is
+    /// or was smoothed from. Fills `diagonals_flipped`, `points_used` and
+    /// `loops`.
+    fn lift(
+        &self,
+        cloud: &[Point3],
+        report: &mut DelaunayReport,
+    ) -> Result<(Mesh, Vec<u32>), MeshError> {
+        let KeptFaces {
+            mut faces,
+            positions,
+            used,
+        } = self.kept_faces();
+        report.diagonals_flipped =
+            canonical_diagonals(&positions, &mut faces, &self.constraint_pairs());
+        sort_faces(&mut faces);
+        let (out_index, vertices, reference) = self.number_vertices(cloud, &used);
+        report.points_used = out_index[..self.n]
+            .iter()
+            .filter(|&&s| s != u32::MAX)
+            .count();
+        let mesh = Mesh {
+            vertices,
+            faces: faces
+                .iter()
+                .map(|f| f.map(|id| out_index[id as usize]))
+                .collect(),
+        };
+        report.loops = self.ring_vertices(&out_index);
+        mesh.validate()?;
+        Ok((mesh, reference))
+    }
+
+    /// Each ring's vertices as output numbers, in ring order.
+    fn ring_vertices(&self, out_index: &[u32]) -> Vec<Vec<u32>> {
+        self.ring_handles
+            .iter()
+            .map(|hs| {
+                hs.iter()
+                    .map(|&h| out_index[self.cdt.vertex(h).data().id as usize])
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// The odd faces, counter-clockwise.
+    fn kept_faces(&self) -> KeptFaces {
+        let kept = inside_faces(&self.cdt);
+        let mut faces: Vec<[u32; 3]> = Vec::with_capacity(kept.len());
+        let mut positions = HashMap::new();
+        let mut used = vec![false; self.n + self.loop_p3.len()];
+        for f in kept {
+            let vs = self.cdt.face(f).vertices();
+            let mut ids = vs.map(|v| v.data().id);
+            let p = vs.map(|v| v.position());
+            let orient =
+                (p[1].x - p[0].x) * (p[2].y - p[0].y) - (p[1].y - p[0].y) * (p[2].x - p[0].x);
+            if orient < 0.0 {
+                ids.swap(1, 2);
+            }
+            faces.push(ids);
+            for (id, p) in vs.map(|v| v.data().id).into_iter().zip(p) {
+                used[id as usize] = true;
+                positions.insert(id, [p.x, p.y]);
+            }
+        }
+        KeptFaces {
+            faces,
+            positions,
+            used,
         }
     }
-    let constraints: HashSet<[u32; 2]> = ring_handles
-        .iter()
-        .flat_map(|hs| {
-            (0..hs.len()).map(|j| {
-                let [a, b] = [hs[j], hs[(j + 1) % hs.len()]].map(|h| cdt.vertex(h).data().id);
-                [a.min(b), a.max(b)]
+
+    /// The rings' segments as id pairs, smaller id first: diagonals that
+    /// are constraints never flip.
+    fn constraint_pairs(&self) -> HashSet<[u32; 2]> {
+        self.ring_handles
+            .iter()
+            .flat_map(|hs| {
+                (0..hs.len()).map(|j| {
+                    let [a, b] =
+                        [hs[j], hs[(j + 1) % hs.len()]].map(|h| self.cdt.vertex(h).data().id);
+                    [a.min(b), a.max(b)]
+                })
             })
-        })
-        .collect();
-    report.diagonals_flipped = canonical_diagonals(&positions, &mut faces_ids, &constraints);
-    // Faces in an order of their own ids (the triangulation's internal
-    // order depends on its history), each starting at its lowest id.
-    for f in faces_ids.iter_mut() {
+            .collect()
+    }
+
+    /// Output numbers for the `used` ids, in id order (so cloud points in
+    /// cloud order, then loop vertices): returns, per id, its output number
+    /// (u32::MAX if unused), and the output vertices with the cloud points
+    /// they are or were smoothed from.
+    fn number_vertices(
+        &self,
+        cloud: &[Point3],
+        used: &[bool],
+    ) -> (Vec<u32>, Vec<Point3>, Vec<u32>) {
+        let n = self.n;
+        let mut out_index = vec![u32::MAX; used.len()];
+        let mut vertices = Vec::new();
+        let mut reference = Vec::new();
+        for (id, slot) in out_index.iter_mut().enumerate() {
+            if used[id] {
+                *slot = vertices.len() as u32;
+                if id < n {
+                    vertices.push(cloud[id]);
+                    reference.push(id as u32);
+                } else {
+                    vertices.push(self.loop_p3[id - n]);
+                    reference.push(self.loop_ref[id - n]);
+                }
+            }
+        }
+        (out_index, vertices, reference)
+    }
+}
+
+/// The faces step 6 keeps, before their diagonals are made canonical.
+struct KeptFaces {
+    /// Counter-clockwise id triples.
+    faces: Vec<[u32; 3]>,
+    /// The 2D position of every id they use.
+    positions: HashMap<u32, [f64; 2]>,
+    /// Per id, whether they use it.
+    used: Vec<bool>,
+}
+
+/// Ring indices, the largest by area first: the outer borders go in
+/// before the holes they hold.
+fn largest_first(rings: &[Ring]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..rings.len()).collect();
+    order.sort_by(|&a, &b| rings[b].area().abs().total_cmp(&rings[a].area().abs()));
+    order
+}
+
+/// Faces in an order of their own ids (the triangulation's internal
+/// order depends on its history), each starting at its lowest id.
+fn sort_faces(faces: &mut [[u32; 3]]) {
+    for f in faces.iter_mut() {
         let first = (0..3).min_by_key(|&k| f[k]).unwrap_or(0);
         f.rotate_left(first);
     }
-    faces_ids.sort_unstable();
-    let mut vertices = Vec::new();
-    let mut reference = Vec::new();
-    for (id, slot) in out_index.iter_mut().enumerate() {
-        if *slot == 0 {
-            *slot = vertices.len() as u32;
-            if id < n {
-                vertices.push(cloud[id]);
-                reference.push(id as u32);
-            } else {
-                vertices.push(loop_p3[id - n]);
-                reference.push(loop_ref[id - n]);
-            }
-        }
-    }
-    report.points_used = out_index[..n].iter().filter(|&&s| s != u32::MAX).count();
-    let mesh = Mesh {
-        vertices,
-        faces: faces_ids
-            .iter()
-            .map(|f| f.map(|id| out_index[id as usize]))
-            .collect(),
-    };
-    report.loops = ring_handles
-        .iter()
-        .map(|hs| {
-            hs.iter()
-                .map(|&h| out_index[cdt.vertex(h).data().id as usize])
-                .collect()
-        })
-        .collect();
-    mesh.validate()?;
+    faces.sort_unstable();
+}
 
-    // 7. Triangles against the local normals; degenerate faces.
+/// Step 7, **height-field check on the triangles**: a lifted
+/// counter-clockwise triangle can never be flipped relative to the plane
+/// normal, so folds show instead as triangles joining the overlapping
+/// sheets, steep to the surface. More than [`MISFIT_SHARE`] of misfits
+/// ([`is_misfit`]) is [`MeshError::NotAHeightField`]. Fills
+/// `degenerate_faces` (below [`DEGENERATE`]·β², counted, not removed) and
+/// `misfit_triangles_percent`.
+fn check_triangles(
+    mesh: &Mesh,
+    reference: &[u32],
+    normals: &[Point3],
+    beta_median: f64,
+    report: &mut DelaunayReport,
+) -> Result<(), MeshError> {
     let mut misfits = 0;
     for face in &mesh.faces {
         let [a, b, c] = face.map(|v| mesh.vertices[v as usize]);
@@ -379,16 +621,9 @@ pub fn delaunay_mesh_with_report(
         if 0.5 * len <= DEGENERATE * beta_median * beta_median {
             report.degenerate_faces += 1;
         }
-        if len == 0.0 {
-            misfits += 1;
-            continue;
-        }
-        let fit: f64 = face
-            .iter()
-            .map(|&v| dot(nt, normals[reference[v as usize] as usize]).abs() / len)
-            .sum::<f64>()
-            / 3.0;
-        if fit < MISFIT_COS {
+        // The local normals of the points the face's vertices stand for.
+        let vertex_normals = face.map(|v| normals[reference[v as usize] as usize]);
+        if is_misfit(nt, len, vertex_normals) {
             misfits += 1;
         }
     }
@@ -400,8 +635,22 @@ pub fn delaunay_mesh_with_report(
             limit: 100.0 * MISFIT_SHARE,
         });
     }
-    report.area = mesh.area();
-    Ok((mesh, report))
+    Ok(())
+}
+
+/// Does a triangle with normal `nt` (unnormalised, of length `len`) not
+/// follow the surface: a mean |n_t·nᵥ| over its vertices' local normals
+/// below [`MISFIT_COS`]? A zero-area triangle counts as one.
+fn is_misfit(nt: Point3, len: f64, vertex_normals: [Point3; 3]) -> bool {
+    if len == 0.0 {
+        return true;
+    }
+    let fit: f64 = vertex_normals
+        .iter()
+        .map(|&m| dot(nt, m).abs() / len)
+        .sum::<f64>()
+        / 3.0;
+    fit < MISFIT_COS
 }
 
 pub(crate) type Cdt = ConstrainedDelaunayTriangulation<Node>;

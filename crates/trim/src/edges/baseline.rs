@@ -374,7 +374,7 @@ struct SplineSystem {
     /// Inverse weights: 0 at the pinned ends, 1 elsewhere.
     dinv: Vec<f64>,
     /// Nonzeros of each row of Q: (column, value).
-    q_rows: Vec<Vec<(usize, f64)>>,
+    q_rows: SparseRows,
     /// Qᵀ y, one row per column of Q.
     qty: Vec<[f64; 3]>,
     /// R and Qᵀ W⁻¹ Q in the same envelope.
@@ -383,90 +383,19 @@ struct SplineSystem {
 }
 
 impl SplineSystem {
+    /// The system of `points` (at least [`MIN_POINTS`], finite); None when
+    /// the edge has no finite, nonzero length.
     fn new(points: &[Point3], closed: bool) -> Option<Self> {
         let n = points.len();
         let (t, total) = chord_parameter(points, closed)?;
-        let segments = if closed { n } else { n - 1 };
-        let floor = 1e-3 / segments as f64;
-        let mut h: Vec<f64> = (0..segments)
-            .map(|i| {
-                let next = if i + 1 < n { t[i + 1] } else { total };
-                ((next - t[i]) / total).max(floor)
-            })
-            .collect();
-        let sum: f64 = h.iter().sum();
-        for v in &mut h {
-            *v /= sum;
-        }
-        let mut tau = Vec::with_capacity(n);
-        let mut acc = 0.0;
-        for i in 0..n {
-            tau.push(acc);
-            if i < h.len() {
-                acc += h[i];
-            }
-        }
-        let mut dinv = vec![1.0; n];
-        if !closed {
-            dinv[0] = 0.0;
-            dinv[n - 1] = 0.0;
-        }
-        // Columns of Q: one per knot with a second derivative (interior
-        // knots when open, every knot when closed).
-        let cols = if closed { n } else { n - 2 };
-        let knot = |c: usize| if closed { c } else { c + 1 };
-        let mut q_rows: Vec<Vec<(usize, f64)>> = vec![Vec::with_capacity(3); n];
-        let mut r_entries: Vec<(usize, usize, f64)> = Vec::with_capacity(2 * cols);
-        for c in 0..cols {
-            let j = knot(c);
-            let (jm, jp) = ((j + n - 1) % n, (j + 1) % n);
-            let (hm, hj) = (h[(j + segments - 1) % segments], h[j % segments]);
-            q_rows[jm].push((c, 1.0 / hm));
-            q_rows[j].push((c, -1.0 / hm - 1.0 / hj));
-            q_rows[jp].push((c, 1.0 / hj));
-            r_entries.push((c, c, (hm + hj) / 3.0));
-            let next = if closed {
-                Some((c + 1) % cols)
-            } else {
-                (c + 1 < cols).then_some(c + 1)
-            };
-            if let Some(c2) = next {
-                r_entries.push((c.max(c2), c.min(c2), hj / 6.0));
-            }
-        }
-        let mut qdq_entries: Vec<(usize, usize, f64)> = Vec::with_capacity(9 * n);
-        for (row, &d) in q_rows.iter().zip(&dinv) {
-            if d == 0.0 {
-                continue;
-            }
-            for &(a, va) in row {
-                for &(b, vb) in row {
-                    if a >= b {
-                        qdq_entries.push((a, b, d * va * vb));
-                    }
-                }
-            }
-        }
-        let mut first: Vec<usize> = (0..cols).collect();
-        for &(i, j, _) in r_entries.iter().chain(&qdq_entries) {
-            first[i] = first[i].min(j);
-        }
-        let mut r = Skyline::with_first(first.clone());
-        let mut qdq = Skyline::with_first(first);
-        for &(i, j, v) in &r_entries {
-            r.add(i, j, v);
-        }
-        for &(i, j, v) in &qdq_entries {
-            qdq.add(i, j, v);
-        }
-        let mut qty = vec![[0.0; 3]; cols];
-        for (row, p) in q_rows.iter().zip(points) {
-            for &(c, v) in row {
-                for k in 0..3 {
-                    qty[c][k] += v * p[k];
-                }
-            }
-        }
+        let h = parameter_steps(&t, total, closed);
+        let tau = knots(&h, n);
+        let dinv = inverse_weights(n, closed);
+        let cols = q_columns(n, closed);
+        let (q_rows, r_entries) = second_differences(&h, n, closed);
+        let qdq_entries = weighted_gram(&q_rows, &dinv);
+        let (r, qdq) = shared_envelope(cols, &r_entries, &qdq_entries);
+        let qty = q_transpose_times(&q_rows, points, cols);
         Some(Self {
             closed,
             y: points.to_vec(),
@@ -566,6 +495,147 @@ impl SplineSystem {
             sum / count as f64
         }
     }
+}
+
+/// Lower-triangle entries (row, column, value), row ≥ column, of a
+/// symmetric matrix, to be summed into a [`Skyline`].
+type Entries = Vec<(usize, usize, f64)>;
+
+/// Nonzeros of each row of Q: (column, value).
+type SparseRows = Vec<Vec<(usize, f64)>>;
+
+/// Number of columns of Q: one per knot with a second derivative
+/// (interior knots when open, every knot when closed).
+fn q_columns(n: usize, closed: bool) -> usize {
+    if closed {
+        n
+    } else {
+        n - 2
+    }
+}
+
+/// The parameter steps from the cumulative chord length `t` (of `total`
+/// length), each at least 10⁻³ of the mean step, so that duplicate points
+/// do not make the system singular, then normalised to sum 1; closed, the
+/// last step closes the loop.
+fn parameter_steps(t: &[f64], total: f64, closed: bool) -> Vec<f64> {
+    let n = t.len();
+    let segments = if closed { n } else { n - 1 };
+    let floor = 1e-3 / segments as f64;
+    let mut h: Vec<f64> = (0..segments)
+        .map(|i| {
+            let next = if i + 1 < n { t[i + 1] } else { total };
+            ((next - t[i]) / total).max(floor)
+        })
+        .collect();
+    let sum: f64 = h.iter().sum();
+    for v in &mut h {
+        *v /= sum;
+    }
+    h
+}
+
+/// The `n` knots τ: the cumulative steps `h`, from 0.
+fn knots(h: &[f64], n: usize) -> Vec<f64> {
+    let mut tau = Vec::with_capacity(n);
+    let mut acc = 0.0;
+    for i in 0..n {
+        tau.push(acc);
+        if i < h.len() {
+            acc += h[i];
+        }
+    }
+    tau
+}
+
+/// The inverse weights W⁻¹: 0 at the ends of an open edge, which are
+/// pinned (infinite weight), 1 elsewhere.
+fn inverse_weights(n: usize, closed: bool) -> Vec<f64> {
+    let mut dinv = vec![1.0; n];
+    if !closed {
+        dinv[0] = 0.0;
+        dinv[n - 1] = 0.0;
+    }
+    dinv
+}
+
+/// The rows of the second-difference matrix Q (n rows, one column per
+/// knot with a second derivative) and the entries of the Gram matrix R of
+/// those second derivatives: tridiagonal, cyclic when `closed`.
+fn second_differences(h: &[f64], n: usize, closed: bool) -> (SparseRows, Entries) {
+    let segments = h.len();
+    let cols = q_columns(n, closed);
+    let knot = |c: usize| if closed { c } else { c + 1 };
+    let mut q_rows: SparseRows = vec![Vec::with_capacity(3); n];
+    let mut r_entries: Entries = Vec::with_capacity(2 * cols);
+    for c in 0..cols {
+        let j = knot(c);
+        let (jm, jp) = ((j + n - 1) % n, (j + 1) % n);
+        let (hm, hj) = (h[(j + segments - 1) % segments], h[j % segments]);
+        q_rows[jm].push((c, 1.0 / hm));
+        q_rows[j].push((c, -1.0 / hm - 1.0 / hj));
+        q_rows[jp].push((c, 1.0 / hj));
+        r_entries.push((c, c, (hm + hj) / 3.0));
+        let next = if closed {
+            Some((c + 1) % cols)
+        } else {
+            (c + 1 < cols).then_some(c + 1)
+        };
+        if let Some(c2) = next {
+            r_entries.push((c.max(c2), c.min(c2), hj / 6.0));
+        }
+    }
+    (q_rows, r_entries)
+}
+
+/// The entries of Qᵀ W⁻¹ Q, row by row of Q (the pinned rows, of weight
+/// 0, add nothing).
+fn weighted_gram(q_rows: &SparseRows, dinv: &[f64]) -> Entries {
+    let mut qdq_entries: Entries = Vec::with_capacity(9 * q_rows.len());
+    for (row, &d) in q_rows.iter().zip(dinv) {
+        if d == 0.0 {
+            continue;
+        }
+        for &(a, va) in row {
+            for &(b, vb) in row {
+                if a >= b {
+                    qdq_entries.push((a, b, d * va * vb));
+                }
+            }
+        }
+    }
+    qdq_entries
+}
+
+/// R and Qᵀ W⁻¹ Q, `cols` × `cols`, in the same envelope (the one both
+/// need), so that R + λ Qᵀ W⁻¹ Q is a sum of their data.
+fn shared_envelope(cols: usize, r_entries: &Entries, qdq_entries: &Entries) -> (Skyline, Skyline) {
+    let mut first: Vec<usize> = (0..cols).collect();
+    for &(i, j, _) in r_entries.iter().chain(qdq_entries) {
+        first[i] = first[i].min(j);
+    }
+    let mut r = Skyline::with_first(first.clone());
+    let mut qdq = Skyline::with_first(first);
+    for &(i, j, v) in r_entries {
+        r.add(i, j, v);
+    }
+    for &(i, j, v) in qdq_entries {
+        qdq.add(i, j, v);
+    }
+    (r, qdq)
+}
+
+/// Qᵀ y for the three components, one row per column of Q (`cols`).
+fn q_transpose_times(q_rows: &SparseRows, points: &[Point3], cols: usize) -> Vec<[f64; 3]> {
+    let mut qty = vec![[0.0; 3]; cols];
+    for (row, p) in q_rows.iter().zip(points) {
+        for &(c, v) in row {
+            for k in 0..3 {
+                qty[c][k] += v * p[k];
+            }
+        }
+    }
+    qty
 }
 
 #[cfg(test)]

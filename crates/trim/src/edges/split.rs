@@ -47,12 +47,22 @@ pub fn split_at_jumps(
     links: &[[u32; 2]],
     tour: Vec<u32>,
 ) -> (Vec<Vec<u32>>, usize) {
-    let n = tour.len();
     let ok = |a: u32, b: u32| supported(points, beta, links, a, b);
-    let Some(first_jump) = (0..n).find(|&k| !ok(tour[k], tour[(k + 1) % n])) else {
+    let Some(pieces) = cut_at_jumps(&tour, ok) else {
         return (vec![tour], 0);
     };
-    // Pieces: maximal runs of supported steps, starting after a jump.
+    let partner = join_ends(points, &pieces, ok);
+    let (mut loops, open) = follow_chains(&pieces, &partner);
+    let unclosed = close_open_chains(points, links, open, &mut loops);
+    let (kept, shadowed) = drop_shadowed_loops(points, beta, loops);
+    (kept, unclosed + shadowed)
+}
+
+/// The pieces of `tour`: maximal runs of supported steps, each starting
+/// after a jump. None if the tour has no jump.
+fn cut_at_jumps(tour: &[u32], ok: impl Fn(u32, u32) -> bool) -> Option<Vec<Vec<u32>>> {
+    let n = tour.len();
+    let first_jump = (0..n).find(|&k| !ok(tour[k], tour[(k + 1) % n]))?;
     let mut pieces: Vec<Vec<u32>> = Vec::new();
     let mut current = Vec::new();
     for j in 1..=n {
@@ -62,42 +72,29 @@ pub fn split_at_jumps(
             pieces.push(std::mem::take(&mut current));
         }
     }
-    // End e = 2·piece + side (0: first point, 1: last point).
-    let end_point = |e: usize| {
-        let p = &pieces[e / 2];
-        if e & 1 == 0 {
-            p[0]
-        } else {
-            p[p.len() - 1]
-        }
-    };
-    let ends = 2 * pieces.len();
-    let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
-    for e in 0..ends {
-        for f in e + 1..ends {
-            // A one-point piece does not close on itself.
-            if f == e + 1 && e & 1 == 0 && pieces[e / 2].len() == 1 {
-                continue;
-            }
-            let (a, b) = (end_point(e), end_point(f));
-            if ok(a, b) {
-                pairs.push((dist2(points[a as usize], points[b as usize]), e, f));
-            }
-        }
+    Some(pieces)
+}
+
+/// The point at piece end `e`: ends are numbered 2·piece + side (0: first
+/// point, 1: last point).
+fn end_point(pieces: &[Vec<u32>], e: usize) -> u32 {
+    let p = &pieces[e / 2];
+    if e & 1 == 0 {
+        p[0]
+    } else {
+        p[p.len() - 1]
     }
-    pairs.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2)));
-    let mut partner = vec![usize::MAX; ends];
+}
+
+/// Joins the pieces' ends by supported steps, nearest pair first; an end
+/// joins at most one other end, and a chain of pieces closes at most
+/// once. Returns each end's partner (usize::MAX for a free end).
+fn join_ends(points: &[Point3], pieces: &[Vec<u32>], ok: impl Fn(u32, u32) -> bool) -> Vec<usize> {
+    let mut partner = vec![usize::MAX; 2 * pieces.len()];
     let mut closed = vec![false; pieces.len()];
-    // Chains as union–find over pieces; a chain closes at most once.
+    // Chains as union–find over pieces.
     let mut parent: Vec<usize> = (0..pieces.len()).collect();
-    fn root(parent: &mut [usize], mut i: usize) -> usize {
-        while parent[i] != i {
-            parent[i] = parent[parent[i]];
-            i = parent[i];
-        }
-        i
-    }
-    for &(_, e, f) in &pairs {
+    for (e, f) in supported_end_pairs(points, pieces, ok) {
         if partner[e] != usize::MAX || partner[f] != usize::MAX {
             continue;
         }
@@ -116,41 +113,58 @@ pub fn split_at_jumps(
         partner[e] = f;
         partner[f] = e;
     }
-    // Walk each chain from a free end (open) or from any end (closed).
+    partner
+}
+
+/// The pairs of piece ends (e < f) joined by a supported step, nearest
+/// first (ties by e, then f).
+fn supported_end_pairs(
+    points: &[Point3],
+    pieces: &[Vec<u32>],
+    ok: impl Fn(u32, u32) -> bool,
+) -> Vec<(usize, usize)> {
+    let ends = 2 * pieces.len();
+    let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
+    for e in 0..ends {
+        for f in e + 1..ends {
+            // A one-point piece does not close on itself.
+            if f == e + 1 && e & 1 == 0 && pieces[e / 2].len() == 1 {
+                continue;
+            }
+            let (a, b) = (end_point(pieces, e), end_point(pieces, f));
+            if ok(a, b) {
+                pairs.push((dist2(points[a as usize], points[b as usize]), e, f));
+            }
+        }
+    }
+    pairs.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2)));
+    pairs.into_iter().map(|(_, e, f)| (e, f)).collect()
+}
+
+/// The union–find root of piece `i`, halving the path on the way.
+fn root(parent: &mut [usize], mut i: usize) -> usize {
+    while parent[i] != i {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    i
+}
+
+/// The chains of joined pieces: the closed ones of at least
+/// [`MIN_LOOP_POINTS`] points as loops (canonical), the others as open
+/// chains, those with a free end first, walked from it.
+fn follow_chains(pieces: &[Vec<u32>], partner: &[usize]) -> (Vec<Vec<u32>>, Vec<Vec<u32>>) {
     let mut visited = vec![false; pieces.len()];
     let mut loops = Vec::new();
-    let mut dropped = 0;
-    let walk = |start: usize, visited: &mut [bool]| -> (Vec<u32>, bool) {
-        let mut chain = Vec::new();
-        let mut e = start;
-        loop {
-            let piece = e / 2;
-            visited[piece] = true;
-            if e & 1 == 0 {
-                chain.extend_from_slice(&pieces[piece]);
-            } else {
-                chain.extend(pieces[piece].iter().rev());
-            }
-            let next = partner[e ^ 1];
-            if next == usize::MAX {
-                return (chain, false);
-            }
-            if next == start || visited[next / 2] {
-                return (chain, true);
-            }
-            e = next;
-        }
-    };
     let mut open = Vec::new();
-    for e in 0..ends {
-        // Open chains first, from their free end.
+    for e in 0..partner.len() {
         if partner[e] == usize::MAX && !visited[e / 2] {
-            open.push(walk(e, &mut visited).0);
+            open.push(walk_chain(pieces, partner, e, &mut visited).0);
         }
     }
     for p in 0..pieces.len() {
         if !visited[p] {
-            let (chain, closed) = walk(2 * p, &mut visited);
+            let (chain, closed) = walk_chain(pieces, partner, 2 * p, &mut visited);
             if closed && chain.len() >= MIN_LOOP_POINTS {
                 loops.push(canonical(chain));
             } else {
@@ -158,23 +172,55 @@ pub fn split_at_jumps(
             }
         }
     }
-    // Open chains, longest first, are closed along the links through
-    // points no loop holds yet.
-    let mut used: HashSet<u32> = loops.iter().flatten().copied().collect();
-    let mut adjacency: HashMap<u32, Vec<u32>> = HashMap::new();
-    for &[a, b] in links {
-        adjacency.entry(a).or_default().push(b);
-        adjacency.entry(b).or_default().push(a);
+    (loops, open)
+}
+
+/// The points of the chain that starts at piece end `start`, marking its
+/// pieces `visited`, and whether it closes.
+fn walk_chain(
+    pieces: &[Vec<u32>],
+    partner: &[usize],
+    start: usize,
+    visited: &mut [bool],
+) -> (Vec<u32>, bool) {
+    let mut chain = Vec::new();
+    let mut e = start;
+    loop {
+        let piece = e / 2;
+        visited[piece] = true;
+        if e & 1 == 0 {
+            chain.extend_from_slice(&pieces[piece]);
+        } else {
+            chain.extend(pieces[piece].iter().rev());
+        }
+        let next = partner[e ^ 1];
+        if next == usize::MAX {
+            return (chain, false);
+        }
+        if next == start || visited[next / 2] {
+            return (chain, true);
+        }
+        e = next;
     }
+}
+
+/// Closes the `open` chains, longest first, along the links through
+/// points no loop holds yet ([`peel_cycle`]), adding the cycles to
+/// `loops`; returns the number of chains dropped because they could not
+/// close.
+fn close_open_chains(
+    points: &[Point3],
+    links: &[[u32; 2]],
+    mut open: Vec<Vec<u32>>,
+    loops: &mut Vec<Vec<u32>>,
+) -> usize {
+    let mut dropped = 0;
+    let mut used: HashSet<u32> = loops.iter().flatten().copied().collect();
+    let adjacency = link_adjacency(links);
     // Longest first (popped from the end).
     open.sort_by(|x, y| x.len().cmp(&y.len()).then(y.cmp(x)));
     while let Some(chain) = open.pop() {
-        // The runs of the chain that no loop took meanwhile.
-        let runs: Vec<Vec<u32>> = chain
-            .split(|p| used.contains(p))
-            .filter(|run| run.len() >= 2)
-            .map(<[u32]>::to_vec)
-            .collect();
+        let runs = unclaimed_runs(&chain, &used);
         if runs.len() != 1 {
             dropped += usize::from(runs.is_empty());
             open.extend(runs);
@@ -192,11 +238,41 @@ pub fn split_at_jumps(
             None => dropped += 1,
         }
     }
-    // A loop that runs within 3β of longer loops all along is a parallel
-    // copy of their border (a cycle inside a thick band of boundary
-    // points), not a border of its own.
+    dropped
+}
+
+/// Each point's neighbours along the links.
+fn link_adjacency(links: &[[u32; 2]]) -> HashMap<u32, Vec<u32>> {
+    let mut adjacency: HashMap<u32, Vec<u32>> = HashMap::new();
+    for &[a, b] in links {
+        adjacency.entry(a).or_default().push(b);
+        adjacency.entry(b).or_default().push(a);
+    }
+    adjacency
+}
+
+/// The runs of at least 2 points of `chain` that no loop took meanwhile
+/// (not `used`).
+fn unclaimed_runs(chain: &[u32], used: &HashSet<u32>) -> Vec<Vec<u32>> {
+    chain
+        .split(|p| used.contains(p))
+        .filter(|run| run.len() >= 2)
+        .map(<[u32]>::to_vec)
+        .collect()
+}
+
+/// Drops, longest first, each loop that runs within 3β of longer loops all
+/// along: a parallel copy of their border (a cycle inside a thick band of
+/// boundary points), not a border of its own. Returns the loops kept, in
+/// sorted order, and the number dropped.
+fn drop_shadowed_loops(
+    points: &[Point3],
+    beta: &[f64],
+    mut loops: Vec<Vec<u32>>,
+) -> (Vec<Vec<u32>>, usize) {
     loops.sort_by(|x, y| y.len().cmp(&x.len()).then(x.cmp(y)));
     let mut kept: Vec<Vec<u32>> = Vec::new();
+    let mut dropped = 0;
     for ring in loops {
         let shadowed = ring.iter().all(|&p| {
             kept.iter()
