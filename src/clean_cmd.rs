@@ -58,6 +58,9 @@ pub struct Report {
     pub faces_in: usize,
     /// Input faces that named a vertex twice (no area), dropped.
     pub slivers_dropped: usize,
+    /// Input faces that repeated an earlier one (same corners, same turn),
+    /// dropped.
+    pub repeated_faces_dropped: usize,
     /// Input faces removed in the border bands.
     pub faces_removed: usize,
     /// New faces.
@@ -168,6 +171,7 @@ impl Report {
                 .collect(),
             faces_in: r.faces_in,
             slivers_dropped: r.slivers_dropped,
+            repeated_faces_dropped: r.repeated_faces_dropped,
             faces_removed: r.faces_removed,
             faces_added: r.faces_added,
             faces_out: r.faces_out,
@@ -229,6 +233,18 @@ impl crate::report::Table for Report {
             ("write time", format!("{:.1} ms", self.write_ms)),
             ("output", self.output.clone()),
         ];
+        if self.repeated_faces_dropped > 0 {
+            rows.insert(
+                3,
+                (
+                    "repeats dropped",
+                    format!(
+                        "{} (faces written twice, same turn)",
+                        self.repeated_faces_dropped
+                    ),
+                ),
+            );
+        }
         if self.slivers_dropped > 0 {
             rows.insert(
                 3,

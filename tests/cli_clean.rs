@@ -221,27 +221,28 @@ fn a_closed_mesh_is_written_unchanged_and_reports_no_new_angle() {
     assert!(stdout.contains("none (no new faces)"), "{stdout}");
 }
 
-/// A binary STL sliver whose two corners coincide (one face naming a vertex
-/// twice once the reader merges them) is dropped and counted; the rest is
-/// cleaned to the same bytes as the file without it.
-#[test]
-fn an_stl_sliver_with_two_equal_corners_is_dropped_and_counted() {
-    let dir = tempfile::tempdir().unwrap();
+/// The fixture with `extra` binary STL triangles appended, written to
+/// `dir/name`; returns its path and the fixture's triangle count.
+fn fixture_with(dir: &Path, name: &str, extra: &[Vec<u8>]) -> (std::path::PathBuf, u32) {
     let mut stl = std::fs::read(JAGGED).unwrap();
     let count = u32::from_le_bytes(stl[80..84].try_into().unwrap());
-    // The first triangle again, its third corner moved onto its second.
-    let mut sliver = stl[84..134].to_vec();
-    let second_corner = sliver[24..36].to_vec();
-    sliver[36..48].copy_from_slice(&second_corner);
-    stl.extend_from_slice(&sliver);
-    stl[80..84].copy_from_slice(&(count + 1).to_le_bytes());
-    let input = dir.path().join("sliver.stl");
-    std::fs::write(&input, &stl).unwrap();
-    let (want, got) = (dir.path().join("want.stl"), dir.path().join("got.stl"));
-    let report = dir.path().join("report.json");
+    for triangle in extra {
+        stl.extend_from_slice(triangle);
+    }
+    stl[80..84].copy_from_slice(&(count + extra.len() as u32).to_le_bytes());
+    let path = dir.join(name);
+    std::fs::write(&path, &stl).unwrap();
+    (path, count)
+}
+
+/// Cleans the fixture and `input`; returns `input`'s JSON report after
+/// checking that both outputs have the same bytes.
+fn cleaned_like_the_fixture(dir: &Path, input: &Path) -> serde_json::Value {
+    let (want, got) = (dir.join("want.stl"), dir.join("got.stl"));
+    let report = dir.join("report.json");
     for run in [
         meshtrim(&["clean", JAGGED, s(&want)], None),
-        meshtrim(&["clean", s(&input), s(&got), "--report", s(&report)], None),
+        meshtrim(&["clean", s(input), s(&got), "--report", s(&report)], None),
     ] {
         assert!(
             run.status.success(),
@@ -249,9 +250,38 @@ fn an_stl_sliver_with_two_equal_corners_is_dropped_and_counted() {
             String::from_utf8_lossy(&run.stderr)
         );
     }
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap();
-    assert_eq!(json["slivers_dropped"], 1);
-    assert_eq!(json["faces_in"], u64::from(count) + 1);
     assert_eq!(std::fs::read(&want).unwrap(), std::fs::read(&got).unwrap());
+    serde_json::from_str(&std::fs::read_to_string(&report).unwrap()).unwrap()
+}
+
+/// A binary STL sliver whose two corners coincide (one face naming a vertex
+/// twice once the reader merges them) is dropped and counted; the rest is
+/// cleaned to the same bytes as the file without it.
+#[test]
+fn an_stl_sliver_with_two_equal_corners_is_dropped_and_counted() {
+    let dir = tempfile::tempdir().unwrap();
+    let stl = std::fs::read(JAGGED).unwrap();
+    // The first triangle again, its third corner moved onto its second.
+    let mut sliver = stl[84..134].to_vec();
+    let second_corner = sliver[24..36].to_vec();
+    sliver[36..48].copy_from_slice(&second_corner);
+    let (input, count) = fixture_with(dir.path(), "sliver.stl", &[sliver]);
+    let json = cleaned_like_the_fixture(dir.path(), &input);
+    assert_eq!(json["slivers_dropped"], 1);
+    assert_eq!(json["repeated_faces_dropped"], 0);
+    assert_eq!(json["faces_in"], u64::from(count) + 1);
+}
+
+/// A triangle written twice is dropped and counted; it used to stop the
+/// cleanup with "3 edges are shared by more than two faces".
+#[test]
+fn an_stl_triangle_written_twice_is_dropped_and_counted() {
+    let dir = tempfile::tempdir().unwrap();
+    let stl = std::fs::read(JAGGED).unwrap();
+    let triangle = |t: usize| stl[84 + 50 * t..134 + 50 * t].to_vec();
+    let (input, count) = fixture_with(dir.path(), "twice.stl", &[triangle(100), triangle(7)]);
+    let json = cleaned_like_the_fixture(dir.path(), &input);
+    assert_eq!(json["repeated_faces_dropped"], 2);
+    assert_eq!(json["slivers_dropped"], 0);
+    assert_eq!(json["faces_in"], u64::from(count) + 2);
 }

@@ -59,7 +59,7 @@
 //! output is never a broken mesh.
 
 use std::borrow::Cow;
-use std::collections::{BTreeSet, HashMap};
+use std::collections::{BTreeSet, HashMap, HashSet};
 
 use rayon::prelude::*;
 use spade::handles::FixedVertexHandle;
@@ -137,8 +137,12 @@ pub struct CleanReport {
     /// Input faces.
     pub faces_in: usize,
     /// Input faces that named a vertex twice, dropped before anything else
-    /// (see [`without_slivers`]).
+    /// (see [`without_empty_faces`]).
     pub slivers_dropped: usize,
+    /// Input faces that repeated an earlier face with the same corners in
+    /// the same turn, dropped before anything else (see
+    /// [`without_empty_faces`]).
+    pub repeated_faces_dropped: usize,
     /// Input faces removed (in the bands).
     pub faces_removed: usize,
     /// New faces (the bands triangulated again).
@@ -166,7 +170,7 @@ pub fn clean_mesh(
 ) -> Result<(Mesh, CleanReport), MeshError> {
     mesh.validate()?;
     let faces_in = mesh.faces.len();
-    let (kept, slivers_dropped) = without_slivers(mesh);
+    let (kept, dropped) = without_empty_faces(mesh);
     let mesh: &Mesh = &kept;
     if mesh.faces.is_empty() {
         return Err(MeshError::NoFaces);
@@ -182,7 +186,8 @@ pub fn clean_mesh(
     let mut report = CleanReport {
         loops_in: borders.len(),
         faces_in,
-        slivers_dropped,
+        slivers_dropped: dropped.slivers,
+        repeated_faces_dropped: dropped.repeats,
         area_in: mesh.area(),
         ..Default::default()
     };
@@ -923,25 +928,74 @@ fn smallest_angle(vertices: &[Point3], face: [u32; 3]) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
-/// `mesh` without its faces that name a vertex twice, and how many there
-/// were. Such a face (a binary STL's sliver whose two corners coincide
-/// becomes one once its vertices are merged) has no area and no border of
-/// its own: the faces on either side of it already share its one real
-/// edge. Kept, that edge would count twice and read as non-manifold; so
-/// they are dropped, as MeshLab's "Remove Zero Area Faces" would, and
-/// counted in the report. Faces of three distinct but collinear vertices
-/// stay: they hold the surface together.
-fn without_slivers(mesh: &Mesh) -> (Cow<'_, Mesh>, usize) {
+/// Faces dropped before cleaning, by kind.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+struct DroppedFaces {
+    /// Faces that named a vertex twice.
+    slivers: usize,
+    /// Faces that repeated an earlier one, corners and turn alike.
+    repeats: usize,
+}
+
+/// `mesh` without the faces that add no surface, and how many there were.
+///
+/// - A face that names a vertex twice (a binary STL's sliver whose two
+///   corners coincide becomes one once its vertices are merged) has no
+///   area and no border of its own: the faces on either side of it already
+///   share its one real edge. Kept, that edge would count twice and read
+///   as non-manifold.
+/// - A face that repeats an earlier one with the same corners in the same
+///   turn (a triangle written twice, as exporters that concatenate patches
+///   do) covers the same surface again. Kept, each of its edges would
+///   count three times and read as non-manifold. The first copy stays.
+///
+/// Both are dropped, as MeshLab's "Remove Zero Area Faces" and "Remove
+/// Duplicate Faces" would, and counted in the report. Faces of three
+/// distinct but collinear vertices stay (they hold the surface together),
+/// and so does a face that repeats another's corners in the opposite turn:
+/// which of the two agrees with its neighbours is not known here, so the
+/// mesh stays as it is and its edges are reported as non-manifold.
+fn without_empty_faces(mesh: &Mesh) -> (Cow<'_, Mesh>, DroppedFaces) {
     let distinct = |f: &[u32; 3]| f[0] != f[1] && f[1] != f[2] && f[2] != f[0];
-    let slivers = mesh.faces.iter().filter(|f| !distinct(f)).count();
-    if slivers == 0 {
-        return (Cow::Borrowed(mesh), 0);
+    let mut seen = HashSet::with_capacity(mesh.faces.len());
+    let mut dropped = DroppedFaces::default();
+    let keep: Vec<bool> = mesh
+        .faces
+        .iter()
+        .map(|f| {
+            if !distinct(f) {
+                dropped.slivers += 1;
+                false
+            } else if !seen.insert(same_turn_key(*f)) {
+                dropped.repeats += 1;
+                false
+            } else {
+                true
+            }
+        })
+        .collect();
+    if dropped == DroppedFaces::default() {
+        return (Cow::Borrowed(mesh), dropped);
     }
     let kept = Mesh {
         vertices: mesh.vertices.clone(),
-        faces: mesh.faces.iter().copied().filter(distinct).collect(),
+        faces: mesh
+            .faces
+            .iter()
+            .zip(&keep)
+            .filter(|(_, &k)| k)
+            .map(|(f, _)| *f)
+            .collect(),
     };
-    (Cow::Owned(kept), slivers)
+    (Cow::Owned(kept), dropped)
+}
+
+/// A face's corners rotated to start at the lowest index: equal for two
+/// faces with the same corners in the same turn, different for opposite
+/// turns.
+fn same_turn_key(f: [u32; 3]) -> [u32; 3] {
+    let first = (0..3).min_by_key(|&k| f[k]).unwrap_or(0);
+    [f[first], f[(first + 1) % 3], f[(first + 2) % 3]]
 }
 
 /// Edge-manifold with consistent orientation: every undirected edge used
@@ -1267,6 +1321,32 @@ mod tests {
         assert_eq!(got, want);
         assert_eq!(report.slivers_dropped, 3);
         assert_eq!(report.faces_in, mesh.faces.len() + 3);
+    }
+
+    /// A face written twice with the same corners in the same turn is
+    /// dropped and counted (it used to read as 3 non-manifold edges); one
+    /// in the opposite turn stays, and its edges are still reported.
+    #[test]
+    fn repeated_faces_are_dropped_when_they_turn_the_same_way() {
+        let mesh = jagged_annulus(8.0, 3.0, 3);
+        let beta = vec![1.0; mesh.vertices.len()];
+        let options = CleanOptions::default();
+        let (want, _) = clean_mesh(&mesh, &beta, &options).unwrap();
+        let mut repeated = mesh.clone();
+        let [a, b, c] = mesh.faces[5];
+        repeated.faces.push([b, c, a]);
+        repeated.faces.push(mesh.faces[9]);
+        repeated.faces.push([c, a, b]);
+        let (got, report) = clean_mesh(&repeated, &beta, &options).unwrap();
+        assert_eq!(got, want);
+        assert_eq!(report.repeated_faces_dropped, 3);
+        assert_eq!(report.slivers_dropped, 0);
+        let mut reversed = mesh.clone();
+        reversed.faces.push([a, c, b]);
+        assert!(matches!(
+            clean_mesh(&reversed, &beta, &options),
+            Err(MeshError::NonManifold { .. })
+        ));
     }
 
     /// A mesh of slivers alone has no faces to clean.
