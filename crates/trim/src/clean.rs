@@ -69,7 +69,8 @@ use spade::{
 
 use crate::cloud::{cross, dist2, dot, norm2, sub, Point3};
 use crate::delaunay::{
-    inside_faces, median, obstacle, orient, untwist, Cdt, DelaunayReport, Node, Ring, STEINER,
+    inside_faces, median, obstacle, orient, untwist, Cdt, DelaunayReport, Node, Ring, SegmentGrid,
+    STEINER,
 };
 use crate::edges::cluster::MIN_LOOP_POINTS;
 use crate::edges::loop_from_tour;
@@ -437,20 +438,13 @@ impl Band {
         }
     }
 
-    /// The patch replacing the group's loops, or why not.
+    /// The patch replacing the group's loops, or why not: the smoothed
+    /// loops in the band's projection (steps 2 and 3), what goes (step 4)
+    /// and the gap filled (step 5).
     fn replace(&self, cx: &Context, group: &[usize]) -> Result<Patch, Retry> {
         let mesh = cx.mesh;
         let projection = Projection::of(cx, &self.faces);
-        let mut rings: Vec<Ring> = group
-            .iter()
-            .filter_map(|&l| cx.rings[l].as_ref())
-            .map(|r| {
-                let mut ring = r.clone();
-                ring.p2 = ring.p3.iter().map(|&p| projection.to2(p)).collect();
-                ring.merge_coincident();
-                ring
-            })
-            .collect();
+        let mut rings = projected_rings(cx, group, &projection);
         let grid = untwist(
             &mut rings,
             cx.beta_median,
@@ -458,24 +452,66 @@ impl Band {
             &mut DelaunayReport::default(),
         )
         .map_err(|e| untwist_failure(e, &rings))?;
+        let stay = self.staying_vertices(cx, group, &projection, &grid, &rings);
+        let removed = self.cut_faces(mesh, &projection, &grid, &stay);
+        let turned = self.turned_faces(mesh, &projection);
+        let removed = with_turned_neighbours(mesh, removed, &turned, |f| self.is_inner(mesh, f));
+        let gap = Gap {
+            border_edges: group_border_edges(cx, group),
+            folded: turned
+                .iter()
+                .flat_map(|&f| mesh.faces[f as usize])
+                .collect(),
+            projection,
+            rings,
+            stay,
+        };
+        self.fill_gap(cx, &gap, removed)
+    }
+
+    /// Whether each vertex of the band's faces stays: it lies on the
+    /// surface's side of the smoothed loops (inside an odd number of them
+    /// when one is an outer border, of positive area; an even number when
+    /// all are holes), farther than [`MARGIN`]·βᵢ from them (closer, it
+    /// would only make a sliver against the new border), and is not a
+    /// vertex of the group's old border.
+    fn staying_vertices(
+        &self,
+        cx: &Context,
+        group: &[usize],
+        projection: &Projection,
+        grid: &SegmentGrid,
+        rings: &[Ring],
+    ) -> HashMap<u32, bool> {
+        let mesh = cx.mesh;
         let has_outer = rings.iter().any(|r| r.area() > 0.0);
         let old_border: BTreeSet<u32> = group
             .iter()
             .flat_map(|&l| cx.borders[l].iter().copied())
             .collect();
-        let p2 = |v: u32| projection.to2(mesh.vertices[v as usize]);
         let stays = |v: u32| {
-            let p = p2(v);
+            let p = projection.vertex_to2(mesh, v);
             !old_border.contains(&v)
                 && grid.parity(p) == has_outer
                 && !grid.near(p, MARGIN * cx.beta[v as usize])
         };
-        let stay: HashMap<u32, bool> = self
-            .faces
+        self.faces
             .iter()
             .flat_map(|&f| mesh.faces[f as usize])
             .map(|v| (v, stays(v)))
-            .collect();
+            .collect()
+    }
+
+    /// The band's faces with a vertex that goes, or crossed by a smoothed
+    /// loop, ascending.
+    fn cut_faces(
+        &self,
+        mesh: &Mesh,
+        projection: &Projection,
+        grid: &SegmentGrid,
+        stay: &HashMap<u32, bool>,
+    ) -> Vec<u32> {
+        let p2 = |v: u32| projection.vertex_to2(mesh, v);
         let mut removed = Vec::new();
         for &f in &self.faces {
             let face = mesh.faces[f as usize];
@@ -486,75 +522,53 @@ impl Band {
                 removed.push(f);
             }
         }
-        // Faces that turn over in the projection (a range scan's skirt
-        // across a depth jump at a silhouette, a fold) go too when they
-        // touch what goes and lie inside the band: the gap filling
-        // replaces them by one layer. Kept faces beyond may turn over: the
-        // new faces join them along the walls with opposite edge
-        // directions all the same (the safety net below checks it).
-        let turned: BTreeSet<u32> = self
-            .faces
+        removed
+    }
+
+    /// The band's faces that turn over in the projection (a range scan's
+    /// skirt across a depth jump at a silhouette, a fold). They go too
+    /// when they touch what goes and lie inside the band
+    /// ([`with_turned_neighbours`], [`Band::is_inner`]): the gap filling
+    /// replaces them by one layer. Kept faces beyond may turn over: the
+    /// new faces join them along the walls with opposite edge directions
+    /// all the same (the safety net of [`clean_mesh`] checks it).
+    fn turned_faces(&self, mesh: &Mesh, projection: &Projection) -> BTreeSet<u32> {
+        self.faces
             .iter()
             .copied()
             .filter(|&f| {
-                let [a, b, c] = mesh.faces[f as usize].map(p2);
+                let [a, b, c] = mesh.faces[f as usize].map(|v| projection.vertex_to2(mesh, v));
                 orient(a, b, c) <= 0.0
             })
-            .collect();
-        let inner = |f: u32| {
-            mesh.faces[f as usize]
-                .iter()
-                .all(|v| self.rings_from_border[v].0 + 2 < self.depth)
-        };
-        let mut removed = with_turned_neighbours(mesh, removed, &turned, inner);
-        let border_edges: BTreeSet<(u32, u32)> = group
+            .collect()
+    }
+
+    /// Whether every vertex of face `f` lies more than two rings inside
+    /// the band's rim.
+    fn is_inner(&self, mesh: &Mesh, f: u32) -> bool {
+        mesh.faces[f as usize]
             .iter()
-            .flat_map(|&l| {
-                let b = &cx.borders[l];
-                (0..b.len()).map(move |i| (b[i], b[(i + 1) % b.len()]))
-            })
-            .collect();
-        // The vertices of turned faces belong to a fold's second layer: the
-        // new faces are made without them.
-        let folded: BTreeSet<u32> = turned
-            .iter()
-            .flat_map(|&f| mesh.faces[f as usize])
-            .collect();
-        // Where a fold beyond the turned faces makes two walls cross in the
-        // projection, the faces round the crossing go too, and the gap is
-        // triangulated again, a few times at most.
+            .all(|v| self.rings_from_border[v].0 + 2 < self.depth)
+    }
+
+    /// Step 5 for the faces `removed`. Where a fold beyond the turned
+    /// faces makes two walls cross in the projection, the faces round the
+    /// crossing go too, and the gap is triangulated again, a few times at
+    /// most ([`WALL_REPAIRS`]).
+    fn fill_gap(&self, cx: &Context, gap: &Gap, mut removed: Vec<u32>) -> Result<Patch, Retry> {
         for _ in 0..=WALL_REPAIRS {
-            let at_rim: BTreeSet<usize> = removed
-                .iter()
-                .flat_map(|&f| mesh.faces[f as usize])
-                .map(|v| self.rings_from_border[&v])
-                .filter(|&(d, _)| d + 1 >= self.depth)
-                .map(|(_, origin)| origin)
-                .collect();
+            let at_rim = self.loops_reaching_rim(cx.mesh, &removed);
             if !at_rim.is_empty() {
                 return Err(Retry::Grow(at_rim.into_iter().collect()));
             }
-            let walls = walls(mesh, &self.faces, &removed, &border_edges, &stay);
-            let free: BTreeSet<u32> = removed
-                .iter()
-                .flat_map(|&f| mesh.faces[f as usize])
-                .filter(|v| stay[v] && !folded.contains(v))
-                .collect();
-            match triangulate(mesh, &projection, &rings, &walls, &free, cx.beta_median) {
+            match self.triangulate_gap(cx, gap, &removed) {
                 Ok(mut patch) => {
                     patch.removed = removed;
                     return Ok(patch);
                 }
                 Err(Blocked::Walls(vertices)) => {
                     let before = removed.len();
-                    let mut all: BTreeSet<u32> = removed.into_iter().collect();
-                    all.extend(
-                        vertices
-                            .iter()
-                            .flat_map(|&v| cx.topology.faces_of(v).iter().copied())
-                            .filter(|&f| self.faces.binary_search(&f).is_ok()),
-                    );
-                    removed = all.into_iter().collect();
+                    removed = self.with_faces_round(cx, removed, &vertices);
                     if removed.len() == before {
                         break;
                     }
@@ -567,6 +581,93 @@ impl Band {
             Vec::new(),
         ))
     }
+
+    /// The loops (positions in the group) whose cut reaches the band's
+    /// rim: a removed face has a vertex `depth` − 1 or more rings from the
+    /// border.
+    fn loops_reaching_rim(&self, mesh: &Mesh, removed: &[u32]) -> BTreeSet<usize> {
+        removed
+            .iter()
+            .flat_map(|&f| mesh.faces[f as usize])
+            .map(|v| self.rings_from_border[&v])
+            .filter(|&(d, _)| d + 1 >= self.depth)
+            .map(|(_, origin)| origin)
+            .collect()
+    }
+
+    /// The gap left by the faces `removed`, triangulated: bounded by the
+    /// smoothed loops and the walls, with the kept vertices of the removed
+    /// faces (not those of the fold's second layer) inside.
+    fn triangulate_gap(&self, cx: &Context, gap: &Gap, removed: &[u32]) -> Result<Patch, Blocked> {
+        let mesh = cx.mesh;
+        let walls = walls(mesh, &self.faces, removed, &gap.border_edges, &gap.stay);
+        let free: BTreeSet<u32> = removed
+            .iter()
+            .flat_map(|&f| mesh.faces[f as usize])
+            .filter(|v| gap.stay[v] && !gap.folded.contains(v))
+            .collect();
+        triangulate(
+            mesh,
+            &gap.projection,
+            &gap.rings,
+            &walls,
+            &free,
+            cx.beta_median,
+        )
+    }
+
+    /// `removed` and the band's faces round `vertices` (where two walls
+    /// cross), ascending.
+    fn with_faces_round(&self, cx: &Context, removed: Vec<u32>, vertices: &[u32]) -> Vec<u32> {
+        let mut all: BTreeSet<u32> = removed.into_iter().collect();
+        all.extend(
+            vertices
+                .iter()
+                .flat_map(|&v| cx.topology.faces_of(v).iter().copied())
+                .filter(|&f| self.faces.binary_search(&f).is_ok()),
+        );
+        all.into_iter().collect()
+    }
+}
+
+/// What filling one band's gap reads besides the faces removed.
+struct Gap {
+    projection: Projection,
+    /// The smoothed loops, projected and untwisted.
+    rings: Vec<Ring>,
+    /// Whether each vertex of the band's faces stays.
+    stay: HashMap<u32, bool>,
+    /// The vertices of turned faces: they belong to a fold's second layer,
+    /// so the new faces are made without them.
+    folded: BTreeSet<u32>,
+    /// The directed edges of the group's old borders.
+    border_edges: BTreeSet<(u32, u32)>,
+}
+
+/// The group's smoothed loops in the band's projection, with the vertices
+/// that coincide there merged.
+fn projected_rings(cx: &Context, group: &[usize], projection: &Projection) -> Vec<Ring> {
+    group
+        .iter()
+        .filter_map(|&l| cx.rings[l].as_ref())
+        .map(|r| {
+            let mut ring = r.clone();
+            ring.p2 = ring.p3.iter().map(|&p| projection.to2(p)).collect();
+            ring.merge_coincident();
+            ring
+        })
+        .collect()
+}
+
+/// The directed edges of the borders of the group's loops.
+fn group_border_edges(cx: &Context, group: &[usize]) -> BTreeSet<(u32, u32)> {
+    group
+        .iter()
+        .flat_map(|&l| {
+            let b = &cx.borders[l];
+            (0..b.len()).map(move |i| (b[i], b[(i + 1) % b.len()]))
+        })
+        .collect()
 }
 
 /// The edges (directed as the removed faces run them) that bound the removed region against what stays: shared with a kept
@@ -828,6 +929,11 @@ impl Projection {
     fn to2(&self, p: Point3) -> [f64; 2] {
         let d = sub(p, self.origin);
         [dot(d, self.u), dot(d, self.v)]
+    }
+
+    /// The projection of the mesh's vertex `v`.
+    fn vertex_to2(&self, mesh: &Mesh, v: u32) -> [f64; 2] {
+        self.to2(mesh.vertices[v as usize])
     }
 }
 
