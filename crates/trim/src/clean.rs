@@ -722,80 +722,162 @@ fn triangulate(
     free: &BTreeSet<u32>,
     scale: f64,
 ) -> Result<Patch, Blocked> {
-    let n = mesh.vertices.len() as u32;
-    let mut cdt = Cdt::new();
-    let mut patch = Patch::default();
-    let mut handle_of: HashMap<u32, FixedVertexHandle> = HashMap::new();
-    let coincide = |ring: Option<usize>| {
-        leave(
-            "two vertices coincide in the projection of the band",
-            ring.into_iter().collect(),
-        )
-    };
-    let mut insert = |cdt: &mut Cdt, p: [f64; 2], id: u32, ring: Option<usize>| {
-        if let Some(&h) = handle_of.get(&id) {
+    let mut gap = GapTriangulation::new(mesh);
+    let ring_handles = gap.insert_rings(rings).map_err(Blocked::Other)?;
+    gap.insert_mesh_vertices(mesh, projection, walls, free)
+        .map_err(Blocked::Other)?;
+    gap.constrain_rings(&ring_handles)?;
+    gap.constrain_walls(walls)?;
+    refine_gap(&mut gap.cdt, mesh, &mut gap.patch, scale);
+    Ok(gap.into_patch())
+}
+
+/// A gap's triangulation as it is built: its vertices are the smoothed
+/// loops' (new vertices of the patch) and mesh vertices, each inserted
+/// once under its id.
+struct GapTriangulation {
+    cdt: Cdt,
+    patch: Patch,
+    handle_of: HashMap<u32, FixedVertexHandle>,
+    /// The mesh's vertex count: ids from here on are the patch's vertices.
+    n: u32,
+}
+
+impl GapTriangulation {
+    fn new(mesh: &Mesh) -> Self {
+        GapTriangulation {
+            cdt: Cdt::new(),
+            patch: Patch::default(),
+            handle_of: HashMap::new(),
+            n: mesh.vertices.len() as u32,
+        }
+    }
+
+    /// Inserts vertex `id` at `p`, or gives its handle if it is in. Two
+    /// vertices at the same place cannot both be vertices of the new
+    /// faces: the loop `ring` is left (or, for a mesh vertex, the group).
+    fn insert(
+        &mut self,
+        p: [f64; 2],
+        id: u32,
+        ring: Option<usize>,
+    ) -> Result<FixedVertexHandle, Retry> {
+        if let Some(&h) = self.handle_of.get(&id) {
             return Ok(h);
         }
-        if let PositionInTriangulation::OnVertex(_) = cdt.locate(crate::delaunay::point(p)) {
+        if let PositionInTriangulation::OnVertex(_) = self.cdt.locate(crate::delaunay::point(p)) {
             return Err(coincide(ring));
         }
-        let h = cdt.insert(Node::new(p, id)).map_err(|_| coincide(ring))?;
-        handle_of.insert(id, h);
+        let h = self
+            .cdt
+            .insert(Node::new(p, id))
+            .map_err(|_| coincide(ring))?;
+        self.handle_of.insert(id, h);
         Ok(h)
-    };
-    let mut ring_handles = Vec::new();
-    for (k, ring) in rings.iter().enumerate() {
-        let mut hs = Vec::with_capacity(ring.len());
-        for (j, &p) in ring.p2.iter().enumerate() {
-            let id = n + patch.vertices.len() as u32;
-            patch.vertices.push(ring.p3[j]);
-            hs.push(insert(&mut cdt, p, id, Some(k)).map_err(Blocked::Other)?);
+    }
+
+    /// Inserts every smoothed loop's vertices as new vertices of the
+    /// patch; their handles, loop by loop.
+    fn insert_rings(&mut self, rings: &[Ring]) -> Result<Vec<Vec<FixedVertexHandle>>, Retry> {
+        let mut ring_handles = Vec::new();
+        for (k, ring) in rings.iter().enumerate() {
+            let mut hs = Vec::with_capacity(ring.len());
+            for (j, &p) in ring.p2.iter().enumerate() {
+                let id = self.n + self.patch.vertices.len() as u32;
+                self.patch.vertices.push(ring.p3[j]);
+                hs.push(self.insert(p, id, Some(k))?);
+            }
+            ring_handles.push(hs);
         }
-        ring_handles.push(hs);
+        Ok(ring_handles)
     }
-    let wall_vertices: BTreeSet<u32> = walls.iter().flatten().copied().collect();
-    for &v in wall_vertices.iter().chain(free) {
-        insert(&mut cdt, projection.to2(mesh.vertices[v as usize]), v, None)
-            .map_err(Blocked::Other)?;
+
+    /// Inserts the walls' vertices, then the free vertices, ascending.
+    fn insert_mesh_vertices(
+        &mut self,
+        mesh: &Mesh,
+        projection: &Projection,
+        walls: &[[u32; 2]],
+        free: &BTreeSet<u32>,
+    ) -> Result<(), Retry> {
+        let wall_vertices: BTreeSet<u32> = walls.iter().flatten().copied().collect();
+        for &v in wall_vertices.iter().chain(free) {
+            self.insert(projection.vertex_to2(mesh, v), v, None)?;
+        }
+        Ok(())
     }
-    let constrain = |cdt: &mut Cdt, a, b, ring: Option<usize>| {
-        if let Some(other) = obstacle(cdt, a, b) {
+
+    /// Every segment of the smoothed loops as a constraint.
+    fn constrain_rings(&mut self, ring_handles: &[Vec<FixedVertexHandle>]) -> Result<(), Blocked> {
+        for (k, hs) in ring_handles.iter().enumerate() {
+            for j in 0..hs.len() {
+                self.constrain(hs[j], hs[(j + 1) % hs.len()], Some(k))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Every wall as a constraint.
+    fn constrain_walls(&mut self, walls: &[[u32; 2]]) -> Result<(), Blocked> {
+        for w in walls {
+            self.constrain(self.handle_of[&w[0]], self.handle_of[&w[1]], None)?;
+        }
+        Ok(())
+    }
+
+    /// Adds the constraint from `a` to `b` unless a vertex or constraint is
+    /// in its way: then a smoothed loop's segment (of loop `ring`) leaves
+    /// that loop, and a wall reports the vertices involved, so that the
+    /// faces round them can go.
+    fn constrain(
+        &mut self,
+        a: FixedVertexHandle,
+        b: FixedVertexHandle,
+        ring: Option<usize>,
+    ) -> Result<(), Blocked> {
+        if let Some(other) = obstacle(&self.cdt, a, b) {
             return Err(match ring {
                 Some(k) => {
                     Blocked::Other(leave("the smoothed border crosses the kept mesh", vec![k]))
                 }
                 None => Blocked::Walls(vec![
-                    cdt.vertex(a).data().id,
-                    cdt.vertex(b).data().id,
+                    self.cdt.vertex(a).data().id,
+                    self.cdt.vertex(b).data().id,
                     other,
                 ]),
             });
         }
-        cdt.add_constraint(a, b);
+        self.cdt.add_constraint(a, b);
         Ok(())
-    };
-    for (k, hs) in ring_handles.iter().enumerate() {
-        for j in 0..hs.len() {
-            constrain(&mut cdt, hs[j], hs[(j + 1) % hs.len()], Some(k))?;
+    }
+
+    /// The patch with its faces: those between the constraints (the
+    /// parity flood fill of [`inside_faces`]), each turned to run
+    /// counter-clockwise in the projection, as the band's unturned faces do.
+    fn into_patch(mut self) -> Patch {
+        for f in inside_faces(&self.cdt) {
+            let vs = self.cdt.face(f).vertices();
+            let mut ids = vs.map(|v| v.data().id);
+            let p = vs.map(|v| {
+                let q = v.position();
+                [q.x, q.y]
+            });
+            if orient(p[0], p[1], p[2]) < 0.0 {
+                ids.swap(1, 2);
+            }
+            self.patch.faces.push(ids);
         }
+        self.patch
     }
-    for w in walls {
-        constrain(&mut cdt, handle_of[&w[0]], handle_of[&w[1]], None)?;
-    }
-    refine_gap(&mut cdt, mesh, &mut patch, scale);
-    for f in inside_faces(&cdt) {
-        let vs = cdt.face(f).vertices();
-        let mut ids = vs.map(|v| v.data().id);
-        let p = vs.map(|v| {
-            let q = v.position();
-            [q.x, q.y]
-        });
-        if orient(p[0], p[1], p[2]) < 0.0 {
-            ids.swap(1, 2);
-        }
-        patch.faces.push(ids);
-    }
-    Ok(patch)
+}
+
+/// Two vertices coincide in the projection: the loop `ring` is left, or,
+/// without one, the whole group.
+fn coincide(ring: Option<usize>) -> Retry {
+    leave(
+        "two vertices coincide in the projection of the band",
+        ring.into_iter().collect(),
+    )
 }
 
 /// Where the gap is wide and holds no mesh vertex (a deep notch the
