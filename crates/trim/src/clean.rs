@@ -169,6 +169,26 @@ pub fn clean_mesh(
     let faces_in = mesh.faces.len();
     let (kept, slivers_dropped) = without_slivers(mesh);
     let mesh: &Mesh = &kept;
+    check_cleanable(mesh, beta)?;
+    let borders = mesh.boundary_loops();
+    let rings = smoothed_loops(mesh, beta, &borders, options);
+    let report = CleanReport {
+        loops_in: borders.len(),
+        loops_too_small: rings.iter().filter(|r| r.is_none()).count(),
+        faces_in,
+        slivers_dropped,
+        area_in: mesh.area(),
+        ..Default::default()
+    };
+    let mut outcomes = replace_bands(mesh, beta, &borders, &rings);
+    let out = assemble_manifold(mesh, &mut outcomes);
+    finish(out, &outcomes, report)
+}
+
+/// What the cleanup needs of the mesh left once its slivers are dropped:
+/// faces, one β per vertex, every edge used at most twice and never twice
+/// the same way.
+fn check_cleanable(mesh: &Mesh, beta: &[f64]) -> Result<(), MeshError> {
     if mesh.faces.is_empty() {
         return Err(MeshError::NoFaces);
     }
@@ -178,46 +198,61 @@ pub fn clean_mesh(
             vertices: mesh.vertices.len(),
         });
     }
-    check_manifold(mesh)?;
-    let borders = mesh.boundary_loops();
-    let mut report = CleanReport {
-        loops_in: borders.len(),
-        faces_in,
-        slivers_dropped,
-        area_in: mesh.area(),
-        ..Default::default()
-    };
+    check_manifold(mesh)
+}
+
+/// Step 2: each border loop smoothed (corners, FFT edges and, with
+/// `options.offset`, the outward offset) and evened out, in parallel;
+/// None for loops of fewer than [`MIN_LOOP_POINTS`] vertices, too small
+/// to smooth.
+fn smoothed_loops(
+    mesh: &Mesh,
+    beta: &[f64],
+    borders: &[Vec<u32>],
+    options: &CleanOptions,
+) -> Vec<Option<Ring>> {
     let index = options.offset.then(|| NeighbourIndex::new(&mesh.vertices));
-    let smoothable: Vec<bool> = borders.iter().map(|b| b.len() >= MIN_LOOP_POINTS).collect();
-    report.loops_too_small = smoothable.iter().filter(|&&s| !s).count();
-    let rings: Vec<Option<Ring>> = borders
+    borders
         .par_iter()
-        .zip(&smoothable)
-        .map(|(border, &smooth)| {
-            smooth.then(|| {
+        .map(|border| {
+            (border.len() >= MIN_LOOP_POINTS).then(|| {
                 let lp = loop_from_tour(&mesh.vertices, beta, border.clone(), index.as_ref());
                 even_out(Ring::from_loop(&lp, beta))
             })
         })
-        .collect();
+        .collect()
+}
+
+/// Steps 3 to 5 for every smoothed loop: its band, what goes and the new
+/// faces, one outcome per group of loops whose bands overlap.
+fn replace_bands(
+    mesh: &Mesh,
+    beta: &[f64],
+    borders: &[Vec<u32>],
+    rings: &[Option<Ring>],
+) -> Vec<Outcome> {
     let topology = Topology::new(mesh);
     let context = Context {
         mesh,
         beta,
-        borders: &borders,
-        rings: &rings,
+        borders,
+        rings,
         topology: &topology,
         beta_median: median(beta),
     };
-    let mut outcomes = replace_all(&context);
-    let mut out = loop {
-        let (out, origin) = assemble(mesh, &outcomes);
+    replace_all(&context)
+}
+
+/// The input with every patch applied. A safety net: a patch whose faces
+/// would make an edge non-manifold (not seen on the test data) is
+/// dropped, its loops left, and the rest is assembled again.
+fn assemble_manifold(mesh: &Mesh, outcomes: &mut [Outcome]) -> Mesh {
+    loop {
+        let (out, origin) = assemble(mesh, outcomes);
         let bad = patches_breaking_manifold(&out, &origin);
         if bad.is_empty() {
-            break out;
+            return out;
         }
-        // A safety net: a patch whose faces would make an edge non-manifold
-        // (not seen on the test data) is dropped, its loops left.
         for g in bad {
             if let Some(patch) = outcomes[g].patch.take() {
                 outcomes[g].left.push(LeftLoops {
@@ -226,8 +261,17 @@ pub fn clean_mesh(
                 });
             }
         }
-    };
-    summarise(&outcomes, &out, &mut report);
+    }
+}
+
+/// Step 6 and the output's part of the report: what the patches did,
+/// unused vertices removed, the result checked, its faces and area.
+fn finish(
+    mut out: Mesh,
+    outcomes: &[Outcome],
+    mut report: CleanReport,
+) -> Result<(Mesh, CleanReport), MeshError> {
+    summarise(outcomes, &out, &mut report);
     out.remove_unused_vertices();
     check_manifold(&out)?;
     report.faces_out = out.faces.len();
@@ -531,7 +575,7 @@ impl Band {
     /// ([`with_turned_neighbours`], [`Band::is_inner`]): the gap filling
     /// replaces them by one layer. Kept faces beyond may turn over: the
     /// new faces join them along the walls with opposite edge directions
-    /// all the same (the safety net of [`clean_mesh`] checks it).
+    /// all the same (the safety net of [`assemble_manifold`] checks it).
     fn turned_faces(&self, mesh: &Mesh, projection: &Projection) -> BTreeSet<u32> {
         self.faces
             .iter()
