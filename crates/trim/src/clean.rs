@@ -69,7 +69,8 @@ use spade::{
 
 use crate::cloud::{cross, dist2, dot, norm2, sub, Point3};
 use crate::delaunay::{
-    inside_faces, median, obstacle, orient, untwist, Cdt, DelaunayReport, Node, Ring, STEINER,
+    inside_faces, median, obstacle, orient, untwist, Cdt, DelaunayReport, Node, Ring, SegmentGrid,
+    STEINER,
 };
 use crate::edges::cluster::MIN_LOOP_POINTS;
 use crate::edges::loop_from_tour;
@@ -172,6 +173,27 @@ pub fn clean_mesh(
     let faces_in = mesh.faces.len();
     let (kept, dropped) = without_empty_faces(mesh);
     let mesh: &Mesh = &kept;
+    check_cleanable(mesh, beta)?;
+    let borders = mesh.boundary_loops();
+    let rings = smoothed_loops(mesh, beta, &borders, options);
+    let report = CleanReport {
+        loops_in: borders.len(),
+        loops_too_small: rings.iter().filter(|r| r.is_none()).count(),
+        faces_in,
+        slivers_dropped: dropped.slivers,
+        repeated_faces_dropped: dropped.repeats,
+        area_in: mesh.area(),
+        ..Default::default()
+    };
+    let mut outcomes = replace_bands(mesh, beta, &borders, &rings);
+    let out = assemble_manifold(mesh, &mut outcomes);
+    finish(out, &outcomes, report)
+}
+
+/// What the cleanup needs of the mesh left once its empty faces are dropped:
+/// faces, one β per vertex, every edge used at most twice and never twice
+/// the same way.
+fn check_cleanable(mesh: &Mesh, beta: &[f64]) -> Result<(), MeshError> {
     if mesh.faces.is_empty() {
         return Err(MeshError::NoFaces);
     }
@@ -181,47 +203,61 @@ pub fn clean_mesh(
             vertices: mesh.vertices.len(),
         });
     }
-    check_manifold(mesh)?;
-    let borders = mesh.boundary_loops();
-    let mut report = CleanReport {
-        loops_in: borders.len(),
-        faces_in,
-        slivers_dropped: dropped.slivers,
-        repeated_faces_dropped: dropped.repeats,
-        area_in: mesh.area(),
-        ..Default::default()
-    };
+    check_manifold(mesh)
+}
+
+/// Step 2: each border loop smoothed (corners, FFT edges and, with
+/// `options.offset`, the outward offset) and evened out, in parallel;
+/// None for loops of fewer than [`MIN_LOOP_POINTS`] vertices, too small
+/// to smooth.
+fn smoothed_loops(
+    mesh: &Mesh,
+    beta: &[f64],
+    borders: &[Vec<u32>],
+    options: &CleanOptions,
+) -> Vec<Option<Ring>> {
     let index = options.offset.then(|| NeighbourIndex::new(&mesh.vertices));
-    let smoothable: Vec<bool> = borders.iter().map(|b| b.len() >= MIN_LOOP_POINTS).collect();
-    report.loops_too_small = smoothable.iter().filter(|&&s| !s).count();
-    let rings: Vec<Option<Ring>> = borders
+    borders
         .par_iter()
-        .zip(&smoothable)
-        .map(|(border, &smooth)| {
-            smooth.then(|| {
+        .map(|border| {
+            (border.len() >= MIN_LOOP_POINTS).then(|| {
                 let lp = loop_from_tour(&mesh.vertices, beta, border.clone(), index.as_ref());
                 even_out(Ring::from_loop(&lp, beta))
             })
         })
-        .collect();
+        .collect()
+}
+
+/// Steps 3 to 5 for every smoothed loop: its band, what goes and the new
+/// faces, one outcome per group of loops whose bands overlap.
+fn replace_bands(
+    mesh: &Mesh,
+    beta: &[f64],
+    borders: &[Vec<u32>],
+    rings: &[Option<Ring>],
+) -> Vec<Outcome> {
     let topology = Topology::new(mesh);
     let context = Context {
         mesh,
         beta,
-        borders: &borders,
-        rings: &rings,
+        borders,
+        rings,
         topology: &topology,
         beta_median: median(beta),
     };
-    let mut outcomes = replace_all(&context);
-    let mut out = loop {
-        let (out, origin) = assemble(mesh, &outcomes);
+    replace_all(&context)
+}
+
+/// The input with every patch applied. A safety net: a patch whose faces
+/// would make an edge non-manifold (not seen on the test data) is
+/// dropped, its loops left, and the rest is assembled again.
+fn assemble_manifold(mesh: &Mesh, outcomes: &mut [Outcome]) -> Mesh {
+    loop {
+        let (out, origin) = assemble(mesh, outcomes);
         let bad = patches_breaking_manifold(&out, &origin);
         if bad.is_empty() {
-            break out;
+            return out;
         }
-        // A safety net: a patch whose faces would make an edge non-manifold
-        // (not seen on the test data) is dropped, its loops left.
         for g in bad {
             if let Some(patch) = outcomes[g].patch.take() {
                 outcomes[g].left.push(LeftLoops {
@@ -230,8 +266,17 @@ pub fn clean_mesh(
                 });
             }
         }
-    };
-    summarise(&outcomes, &out, &mut report);
+    }
+}
+
+/// Step 6 and the output's part of the report: what the patches did,
+/// unused vertices removed, the result checked, its faces and area.
+fn finish(
+    mut out: Mesh,
+    outcomes: &[Outcome],
+    mut report: CleanReport,
+) -> Result<(Mesh, CleanReport), MeshError> {
+    summarise(outcomes, &out, &mut report);
     out.remove_unused_vertices();
     check_manifold(&out)?;
     report.faces_out = out.faces.len();
@@ -442,20 +487,13 @@ impl Band {
         }
     }
 
-    /// The patch replacing the group's loops, or why not.
+    /// The patch replacing the group's loops, or why not: the smoothed
+    /// loops in the band's projection (steps 2 and 3), what goes (step 4)
+    /// and the gap filled (step 5).
     fn replace(&self, cx: &Context, group: &[usize]) -> Result<Patch, Retry> {
         let mesh = cx.mesh;
         let projection = Projection::of(cx, &self.faces);
-        let mut rings: Vec<Ring> = group
-            .iter()
-            .filter_map(|&l| cx.rings[l].as_ref())
-            .map(|r| {
-                let mut ring = r.clone();
-                ring.p2 = ring.p3.iter().map(|&p| projection.to2(p)).collect();
-                ring.merge_coincident();
-                ring
-            })
-            .collect();
+        let mut rings = projected_rings(cx, group, &projection);
         let grid = untwist(
             &mut rings,
             cx.beta_median,
@@ -463,24 +501,66 @@ impl Band {
             &mut DelaunayReport::default(),
         )
         .map_err(|e| untwist_failure(e, &rings))?;
+        let stay = self.staying_vertices(cx, group, &projection, &grid, &rings);
+        let removed = self.cut_faces(mesh, &projection, &grid, &stay);
+        let turned = self.turned_faces(mesh, &projection);
+        let removed = with_turned_neighbours(mesh, removed, &turned, |f| self.is_inner(mesh, f));
+        let gap = Gap {
+            border_edges: group_border_edges(cx, group),
+            folded: turned
+                .iter()
+                .flat_map(|&f| mesh.faces[f as usize])
+                .collect(),
+            projection,
+            rings,
+            stay,
+        };
+        self.fill_gap(cx, &gap, removed)
+    }
+
+    /// Whether each vertex of the band's faces stays: it lies on the
+    /// surface's side of the smoothed loops (inside an odd number of them
+    /// when one is an outer border, of positive area; an even number when
+    /// all are holes), farther than [`MARGIN`]·βᵢ from them (closer, it
+    /// would only make a sliver against the new border), and is not a
+    /// vertex of the group's old border.
+    fn staying_vertices(
+        &self,
+        cx: &Context,
+        group: &[usize],
+        projection: &Projection,
+        grid: &SegmentGrid,
+        rings: &[Ring],
+    ) -> HashMap<u32, bool> {
+        let mesh = cx.mesh;
         let has_outer = rings.iter().any(|r| r.area() > 0.0);
         let old_border: BTreeSet<u32> = group
             .iter()
             .flat_map(|&l| cx.borders[l].iter().copied())
             .collect();
-        let p2 = |v: u32| projection.to2(mesh.vertices[v as usize]);
         let stays = |v: u32| {
-            let p = p2(v);
+            let p = projection.vertex_to2(mesh, v);
             !old_border.contains(&v)
                 && grid.parity(p) == has_outer
                 && !grid.near(p, MARGIN * cx.beta[v as usize])
         };
-        let stay: HashMap<u32, bool> = self
-            .faces
+        self.faces
             .iter()
             .flat_map(|&f| mesh.faces[f as usize])
             .map(|v| (v, stays(v)))
-            .collect();
+            .collect()
+    }
+
+    /// The band's faces with a vertex that goes, or crossed by a smoothed
+    /// loop, ascending.
+    fn cut_faces(
+        &self,
+        mesh: &Mesh,
+        projection: &Projection,
+        grid: &SegmentGrid,
+        stay: &HashMap<u32, bool>,
+    ) -> Vec<u32> {
+        let p2 = |v: u32| projection.vertex_to2(mesh, v);
         let mut removed = Vec::new();
         for &f in &self.faces {
             let face = mesh.faces[f as usize];
@@ -491,75 +571,53 @@ impl Band {
                 removed.push(f);
             }
         }
-        // Faces that turn over in the projection (a range scan's skirt
-        // across a depth jump at a silhouette, a fold) go too when they
-        // touch what goes and lie inside the band: the gap filling
-        // replaces them by one layer. Kept faces beyond may turn over: the
-        // new faces join them along the walls with opposite edge
-        // directions all the same (the safety net below checks it).
-        let turned: BTreeSet<u32> = self
-            .faces
+        removed
+    }
+
+    /// The band's faces that turn over in the projection (a range scan's
+    /// skirt across a depth jump at a silhouette, a fold). They go too
+    /// when they touch what goes and lie inside the band
+    /// ([`with_turned_neighbours`], [`Band::is_inner`]): the gap filling
+    /// replaces them by one layer. Kept faces beyond may turn over: the
+    /// new faces join them along the walls with opposite edge directions
+    /// all the same (the safety net of [`assemble_manifold`] checks it).
+    fn turned_faces(&self, mesh: &Mesh, projection: &Projection) -> BTreeSet<u32> {
+        self.faces
             .iter()
             .copied()
             .filter(|&f| {
-                let [a, b, c] = mesh.faces[f as usize].map(p2);
+                let [a, b, c] = mesh.faces[f as usize].map(|v| projection.vertex_to2(mesh, v));
                 orient(a, b, c) <= 0.0
             })
-            .collect();
-        let inner = |f: u32| {
-            mesh.faces[f as usize]
-                .iter()
-                .all(|v| self.rings_from_border[v].0 + 2 < self.depth)
-        };
-        let mut removed = with_turned_neighbours(mesh, removed, &turned, inner);
-        let border_edges: BTreeSet<(u32, u32)> = group
+            .collect()
+    }
+
+    /// Whether every vertex of face `f` lies more than two rings inside
+    /// the band's rim.
+    fn is_inner(&self, mesh: &Mesh, f: u32) -> bool {
+        mesh.faces[f as usize]
             .iter()
-            .flat_map(|&l| {
-                let b = &cx.borders[l];
-                (0..b.len()).map(move |i| (b[i], b[(i + 1) % b.len()]))
-            })
-            .collect();
-        // The vertices of turned faces belong to a fold's second layer: the
-        // new faces are made without them.
-        let folded: BTreeSet<u32> = turned
-            .iter()
-            .flat_map(|&f| mesh.faces[f as usize])
-            .collect();
-        // Where a fold beyond the turned faces makes two walls cross in the
-        // projection, the faces round the crossing go too, and the gap is
-        // triangulated again, a few times at most.
+            .all(|v| self.rings_from_border[v].0 + 2 < self.depth)
+    }
+
+    /// Step 5 for the faces `removed`. Where a fold beyond the turned
+    /// faces makes two walls cross in the projection, the faces round the
+    /// crossing go too, and the gap is triangulated again, a few times at
+    /// most ([`WALL_REPAIRS`]).
+    fn fill_gap(&self, cx: &Context, gap: &Gap, mut removed: Vec<u32>) -> Result<Patch, Retry> {
         for _ in 0..=WALL_REPAIRS {
-            let at_rim: BTreeSet<usize> = removed
-                .iter()
-                .flat_map(|&f| mesh.faces[f as usize])
-                .map(|v| self.rings_from_border[&v])
-                .filter(|&(d, _)| d + 1 >= self.depth)
-                .map(|(_, origin)| origin)
-                .collect();
+            let at_rim = self.loops_reaching_rim(cx.mesh, &removed);
             if !at_rim.is_empty() {
                 return Err(Retry::Grow(at_rim.into_iter().collect()));
             }
-            let walls = walls(mesh, &self.faces, &removed, &border_edges, &stay);
-            let free: BTreeSet<u32> = removed
-                .iter()
-                .flat_map(|&f| mesh.faces[f as usize])
-                .filter(|v| stay[v] && !folded.contains(v))
-                .collect();
-            match triangulate(mesh, &projection, &rings, &walls, &free, cx.beta_median) {
+            match self.triangulate_gap(cx, gap, &removed) {
                 Ok(mut patch) => {
                     patch.removed = removed;
                     return Ok(patch);
                 }
                 Err(Blocked::Walls(vertices)) => {
                     let before = removed.len();
-                    let mut all: BTreeSet<u32> = removed.into_iter().collect();
-                    all.extend(
-                        vertices
-                            .iter()
-                            .flat_map(|&v| cx.topology.faces_of(v).iter().copied())
-                            .filter(|&f| self.faces.binary_search(&f).is_ok()),
-                    );
-                    removed = all.into_iter().collect();
+                    removed = self.with_faces_round(cx, removed, &vertices);
                     if removed.len() == before {
                         break;
                     }
@@ -572,6 +630,93 @@ impl Band {
             Vec::new(),
         ))
     }
+
+    /// The loops (positions in the group) whose cut reaches the band's
+    /// rim: a removed face has a vertex `depth` − 1 or more rings from the
+    /// border.
+    fn loops_reaching_rim(&self, mesh: &Mesh, removed: &[u32]) -> BTreeSet<usize> {
+        removed
+            .iter()
+            .flat_map(|&f| mesh.faces[f as usize])
+            .map(|v| self.rings_from_border[&v])
+            .filter(|&(d, _)| d + 1 >= self.depth)
+            .map(|(_, origin)| origin)
+            .collect()
+    }
+
+    /// The gap left by the faces `removed`, triangulated: bounded by the
+    /// smoothed loops and the walls, with the kept vertices of the removed
+    /// faces (not those of the fold's second layer) inside.
+    fn triangulate_gap(&self, cx: &Context, gap: &Gap, removed: &[u32]) -> Result<Patch, Blocked> {
+        let mesh = cx.mesh;
+        let walls = walls(mesh, &self.faces, removed, &gap.border_edges, &gap.stay);
+        let free: BTreeSet<u32> = removed
+            .iter()
+            .flat_map(|&f| mesh.faces[f as usize])
+            .filter(|v| gap.stay[v] && !gap.folded.contains(v))
+            .collect();
+        triangulate(
+            mesh,
+            &gap.projection,
+            &gap.rings,
+            &walls,
+            &free,
+            cx.beta_median,
+        )
+    }
+
+    /// `removed` and the band's faces round `vertices` (where two walls
+    /// cross), ascending.
+    fn with_faces_round(&self, cx: &Context, removed: Vec<u32>, vertices: &[u32]) -> Vec<u32> {
+        let mut all: BTreeSet<u32> = removed.into_iter().collect();
+        all.extend(
+            vertices
+                .iter()
+                .flat_map(|&v| cx.topology.faces_of(v).iter().copied())
+                .filter(|&f| self.faces.binary_search(&f).is_ok()),
+        );
+        all.into_iter().collect()
+    }
+}
+
+/// What filling one band's gap reads besides the faces removed.
+struct Gap {
+    projection: Projection,
+    /// The smoothed loops, projected and untwisted.
+    rings: Vec<Ring>,
+    /// Whether each vertex of the band's faces stays.
+    stay: HashMap<u32, bool>,
+    /// The vertices of turned faces: they belong to a fold's second layer,
+    /// so the new faces are made without them.
+    folded: BTreeSet<u32>,
+    /// The directed edges of the group's old borders.
+    border_edges: BTreeSet<(u32, u32)>,
+}
+
+/// The group's smoothed loops in the band's projection, with the vertices
+/// that coincide there merged.
+fn projected_rings(cx: &Context, group: &[usize], projection: &Projection) -> Vec<Ring> {
+    group
+        .iter()
+        .filter_map(|&l| cx.rings[l].as_ref())
+        .map(|r| {
+            let mut ring = r.clone();
+            ring.p2 = ring.p3.iter().map(|&p| projection.to2(p)).collect();
+            ring.merge_coincident();
+            ring
+        })
+        .collect()
+}
+
+/// The directed edges of the borders of the group's loops.
+fn group_border_edges(cx: &Context, group: &[usize]) -> BTreeSet<(u32, u32)> {
+    group
+        .iter()
+        .flat_map(|&l| {
+            let b = &cx.borders[l];
+            (0..b.len()).map(move |i| (b[i], b[(i + 1) % b.len()]))
+        })
+        .collect()
 }
 
 /// The edges (directed as the removed faces run them) that bound the removed region against what stays: shared with a kept
@@ -626,80 +771,162 @@ fn triangulate(
     free: &BTreeSet<u32>,
     scale: f64,
 ) -> Result<Patch, Blocked> {
-    let n = mesh.vertices.len() as u32;
-    let mut cdt = Cdt::new();
-    let mut patch = Patch::default();
-    let mut handle_of: HashMap<u32, FixedVertexHandle> = HashMap::new();
-    let coincide = |ring: Option<usize>| {
-        leave(
-            "two vertices coincide in the projection of the band",
-            ring.into_iter().collect(),
-        )
-    };
-    let mut insert = |cdt: &mut Cdt, p: [f64; 2], id: u32, ring: Option<usize>| {
-        if let Some(&h) = handle_of.get(&id) {
+    let mut gap = GapTriangulation::new(mesh);
+    let ring_handles = gap.insert_rings(rings).map_err(Blocked::Other)?;
+    gap.insert_mesh_vertices(mesh, projection, walls, free)
+        .map_err(Blocked::Other)?;
+    gap.constrain_rings(&ring_handles)?;
+    gap.constrain_walls(walls)?;
+    refine_gap(&mut gap.cdt, mesh, &mut gap.patch, scale);
+    Ok(gap.into_patch())
+}
+
+/// A gap's triangulation as it is built: its vertices are the smoothed
+/// loops' (new vertices of the patch) and mesh vertices, each inserted
+/// once under its id.
+struct GapTriangulation {
+    cdt: Cdt,
+    patch: Patch,
+    handle_of: HashMap<u32, FixedVertexHandle>,
+    /// The mesh's vertex count: ids from here on are the patch's vertices.
+    n: u32,
+}
+
+impl GapTriangulation {
+    fn new(mesh: &Mesh) -> Self {
+        GapTriangulation {
+            cdt: Cdt::new(),
+            patch: Patch::default(),
+            handle_of: HashMap::new(),
+            n: mesh.vertices.len() as u32,
+        }
+    }
+
+    /// Inserts vertex `id` at `p`, or gives its handle if it is in. Two
+    /// vertices at the same place cannot both be vertices of the new
+    /// faces: the loop `ring` is left (or, for a mesh vertex, the group).
+    fn insert(
+        &mut self,
+        p: [f64; 2],
+        id: u32,
+        ring: Option<usize>,
+    ) -> Result<FixedVertexHandle, Retry> {
+        if let Some(&h) = self.handle_of.get(&id) {
             return Ok(h);
         }
-        if let PositionInTriangulation::OnVertex(_) = cdt.locate(crate::delaunay::point(p)) {
+        if let PositionInTriangulation::OnVertex(_) = self.cdt.locate(crate::delaunay::point(p)) {
             return Err(coincide(ring));
         }
-        let h = cdt.insert(Node::new(p, id)).map_err(|_| coincide(ring))?;
-        handle_of.insert(id, h);
+        let h = self
+            .cdt
+            .insert(Node::new(p, id))
+            .map_err(|_| coincide(ring))?;
+        self.handle_of.insert(id, h);
         Ok(h)
-    };
-    let mut ring_handles = Vec::new();
-    for (k, ring) in rings.iter().enumerate() {
-        let mut hs = Vec::with_capacity(ring.len());
-        for (j, &p) in ring.p2.iter().enumerate() {
-            let id = n + patch.vertices.len() as u32;
-            patch.vertices.push(ring.p3[j]);
-            hs.push(insert(&mut cdt, p, id, Some(k)).map_err(Blocked::Other)?);
+    }
+
+    /// Inserts every smoothed loop's vertices as new vertices of the
+    /// patch; their handles, loop by loop.
+    fn insert_rings(&mut self, rings: &[Ring]) -> Result<Vec<Vec<FixedVertexHandle>>, Retry> {
+        let mut ring_handles = Vec::new();
+        for (k, ring) in rings.iter().enumerate() {
+            let mut hs = Vec::with_capacity(ring.len());
+            for (j, &p) in ring.p2.iter().enumerate() {
+                let id = self.n + self.patch.vertices.len() as u32;
+                self.patch.vertices.push(ring.p3[j]);
+                hs.push(self.insert(p, id, Some(k))?);
+            }
+            ring_handles.push(hs);
         }
-        ring_handles.push(hs);
+        Ok(ring_handles)
     }
-    let wall_vertices: BTreeSet<u32> = walls.iter().flatten().copied().collect();
-    for &v in wall_vertices.iter().chain(free) {
-        insert(&mut cdt, projection.to2(mesh.vertices[v as usize]), v, None)
-            .map_err(Blocked::Other)?;
+
+    /// Inserts the walls' vertices, then the free vertices, ascending.
+    fn insert_mesh_vertices(
+        &mut self,
+        mesh: &Mesh,
+        projection: &Projection,
+        walls: &[[u32; 2]],
+        free: &BTreeSet<u32>,
+    ) -> Result<(), Retry> {
+        let wall_vertices: BTreeSet<u32> = walls.iter().flatten().copied().collect();
+        for &v in wall_vertices.iter().chain(free) {
+            self.insert(projection.vertex_to2(mesh, v), v, None)?;
+        }
+        Ok(())
     }
-    let constrain = |cdt: &mut Cdt, a, b, ring: Option<usize>| {
-        if let Some(other) = obstacle(cdt, a, b) {
+
+    /// Every segment of the smoothed loops as a constraint.
+    fn constrain_rings(&mut self, ring_handles: &[Vec<FixedVertexHandle>]) -> Result<(), Blocked> {
+        for (k, hs) in ring_handles.iter().enumerate() {
+            for j in 0..hs.len() {
+                self.constrain(hs[j], hs[(j + 1) % hs.len()], Some(k))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Every wall as a constraint.
+    fn constrain_walls(&mut self, walls: &[[u32; 2]]) -> Result<(), Blocked> {
+        for w in walls {
+            self.constrain(self.handle_of[&w[0]], self.handle_of[&w[1]], None)?;
+        }
+        Ok(())
+    }
+
+    /// Adds the constraint from `a` to `b` unless a vertex or constraint is
+    /// in its way: then a smoothed loop's segment (of loop `ring`) leaves
+    /// that loop, and a wall reports the vertices involved, so that the
+    /// faces round them can go.
+    fn constrain(
+        &mut self,
+        a: FixedVertexHandle,
+        b: FixedVertexHandle,
+        ring: Option<usize>,
+    ) -> Result<(), Blocked> {
+        if let Some(other) = obstacle(&self.cdt, a, b) {
             return Err(match ring {
                 Some(k) => {
                     Blocked::Other(leave("the smoothed border crosses the kept mesh", vec![k]))
                 }
                 None => Blocked::Walls(vec![
-                    cdt.vertex(a).data().id,
-                    cdt.vertex(b).data().id,
+                    self.cdt.vertex(a).data().id,
+                    self.cdt.vertex(b).data().id,
                     other,
                 ]),
             });
         }
-        cdt.add_constraint(a, b);
+        self.cdt.add_constraint(a, b);
         Ok(())
-    };
-    for (k, hs) in ring_handles.iter().enumerate() {
-        for j in 0..hs.len() {
-            constrain(&mut cdt, hs[j], hs[(j + 1) % hs.len()], Some(k))?;
+    }
+
+    /// The patch with its faces: those between the constraints (the
+    /// parity flood fill of [`inside_faces`]), each turned to run
+    /// counter-clockwise in the projection, as the band's unturned faces do.
+    fn into_patch(mut self) -> Patch {
+        for f in inside_faces(&self.cdt) {
+            let vs = self.cdt.face(f).vertices();
+            let mut ids = vs.map(|v| v.data().id);
+            let p = vs.map(|v| {
+                let q = v.position();
+                [q.x, q.y]
+            });
+            if orient(p[0], p[1], p[2]) < 0.0 {
+                ids.swap(1, 2);
+            }
+            self.patch.faces.push(ids);
         }
+        self.patch
     }
-    for w in walls {
-        constrain(&mut cdt, handle_of[&w[0]], handle_of[&w[1]], None)?;
-    }
-    refine_gap(&mut cdt, mesh, &mut patch, scale);
-    for f in inside_faces(&cdt) {
-        let vs = cdt.face(f).vertices();
-        let mut ids = vs.map(|v| v.data().id);
-        let p = vs.map(|v| {
-            let q = v.position();
-            [q.x, q.y]
-        });
-        if orient(p[0], p[1], p[2]) < 0.0 {
-            ids.swap(1, 2);
-        }
-        patch.faces.push(ids);
-    }
-    Ok(patch)
+}
+
+/// Two vertices coincide in the projection: the loop `ring` is left, or,
+/// without one, the whole group.
+fn coincide(ring: Option<usize>) -> Retry {
+    leave(
+        "two vertices coincide in the projection of the band",
+        ring.into_iter().collect(),
+    )
 }
 
 /// Where the gap is wide and holds no mesh vertex (a deep notch the
@@ -833,6 +1060,11 @@ impl Projection {
     fn to2(&self, p: Point3) -> [f64; 2] {
         let d = sub(p, self.origin);
         [dot(d, self.u), dot(d, self.v)]
+    }
+
+    /// The projection of the mesh's vertex `v`.
+    fn vertex_to2(&self, mesh: &Mesh, v: u32) -> [f64; 2] {
+        self.to2(mesh.vertices[v as usize])
     }
 }
 

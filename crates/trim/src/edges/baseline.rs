@@ -164,77 +164,50 @@ pub fn smoothing_spline_edge(points: &[Point3], closed: bool) -> Vec<Point3> {
 
 /// [`smoothing_spline_edge`] with the chosen λ, σ̂ and residual.
 pub fn smoothing_spline_fit(points: &[Point3], closed: bool) -> SplineFit {
-    let unchanged = |sigma: f64| SplineFit {
-        points: points.to_vec(),
-        lambda: 0.0,
-        sigma,
-        rss: 0.0,
-    };
     if points.len() < MIN_POINTS || !all_finite(points) {
-        return unchanged(0.0);
+        return SplineFit::unchanged(points, 0.0);
     }
     let Some(system) = SplineSystem::new(points, closed) else {
-        return unchanged(0.0);
+        return SplineFit::unchanged(points, 0.0);
     };
     let sigma2 = system.noise_variance();
-    let free = if closed {
-        points.len()
-    } else {
-        points.len() - 2
-    };
-    let target = free as f64 * sigma2;
+    let target = smoothing_target(points.len(), closed, sigma2);
     if !target.is_finite() || target <= 0.0 {
-        return unchanged(sigma2.max(0.0).sqrt());
+        return SplineFit::unchanged(points, sigma2.max(0.0).sqrt());
     }
-    let hbar = 1.0 / system.h.len() as f64;
-    let scale = hbar.powi(3);
-    let mu_max = (points.len() as f64).powi(4).min(1e12);
-    let mut lo = (1e-6f64).ln();
-    let mut hi = mu_max.ln();
-    let mut best: Option<(f64, Vec<Point3>, f64)> = None;
-    // The largest λ first: if it stays below the target, it is the answer.
-    if let Some((fit, rss)) = system.solve(scale * hi.exp()) {
-        if rss <= target {
-            best = Some((scale * hi.exp(), fit, rss));
-        }
-    }
-    if best.is_none() {
-        for _ in 0..80 {
-            let mid = 0.5 * (lo + hi);
-            let lambda = scale * mid.exp();
-            match system.solve(lambda) {
-                Some((fit, rss)) => {
-                    let close = (rss / target - 1.0).abs() < 1e-4;
-                    if rss <= target {
-                        lo = mid;
-                    } else {
-                        hi = mid;
-                    }
-                    // Keep the last fit at or below the target (or on it).
-                    if rss <= target || close {
-                        best = Some((lambda, fit, rss));
-                    }
-                    if close {
-                        break;
-                    }
-                }
-                None => hi = mid,
-            }
-            if hi - lo < 1e-6 {
-                break;
-            }
-        }
-    }
-    match best {
+    match system.fit_to_target(target) {
         Some((lambda, fit, rss)) if all_finite(&fit) => SplineFit {
             points: fit,
             lambda,
             sigma: sigma2.sqrt(),
             rss,
         },
-        _ => unchanged(sigma2.sqrt()),
+        _ => SplineFit::unchanged(points, sigma2.sqrt()),
     }
 }
+
+impl SplineFit {
+    /// The input as it stands (λ = 0, no residual), with the noise
+    /// estimate `sigma` when there is one.
+    fn unchanged(points: &[Point3], sigma: f64) -> SplineFit {
+        SplineFit {
+            points: points.to_vec(),
+            lambda: 0.0,
+            sigma,
+            rss: 0.0,
+        }
+    }
+}
+
+/// Reinsch's smoothing target m·σ̂² for the residual sum of squares, m the
+/// number of free points: n − 2 open (the ends are kept), n closed.
+fn smoothing_target(n: usize, closed: bool, sigma2: f64) -> f64 {
+    let free = if closed { n } else { n - 2 };
+    free as f64 * sigma2
+}
+
+/// A fit at one λ: (λ, the fitted points, their residual sum of squares).
+type LambdaFit = (f64, Vec<Point3>, f64);
 
 /// Cumulative chord length of `points` (starting at 0) and the total
 /// length, including the closing segment when `closed`. None when the
@@ -407,6 +380,62 @@ impl SplineSystem {
             r,
             qdq,
         })
+    }
+
+    /// The fit whose residual sum of squares meets `target` (see the
+    /// module doc): λ = μ·h̄³ with μ between 10⁻⁶ and min(n⁴, 10¹²), the
+    /// largest if even it stays below the target, otherwise found by
+    /// bisection on log μ. None when no fit at or near the target was
+    /// found.
+    fn fit_to_target(&self, target: f64) -> Option<LambdaFit> {
+        let hbar = 1.0 / self.h.len() as f64;
+        let scale = hbar.powi(3);
+        let mu_max = (self.y.len() as f64).powi(4).min(1e12);
+        let lo = (1e-6f64).ln();
+        let hi = mu_max.ln();
+        self.fit_at_largest(scale, hi, target)
+            .or_else(|| self.bisect(scale, lo, hi, target))
+    }
+
+    /// The largest λ first (`scale`·e^`hi`): if it stays below the
+    /// target, it is the answer.
+    fn fit_at_largest(&self, scale: f64, hi: f64, target: f64) -> Option<LambdaFit> {
+        let (fit, rss) = self.solve(scale * hi.exp())?;
+        (rss <= target).then(|| (scale * hi.exp(), fit, rss))
+    }
+
+    /// Bisection on log μ between `lo` and `hi` (λ = `scale`·e^log μ):
+    /// RSS increases with λ. Stops when RSS is within 10⁻⁴ of the target
+    /// (relative) or the interval is narrower than 10⁻⁶; λ that fail to
+    /// give a fit count as too large.
+    fn bisect(&self, scale: f64, mut lo: f64, mut hi: f64, target: f64) -> Option<LambdaFit> {
+        let mut best = None;
+        for _ in 0..80 {
+            let mid = 0.5 * (lo + hi);
+            let lambda = scale * mid.exp();
+            match self.solve(lambda) {
+                Some((fit, rss)) => {
+                    let close = (rss / target - 1.0).abs() < 1e-4;
+                    if rss <= target {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                    // Keep the last fit at or below the target (or on it).
+                    if rss <= target || close {
+                        best = Some((lambda, fit, rss));
+                    }
+                    if close {
+                        break;
+                    }
+                }
+                None => hi = mid,
+            }
+            if hi - lo < 1e-6 {
+                break;
+            }
+        }
+        best
     }
 
     /// The fit at `lambda` and its residual sum of squares.
