@@ -1209,16 +1209,8 @@ fn without_empty_faces(mesh: &Mesh) -> (Cow<'_, Mesh>, DroppedFaces) {
     if dropped == DroppedFaces::default() {
         return (Cow::Borrowed(mesh), dropped);
     }
-    let kept = Mesh {
-        vertices: mesh.vertices.clone(),
-        faces: mesh
-            .faces
-            .iter()
-            .zip(&keep)
-            .filter(|(_, &k)| k)
-            .map(|(f, _)| *f)
-            .collect(),
-    };
+    let mut kept = mesh.clone();
+    kept.retain_faces(&keep);
     (Cow::Owned(kept), dropped)
 }
 

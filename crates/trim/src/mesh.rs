@@ -184,6 +184,14 @@ impl Mesh {
         chain_loops(next)
     }
 
+    /// Keeps the faces whose entry in `keep` is true, in order; vertices
+    /// stay as they are.
+    pub fn retain_faces(&mut self, keep: &[bool]) {
+        let mut flags = keep.iter();
+        self.faces
+            .retain(|_| flags.next().copied().unwrap_or(false));
+    }
+
     /// Drops vertices no face uses, keeping the others in order.
     pub fn remove_unused_vertices(&mut self) {
         let mut new_index = vec![u32::MAX; self.vertices.len()];

@@ -143,16 +143,8 @@ pub fn trim_mesh(
     for (&o, &k) in origin.iter().zip(&keep) {
         survived[o as usize] |= k;
     }
-    let mut kept = Mesh {
-        vertices: cut.vertices,
-        faces: cut
-            .faces
-            .iter()
-            .zip(&keep)
-            .filter(|(_, &k)| k)
-            .map(|(f, _)| *f)
-            .collect(),
-    };
+    let mut kept = cut;
+    kept.retain_faces(&keep);
     kept.remove_unused_vertices();
     let report = TrimReport {
         faces_in: mesh.faces.len(),
