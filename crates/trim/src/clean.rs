@@ -76,7 +76,7 @@ use crate::edges::cluster::MIN_LOOP_POINTS;
 use crate::edges::loop_from_tour;
 use crate::error::MeshError;
 use crate::frame::fit_plane;
-use crate::mesh::Mesh;
+use crate::mesh::{lowest_first, Mesh};
 use crate::neighbours::NeighbourIndex;
 
 /// Vertices closer than this many β to a smoothed loop are replaced.
@@ -1198,7 +1198,7 @@ fn without_empty_faces(mesh: &Mesh) -> (Cow<'_, Mesh>, DroppedFaces) {
             if !distinct(f) {
                 dropped.slivers += 1;
                 false
-            } else if !seen.insert(same_turn_key(*f)) {
+            } else if !seen.insert(lowest_first(*f)) {
                 dropped.repeats += 1;
                 false
             } else {
@@ -1212,14 +1212,6 @@ fn without_empty_faces(mesh: &Mesh) -> (Cow<'_, Mesh>, DroppedFaces) {
     let mut kept = mesh.clone();
     kept.retain_faces(&keep);
     (Cow::Owned(kept), dropped)
-}
-
-/// A face's corners rotated to start at the lowest index: equal for two
-/// faces with the same corners in the same turn, different for opposite
-/// turns.
-fn same_turn_key(f: [u32; 3]) -> [u32; 3] {
-    let first = (0..3).min_by_key(|&k| f[k]).unwrap_or(0);
-    [f[first], f[(first + 1) % 3], f[(first + 2) % 3]]
 }
 
 /// Edge-manifold with consistent orientation: every undirected edge used

@@ -77,7 +77,7 @@ use crate::cloud::{cross, dot, norm2, sub, Point3};
 use crate::edges::Edges;
 use crate::error::MeshError;
 use crate::frame::{fit_plane, Frame};
-use crate::mesh::Mesh;
+use crate::mesh::{lowest_first, Mesh};
 use crate::neighbours::NeighbourIndex;
 
 pub mod diagonals;
@@ -593,8 +593,7 @@ fn largest_first(rings: &[Ring]) -> Vec<usize> {
 /// order depends on its history), each starting at its lowest id.
 fn sort_faces(faces: &mut [[u32; 3]]) {
     for f in faces.iter_mut() {
-        let first = (0..3).min_by_key(|&k| f[k]).unwrap_or(0);
-        f.rotate_left(first);
+        *f = lowest_first(*f);
     }
     faces.sort_unstable();
 }

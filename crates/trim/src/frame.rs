@@ -391,8 +391,8 @@ pub fn ray_shear(frame: &Frame, ray: Point3) -> [f64; 2] {
 /// other gets the shear of the same direction at unit size, bit for bit.
 fn moderate(mut v: Point3) -> Point3 {
     const BIG: f64 = 18_446_744_073_709_551_616.0; // 2^64
-                                                   // Scaled with the vector, exactly (a power of two): the largest
-                                                   // |component| is found once per ray, which runs for every point.
+                                                   // Found once per ray (which runs for every point) and scaled with the
+                                                   // vector, exactly, since BIG is a power of two.
     let mut largest = v.iter().fold(0.0f64, |m, c| m.max(c.abs()));
     while largest >= BIG && largest.is_finite() {
         v = v.map(|c| c / BIG);

@@ -31,6 +31,14 @@ pub fn check_vertex_range(vertices: &[Point3]) -> Result<(), MeshError> {
     }
 }
 
+/// A face's corners rotated to start at its lowest index, keeping their
+/// turn: equal for two faces with the same corners in the same turn,
+/// different for opposite turns. Gives faces an order of their own ids.
+pub fn lowest_first(f: [u32; 3]) -> [u32; 3] {
+    let first = (0..3).min_by_key(|&k| f[k]).unwrap_or(0);
+    [f[first], f[(first + 1) % 3], f[(first + 2) % 3]]
+}
+
 impl Mesh {
     /// Checks indices and coordinates (finite, and within the supported
     /// range: [`check_vertex_range`]).

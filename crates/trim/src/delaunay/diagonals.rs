@@ -146,8 +146,7 @@ mod tests {
 
     fn canonical(mut faces: Vec<[u32; 3]>) -> Vec<[u32; 3]> {
         for f in faces.iter_mut() {
-            let first = (0..3).min_by_key(|&k| f[k]).unwrap_or(0);
-            f.rotate_left(first);
+            *f = crate::mesh::lowest_first(*f);
         }
         faces.sort_unstable();
         faces
