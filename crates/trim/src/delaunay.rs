@@ -78,13 +78,16 @@ use crate::edges::Edges;
 use crate::error::MeshError;
 use crate::frame::{fit_plane, Frame};
 use crate::mesh::{lowest_first, Mesh};
-use crate::neighbours::NeighbourIndex;
+use crate::morton::{octree_runs, spatial_order, MortonCells, MortonGrid};
+use crate::neighbours::{NeighbourIndex, RunScratch};
 
 pub mod diagonals;
 use diagonals::canonical_diagonals;
 
 /// Neighbourhood size of the local normals of the height-field check.
 pub const NORMAL_K: usize = 30;
+/// Most points per k-NN run of the local normals (as BPD's runs).
+const NORMAL_RUN: usize = 32;
 /// A local normal with |nᵢ·n| below this stands on edge over the plane.
 pub const STEEP_COS: f64 = 0.1;
 /// Largest accepted share of such points.
@@ -222,20 +225,53 @@ impl Projection {
 /// Step 2, **local normals**: each point's normal fitted to its
 /// [`NORMAL_K`] nearest neighbours, oriented to the side `plane_normal`
 /// points to.
+///
+/// The search runs over the points in Morton order, as BPD's does (about
+/// twice as fast as kiddo's tree at 1M points), with ties cut by input
+/// index: the same neighbours in the same order as [`NeighbourIndex::new`]
+/// gives, so the same normals.
 fn local_normals(cloud: &[Point3], plane_normal: Point3) -> Vec<Point3> {
-    let index = NeighbourIndex::new(cloud);
-    (0..cloud.len())
-        .into_par_iter()
-        .map_init(Vec::new, |nb, i| {
-            index.nearest(i, NORMAL_K, nb);
-            let m = fit_plane(cloud, nb).normal;
-            if dot(m, plane_normal) < 0.0 {
-                m.map(|c| -c)
-            } else {
-                m
+    let grid = MortonGrid::of(cloud);
+    let (order, keys) = spatial_order(cloud, &grid);
+    let sorted: Vec<Point3> = order.par_iter().map(|&i| cloud[i as usize]).collect();
+    let index =
+        NeighbourIndex::in_morton_order(&sorted, MortonCells::new(grid, &keys)).with_ranks(&order);
+    // Each run's normals written in place, in Morton order.
+    let mut by_position = vec![[0.0; 3]; cloud.len()];
+    let mut jobs = Vec::new();
+    let mut rest = by_position.as_mut_slice();
+    for run in octree_runs(&keys, NORMAL_RUN) {
+        let (out, tail) = rest.split_at_mut(run.len());
+        jobs.push((run, out));
+        rest = tail;
+    }
+    let k = NORMAL_K.min(cloud.len());
+    jobs.into_par_iter().for_each_init(
+        || (RunScratch::default(), Vec::new()),
+        |(scratch, members), (run, out)| {
+            members.resize(run.len() * k, 0);
+            index.nearest_of_run(run, k, members, scratch);
+            for (nb, normal) in members.chunks_exact_mut(k).zip(out) {
+                nb.iter_mut().for_each(|q| *q = order[*q as usize]);
+                *normal = oriented_normal(cloud, nb, plane_normal);
             }
-        })
-        .collect()
+        },
+    );
+    let mut normals = vec![[0.0; 3]; cloud.len()];
+    for (&i, m) in order.iter().zip(by_position) {
+        normals[i as usize] = m;
+    }
+    normals
+}
+
+/// The normal of the plane fitted to `members`, on `plane_normal`'s side.
+fn oriented_normal(cloud: &[Point3], members: &[u32], plane_normal: Point3) -> Point3 {
+    let m = fit_plane(cloud, members).normal;
+    if dot(m, plane_normal) < 0.0 {
+        m.map(|c| -c)
+    } else {
+        m
+    }
 }
 
 /// Step 2, **height-field check on the points**: where the surface stands
@@ -467,8 +503,14 @@ impl LoopCdt {
             positions,
             used,
         } = self.kept_faces();
-        report.diagonals_flipped =
-            canonical_diagonals(&positions, &mut faces, &self.constraint_pairs());
+        // Jittered and real float clouds have no co-circular quad: the
+        // flip pass, which indexes every edge, is skipped without changing
+        // its result (it flips only where a quad is co-circular).
+        report.diagonals_flipped = if self.has_cocircular_quad() {
+            canonical_diagonals(&positions, &mut faces, &self.constraint_pairs())
+        } else {
+            0
+        };
         sort_faces(&mut faces);
         let (out_index, vertices, reference) = self.number_vertices(cloud, &used);
         report.points_used = out_index[..self.n]
@@ -525,6 +567,32 @@ impl LoopCdt {
             positions,
             used,
         }
+    }
+
+    /// Whether some edge that is not a constraint has two triangles whose
+    /// quad is co-circular, tested exactly as [`canonical_diagonals`] tests
+    /// its first edges (ids a < b, c left of a → b, d left of b → a): if
+    /// none is, that pass flips nothing. Faces outside the loops are
+    /// tested too, so this can only say yes more often.
+    fn has_cocircular_quad(&self) -> bool {
+        let at = |v: spade::handles::VertexHandle<'_, Node, (), spade::CdtEdge<()>, ()>| {
+            let p = v.position();
+            [p.x, p.y]
+        };
+        self.cdt.undirected_edges().any(|edge| {
+            if edge.is_constraint_edge() {
+                return false;
+            }
+            let mut forward = edge.as_directed();
+            if forward.from().data().id > forward.to().data().id {
+                forward = forward.rev();
+            }
+            let (Some(c), Some(d)) = (forward.opposite_vertex(), forward.rev().opposite_vertex())
+            else {
+                return false;
+            };
+            diagonals::cocircular(at(forward.from()), at(forward.to()), at(c), at(d))
+        })
     }
 
     /// The rings' segments as id pairs, smaller id first: diagonals that
@@ -1166,6 +1234,52 @@ impl SegmentGrid {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use rand::{RngExt, SeedableRng};
+
+    /// The straightforward local normals: kiddo's tree, one query a point.
+    fn local_normals_reference(cloud: &[Point3], plane_normal: Point3) -> Vec<Point3> {
+        let index = NeighbourIndex::new(cloud);
+        let mut nb = Vec::new();
+        (0..cloud.len())
+            .map(|i| {
+                index.nearest(i, NORMAL_K, &mut nb);
+                oriented_normal(cloud, &nb, plane_normal)
+            })
+            .collect()
+    }
+
+    /// The Morton-run search gives the reference's normals bit for bit, on
+    /// wavy sheets with quantised coordinates (ties at every distance) and
+    /// repeated points, and on clouds smaller than a neighbourhood.
+    #[test]
+    fn local_normals_match_the_reference() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        for case in 0..12 {
+            let n = [5, 29, 30, 31, 400, 3000][case % 6];
+            let step = if case < 6 { 0.0 } else { 0.25 };
+            let mut cloud: Vec<Point3> = (0..n)
+                .map(|_| {
+                    let (x, y): (f64, f64) =
+                        (rng.random_range(0.0..20.0), rng.random_range(0.0..20.0));
+                    let p = [x, y, (0.3 * x).sin() + 0.1 * y];
+                    if step > 0.0 {
+                        p.map(|c: f64| (c / step).round() * step)
+                    } else {
+                        p
+                    }
+                })
+                .collect();
+            for i in 0..n / 10 {
+                cloud.push(cloud[(7 * i) % n]);
+            }
+            let up = [0.0, 0.0, 1.0];
+            assert_eq!(
+                local_normals(&cloud, up),
+                local_normals_reference(&cloud, up),
+                "case {case}"
+            );
+        }
+    }
 
     fn ring(p2: Vec<[f64; 2]>) -> Ring {
         Ring {

@@ -99,7 +99,7 @@ fn third(face: &[u32; 3], a: u32, b: u32) -> u32 {
 }
 
 /// Are the four points on one circle, within [`COCIRCULAR`]?
-fn cocircular(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> bool {
+pub(crate) fn cocircular(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> bool {
     // Relative to d, which keeps the determinant's terms small.
     let [u, v, w] = [a, b, c].map(|p| [p[0] - d[0], p[1] - d[1]]);
     let lift = |p: [f64; 2]| p[0] * p[0] + p[1] * p[1];
