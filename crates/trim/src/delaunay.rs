@@ -257,6 +257,9 @@ fn local_normals(cloud: &[Point3], plane_normal: Point3) -> Vec<Point3> {
             }
         },
     );
+    // The sorted copy's block is free again for the normals.
+    drop(index);
+    drop(sorted);
     let mut normals = vec![[0.0; 3]; cloud.len()];
     for (&i, m) in order.iter().zip(by_position) {
         normals[i as usize] = m;
