@@ -285,3 +285,33 @@ fn an_stl_triangle_written_twice_is_dropped_and_counted() {
     assert_eq!(json["slivers_dropped"], 0);
     assert_eq!(json["faces_in"], u64::from(count) + 2);
 }
+
+/// Two corners of the fixture thrown far off (the sign and exponent bytes
+/// of their x flipped, as a damaged file would): a wall of one band's gap
+/// then runs into the smoothed loop itself, and the vertex in its way is
+/// one of the loop's new vertices, which the mesh does not have. That
+/// panicked (index out of bounds, found by mutating the fixtures); now the
+/// loop is left as it is, with the reason.
+#[test]
+fn a_wall_blocked_by_the_smoothed_loop_leaves_the_loop() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut stl = std::fs::read(JAGGED).unwrap();
+    // The top byte of x: triangle 4,738's second corner, 4,750's third.
+    stl[237_011] = 170;
+    stl[237_623] = 8;
+    let input = dir.path().join("thrown.stl");
+    std::fs::write(&input, &stl).unwrap();
+    let output = dir.path().join("out.ply");
+    let run = meshtrim(&["clean", s(&input), s(&output)], None);
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert!(
+        stdout.contains("the mesh folds over the new border's plane beside it"),
+        "{stdout}"
+    );
+    assert!(output.exists());
+}

@@ -1265,8 +1265,14 @@ impl Topology {
         }
     }
 
+    /// The faces round vertex `v`; none for a vertex the mesh does not
+    /// have (a patch's new smoothed-loop vertex, which a blocked wall can
+    /// name).
     fn faces_of(&self, v: u32) -> &[u32] {
-        &self.faces[self.start[v as usize] as usize..self.start[v as usize + 1] as usize]
+        match (self.start.get(v as usize), self.start.get(v as usize + 1)) {
+            (Some(&from), Some(&to)) => &self.faces[from as usize..to as usize],
+            _ => &[],
+        }
     }
 }
 
