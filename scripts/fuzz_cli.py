@@ -1,0 +1,234 @@
+"""Mutation fuzzing of the meshtrim CLI: no input may make it panic.
+
+    python3 scripts/fuzz_cli.py [--seed N] [--cases N] [--kind bytes|mesh|cloud|all]
+
+Builds nothing: it runs `target/release/meshtrim` (build it first) on
+mutated copies of the fixtures and of files it derives from them (every
+cloud and mesh format meshtrim reads), in a temporary directory.
+
+- `bytes`: random byte changes, truncations, insertions (`nan`, `1e400`,
+  NUL, blanks) and repeated stretches of the files themselves; read by
+  `detect`, `edges`, `clean` and the main job.
+- `mesh`: the jagged fixture's geometry changed: spikes (up to 10³ × its
+  size), jitter, collapsed and repeated vertices, dropped and reversed
+  faces, flattened heights; run through `clean`, the main job, `detect`
+  and `mesh`.
+- `cloud`: the fixture cloud changed: spikes, thousands of copies,
+  quantised coordinates, tiny subsets, straight lines, huge offsets, a flat
+  plane, a cluster of near-coincident points; run through `detect`,
+  `edges`, `mesh` and the main job.
+
+A run that exits with Rust's panic code (101) or prints "panicked" is
+reported and its input kept (in `fuzz-failures/`); errors with a message
+are what bad input should get. Exits 1 if any run panicked.
+"""
+
+import argparse
+import os
+import random
+import shutil
+import struct
+import subprocess
+import sys
+import tempfile
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+EXE = os.path.join(ROOT, "target", "release", "meshtrim")
+FIXTURES = os.path.join(ROOT, "fixtures", "meshes")
+CLOUD = os.path.join(FIXTURES, "blade_small.ply")
+POISSON = os.path.join(FIXTURES, "blade_small_poisson.ply")
+JAGGED = os.path.join(FIXTURES, "blade_jagged.stl")
+
+
+def run(cmd):
+    try:
+        return subprocess.run([EXE] + cmd, capture_output=True, timeout=120)
+    except subprocess.TimeoutExpired:
+        return None
+
+
+def derive_sources(work):
+    """The fixtures in every format meshtrim reads."""
+    csv = os.path.join(work, "cloud.csv")
+    run(["detect", CLOUD, "-o", csv])
+    rows = [line.split(",")[:3] for line in open(csv).read().splitlines()[1:]][:4000]
+    with open(os.path.join(work, "cloud.xyz"), "w") as f:
+        f.write("".join(" ".join(r) + "\n" for r in rows))
+    with open(os.path.join(work, "cloud.obj"), "w") as f:
+        f.write("".join("v " + " ".join(r) + "\n" for r in rows))
+    header = (
+        "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+        f"WIDTH {len(rows)}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {len(rows)}\nDATA "
+    )
+    with open(os.path.join(work, "cloud_ascii.pcd"), "w") as f:
+        f.write(header + "ascii\n" + "".join(" ".join(r) + "\n" for r in rows))
+    with open(os.path.join(work, "cloud_binary.pcd"), "wb") as f:
+        f.write((header + "binary\n").encode())
+        for r in rows:
+            f.write(struct.pack("<3f", *map(float, r)))
+    for ext in ("stl", "obj", "gltf", "glb", "ply"):
+        run(["clean", JAGGED, os.path.join(work, f"mesh.{ext}")])
+    clouds = [CLOUD] + [os.path.join(work, n) for n in
+                        ("cloud.csv", "cloud.xyz", "cloud.obj", "cloud_ascii.pcd", "cloud_binary.pcd")]
+    meshes = [JAGGED, POISSON] + [os.path.join(work, f"mesh.{e}") for e in ("stl", "obj", "gltf", "glb", "ply")]
+    return clouds, meshes
+
+
+def commands(path, is_mesh, work):
+    out = lambda name: os.path.join(work, name)
+    if is_mesh:
+        return [["clean", path, out("clean.ply")], [path, CLOUD, out("trim.ply")],
+                ["detect", path, "-o", out("d.csv")], ["mesh", path, out("m.ply")]]
+    return [["detect", path, "-o", out("d.csv")], ["edges", path, "-o", out("e.json")],
+            ["mesh", path, out("m.ply")], [POISSON, path, out("trim.ply")]]
+
+
+def mutate_bytes(rng, data):
+    op = rng.choice(["flip", "truncate", "insert", "repeat"])
+    if op == "flip":
+        for _ in range(rng.randint(1, 20)):
+            data[rng.randrange(len(data))] = rng.randrange(256)
+    elif op == "truncate":
+        del data[rng.randrange(len(data)):]
+    elif op == "insert":
+        i = rng.randrange(len(data))
+        data[i:i] = rng.choice([b" ", b"\n", b"-", b"nan", b"1e400", b"\x00", b"0"]) * rng.randint(1, 3)
+    else:
+        i = rng.randrange(len(data))
+        j = min(len(data), i + rng.randint(1, 200))
+        data[j:j] = data[i:j]
+    return op
+
+
+def read_obj(path):
+    lines = open(path).read().splitlines()
+    vertices = [list(map(float, l.split()[1:4])) for l in lines if l.startswith("v ")]
+    faces = [l.split()[1:] for l in lines if l.startswith("f ")]
+    return vertices, faces
+
+
+def mutate_mesh(rng, vertices, faces, size):
+    op = rng.choice(["spike", "jitter", "collapse", "drop faces", "reverse faces", "repeat vertices", "flatten"])
+    k = rng.randint(1, 30)
+    if op == "spike":
+        for _ in range(k):
+            rng.choice(vertices)[rng.randrange(3)] += rng.choice([-1, 1]) * size * rng.choice([0.01, 0.1, 1, 10, 1e3])
+    elif op == "jitter":
+        s = size * rng.choice([1e-4, 1e-3, 1e-2, 0.05])
+        for v in vertices:
+            for i in range(3):
+                v[i] += rng.uniform(-s, s)
+    elif op == "collapse":
+        for _ in range(k):
+            vertices[rng.randrange(len(vertices))] = list(rng.choice(vertices))
+    elif op == "drop faces":
+        for _ in range(5 * k):
+            if faces:
+                faces.pop(rng.randrange(len(faces)))
+    elif op == "reverse faces":
+        for _ in range(k):
+            rng.choice(faces).reverse()
+    elif op == "repeat vertices":
+        for _ in range(k):
+            f = rng.choice(faces)
+            j = rng.randrange(3)
+            vertices.append(list(vertices[int(f[j].split("/")[0]) - 1]))
+            f[j] = str(len(vertices))
+    else:
+        for v in vertices:
+            v[2] = round(v[2])
+    return op
+
+
+def mutate_cloud(rng, points):
+    op = rng.choice(["spike", "copies", "quantise", "subset", "line", "far", "flat", "cluster"])
+    if op == "spike":
+        for _ in range(rng.randint(1, 50)):
+            rng.choice(points)[rng.randrange(3)] += rng.choice([-1, 1]) * rng.choice([10, 100, 1e4, 1e8])
+    elif op == "copies":
+        points += [list(rng.choice(points)) for _ in range(rng.randint(1, 2000))]
+    elif op == "quantise":
+        step = rng.choice([0.01, 0.5, 2, 5, 20])
+        points[:] = [[round(c / step) * step for c in q] for q in points]
+    elif op == "subset":
+        points[:] = rng.sample(points, rng.randint(1, 200))
+    elif op == "line":
+        a = rng.choice(points)
+        points += [[a[0] + 0.3 * t, a[1], a[2]] for t in range(rng.randint(1, 500))]
+    elif op == "far":
+        offset = rng.choice([1e5, 1e8, 1e12, -1e15])
+        points[:] = [[c + offset for c in q] for q in points]
+    elif op == "flat":
+        points[:] = [[q[0], q[1], 0.0] for q in points]
+    else:
+        a = rng.choice(points)
+        points += [[a[0] + rng.gauss(0, 1e-6), a[1] + rng.gauss(0, 1e-6), a[2]]
+                   for _ in range(rng.randint(30, 3000))]
+    rng.shuffle(points)
+    return op
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seed", type=int, default=1)
+    parser.add_argument("--cases", type=int, default=100, help="mutated inputs per kind")
+    parser.add_argument("--kind", choices=["bytes", "mesh", "cloud", "all"], default="all")
+    args = parser.parse_args()
+    if not os.access(EXE, os.X_OK):
+        sys.exit(f"{EXE} not found: run `cargo build --release` first")
+    rng = random.Random(args.seed)
+    failures = os.path.join(ROOT, "fuzz-failures")
+    runs = panics = 0
+    with tempfile.TemporaryDirectory() as work:
+        clouds, meshes = derive_sources(work)
+
+        def check(path, is_mesh, what):
+            nonlocal runs, panics
+            for cmd in commands(path, is_mesh, work):
+                runs += 1
+                result = run(cmd)
+                if result is None:
+                    print(f"timeout: {what}: meshtrim {' '.join(cmd)}")
+                elif result.returncode == 101 or b"panicked" in result.stderr:
+                    panics += 1
+                    os.makedirs(failures, exist_ok=True)
+                    kept = os.path.join(failures, f"seed{args.seed}-{panics}{os.path.splitext(path)[1]}")
+                    shutil.copy(path, kept)
+                    print(f"PANIC: {what}: meshtrim {cmd[0]} (input kept in {kept})")
+                    print(result.stderr.decode(errors="replace")[:400])
+                    return
+
+        kinds = ["bytes", "mesh", "cloud"] if args.kind == "all" else [args.kind]
+        if "bytes" in kinds:
+            for _ in range(args.cases):
+                source = rng.choice(clouds + meshes)
+                data = bytearray(open(source, "rb").read())
+                op = mutate_bytes(rng, data)
+                path = os.path.join(work, "case" + os.path.splitext(source)[1])
+                open(path, "wb").write(data)
+                check(path, source in meshes, f"{os.path.basename(source)}, bytes {op}")
+        if "mesh" in kinds:
+            vertices, faces = read_obj(os.path.join(work, "mesh.obj"))
+            size = max(max(v[i] for v in vertices) - min(v[i] for v in vertices) for i in range(3))
+            for _ in range(args.cases):
+                vs, fs = [list(v) for v in vertices], [list(f) for f in faces]
+                op = mutate_mesh(rng, vs, fs, size)
+                path = os.path.join(work, "case.obj")
+                with open(path, "w") as f:
+                    f.write("".join("v %r %r %r\n" % tuple(v) for v in vs))
+                    f.write("".join("f " + " ".join(face) + "\n" for face in fs))
+                check(path, True, f"mesh {op}")
+        if "cloud" in kinds:
+            points = [list(map(float, l.split())) for l in open(os.path.join(work, "cloud.xyz"))]
+            for _ in range(args.cases):
+                ps = [list(p) for p in points]
+                op = mutate_cloud(rng, ps)
+                path = os.path.join(work, "case.xyz")
+                open(path, "w").write("".join("%r %r %r\n" % tuple(p) for p in ps))
+                check(path, False, f"cloud {op}")
+    print(f"{runs} runs, {panics} panicked")
+    sys.exit(1 if panics else 0)
+
+
+if __name__ == "__main__":
+    main()
