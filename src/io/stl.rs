@@ -12,8 +12,8 @@
 //! when its header starts with `solid`, as some exporters write), else a
 //! file starting with `solid` is ASCII, else it is binary and too short.
 
-use std::collections::HashMap;
 use std::io::Write;
+use trim::hash::HashMap;
 
 use anyhow::{anyhow, bail, Result};
 use byteorder::{ByteOrder, LittleEndian, WriteBytesExt};
@@ -78,7 +78,7 @@ impl Merger {
                 normals: None,
                 faces: Some(Vec::with_capacity(capacity(triangles))),
             },
-            index: HashMap::with_capacity(capacity(triangles / 2)),
+            index: HashMap::with_capacity_and_hasher(capacity(triangles / 2), Default::default()),
         }
     }
 

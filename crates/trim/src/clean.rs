@@ -59,7 +59,9 @@
 //! output is never a broken mesh.
 
 use std::borrow::Cow;
-use std::collections::{BTreeSet, HashMap, HashSet};
+use std::collections::BTreeSet;
+
+use crate::hash::{HashMap, HashSet};
 
 use rayon::prelude::*;
 use spade::handles::FixedVertexHandle;
@@ -337,7 +339,7 @@ fn replace_all(cx: &Context) -> Vec<Outcome> {
 
 /// Two outcomes whose bands share a face (indices, a < b).
 fn first_overlap(outcomes: &[Outcome]) -> Option<(usize, usize)> {
-    let mut owner: HashMap<u32, usize> = HashMap::new();
+    let mut owner: HashMap<u32, usize> = HashMap::default();
     for (g, outcome) in outcomes.iter().enumerate() {
         for &f in &outcome.band {
             if let Some(&other) = owner.get(&f) {
@@ -451,7 +453,7 @@ impl Band {
     /// Faces with a vertex less than `depth` rings from the border of the
     /// `group`'s loops.
     fn around(cx: &Context, group: &[usize], depth: u32) -> Band {
-        let mut distance: HashMap<u32, (u32, usize)> = HashMap::new();
+        let mut distance: HashMap<u32, (u32, usize)> = HashMap::default();
         for (k, &l) in group.iter().enumerate() {
             for &v in &cx.borders[l] {
                 distance.entry(v).or_insert((0, k));
@@ -729,7 +731,7 @@ fn walls(
     stay: &HashMap<u32, bool>,
 ) -> Vec<[u32; 2]> {
     let removed_set: BTreeSet<u32> = removed.iter().copied().collect();
-    let mut uses: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
+    let mut uses: HashMap<(u32, u32), Vec<u32>> = HashMap::default();
     for &f in band {
         let face = mesh.faces[f as usize];
         for k in 0..3 {
@@ -797,7 +799,7 @@ impl GapTriangulation {
         GapTriangulation {
             cdt: Cdt::new(),
             patch: Patch::default(),
-            handle_of: HashMap::new(),
+            handle_of: HashMap::default(),
             n: mesh.vertices.len() as u32,
         }
     }
@@ -1109,7 +1111,7 @@ fn assemble(mesh: &Mesh, outcomes: &[Outcome]) -> (Mesh, Vec<Option<usize>>) {
 /// The outcomes whose new faces use an edge more than twice or twice the
 /// same way.
 fn patches_breaking_manifold(mesh: &Mesh, origin: &[Option<usize>]) -> BTreeSet<usize> {
-    let mut directed: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
+    let mut directed: HashMap<(u32, u32), Vec<usize>> = HashMap::default();
     for (i, f) in mesh.faces.iter().enumerate() {
         for k in 0..3 {
             directed.entry((f[k], f[(k + 1) % 3])).or_default().push(i);
@@ -1189,7 +1191,7 @@ struct DroppedFaces {
 /// mesh stays as it is and its edges are reported as non-manifold.
 fn without_empty_faces(mesh: &Mesh) -> (Cow<'_, Mesh>, DroppedFaces) {
     let distinct = |f: &[u32; 3]| f[0] != f[1] && f[1] != f[2] && f[2] != f[0];
-    let mut seen = HashSet::with_capacity(mesh.faces.len());
+    let mut seen = HashSet::with_capacity_and_hasher(mesh.faces.len(), Default::default());
     let mut dropped = DroppedFaces::default();
     let keep: Vec<bool> = mesh
         .faces
@@ -1217,7 +1219,7 @@ fn without_empty_faces(mesh: &Mesh) -> (Cow<'_, Mesh>, DroppedFaces) {
 /// Edge-manifold with consistent orientation: every undirected edge used
 /// at most twice, every directed edge at most once.
 fn check_manifold(mesh: &Mesh) -> Result<(), MeshError> {
-    let mut directed: HashMap<(u32, u32), u32> = HashMap::new();
+    let mut directed: HashMap<(u32, u32), u32> = HashMap::default();
     for f in &mesh.faces {
         for k in 0..3 {
             *directed.entry((f[k], f[(k + 1) % 3])).or_insert(0) += 1;
@@ -1309,7 +1311,7 @@ fn with_turned_neighbours(
     turned: &BTreeSet<u32>,
     inner: impl Fn(u32) -> bool,
 ) -> Vec<u32> {
-    let mut by_vertex: HashMap<u32, Vec<u32>> = HashMap::new();
+    let mut by_vertex: HashMap<u32, Vec<u32>> = HashMap::default();
     for &f in turned {
         for v in mesh.faces[f as usize] {
             by_vertex.entry(v).or_default().push(f);

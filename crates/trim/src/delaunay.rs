@@ -63,7 +63,7 @@
 //! below [`DEGENERATE`]·β² (β the median resolution) are counted in the
 //! report, not removed.
 
-use std::collections::{HashMap, HashSet};
+use crate::hash::{HashMap, HashSet};
 
 use rayon::prelude::*;
 use spade::handles::{FixedFaceHandle, FixedVertexHandle, InnerTag};
@@ -548,7 +548,7 @@ impl LoopCdt {
     fn kept_faces(&self) -> KeptFaces {
         let kept = inside_faces(&self.cdt);
         let mut faces: Vec<[u32; 3]> = Vec::with_capacity(kept.len());
-        let mut positions = HashMap::new();
+        let mut positions = HashMap::default();
         let mut used = vec![false; self.n + self.loop_p3.len()];
         for f in kept {
             let vs = self.cdt.face(f).vertices();

@@ -38,6 +38,7 @@ pub mod edges;
 pub mod error;
 pub mod evaluate;
 pub mod frame;
+pub mod hash;
 pub mod mesh;
 pub mod morton;
 pub mod neighbours;

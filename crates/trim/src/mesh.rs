@@ -1,7 +1,7 @@
 //! Triangle meshes: validation, area, boundary loops and manifoldness, the
 //! checks the trimming stage and its tests need.
 
-use std::collections::HashMap;
+use crate::hash::HashMap;
 
 use crate::cloud::{cross, norm2, out_of_range, sub, Point3};
 use crate::cloud::{MAX_COORDINATE, MIN_LARGEST_COORDINATE};
@@ -79,7 +79,7 @@ impl Mesh {
 
     /// How many faces use each undirected edge.
     pub fn edge_uses(&self) -> HashMap<(u32, u32), u32> {
-        let mut uses = HashMap::new();
+        let mut uses = HashMap::default();
         for f in &self.faces {
             for k in 0..3 {
                 let (a, b) = (f[k], f[(k + 1) % 3]);
@@ -162,7 +162,7 @@ impl Mesh {
     /// vertex, anywhere on the surface.
     pub fn boundary_loops(&self) -> Vec<Vec<u32>> {
         let edges = self.sorted_edges();
-        let mut next: HashMap<u32, Vec<u32>> = HashMap::new();
+        let mut next: HashMap<u32, Vec<u32>> = HashMap::default();
         for on_edge in edges.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
             if let [(low, high, face)] = on_edge {
                 if low == high {
@@ -180,7 +180,7 @@ impl Mesh {
     #[cfg(test)]
     pub(crate) fn boundary_loops_reference(&self) -> Vec<Vec<u32>> {
         let uses = self.edge_uses();
-        let mut next: HashMap<u32, Vec<u32>> = HashMap::new();
+        let mut next: HashMap<u32, Vec<u32>> = HashMap::default();
         for f in &self.faces {
             for k in 0..3 {
                 let (a, b) = (f[k], f[(k + 1) % 3]);

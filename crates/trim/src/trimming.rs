@@ -42,7 +42,7 @@
 //!    and until stop 17 about 30 % of the zippered bunny went with them.
 //! 5. Unused vertices are removed.
 
-use std::collections::HashMap;
+use crate::hash::HashMap;
 
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
@@ -394,7 +394,7 @@ fn cut_both_sides(mesh: &Mesh, field: &[f64]) -> Cut {
         beyond: Vec::with_capacity(capacity),
         split: 0,
     };
-    let mut crossing: HashMap<(u32, u32), u32> = HashMap::new();
+    let mut crossing: HashMap<(u32, u32), u32> = HashMap::default();
     for (index, face) in mesh.faces.iter().enumerate() {
         let f = face.map(|v| field[v as usize]);
         if f.iter().all(|&x| x <= 0.0) {
@@ -539,7 +539,7 @@ fn face_pieces(mesh: &Mesh, beyond: &[bool]) -> Vec<u32> {
 fn face_pieces_reference(mesh: &Mesh, beyond: &[bool]) -> Vec<u32> {
     let n = mesh.faces.len();
     let mut parent: Vec<u32> = (0..n as u32).collect();
-    let mut first_on_edge: HashMap<(u32, u32, bool), u32> = HashMap::new();
+    let mut first_on_edge: HashMap<(u32, u32, bool), u32> = HashMap::default();
     for (f, face) in mesh.faces.iter().enumerate() {
         for k in 0..3 {
             let (a, b) = (face[k], face[(k + 1) % 3]);

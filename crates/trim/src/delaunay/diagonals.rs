@@ -12,7 +12,7 @@
 //! holds the quad's lowest id. A co-circular polygon of more points ends
 //! as the fan from its lowest id, whatever the order of the flips.
 
-use std::collections::{HashMap, HashSet};
+use crate::hash::{HashMap, HashSet};
 
 use super::orient;
 
@@ -32,7 +32,8 @@ pub fn canonical_diagonals(
     constraints: &HashSet<[u32; 2]>,
 ) -> usize {
     // Directed edge → the face on its left.
-    let mut left: HashMap<[u32; 2], usize> = HashMap::with_capacity(3 * faces.len());
+    let mut left: HashMap<[u32; 2], usize> =
+        HashMap::with_capacity_and_hasher(3 * faces.len(), Default::default());
     for (f, face) in faces.iter().enumerate() {
         for k in 0..3 {
             left.insert([face[k], face[(k + 1) % 3]], f);
@@ -156,7 +157,7 @@ mod tests {
     fn any_diagonals_of_a_lattice_end_the_same() {
         let (positions, mut a) = lattice(6, 4, |i, j| (i + j) % 2 == 0);
         let (_, mut b) = lattice(6, 4, |i, j| (i * 7 + j * 3) % 5 < 2);
-        let none = HashSet::new();
+        let none = HashSet::default();
         canonical_diagonals(&positions, &mut a, &none);
         canonical_diagonals(&positions, &mut b, &none);
         assert_eq!(canonical(a.clone()), canonical(b));
@@ -190,7 +191,7 @@ mod tests {
             [3, 4, 5],
         ];
         let mut faces: Vec<[u32; 3]> = strip.iter().map(|t| t.map(|k| ids[k])).collect();
-        canonical_diagonals(&positions, &mut faces, &HashSet::new());
+        canonical_diagonals(&positions, &mut faces, &HashSet::default());
         assert_eq!(faces.len(), 6);
         assert!(faces.iter().all(|f| f.contains(&0)), "{faces:?}");
     }
@@ -202,17 +203,17 @@ mod tests {
         // is a constraint or the quad is not co-circular.
         let mut flipped = faces.clone();
         assert_eq!(
-            canonical_diagonals(&positions, &mut flipped, &HashSet::new()),
+            canonical_diagonals(&positions, &mut flipped, &HashSet::default()),
             1
         );
         let mut kept = faces.clone();
-        let constraint = HashSet::from([[1, 2]]);
+        let constraint: HashSet<[u32; 2]> = [[1, 2]].into_iter().collect();
         assert_eq!(canonical_diagonals(&positions, &mut kept, &constraint), 0);
         assert_eq!(kept, faces);
         positions.insert(3, [1.0, 1.001]);
         let mut kept = faces.clone();
         assert_eq!(
-            canonical_diagonals(&positions, &mut kept, &HashSet::new()),
+            canonical_diagonals(&positions, &mut kept, &HashSet::default()),
             0
         );
     }

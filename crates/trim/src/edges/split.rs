@@ -21,7 +21,9 @@
 //! length a border sampled at resolution β never needs.
 
 use std::cmp::Reverse;
-use std::collections::{BinaryHeap, HashMap, HashSet};
+use std::collections::BinaryHeap;
+
+use crate::hash::{HashMap, HashSet};
 
 use crate::cloud::{dist2, Point3};
 
@@ -243,7 +245,7 @@ fn close_open_chains(
 
 /// Each point's neighbours along the links.
 fn link_adjacency(links: &[[u32; 2]]) -> HashMap<u32, Vec<u32>> {
-    let mut adjacency: HashMap<u32, Vec<u32>> = HashMap::new();
+    let mut adjacency: HashMap<u32, Vec<u32>> = HashMap::default();
     for &[a, b] in links {
         adjacency.entry(a).or_default().push(b);
         adjacency.entry(b).or_default().push(a);
@@ -353,7 +355,7 @@ fn link_paths(
     blocked: impl Fn(u32) -> bool,
     target: impl Fn(u32) -> bool,
 ) -> Vec<(u32, Vec<u32>)> {
-    let mut best: HashMap<u32, (f64, u32)> = HashMap::from([(from, (0.0, from))]);
+    let mut best: HashMap<u32, (f64, u32)> = [(from, (0.0, from))].into_iter().collect();
     let mut heap = BinaryHeap::from([Reverse((Length(0.0), from))]);
     let mut reached = Vec::new();
     while let Some(Reverse((Length(d), v))) = heap.pop() {
