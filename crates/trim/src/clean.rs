@@ -1111,19 +1111,12 @@ fn assemble(mesh: &Mesh, outcomes: &[Outcome]) -> (Mesh, Vec<Option<usize>>) {
 /// The outcomes whose new faces use an edge more than twice or twice the
 /// same way.
 fn patches_breaking_manifold(mesh: &Mesh, origin: &[Option<usize>]) -> BTreeSet<usize> {
-    let mut directed: HashMap<(u32, u32), Vec<usize>> = HashMap::default();
-    for (i, f) in mesh.faces.iter().enumerate() {
-        for k in 0..3 {
-            directed.entry((f[k], f[(k + 1) % 3])).or_default().push(i);
-        }
-    }
     let mut bad = BTreeSet::new();
-    for (&(a, b), faces) in &directed {
-        let reverse = directed.get(&(b, a)).map_or(0, Vec::len);
-        if faces.len() > 1 || reverse > 1 {
-            bad.extend(faces.iter().filter_map(|&i| origin[i]));
+    for_each_edge(mesh, |faces, forward, backward| {
+        if forward > 1 || backward > 1 {
+            bad.extend(faces.iter().filter_map(|e| origin[e.2 as usize]));
         }
-    }
+    });
     bad
 }
 
@@ -1231,14 +1224,25 @@ fn check_manifold(mesh: &Mesh) -> Result<(), MeshError> {
 
 /// The undirected edges used by more than two faces, and the directed
 /// edges used more than once (two faces that meet there turn opposite
-/// ways), from the mesh's sorted edges: a counting sort, several times
-/// faster than hashing every edge twice.
+/// ways).
 fn edge_defects(mesh: &Mesh) -> (usize, usize) {
-    let edges = mesh.sorted_edges();
     let (mut over, mut misoriented) = (0, 0);
+    for_each_edge(mesh, |faces, forward, backward| {
+        over += usize::from(faces.len() > 2);
+        misoriented += usize::from(forward > 1) + usize::from(backward > 1);
+    });
+    (over, misoriented)
+}
+
+/// Calls `visit` for every undirected edge of `mesh` with its entries in
+/// [`Mesh::sorted_edges`] (one per use: smaller vertex, larger, face) and
+/// how many times faces run along it from the smaller vertex to the
+/// larger and back. Sorted edges are a counting sort, several times
+/// faster than hashing every edge.
+fn for_each_edge(mesh: &Mesh, mut visit: impl FnMut(&[(u32, u32, u32)], usize, usize)) {
+    let edges = mesh.sorted_edges();
     for run in edges.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
         let (a, b) = (run[0].0, run[0].1);
-        over += usize::from(run.len() > 2);
         let (mut forward, mut backward) = (0, 0);
         for (i, &(_, _, f)) in run.iter().enumerate() {
             // A face holds the edge once per entry; count its turns once.
@@ -1252,9 +1256,8 @@ fn edge_defects(mesh: &Mesh) -> (usize, usize) {
                 backward += usize::from(a != b && step == (b, a));
             }
         }
-        misoriented += usize::from(forward > 1) + usize::from(backward > 1);
+        visit(run, forward, backward);
     }
-    (over, misoriented)
 }
 
 /// The faces around each vertex (compressed rows).
@@ -1405,9 +1408,31 @@ mod tests {
         )
     }
 
-    /// The sorted-edge count agrees with the hashed one on random faces
-    /// over few vertices: repeated, reversed and fanned faces, and faces
-    /// naming a vertex twice or three times.
+    /// [`patches_breaking_manifold`] by hashing every directed edge, as it
+    /// was first written.
+    fn patches_breaking_manifold_reference(
+        mesh: &Mesh,
+        origin: &[Option<usize>],
+    ) -> BTreeSet<usize> {
+        let mut directed: HashMap<(u32, u32), Vec<usize>> = HashMap::default();
+        for (i, f) in mesh.faces.iter().enumerate() {
+            for k in 0..3 {
+                directed.entry((f[k], f[(k + 1) % 3])).or_default().push(i);
+            }
+        }
+        let mut bad = BTreeSet::new();
+        for (&(a, b), faces) in &directed {
+            let reverse = directed.get(&(b, a)).map_or(0, Vec::len);
+            if faces.len() > 1 || reverse > 1 {
+                bad.extend(faces.iter().filter_map(|&i| origin[i]));
+            }
+        }
+        bad
+    }
+
+    /// The sorted-edge counts and the patches they blame agree with the
+    /// hashed ones on random faces over few vertices: repeated, reversed
+    /// and fanned faces, and faces naming a vertex twice or three times.
     #[test]
     fn edge_defects_match_the_reference() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(20);
@@ -1423,6 +1448,14 @@ mod tests {
             assert_eq!(
                 edge_defects(&mesh),
                 edge_defects_reference(&mesh),
+                "case {case}: {mesh:?}"
+            );
+            let origin: Vec<Option<usize>> = (0..mesh.faces.len())
+                .map(|_| rng.random_bool(0.7).then(|| rng.random_range(0..4)))
+                .collect();
+            assert_eq!(
+                patches_breaking_manifold(&mesh, &origin),
+                patches_breaking_manifold_reference(&mesh, &origin),
                 "case {case}: {mesh:?}"
             );
         }
