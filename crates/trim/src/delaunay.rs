@@ -578,8 +578,8 @@ impl LoopCdt {
     /// none is, that pass flips nothing. Faces outside the loops are
     /// tested too, so this can only say yes more often.
     fn has_cocircular_quad(&self) -> bool {
-        let at = |v: spade::handles::VertexHandle<'_, Node, (), spade::CdtEdge<()>, ()>| {
-            let p = v.position();
+        let at = |v: FixedVertexHandle| {
+            let p = self.cdt.vertex(v).position();
             [p.x, p.y]
         };
         self.cdt.undirected_edges().any(|edge| {
@@ -594,7 +594,8 @@ impl LoopCdt {
             else {
                 return false;
             };
-            diagonals::cocircular(at(forward.from()), at(forward.to()), at(c), at(d))
+            let [a, b] = [forward.from().fix(), forward.to().fix()];
+            diagonals::cocircular(at(a), at(b), at(c.fix()), at(d.fix()))
         })
     }
 
