@@ -1620,16 +1620,23 @@ mod tests {
         ));
     }
 
+    /// A jagged annulus, its β, the default options and its cleaned mesh:
+    /// what the tests of faces to drop compare against.
+    fn annulus_cleaned() -> (Mesh, Vec<f64>, CleanOptions, Mesh) {
+        let mesh = jagged_annulus(8.0, 3.0, 3);
+        let beta = vec![1.0; mesh.vertices.len()];
+        let options = CleanOptions::default();
+        let (cleaned, _) = clean_mesh(&mesh, &beta, &options).unwrap();
+        (mesh, beta, options, cleaned)
+    }
+
     /// Faces with two equal corners (a binary STL's sliver, merged) are
     /// dropped and counted; they used to stop the cleanup (reported first
     /// as a non-manifold edge, then as an error of their own). The rest of
     /// the mesh is cleaned exactly as it would be without them.
     #[test]
     fn faces_naming_a_vertex_twice_are_dropped() {
-        let mesh = jagged_annulus(8.0, 3.0, 3);
-        let beta = vec![1.0; mesh.vertices.len()];
-        let options = CleanOptions::default();
-        let (want, _) = clean_mesh(&mesh, &beta, &options).unwrap();
+        let (mesh, beta, options, want) = annulus_cleaned();
         let mut with_slivers = mesh.clone();
         let [a, b, _] = mesh.faces[5];
         let [c, d, _] = mesh.faces[9];
@@ -1647,10 +1654,7 @@ mod tests {
     /// in the opposite turn stays, and its edges are still reported.
     #[test]
     fn repeated_faces_are_dropped_when_they_turn_the_same_way() {
-        let mesh = jagged_annulus(8.0, 3.0, 3);
-        let beta = vec![1.0; mesh.vertices.len()];
-        let options = CleanOptions::default();
-        let (want, _) = clean_mesh(&mesh, &beta, &options).unwrap();
+        let (mesh, beta, options, want) = annulus_cleaned();
         let mut repeated = mesh.clone();
         let [a, b, c] = mesh.faces[5];
         repeated.faces.push([b, c, a]);

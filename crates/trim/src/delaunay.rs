@@ -78,7 +78,7 @@ use crate::edges::Edges;
 use crate::error::MeshError;
 use crate::frame::{fit_plane, Frame};
 use crate::mesh::{lowest_first, Mesh};
-use crate::morton::{octree_runs, spatial_order, MortonCells, MortonGrid};
+use crate::morton::{octree_runs, spatial_order, split_by_runs, MortonCells, MortonGrid};
 use crate::neighbours::{NeighbourIndex, RunScratch};
 
 pub mod diagonals;
@@ -238,15 +238,10 @@ fn local_normals(cloud: &[Point3], plane_normal: Point3) -> Vec<Point3> {
         NeighbourIndex::in_morton_order(&sorted, MortonCells::new(grid, &keys)).with_ranks(&order);
     // Each run's normals written in place, in Morton order.
     let mut by_position = vec![[0.0; 3]; cloud.len()];
-    let mut jobs = Vec::new();
-    let mut rest = by_position.as_mut_slice();
-    for run in octree_runs(&keys, NORMAL_RUN) {
-        let (out, tail) = rest.split_at_mut(run.len());
-        jobs.push((run, out));
-        rest = tail;
-    }
+    let runs = octree_runs(&keys, NORMAL_RUN);
+    let pieces = split_by_runs(&runs, &mut by_position, 1);
     let k = NORMAL_K.min(cloud.len());
-    jobs.into_par_iter().for_each_init(
+    runs.into_par_iter().zip(pieces).for_each_init(
         || (RunScratch::default(), Vec::new()),
         |(scratch, members), (run, out)| {
             members.resize(run.len() * k, 0);
@@ -501,15 +496,17 @@ impl LoopCdt {
         cloud: &[Point3],
         report: &mut DelaunayReport,
     ) -> Result<(Mesh, Vec<u32>), MeshError> {
+        // Jittered and real float clouds have no co-circular quad: the
+        // flip pass, which indexes every edge and needs every position, is
+        // skipped without changing its result (it flips only where a quad
+        // is co-circular).
+        let flips_possible = self.has_cocircular_quad();
         let KeptFaces {
             mut faces,
             positions,
             used,
-        } = self.kept_faces();
-        // Jittered and real float clouds have no co-circular quad: the
-        // flip pass, which indexes every edge, is skipped without changing
-        // its result (it flips only where a quad is co-circular).
-        report.diagonals_flipped = if self.has_cocircular_quad() {
+        } = self.kept_faces(flips_possible);
+        report.diagonals_flipped = if flips_possible {
             canonical_diagonals(&positions, &mut faces, &self.constraint_pairs())
         } else {
             0
@@ -545,7 +542,7 @@ impl LoopCdt {
     }
 
     /// The odd faces, counter-clockwise.
-    fn kept_faces(&self) -> KeptFaces {
+    fn kept_faces(&self, with_positions: bool) -> KeptFaces {
         let kept = inside_faces(&self.cdt);
         let mut faces: Vec<[u32; 3]> = Vec::with_capacity(kept.len());
         let mut positions = HashMap::default();
@@ -562,7 +559,9 @@ impl LoopCdt {
             faces.push(ids);
             for (id, p) in vs.map(|v| v.data().id).into_iter().zip(p) {
                 used[id as usize] = true;
-                positions.insert(id, [p.x, p.y]);
+                if with_positions {
+                    positions.insert(id, [p.x, p.y]);
+                }
             }
         }
         KeptFaces {
@@ -647,7 +646,7 @@ impl LoopCdt {
 struct KeptFaces {
     /// Counter-clockwise id triples.
     faces: Vec<[u32; 3]>,
-    /// The 2D position of every id they use.
+    /// The 2D position of every id they use (empty unless asked for).
     positions: HashMap<u32, [f64; 2]>,
     /// Per id, whether they use it.
     used: Vec<bool>,

@@ -90,6 +90,24 @@ pub fn octree_runs(keys: &[u64], max: usize) -> Vec<std::ops::Range<usize>> {
     runs
 }
 
+/// `out` cut into one piece per run, `per_point` items for each of the
+/// run's points, in run order (the runs cover the order in sequence, as
+/// [`octree_runs`] makes them): so that each run's results are written in
+/// place by parallel jobs. With `per_point` 0 every piece is empty.
+pub fn split_by_runs<'a, T>(
+    runs: &[std::ops::Range<usize>],
+    mut out: &'a mut [T],
+    per_point: usize,
+) -> Vec<&'a mut [T]> {
+    runs.iter()
+        .map(|run| {
+            let (piece, rest) = std::mem::take(&mut out).split_at_mut(run.len() * per_point);
+            out = rest;
+            piece
+        })
+        .collect()
+}
+
 fn split_cell(
     keys: &[u64],
     cell: std::ops::Range<usize>,

@@ -28,7 +28,7 @@ use crate::cloud::{
 };
 use crate::error::CloudError;
 use crate::frame::{fit_plane_normal, project_sheared, ray_shear, Frame, Point2};
-use crate::morton::{octree_runs, spatial_order, MortonCells, MortonGrid};
+use crate::morton::{octree_runs, spatial_order, split_by_runs, MortonCells, MortonGrid};
 use crate::neighbours::{NeighbourIndex, RunScratch};
 use crate::resolution::{beta_of, nearest_distances, Columns};
 
@@ -367,17 +367,16 @@ fn neighbourhoods(
     match how {
         TestImpl::Fast => {
             let runs = octree_runs(&keys, RUN);
-            let mut rest = lists.as_mut_slice();
-            let mut rest_sampling = sampling.as_deref_mut().unwrap_or_default();
-            let mut jobs = Vec::with_capacity(runs.len());
-            for run in runs {
-                let (out, tail) = rest.split_at_mut(run.len() * k);
-                let sampled = run.len().min(rest_sampling.len());
-                let (out_sampling, tail_sampling) = rest_sampling.split_at_mut(sampled);
-                jobs.push((run, out, out_sampling));
-                rest = tail;
-                rest_sampling = tail_sampling;
-            }
+            let sampled = usize::from(sampling.is_some());
+            let sampling_pieces =
+                split_by_runs(&runs, sampling.as_deref_mut().unwrap_or_default(), sampled);
+            let list_pieces = split_by_runs(&runs, &mut lists, k);
+            let mut jobs: Vec<_> = runs
+                .into_iter()
+                .zip(list_pieces)
+                .zip(sampling_pieces)
+                .map(|((run, out), out_sampling)| (run, out, out_sampling))
+                .collect();
             let per_block = block_len(points.len()) / RUN;
             for block in jobs.chunks_mut(per_block) {
                 block.par_iter_mut().for_each_init(
