@@ -48,6 +48,9 @@ pub struct Report {
     pub pieces_restored: usize,
     /// Vertices snapped onto the cut to avoid slivers.
     pub vertices_snapped: usize,
+    /// Parts of faces dropped because no cloud point lies within reach
+    /// (2 local resolutions): envelope that no wall cut off.
+    pub faces_out_of_reach: usize,
     /// Area of the input mesh.
     pub area_in: f64,
     /// Area of the output mesh.
@@ -189,6 +192,7 @@ impl Report {
             pieces_dropped: r.pieces_dropped,
             pieces_restored: r.pieces_restored,
             vertices_snapped: r.vertices_snapped,
+            faces_out_of_reach: r.faces_out_of_reach,
             area_in: r.area_in,
             area_out: r.area_out,
             border_to_edge: r.loops.iter().map(fit).collect(),
@@ -226,6 +230,7 @@ impl crate::report::Table for Report {
             ("faces removed", self.faces_removed.to_string()),
             ("pieces dropped", self.pieces_dropped.to_string()),
             ("pieces restored", self.pieces_restored.to_string()),
+            ("faces out of reach", self.faces_out_of_reach.to_string()),
             (
                 "area in / out",
                 format!("{:.6} / {:.6}", self.area_in, self.area_out),

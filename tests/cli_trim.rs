@@ -81,6 +81,7 @@ fn trims_the_fixture_and_reports() {
         "faces_split",
         "pieces_dropped",
         "pieces_restored",
+        "faces_out_of_reach",
     ] {
         assert!(json.get(key).is_some(), "missing {key}");
     }

@@ -98,3 +98,74 @@ fn an_overshooting_capped_mesh_is_cut_to_the_notched_plate() {
     assert!(report.pieces_dropped >= 2, "{report:?}");
     assert_eq!(report.pieces_restored, 0, "{report:?}");
 }
+
+/// Where a border did not close into a loop, no wall cuts the envelope off
+/// and the piece beyond it is the part's own: the reach of the cloud (2 β)
+/// ends it instead. The notched plate's mesh overshoots by 5 spacings; with
+/// the outer loop left out of the edges, the overshoot is cut back to the
+/// cloud's reach while the hole is still cut along its smoothed loop.
+#[test]
+fn envelope_that_no_wall_cuts_off_ends_at_the_clouds_reach() {
+    let cloud = synthetic::notched_plate(1.0, 2);
+    let front = grid(-5.0, 65.0, -5.0, 45.0, 0.7, 0.0, false);
+    let back = grid(-5.0, 65.0, -5.0, 45.0, 0.7, -3.0, true);
+    let mesh = append(front, &back);
+    let detection = detect_boundary(&cloud.points, &BpdOptions::default()).unwrap();
+    let mut edges = reconstruct_edges(&cloud.points, &detection, &EdgeOptions::default());
+    assert_eq!(edges.loops.len(), 2, "outer border and the hole");
+    let outer = (0..2)
+        .max_by_key(|&l| edges.loops[l].boundary_points.len())
+        .unwrap();
+    edges.loops.remove(outer);
+    let (out, report) = trim_mesh(&mesh, &cloud.points, &detection, &edges).unwrap();
+    // Every kept vertex within reach of the cloud. The cut runs straight
+    // across each face between the field's zeros at its edges, so it may
+    // pass up to half a face diagonal (0.5 here) farther out.
+    let farthest = out
+        .vertices
+        .iter()
+        .map(|v| {
+            let (i, d2) = cloud
+                .points
+                .iter()
+                .enumerate()
+                .map(|(i, p)| (i, (0..3).map(|c| (v[c] - p[c]).powi(2)).sum::<f64>()))
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .unwrap();
+            d2.sqrt() - trim::trimming::REACH * detection.beta[i]
+        })
+        .fold(f64::NEG_INFINITY, f64::max);
+    eprintln!("farthest vertex {farthest:.3} beyond reach, {report:?}");
+    assert!(farthest <= 0.5, "{farthest:.3} beyond the reach");
+    assert!(report.faces_out_of_reach > 0, "{report:?}");
+    // The overshoot went, and only it: the area is the plate's and a
+    // fringe within reach of its outer border (perimeter 200 spacings).
+    let plate = true_area_of_notched_plate(1.0);
+    let beta_max = detection.beta.iter().copied().fold(0.0, f64::max);
+    let fringe = 200.0 * trim::trimming::REACH * beta_max;
+    assert!(
+        out.area() > plate && out.area() < plate + fringe,
+        "area {} against the plate's {plate} and the fringe {fringe}",
+        out.area()
+    );
+    assert!(
+        out.vertices.iter().all(|v| v[2] == 0.0),
+        "the far sheet must go"
+    );
+    assert!(out.is_edge_manifold());
+    // The hole is still cut along its smoothed loop: the shorter border.
+    let borders = out.boundary_loops();
+    assert_eq!(borders.len(), 2);
+    let hole = borders.iter().min_by_key(|b| b.len()).unwrap();
+    let truth = BoundaryIndex::new(&cloud);
+    let to_truth: Vec<f64> = hole
+        .iter()
+        .map(|&v| truth.distance(out.vertices[v as usize]))
+        .collect();
+    let mean = to_truth.iter().sum::<f64>() / to_truth.len() as f64;
+    let max = to_truth.iter().copied().fold(0.0, f64::max);
+    assert!(
+        mean <= 0.3 && max <= 2.0,
+        "hole border mean {mean:.3}, max {max:.3}"
+    );
+}
