@@ -149,41 +149,21 @@ pub fn trim_mesh(
     let field: Vec<f64> = field_and_snap.into_iter().map(|s| s.0).collect();
     // The cut runs on one thread; the cloud's tree for the second cut is
     // built on the other meanwhile.
+    let (first_cut, reach) = rayon::join(
+        || cut_both_sides(mesh, &field),
+        || Reach::new(cloud, &detection.beta),
+    );
+    let faces_split = first_cut.split;
     let (
         Cut {
             mesh: cut,
             origin,
             beyond,
-            split: faces_split,
+            ..
         },
-        reach,
-    ) = rayon::join(
-        || cut_both_sides(mesh, &field),
-        || Reach::new(cloud, &detection.beta),
-    );
-    // The second cut, along the cloud's reach.
-    let reach_and_snap: Vec<(f64, bool)> = cut
-        .vertices
-        .par_iter()
-        .map(|&v| snapped(reach.excess(v)))
-        .collect();
-    snapped_count += reach_and_snap.iter().filter(|s| s.1).count();
-    let reach_field: Vec<f64> = reach_and_snap.into_iter().map(|s| s.0).collect();
-    let Cut {
-        mesh: mut cut,
-        origin: part_of,
-        beyond: out_of_reach,
-        ..
-    } = cut_both_sides(&cut, &reach_field);
-    let in_reach: Vec<bool> = out_of_reach.iter().map(|&o| !o).collect();
-    let faces_out_of_reach = out_of_reach.iter().filter(|&&o| o).count();
-    cut.retain_faces(&in_reach);
-    let (origin, beyond): (Vec<u32>, Vec<bool>) = part_of
-        .iter()
-        .zip(&in_reach)
-        .filter(|(_, &kept)| kept)
-        .map(|(&f, _)| (origin[f as usize], beyond[f as usize]))
-        .unzip();
+        out_of_reach,
+    ) = within_reach(first_cut, &reach);
+    snapped_count += out_of_reach.snapped;
     let support = supported_faces(&cut, &beyond, cloud, &detection.beta)?;
     let keep = support.keep;
     let mut survived = vec![false; mesh.faces.len()];
@@ -201,12 +181,92 @@ pub fn trim_mesh(
         pieces_dropped: support.dropped,
         pieces_restored: support.restored,
         vertices_snapped: snapped_count,
-        faces_out_of_reach,
+        faces_out_of_reach: out_of_reach.faces,
         area_in: mesh.area(),
         area_out: kept.area(),
         loops: walls.border_fit(&kept),
     };
     Ok((kept, report))
+}
+
+/// What the cut along the cloud's reach removed.
+struct OutOfReach {
+    /// Faces of the cut mesh dropped.
+    faces: usize,
+    /// Vertices snapped onto the reach.
+    snapped: usize,
+}
+
+/// Step 4 of the module doc: cuts `cut` again along the cloud's reach and
+/// drops the faces beyond it, except spots smaller than a disc of radius β
+/// (their largest β), which the cloud cannot resolve: BPD finds no hole
+/// smaller than that, and the Poisson surface pokes that far out of reach
+/// in little domes over a scan's crevices. Faces and their origins are
+/// those of `cut`'s input mesh.
+fn within_reach(cut: Cut, reach: &Reach) -> (Cut, OutOfReach) {
+    let field_and_snap: Vec<((f64, bool), f64)> = cut
+        .mesh
+        .vertices
+        .par_iter()
+        .map(|&v| {
+            let (g, beta) = reach.excess(v);
+            (snapped((g, beta)), beta)
+        })
+        .collect();
+    let snapped_count = field_and_snap.iter().filter(|s| s.0 .1).count();
+    let field: Vec<f64> = field_and_snap.iter().map(|s| s.0 .0).collect();
+    let beta: Vec<f64> = field_and_snap.iter().map(|s| s.1).collect();
+    let Cut {
+        mesh: mut second,
+        origin: part_of,
+        beyond: mut out_of_reach,
+        ..
+    } = cut_both_sides(&cut.mesh, &field);
+    keep_unresolved_spots(&second, &beta, &mut out_of_reach);
+    let in_reach: Vec<bool> = out_of_reach.iter().map(|&o| !o).collect();
+    second.retain_faces(&in_reach);
+    let (origin, beyond) = part_of
+        .iter()
+        .zip(&in_reach)
+        .filter(|(_, &kept)| kept)
+        .map(|(&f, _)| (cut.origin[f as usize], cut.beyond[f as usize]))
+        .unzip();
+    let dropped = OutOfReach {
+        faces: out_of_reach.iter().filter(|&&o| o).count(),
+        snapped: snapped_count,
+    };
+    let within = Cut {
+        mesh: second,
+        origin,
+        beyond,
+        split: cut.split,
+    };
+    (within, dropped)
+}
+
+/// Clears `out_of_reach` on each connected spot of such faces whose area
+/// is below π β², β the largest at its vertices (`beta`, per vertex of
+/// `mesh`'s vertices before the cut: each such face has one).
+fn keep_unresolved_spots(mesh: &Mesh, beta: &[f64], out_of_reach: &mut [bool]) {
+    let piece = face_pieces(mesh, out_of_reach);
+    let pieces = piece.iter().map(|&p| p as usize + 1).max().unwrap_or(0);
+    let mut area = vec![0.0f64; pieces];
+    let mut largest_beta = vec![0.0f64; pieces];
+    for (f, face) in mesh.faces.iter().enumerate() {
+        if out_of_reach[f] {
+            let p = piece[f] as usize;
+            area[p] += mesh.face_area(f);
+            for &v in face {
+                largest_beta[p] = largest_beta[p].max(beta.get(v as usize).copied().unwrap_or(0.0));
+            }
+        }
+    }
+    for (f, o) in out_of_reach.iter_mut().enumerate() {
+        let p = piece[f] as usize;
+        if *o && area[p] < std::f64::consts::PI * largest_beta[p] * largest_beta[p] {
+            *o = false;
+        }
+    }
 }
 
 /// A field value and whether it was snapped to 0: a vertex closer to the

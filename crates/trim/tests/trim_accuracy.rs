@@ -169,3 +169,69 @@ fn envelope_that_no_wall_cuts_off_ends_at_the_clouds_reach() {
         "hole border mean {mean:.3}, max {max:.3}"
     );
 }
+
+/// The reach cut opens a gap of the cloud only where the spot out of reach
+/// is at least a disc of radius β: a sheet sampled with two round gaps and
+/// no loops at all (as if no border had closed), meshed finely straight
+/// across both. The gap of 6 β leaves a spot of about 4 β radius out of
+/// reach: a hole. The gap of 2.5 β leaves one of about 0.5 β, which the
+/// cloud cannot resolve: no hole.
+#[test]
+fn only_gaps_the_cloud_resolves_open_holes_beyond_its_reach() {
+    let mut rng = 0x2545_f491_4f6c_dd1du64;
+    let mut jitter = move || {
+        rng ^= rng << 13;
+        rng ^= rng >> 7;
+        rng ^= rng << 17;
+        (rng >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    let lattice: Vec<Point3> = (0..60)
+        .flat_map(|j| (0..60).map(move |i| (i, j)))
+        .map(|(i, j)| [i as f64 + 0.3 * jitter(), j as f64 + 0.3 * jitter(), 0.0])
+        .collect();
+    let beta = {
+        let d = detect_boundary(&lattice, &BpdOptions::default()).unwrap();
+        let mut b = d.beta.clone();
+        b.sort_by(f64::total_cmp);
+        b[b.len() / 2]
+    };
+    let (small, big) = (([15.0, 30.0], 2.5 * beta), ([44.0, 30.0], 6.0 * beta));
+    let outside = |p: &Point3, (c, r): ([f64; 2], f64)| (p[0] - c[0]).hypot(p[1] - c[1]) > r;
+    let points: Vec<Point3> = lattice
+        .into_iter()
+        .filter(|p| outside(p, small) && outside(p, big))
+        .collect();
+    let detection = detect_boundary(&points, &BpdOptions::default()).unwrap();
+    let mut edges = reconstruct_edges(&points, &detection, &EdgeOptions::default());
+    edges.loops.clear();
+    let mesh = grid(0.0, 59.0, 0.0, 59.0, 0.4, 0.0, false);
+    let (out, report) = trim_mesh(&mesh, &points, &detection, &edges).unwrap();
+    // Loops inside the sheet's own border.
+    let inner = |l: &&Vec<u32>| {
+        l.iter().all(|&v| {
+            let p = out.vertices[v as usize];
+            p[0] > 3.0 && p[0] < 56.0 && p[1] > 3.0 && p[1] < 56.0
+        })
+    };
+    let holes: Vec<[f64; 2]> = out
+        .boundary_loops()
+        .iter()
+        .filter(inner)
+        .map(|l| {
+            let n = l.len() as f64;
+            let sum = l.iter().fold([0.0, 0.0], |s, &v| {
+                let p = out.vertices[v as usize];
+                [s[0] + p[0], s[1] + p[1]]
+            });
+            [sum[0] / n, sum[1] / n]
+        })
+        .collect();
+    eprintln!("β {beta:.3}, holes at {holes:?}, {report:?}");
+    assert_eq!(holes.len(), 1, "one hole: {holes:?}");
+    assert!(
+        (holes[0][0] - 44.0).hypot(holes[0][1] - 30.0) < 1.0,
+        "{holes:?}"
+    );
+    assert!(report.faces_out_of_reach > 0, "{report:?}");
+    assert!(out.is_edge_manifold());
+}
