@@ -49,12 +49,18 @@ fn trimmed(cloud: &SyntheticCloud, mesh: &Mesh) -> (Mesh, trim::trimming::TrimRe
     trim_mesh(mesh, &cloud.points, &detection, &edges).unwrap()
 }
 
-#[test]
-fn an_overshooting_capped_mesh_is_cut_to_the_notched_plate() {
+/// The notched plate (spacing 1) and a mesh that overshoots it by 5
+/// spacings, caps its hole and has an unsupported far sheet 3 below.
+fn notched_plate_and_overshooting_envelope() -> (SyntheticCloud, Mesh) {
     let cloud = synthetic::notched_plate(1.0, 2);
     let front = grid(-5.0, 65.0, -5.0, 45.0, 0.7, 0.0, false);
     let back = grid(-5.0, 65.0, -5.0, 45.0, 0.7, -3.0, true);
-    let mesh = append(front, &back);
+    (cloud, append(front, &back))
+}
+
+#[test]
+fn an_overshooting_capped_mesh_is_cut_to_the_notched_plate() {
+    let (cloud, mesh) = notched_plate_and_overshooting_envelope();
     let (out, report) = trimmed(&cloud, &mesh);
     let truth = BoundaryIndex::new(&cloud);
     let h = 1.0;
@@ -106,10 +112,7 @@ fn an_overshooting_capped_mesh_is_cut_to_the_notched_plate() {
 /// cloud's reach while the hole is still cut along its smoothed loop.
 #[test]
 fn envelope_that_no_wall_cuts_off_ends_at_the_clouds_reach() {
-    let cloud = synthetic::notched_plate(1.0, 2);
-    let front = grid(-5.0, 65.0, -5.0, 45.0, 0.7, 0.0, false);
-    let back = grid(-5.0, 65.0, -5.0, 45.0, 0.7, -3.0, true);
-    let mesh = append(front, &back);
+    let (cloud, mesh) = notched_plate_and_overshooting_envelope();
     let detection = detect_boundary(&cloud.points, &BpdOptions::default()).unwrap();
     let mut edges = reconstruct_edges(&cloud.points, &detection, &EdgeOptions::default());
     assert_eq!(edges.loops.len(), 2, "outer border and the hole");
