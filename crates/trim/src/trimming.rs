@@ -38,6 +38,9 @@
 //!    (an empty circle of radius β would have made its neighbours
 //!    boundary), and the smoothed cut lies half a row beyond the boundary
 //!    points, so where the loops close this cut rarely touches anything.
+//!    Spots out of reach smaller than a disc of radius β stay: the cloud
+//!    does not resolve them, and on closed scans the Poisson surface rises
+//!    that far out of reach in small domes over crevices.
 //! 5. **Keeping what the cloud supports.** The faces of each side fall into
 //!    connected pieces (pieces never cross the walls): inside, the part and
 //!    on a closed envelope pieces of its far side; beyond, the envelope
@@ -298,6 +301,8 @@ impl<'a> Reach<'a> {
     /// point and β that point's local resolution; and β, which snaps g.
     /// g > 0 where v is out of the cloud's reach.
     fn excess(&self, v: Point3) -> (f64, f64) {
+        // kiddo refuses only more points than its item index holds (2⁶⁴):
+        // then, as without walls, nothing is cut.
         let Some(tree) = &self.tree else {
             return (-1.0, 0.0);
         };
