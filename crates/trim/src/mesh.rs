@@ -97,40 +97,7 @@ impl Mesh {
     /// sorting or hashing all edges of a large mesh; the same result as
     /// sorting the tuples (tested).
     pub fn sorted_edges(&self) -> Vec<(u32, u32, u32)> {
-        // Sized by the largest index used, so a face that names a vertex
-        // past the end (an invalid mesh, which `validate` reports) still
-        // gets its edges instead of a panic.
-        let vertices = self
-            .faces
-            .iter()
-            .flatten()
-            .max()
-            .map_or(0, |&v| v as usize + 1);
-        let mut start = vec![0u32; vertices + 1];
-        for face in &self.faces {
-            for k in 0..3 {
-                start[face[k].min(face[(k + 1) % 3]) as usize + 1] += 1;
-            }
-        }
-        for v in 1..start.len() {
-            start[v] += start[v - 1];
-        }
-        let mut edges = vec![(0u32, 0u32, 0u32); 3 * self.faces.len()];
-        let mut fill = start.clone();
-        for (f, face) in self.faces.iter().enumerate() {
-            for k in 0..3 {
-                let (a, b) = (face[k], face[(k + 1) % 3]);
-                let slot = &mut fill[a.min(b) as usize];
-                edges[*slot as usize] = (a.min(b), a.max(b), f as u32);
-                *slot += 1;
-            }
-        }
-        // Faces were visited in order, so each vertex's edges are sorted by
-        // face already; a stable sort by the larger vertex finishes.
-        for v in 0..vertices {
-            edges[start[v] as usize..start[v + 1] as usize].sort_by_key(|e| e.1);
-        }
-        edges
+        sorted_edges_of(&self.faces)
     }
 
     /// [`Self::sorted_edges`] by sorting the tuples; the reference for tests.
@@ -254,6 +221,40 @@ fn directed_edge(face: [u32; 3], low: u32, high: u32) -> (u32, u32) {
         .map(|k| (face[k], face[(k + 1) % 3]))
         .find(|&(a, b)| (a.min(b), a.max(b)) == (low, high))
         .unwrap_or((low, high))
+}
+
+/// [`Mesh::sorted_edges`] of a list of faces (which need not be a whole
+/// mesh's: the faces of one part of it, say).
+pub fn sorted_edges_of(faces: &[[u32; 3]]) -> Vec<(u32, u32, u32)> {
+    // Sized by the largest index used, so a face that names a vertex
+    // past the end (an invalid mesh, which `validate` reports) still
+    // gets its edges instead of a panic.
+    let vertices = faces.iter().flatten().max().map_or(0, |&v| v as usize + 1);
+    let mut start = vec![0u32; vertices + 1];
+    for face in faces {
+        for k in 0..3 {
+            start[face[k].min(face[(k + 1) % 3]) as usize + 1] += 1;
+        }
+    }
+    for v in 1..start.len() {
+        start[v] += start[v - 1];
+    }
+    let mut edges = vec![(0u32, 0u32, 0u32); 3 * faces.len()];
+    let mut fill = start.clone();
+    for (f, face) in faces.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (face[k], face[(k + 1) % 3]);
+            let slot = &mut fill[a.min(b) as usize];
+            edges[*slot as usize] = (a.min(b), a.max(b), f as u32);
+            *slot += 1;
+        }
+    }
+    // Faces were visited in order, so each vertex's edges are sorted by
+    // face already; a stable sort by the larger vertex finishes.
+    for v in 0..vertices {
+        edges[start[v] as usize..start[v + 1] as usize].sort_by_key(|e| e.1);
+    }
+    edges
 }
 
 #[cfg(test)]

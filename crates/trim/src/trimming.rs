@@ -67,7 +67,7 @@ use crate::cloud::{dist2, dot, norm2, sub, Point3};
 use crate::edges::offset::{edge_sides, outward};
 use crate::edges::Edges;
 use crate::error::MeshError;
-use crate::mesh::Mesh;
+use crate::mesh::{sorted_edges_of, Mesh};
 use crate::neighbours::NeighbourIndex;
 
 /// Vertices closer to the cut than this many local spacings are moved
@@ -249,25 +249,27 @@ fn within_reach(cut: Cut, reach: &Reach) -> (Cut, OutOfReach) {
 
 /// Clears `out_of_reach` on each connected spot of such faces whose area
 /// is below π β², β the largest at its vertices (`beta`, per vertex of
-/// `mesh`'s vertices before the cut: each such face has one).
+/// `mesh`'s vertices before the cut: each such face has one). Only the
+/// faces out of reach are joined into spots.
 fn keep_unresolved_spots(mesh: &Mesh, beta: &[f64], out_of_reach: &mut [bool]) {
-    let piece = face_pieces(mesh, out_of_reach);
-    let pieces = piece.iter().map(|&p| p as usize + 1).max().unwrap_or(0);
-    let mut area = vec![0.0f64; pieces];
-    let mut largest_beta = vec![0.0f64; pieces];
-    for (f, face) in mesh.faces.iter().enumerate() {
-        if out_of_reach[f] {
-            let p = piece[f] as usize;
-            area[p] += mesh.face_area(f);
-            for &v in face {
-                largest_beta[p] = largest_beta[p].max(beta.get(v as usize).copied().unwrap_or(0.0));
-            }
+    let spot_faces: Vec<usize> = (0..mesh.faces.len()).filter(|&f| out_of_reach[f]).collect();
+    let faces: Vec<[u32; 3]> = spot_faces.iter().map(|&f| mesh.faces[f]).collect();
+    let spot = face_pieces(&faces, &vec![false; faces.len()]);
+    let spots = spot.iter().map(|&p| p as usize + 1).max().unwrap_or(0);
+    let mut area = vec![0.0f64; spots];
+    let mut largest_beta = vec![0.0f64; spots];
+    for (&f, &p) in spot_faces.iter().zip(&spot) {
+        let p = p as usize;
+        area[p] += mesh.face_area(f);
+        for &v in &mesh.faces[f] {
+            let b = beta.get(v as usize).copied().unwrap_or(0.0);
+            largest_beta[p] = largest_beta[p].max(b);
         }
     }
-    for (f, o) in out_of_reach.iter_mut().enumerate() {
-        let p = piece[f] as usize;
-        if *o && area[p] < std::f64::consts::PI * largest_beta[p] * largest_beta[p] {
-            *o = false;
+    for (&f, &p) in spot_faces.iter().zip(&spot) {
+        let p = p as usize;
+        if area[p] < std::f64::consts::PI * largest_beta[p] * largest_beta[p] {
+            out_of_reach[f] = false;
         }
     }
 }
@@ -622,7 +624,7 @@ fn supported_faces(
     if cut.faces.is_empty() {
         return Err(MeshError::Unsupported);
     }
-    let piece = face_pieces(cut, beyond);
+    let piece = face_pieces(&cut.faces, beyond);
     let pieces = piece.iter().map(|&p| p as usize + 1).max().unwrap_or(0);
     let projector = FaceIndex::new(cut);
     let mut hits = vec![0usize; pieces];
@@ -668,11 +670,11 @@ fn supported_faces(
 
 /// Connected pieces of faces sharing an edge; piece ids by first face.
 ///
-/// The faces' edges are sorted rather than hashed ([`Mesh::sorted_edges`]);
+/// The faces' edges are sorted rather than hashed ([`sorted_edges_of`]);
 /// the faces on one edge are joined to its first.
-fn face_pieces(mesh: &Mesh, beyond: &[bool]) -> Vec<u32> {
-    let n = mesh.faces.len();
-    let edges = mesh.sorted_edges();
+fn face_pieces(faces: &[[u32; 3]], beyond: &[bool]) -> Vec<u32> {
+    let n = faces.len();
+    let edges = sorted_edges_of(faces);
     let mut parent: Vec<u32> = (0..n as u32).collect();
     for same_edge in edges.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
         for side in [false, true] {
@@ -690,11 +692,11 @@ fn face_pieces(mesh: &Mesh, beyond: &[bool]) -> Vec<u32> {
 /// [`face_pieces`] with a hash map of edges, the plain way; the reference
 /// for tests.
 #[cfg(test)]
-fn face_pieces_reference(mesh: &Mesh, beyond: &[bool]) -> Vec<u32> {
-    let n = mesh.faces.len();
+fn face_pieces_reference(faces: &[[u32; 3]], beyond: &[bool]) -> Vec<u32> {
+    let n = faces.len();
     let mut parent: Vec<u32> = (0..n as u32).collect();
     let mut first_on_edge: HashMap<(u32, u32, bool), u32> = HashMap::default();
-    for (f, face) in mesh.faces.iter().enumerate() {
+    for (f, face) in faces.iter().enumerate() {
         for k in 0..3 {
             let (a, b) = (face[k], face[(k + 1) % 3]);
             match first_on_edge.entry((a.min(b), a.max(b), beyond[f])) {
@@ -850,8 +852,12 @@ mod tests {
             let sides: Vec<bool> = (0..mesh.faces.len())
                 .map(|f| seed % 2 == 1 && f % 3 == 0)
                 .collect();
-            let pieces = face_pieces(&mesh, &sides);
-            assert_eq!(pieces, face_pieces_reference(&mesh, &sides), "seed {seed}");
+            let pieces = face_pieces(&mesh.faces, &sides);
+            assert_eq!(
+                pieces,
+                face_pieces_reference(&mesh.faces, &sides),
+                "seed {seed}"
+            );
             // Not one piece: the test sees the joining at work.
             assert!(pieces.iter().max() > Some(&3), "seed {seed}");
         }
