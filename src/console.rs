@@ -21,7 +21,7 @@ pub fn print(text: &str) -> Result<()> {
     }
 }
 
-/// [`print`] with a line break after `line`.
+/// [`print()`] with a line break after `line`.
 pub fn print_line(line: &str) -> Result<()> {
     print(&format!("{line}\n"))
 }

@@ -140,11 +140,11 @@ pub struct CleanReport {
     /// Input faces.
     pub faces_in: usize,
     /// Input faces that named a vertex twice, dropped before anything else
-    /// (see [`without_empty_faces`]).
+    /// (see `without_empty_faces`).
     pub slivers_dropped: usize,
     /// Input faces that repeated an earlier face with the same corners in
     /// the same turn, dropped before anything else (see
-    /// [`without_empty_faces`]).
+    /// `without_empty_faces`).
     pub repeated_faces_dropped: usize,
     /// Input faces removed (in the bands).
     pub faces_removed: usize,

@@ -147,7 +147,7 @@ pub fn largest_empty_circle_exceeds(nb: &[Point2], beta: f64, s: &mut CellScratc
 /// [`largest_empty_circle_exceeds`] for the same `nb` and `beta` (such a
 /// cell is complete: every neighbour has clipped it). When no edge of it
 /// lies on the test's box, it is P_i's whole cell and is read as it is.
-/// Otherwise it is clipped afresh from a box [`LINK_BOX`] times wider: for
+/// Otherwise it is clipped afresh from a box `LINK_BOX` times wider: for
 /// a point on the hull the cell is unbounded, and its edges that lie
 /// between the test's box and that box's corners (all farther than β)
 /// were kept or lost with the box's turn in the plane, so the links turned
