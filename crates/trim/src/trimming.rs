@@ -843,6 +843,33 @@ mod tests {
         Mesh { vertices, faces }
     }
 
+    /// The reach's field by kiddo's tree equals the plain one: the nearest
+    /// point by scanning them all, its β, g = d − REACH·β.
+    #[test]
+    fn the_reach_matches_a_scan_of_every_point() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(21);
+        for _ in 0..20 {
+            let cloud: Vec<Point3> = (0..500)
+                .map(|_| [0, 1, 2].map(|_| rng.random_range(-10.0..10.0)))
+                .collect();
+            let beta: Vec<f64> = (0..cloud.len())
+                .map(|_| rng.random_range(0.1..2.0))
+                .collect();
+            let reach = Reach::new(&cloud, &beta);
+            for _ in 0..200 {
+                let v = [0, 1, 2].map(|_| rng.random_range(-15.0..15.0));
+                let (d2, nearest) = cloud
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &p)| (dist2(v, p), i))
+                    .min_by(|a, b| a.0.total_cmp(&b.0))
+                    .unwrap();
+                let want = (d2.sqrt() - REACH * beta[nearest], beta[nearest]);
+                assert_eq!(reach.excess(v), want, "at {v:?}");
+            }
+        }
+    }
+
     #[test]
     fn sorted_edges_give_the_pieces_of_the_hash_map() {
         for seed in 0..20 {
