@@ -1239,7 +1239,8 @@ mod tests {
     use super::*;
     use rand::{RngExt, SeedableRng};
 
-    /// The straightforward local normals: kiddo's tree, one query a point.
+    /// The straightforward local normals: one query a point, each on its
+    /// own, in input order (no Morton runs).
     fn local_normals_reference(cloud: &[Point3], plane_normal: Point3) -> Vec<Point3> {
         let index = NeighbourIndex::new(cloud);
         let mut nb = Vec::new();

@@ -141,15 +141,12 @@ pub fn trim_mesh(
 ) -> Result<(Mesh, TrimReport), MeshError> {
     mesh.validate()?;
     let walls = Walls::new(cloud, detection, edges);
-    // The field, with values within SNAP spacings of the wall set to 0 so
-    // the cut passes through the vertex instead of a sliver beside it.
-    let field_and_snap: Vec<(f64, bool)> = mesh
+    let to_walls: Vec<(f64, f64)> = mesh
         .vertices
         .par_iter()
-        .map(|&v| snapped(walls.signed_distance(v)))
+        .map(|&v| walls.signed_distance(v))
         .collect();
-    let mut snapped_count = field_and_snap.iter().filter(|s| s.1).count();
-    let field: Vec<f64> = field_and_snap.into_iter().map(|s| s.0).collect();
+    let (field, mut snapped_count) = snapped_field(&to_walls);
     // The cut runs on one thread; the cloud's tree for the second cut is
     // built on the other meanwhile.
     let (first_cut, reach) = rayon::join(
@@ -207,18 +204,14 @@ struct OutOfReach {
 /// in little domes over a scan's crevices. Faces and their origins are
 /// those of `cut`'s input mesh.
 fn within_reach(cut: Cut, reach: &Reach) -> (Cut, OutOfReach) {
-    let field_and_snap: Vec<((f64, bool), f64)> = cut
+    let excess: Vec<(f64, f64)> = cut
         .mesh
         .vertices
         .par_iter()
-        .map(|&v| {
-            let (g, beta) = reach.excess(v);
-            (snapped((g, beta)), beta)
-        })
+        .map(|&v| reach.excess(v))
         .collect();
-    let snapped_count = field_and_snap.iter().filter(|s| s.0 .1).count();
-    let field: Vec<f64> = field_and_snap.iter().map(|s| s.0 .0).collect();
-    let beta: Vec<f64> = field_and_snap.iter().map(|s| s.1).collect();
+    let (field, snapped_count) = snapped_field(&excess);
+    let beta: Vec<f64> = excess.iter().map(|&(_, beta)| beta).collect();
     let Cut {
         mesh: mut second,
         origin: part_of,
@@ -274,15 +267,24 @@ fn keep_unresolved_spots(mesh: &Mesh, beta: &[f64], out_of_reach: &mut [bool]) {
     }
 }
 
-/// A field value and whether it was snapped to 0: a vertex closer to the
-/// cut than [`SNAP`] local spacings is moved onto it (f := 0), so that the
-/// cut passes through it instead of leaving a sliver beside it.
-fn snapped((f, spacing): (f64, f64)) -> (f64, bool) {
-    if f != 0.0 && f.abs() < SNAP * spacing {
-        (0.0, true)
-    } else {
-        (f, false)
-    }
+/// The field of a cut from each vertex's (value, local spacing), and how
+/// many values were snapped to 0: a vertex closer to the cut than [`SNAP`]
+/// local spacings is moved onto it (f := 0), so that the cut passes
+/// through it instead of leaving a sliver beside it.
+fn snapped_field(values: &[(f64, f64)]) -> (Vec<f64>, usize) {
+    let mut snapped = 0;
+    let field = values
+        .iter()
+        .map(|&(f, spacing)| {
+            if f != 0.0 && f.abs() < SNAP * spacing {
+                snapped += 1;
+                0.0
+            } else {
+                f
+            }
+        })
+        .collect();
+    (field, snapped)
 }
 
 /// The cloud's reach: how far from the cloud the kept surface may lie.
