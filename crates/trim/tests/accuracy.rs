@@ -290,7 +290,7 @@ fn noise_20_percent_loses_nothing_75_percent_adds_nothing() {
         if r.omega.percent >= 20.0 && r.psi.percent >= 75.0 {
             meets_paper.push(cloud.name.clone());
         }
-        failures.extend(flips_beyond_the_first_rows(cloud, &options));
+        failures.extend(flips_beyond_the_first_rows(cloud, &options, Deep::AnyFlip));
     }
     assert!(
         !meets_paper.is_empty(),
@@ -299,7 +299,67 @@ fn noise_20_percent_loses_nothing_75_percent_adds_nothing() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
-fn flips_beyond_the_first_rows(cloud: &SyntheticCloud, options: &BpdOptions) -> Vec<String> {
+/// The paper's noise test on blades made as its clouds were, decimated
+/// from a dense scan to the target resolution
+/// ([`synthetic::decimated_blade`]), at 4, 8, 16 and 34 mm with two
+/// sampling seeds each: 20 % noise must lose no boundary point and 75 %
+/// add no false one on at least one blade, and on every blade the points
+/// noise turns boundary stay in the first rows (the 4 mm blade with seed
+/// 10 has one interior point labelled boundary without noise, 13.8
+/// spacings deep: a sampling gap of radius β). Measured over five noise patterns (`--example
+/// noise_decimated`, docs/results.md), 7 of 40 cases reach the paper's
+/// Ω ≥ 25 % and Ψ ≥ 75 %, against none of the jittered lattice blades.
+#[test]
+fn noise_on_blades_decimated_as_the_papers_were() {
+    let options = BpdOptions::default();
+    let mut meets_paper = Vec::new();
+    let mut failures = Vec::new();
+    for (h, seed) in [4.0, 8.0, 16.0, 34.0].into_iter().zip(10..) {
+        for cloud in [seed, seed + 90].map(|s| synthetic::decimated_blade(h, s)) {
+            let r = noise_robustness(&cloud, &percent_sweep(5.0, 75.0), &options, 7).unwrap();
+            eprintln!(
+                "{} ({} points): Ω = {} %, Ψ = {} %, against the truth Ω = {} %, Ψ = {} %",
+                cloud.name,
+                cloud.len(),
+                r.omega,
+                r.psi,
+                r.omega_truth,
+                r.psi_truth
+            );
+            if r.omega.percent >= 20.0 && r.psi.percent >= 75.0 {
+                meets_paper.push(cloud.name.clone());
+            }
+            failures.extend(flips_beyond_the_first_rows(
+                &cloud,
+                &options,
+                Deep::NewBoundary,
+            ));
+        }
+    }
+    assert!(
+        !meets_paper.is_empty(),
+        "no decimated blade reaches Ω ≥ 20 %, Ψ ≥ 75 %"
+    );
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// Which flips must stay within the first rows.
+#[derive(Clone, Copy, PartialEq)]
+enum Deep {
+    /// Every changed label.
+    AnyFlip,
+    /// Only points that noise turned boundary: a point the noise-free
+    /// detection labelled boundary deep inside (a sampling gap of the
+    /// detector's own scale, as Poisson-disk decimation leaves) may lose
+    /// that label anywhere.
+    NewBoundary,
+}
+
+fn flips_beyond_the_first_rows(
+    cloud: &SyntheticCloud,
+    options: &BpdOptions,
+    deep: Deep,
+) -> Vec<String> {
     let index = trim::evaluate::BoundaryIndex::new(cloud);
     let clean = detect_boundary(&cloud.points, options).unwrap().boundary;
     let boundary_count = clean.iter().filter(|&&b| b).count();
@@ -311,6 +371,7 @@ fn flips_beyond_the_first_rows(cloud: &SyntheticCloud, options: &BpdOptions) -> 
             .collect();
         let deepest = flipped
             .iter()
+            .filter(|&&i| deep == Deep::AnyFlip || noisy.boundary[i])
             .map(|&i| index.distance(cloud.points[i]) / cloud.spacing[i])
             .fold(0.0, f64::max);
         eprintln!(
