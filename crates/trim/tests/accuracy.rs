@@ -103,6 +103,18 @@ fn blade_at_4_8_16_34_mm() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
+/// Blue noise as the paper's clouds were made: a dense scan decimated by
+/// Poisson-disk elimination ([`synthetic::decimated_blade`]), not a lattice.
+#[test]
+fn blade_decimated_as_the_papers_were_at_4_8_16_34_mm() {
+    let mut failures = Vec::new();
+    for (i, h) in [4.0, 8.0, 16.0, 34.0].into_iter().enumerate() {
+        let cloud = synthetic::decimated_blade(h, 10 + i as u64);
+        failures.extend(scores(&cloud).failure(&cloud.name));
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
 #[test]
 fn variable_density_x10() {
     assert_accurate(&synthetic::variable_density(3.4, 5));
