@@ -319,9 +319,10 @@ fn noise_20_percent_loses_nothing_75_percent_adds_nothing() {
 /// add no false one on at least one blade, and on every blade the points
 /// noise turns boundary stay in the first rows (the 4 mm blade with seed
 /// 10 has one interior point labelled boundary without noise, 13.8
-/// spacings deep: a sampling gap of radius β). Measured over five noise patterns (`--example
-/// noise_decimated`, docs/results.md), 7 of 40 cases reach the paper's
-/// Ω ≥ 25 % and Ψ ≥ 75 %, against none of the jittered lattice blades.
+/// spacings deep, at a sampling gap wider than its β). Measured over five
+/// noise patterns (`--example noise_decimated`, docs/results.md), 7 of 40
+/// cases reach the paper's Ω ≥ 25 % and Ψ ≥ 75 %, against none of the
+/// jittered lattice blades.
 #[test]
 fn noise_on_blades_decimated_as_the_papers_were() {
     let options = BpdOptions::default();
