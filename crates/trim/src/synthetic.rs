@@ -58,6 +58,8 @@
 
 use std::f64::consts::PI;
 
+use crate::cloud::dist2;
+
 pub mod jagged;
 
 /// A position in the parameter domain.
@@ -917,10 +919,6 @@ fn poisson_disk_thinning(points: &[P3], radius: f64, seed: u64) -> Vec<usize> {
     }
     kept.sort_unstable();
     kept
-}
-
-fn dist2(a: P3, b: P3) -> f64 {
-    (0..3).map(|k| (a[k] - b[k]) * (a[k] - b[k])).sum()
 }
 
 /// [`blade`] with the sampling jitter's half-width chosen (a fraction of

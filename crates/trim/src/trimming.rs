@@ -211,6 +211,15 @@ fn within_reach(cut: Cut, reach: &Reach) -> (Cut, OutOfReach) {
         .map(|&v| reach.excess(v))
         .collect();
     let (field, snapped_count) = snapped_field(&excess);
+    // Where every loop closed, nothing is out of reach and the cut below
+    // would copy `cut` face for face: skip it.
+    if field.iter().all(|&g| g <= 0.0) {
+        let dropped = OutOfReach {
+            faces: 0,
+            snapped: snapped_count,
+        };
+        return (cut, dropped);
+    }
     let beta: Vec<f64> = excess.iter().map(|&(_, beta)| beta).collect();
     let Cut {
         mesh: mut second,
