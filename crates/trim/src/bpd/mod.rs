@@ -17,6 +17,8 @@
 pub mod circle;
 pub mod polar;
 
+use std::ops::Range;
+
 use rayon::prelude::*;
 
 use crate::anisotropy::{
@@ -24,7 +26,7 @@ use crate::anisotropy::{
     SamplingMoment,
 };
 use crate::cloud::{
-    check_finite, check_not_degenerate, cross, merge_duplicates, sub, Point3, Sites,
+    check_finite, check_not_degenerate, cross, merge_duplicates, sub, Point3, Sites, PASS_PIECE,
 };
 use crate::error::CloudError;
 use crate::frame::{fit_plane_normal, project_sheared, ray_shear, Frame, Point2};
@@ -261,14 +263,21 @@ struct SpatialOrder {
 impl SpatialOrder {
     /// True when two sites share a Morton key, as copies of a point do.
     fn keys_repeat(&self) -> bool {
-        self.keys.par_windows(2).any(|w| w[0] == w[1])
+        self.keys
+            .par_windows(2)
+            .with_min_len(PASS_PIECE)
+            .any(|w| w[0] == w[1])
     }
 
     /// The sites' Morton order, and their copy in that order.
     fn of(sites: &[Point3]) -> Self {
         let grid = MortonGrid::of(sites);
         let (order, keys) = spatial_order(sites, &grid);
-        let points = order.par_iter().map(|&i| sites[i as usize]).collect();
+        let points = order
+            .par_iter()
+            .with_min_len(PASS_PIECE)
+            .map(|&i| sites[i as usize])
+            .collect();
         Self {
             points,
             order,
@@ -300,7 +309,10 @@ fn prepare(points: &[Point3], options: &BpdOptions) -> Result<Prepared, CloudErr
     if !in_order.keys_repeat() {
         check_sites(points, points.len(), options)?;
         return Ok(Prepared {
-            site_of: (0..points.len() as u32).into_par_iter().collect(),
+            site_of: (0..points.len() as u32)
+                .into_par_iter()
+                .with_min_len(PASS_PIECE)
+                .collect(),
             spatial: in_order,
         });
     }
@@ -361,7 +373,7 @@ fn neighbourhoods(
     let mut sampling = options.anisotropy.then(|| {
         let unset = Sampling::default();
         let mut all = Vec::with_capacity(points.len());
-        all.par_extend(rayon::iter::repeat_n(unset, points.len()));
+        all.par_extend(rayon::iter::repeat_n(unset, points.len()).with_min_len(PASS_PIECE));
         all
     });
     match how {
@@ -377,8 +389,7 @@ fn neighbourhoods(
                 .zip(sampling_pieces)
                 .map(|((run, out), out_sampling)| (run, out, out_sampling))
                 .collect();
-            let per_block = block_len(points.len()) / RUN;
-            for block in jobs.chunks_mut(per_block) {
+            for block in blocks_of_runs(&mut jobs, block_len(points.len()), |job| &job.0) {
                 block.par_iter_mut().for_each_init(
                     || (RunScratch::default(), Vec::new()),
                     |(scratch, projected), (run, out, out_sampling)| {
@@ -464,6 +475,27 @@ fn shear_towards(view: Option<&View>, frame: &Frame, at: Point3) -> [f64; 2] {
     view.map_or([0.0, 0.0], |v| ray_shear(frame, v.ray_to(at)))
 }
 
+/// `jobs` (one per run, in order) cut into blocks of about `block` points:
+/// runs hold fewer than [`RUN`] points on average, so blocks counted in
+/// runs would leave a small last block, where a thread waits.
+fn blocks_of_runs<J>(
+    mut jobs: &mut [J],
+    block: usize,
+    run_of: impl Fn(&J) -> &Range<usize>,
+) -> Vec<&mut [J]> {
+    let mut blocks = Vec::new();
+    while !jobs.is_empty() {
+        let start = run_of(&jobs[0]).start;
+        let len = jobs
+            .partition_point(|job| run_of(job).end <= start + block)
+            .max(1);
+        let (head, tail) = std::mem::take(&mut jobs).split_at_mut(len);
+        blocks.push(head);
+        jobs = tail;
+    }
+    blocks
+}
+
 /// Most points per k-NN run (see [`NeighbourIndex::nearest_of_run`] and
 /// [`octree_runs`]): enough to share one range query among them, few
 /// enough that the run stays small next to a neighbourhood. 32 against 16:
@@ -544,10 +576,19 @@ fn spread_to_input(site_of: &[u32], order: &[u32], verdicts: &[(Decision, f64)])
     Detection {
         boundary: site_of
             .par_iter()
+            .with_min_len(PASS_PIECE)
             .map(|i| at(i).0 != Decision::Interior)
             .collect(),
-        beta: site_of.par_iter().map(|i| at(i).1).collect(),
-        decision: site_of.par_iter().map(|i| at(i).0).collect(),
+        beta: site_of
+            .par_iter()
+            .with_min_len(PASS_PIECE)
+            .map(|i| at(i).1)
+            .collect(),
+        decision: site_of
+            .par_iter()
+            .with_min_len(PASS_PIECE)
+            .map(|i| at(i).0)
+            .collect(),
         duplicates: site_of.len() - verdicts.len(),
         links: Vec::new(),
     }
@@ -751,6 +792,29 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn blocks_of_runs_hold_whole_runs_of_about_a_block_of_points() {
+        let lengths = [32, 5, 17, 32, 1, 30, 32, 8, 20, 32, 32, 3];
+        let mut runs = Vec::new();
+        let mut start = 0;
+        for len in lengths {
+            runs.push(start..start + len);
+            start += len;
+        }
+        let mut jobs = runs.clone();
+        let blocks = blocks_of_runs(&mut jobs, 64, |run| run);
+        let points = |block: &[Range<usize>]| block.last().unwrap().end - block[0].start;
+        assert_eq!(blocks.concat(), runs, "every run once, in order");
+        assert!(blocks.iter().all(|b| points(b) <= 64));
+        // Each block ends only where the next run would overflow it.
+        for pair in blocks.windows(2) {
+            assert!(pair[1][0].end - pair[0][0].start > 64);
+        }
+        // A run longer than a block is a block of its own.
+        let mut long = vec![0..100, 100..110];
+        assert_eq!(blocks_of_runs(&mut long, 64, |run| run).len(), 2);
     }
 
     #[test]
