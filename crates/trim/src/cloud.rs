@@ -43,14 +43,14 @@ pub const MAX_COORDINATE: f64 = 1e50;
 /// 2^-142 ≈ 1.8e-43 to zero, and products of two squared distances
 /// underflow near 1e-77; from 1e-30 up the flush moves a point by less than
 /// 1e-12 of the cloud's size, below the rounding of the plane fit.
+pub const MIN_LARGEST_COORDINATE: f64 = 1e-30;
+
 /// Fewest points per piece of a parallel pass over a cloud: a pass over
 /// fewer runs on the calling thread alone. Such passes (bounds, checks,
 /// keys, copies) take microseconds per thousand points, about what waking
 /// another thread costs: at the 12k benchmark, splitting them made BPD's
 /// preparation take 0.9–1.0 ms instead of 0.55.
 pub const PASS_PIECE: usize = 16384;
-
-pub const MIN_LARGEST_COORDINATE: f64 = 1e-30;
 
 /// The largest |coordinate| of finite `points`, when it lies outside the
 /// supported range ([`MIN_LARGEST_COORDINATE`] to [`MAX_COORDINATE`]).

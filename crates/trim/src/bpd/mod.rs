@@ -553,7 +553,7 @@ fn links_in_input_order(site_of: &[u32], order: &[u32], verdicts: &[Verdict]) ->
     }
     let input_of = |position: u32| first_input[order[position as usize] as usize];
     // Each pair as one integer, smaller index above: sorted, the order of
-    // the pairs, in a third of the time that sorting the pairs took.
+    // the pairs, in less than half the time that sorting the pairs took.
     let mut links: Vec<u64> = verdicts
         .iter()
         .enumerate()
