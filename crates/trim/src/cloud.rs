@@ -50,7 +50,7 @@ pub const MIN_LARGEST_COORDINATE: f64 = 1e-30;
 /// keys, copies) take microseconds per thousand points, about what waking
 /// another thread costs: at the 12k benchmark, splitting them made BPD's
 /// preparation take 0.9–1.0 ms instead of 0.55.
-pub const PASS_PIECE: usize = 16384;
+pub(crate) const PASS_PIECE: usize = 16384;
 
 /// The largest |coordinate| of finite `points`, when it lies outside the
 /// supported range ([`MIN_LARGEST_COORDINATE`] to [`MAX_COORDINATE`]).
