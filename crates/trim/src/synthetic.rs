@@ -872,18 +872,20 @@ pub fn decimated_blade(spacing: f64, seed: u64) -> SyntheticCloud {
         seed,
     );
     let kept = poisson_disk_thinning(&dense.points, DECIMATION_RADIUS * spacing, seed);
-    let pick = |values: &[P3]| kept.iter().map(|&i| values[i]).collect::<Vec<_>>();
+    let uv = pick(&dense.uv, &kept);
     SyntheticCloud {
-        points: pick(&dense.points),
-        normals: pick(&dense.normals),
-        uv: kept.iter().map(|&i| dense.uv[i]).collect(),
-        spacing: kept
-            .iter()
-            .map(|&i| spacing * BLADE.stretch(dense.uv[i]))
-            .collect(),
+        points: pick(&dense.points, &kept),
+        normals: pick(&dense.normals, &kept),
+        spacing: uv.iter().map(|&at| spacing * BLADE.stretch(at)).collect(),
+        uv,
         field: SpacingField::Uniform(spacing),
         ..dense
     }
+}
+
+/// `values` at the indices `kept`.
+fn pick<T: Copy>(values: &[T], kept: &[usize]) -> Vec<T> {
+    kept.iter().map(|&i| values[i]).collect()
 }
 
 /// Indices (increasing) of the points kept by Poisson-disk elimination
