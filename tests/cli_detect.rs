@@ -437,3 +437,39 @@ fn an_stl_scan_is_read_as_its_vertices() {
     assert_eq!(json["points"], 3003, "{json}");
     assert!(json["boundary_points"].as_u64().unwrap() > 200, "{json}");
 }
+
+/// A Leica PTS export of the fixture (a count line, then x y z intensity
+/// r g b, CRLF) reads as the same cloud, with the same labels; cut short,
+/// its count names the truncation.
+#[test]
+fn pts_files_with_point_counts() {
+    let points = fixture_points();
+    let mut pts = format!("{}\r\n", points.len());
+    for p in &points {
+        pts += &format!("{} {} {} -1234 120 130 140\r\n", p[0], p[1], p[2]);
+    }
+    let (dir, path) = input_file("scan.pts", pts.as_bytes());
+    let from_pts = dir.path().join("pts.ply");
+    let from_ply = dir.path().join("ply.ply");
+    for (input, out) in [(path_str(&path), &from_pts), (FIXTURE, &from_ply)] {
+        let run = meshtrim(&["detect", input, "-o", path_str(out)]);
+        assert!(run.status.success(), "{}", stderr(&run));
+    }
+    assert!(std::fs::read(&from_pts).unwrap() == std::fs::read(&from_ply).unwrap());
+
+    let cut: String = pts
+        .lines()
+        .take(points.len() - 3)
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let (_d, path) = input_file("cut.pts", cut.as_bytes());
+    fails(
+        &path,
+        &[],
+        &format!(
+            "line 1: the point count says {} points, but {} follow (a truncated file?)",
+            points.len(),
+            points.len() - 4
+        ),
+    );
+}

@@ -362,7 +362,7 @@ pub(crate) fn lines(text: &str) -> impl Iterator<Item = &str> {
         if rest.is_empty() {
             return None;
         }
-        let (line, after) = match rest.find(['\n', '\r']) {
+        let (line, after) = match memchr::memchr2(b'\n', b'\r', rest.as_bytes()) {
             Some(i) if rest[i..].starts_with("\r\n") => (&rest[..i], &rest[i + 2..]),
             Some(i) => (&rest[..i], &rest[i + 1..]),
             None => (rest, ""),
