@@ -15,8 +15,11 @@
 
 use anyhow::{anyhow, bail, Result};
 
+use rayon::prelude::*;
+
 use super::{
-    capacity, lines, mixed_line_ending, strip_bom, truncated, Cloud, Format, HeaderEol, Point3,
+    capacity, cut_after_newlines, lines, mixed_line_ending, strip_bom, truncated, Cloud, Format,
+    HeaderEol, Point3, PIECE_BYTES,
 };
 
 /// One field of a PCD point.
@@ -296,40 +299,135 @@ impl Raw {
     }
 }
 
+/// `DATA ascii`: one point per line, values separated by whitespace; blank
+/// lines are skipped and lines after the declared points ignored. Pieces
+/// of the text are parsed in parallel and joined in order, so the error
+/// reported is the first in the file, as a one-pass reading gives.
 fn read_ascii(header: &Header, wanted: &Wanted, body: &[u8]) -> Result<Raw> {
+    read_ascii_in_pieces(header, wanted, body, PIECE_BYTES)
+}
+
+fn read_ascii_in_pieces(
+    header: &Header,
+    wanted: &Wanted,
+    body: &[u8],
+    piece_bytes: usize,
+) -> Result<Raw> {
     let text = std::str::from_utf8(body)
         .map_err(|e| anyhow!("the ASCII data is not text (byte {})", e.valid_up_to()))?;
-    // Token index of each field's first element.
-    let mut first = Vec::with_capacity(header.fields.len());
-    let mut total = 0;
-    for f in &header.fields {
-        first.push(total);
-        total += f.count;
-    }
+    let layout = AsciiLayout::of(header);
+    let pieces: Vec<AsciiPiece> = cut_after_newlines(text, piece_bytes)
+        .into_par_iter()
+        .map(|piece| parse_ascii_piece(piece, wanted, &layout))
+        .collect();
     let mut raw = Raw::new(wanted, header.points);
-    let lines = lines(text)
-        .enumerate()
-        .filter(|(_, l)| !l.trim().is_empty());
-    for (i, line) in lines.take(header.points) {
-        let line_no = header.lines + i + 1;
-        let tokens: Vec<&str> = line.split_whitespace().collect();
-        if tokens.len() < total {
-            bail!(
-                "line {line_no}: expected {total} values, found {}",
-                tokens.len()
-            );
+    let mut line0 = header.lines;
+    for piece in pieces {
+        // Points beyond the declared count, and errors after them, are
+        // not the cloud's.
+        let room = header.points - raw.points.len();
+        let take = piece.points.len().min(room);
+        raw.points.extend_from_slice(&piece.points[..take]);
+        if let (Some(normals), Some(more)) = (raw.normals.as_mut(), piece.normals.as_ref()) {
+            normals.extend_from_slice(&more[..take]);
         }
-        raw.push(wanted, |f| {
-            let token = tokens[first[f]];
-            token
-                .parse()
-                .map_err(|_| anyhow!("line {line_no}: '{token}' is not a number"))
-        })?;
+        if take == room {
+            break;
+        }
+        if let Some((i, e)) = piece.error {
+            bail!("line {}: {e}", line0 + i);
+        }
+        line0 += piece.lines;
     }
     if raw.points.len() < header.points {
         return Err(truncated(header.points, "point", raw.points.len()));
     }
     Ok(raw)
+}
+
+/// Where each field's first value sits among a line's values.
+struct AsciiLayout {
+    first: Vec<usize>,
+    /// Values per line.
+    total: usize,
+}
+
+impl AsciiLayout {
+    fn of(header: &Header) -> Self {
+        let mut first = Vec::with_capacity(header.fields.len());
+        let mut total = 0;
+        for f in &header.fields {
+            first.push(total);
+            total += f.count;
+        }
+        AsciiLayout { first, total }
+    }
+}
+
+/// The points of one piece of `DATA ascii`; line numbers count from the
+/// piece's start.
+#[derive(Default)]
+struct AsciiPiece {
+    points: Vec<Point3>,
+    normals: Option<Vec<Point3>>,
+    lines: usize,
+    /// The piece's first error; parsing stops there.
+    error: Option<(usize, String)>,
+}
+
+fn parse_ascii_piece(text: &str, wanted: &Wanted, layout: &AsciiLayout) -> AsciiPiece {
+    let mut piece = AsciiPiece {
+        normals: wanted.normal.map(|_| Vec::new()),
+        ..AsciiPiece::default()
+    };
+    // Not sized by the header's counts, which a damaged file makes absurd.
+    let mut tokens = Vec::new();
+    for line in lines(text) {
+        piece.lines += 1;
+        if line.trim().is_empty() {
+            continue;
+        }
+        tokens.clear();
+        tokens.extend(line.split_whitespace());
+        if let Err(e) = push_ascii_point(&mut piece, wanted, layout, &tokens) {
+            piece.error = Some((piece.lines, e));
+            break;
+        }
+    }
+    piece
+}
+
+/// Appends the point (and normal) of one line's values.
+fn push_ascii_point(
+    piece: &mut AsciiPiece,
+    wanted: &Wanted,
+    layout: &AsciiLayout,
+    tokens: &[&str],
+) -> Result<(), String> {
+    if tokens.len() < layout.total {
+        return Err(format!(
+            "expected {} values, found {}",
+            layout.total,
+            tokens.len()
+        ));
+    }
+    let value = |f: usize| {
+        let token = tokens[layout.first[f]];
+        token
+            .parse::<f64>()
+            .map_err(|_| format!("'{token}' is not a number"))
+    };
+    let [x, y, z] = wanted.xyz;
+    let point = [value(x)?, value(y)?, value(z)?];
+    let normal = match wanted.normal {
+        Some([x, y, z]) => Some([value(x)?, value(y)?, value(z)?]),
+        None => None,
+    };
+    piece.points.push(point);
+    if let (Some(normal), Some(normals)) = (normal, piece.normals.as_mut()) {
+        normals.push(normal);
+    }
+    Ok(())
 }
 
 fn read_binary(header: &Header, wanted: &Wanted, body: &[u8]) -> Result<Raw> {
@@ -439,6 +537,86 @@ fn keep_finite(raw: Raw) -> Cloud {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The one-pass reading of `DATA ascii` the pieces must match.
+    fn read_ascii_serial(header: &Header, wanted: &Wanted, body: &[u8]) -> Result<Raw> {
+        let text = std::str::from_utf8(body)
+            .map_err(|e| anyhow!("the ASCII data is not text (byte {})", e.valid_up_to()))?;
+        let layout = AsciiLayout::of(header);
+        let mut raw = Raw::new(wanted, header.points);
+        let lines = lines(text)
+            .enumerate()
+            .filter(|(_, l)| !l.trim().is_empty());
+        for (i, line) in lines.take(header.points) {
+            let line_no = header.lines + i + 1;
+            let tokens: Vec<&str> = line.split_whitespace().collect();
+            if tokens.len() < layout.total {
+                bail!(
+                    "line {line_no}: expected {} values, found {}",
+                    layout.total,
+                    tokens.len()
+                );
+            }
+            raw.push(wanted, |f| {
+                let token = tokens[layout.first[f]];
+                token
+                    .parse()
+                    .map_err(|_| anyhow!("line {line_no}: '{token}' is not a number"))
+            })?;
+        }
+        if raw.points.len() < header.points {
+            return Err(truncated(header.points, "point", raw.points.len()));
+        }
+        Ok(raw)
+    }
+
+    /// Random ASCII bodies (blank lines, every line ending, short and bad
+    /// lines, more or fewer lines than declared) read in pieces of a few
+    /// bytes give what the one-pass reading gives.
+    #[test]
+    fn ascii_pieces_read_as_one_pass_does() {
+        let mut rng = trim::synthetic::SplitMix64::new(29);
+        let mut below = |n: u64| (rng.next_u64() % n) as usize;
+        let ends = ["\n", "\r\n", "\r"];
+        let mut errors = 0;
+        for case in 0..2000 {
+            let declared = below(12);
+            let head = format!(
+                "FIELDS x y z normal_x normal_y normal_z\nSIZE 4 4 4 4 4 4\nTYPE F F F F F F\n\
+                 COUNT 1 1 1 1 1 1\nWIDTH {declared}\nHEIGHT 1\nPOINTS {declared}\nDATA ascii\n"
+            );
+            let mut body = String::new();
+            for l in 0..below(15) {
+                body += &match below(20) {
+                    0 => String::new(),
+                    1 => "  \t".to_string(),
+                    2 => "1 2 3".to_string(),
+                    3 => "1 2 x 0 0 1".to_string(),
+                    4 => "1 2 3 0 0 y".to_string(),
+                    _ => format!("{l} {case} -{} 0 0 1 7", below(100)),
+                };
+                body += ends[below(3)];
+            }
+            let file = format!("{head}{body}");
+            let header = parse_header(file.as_bytes()).unwrap();
+            let wanted = wanted_fields(&header).unwrap();
+            let data = &file.as_bytes()[header.body_start..];
+            let outcome = |raw: Result<Raw>| {
+                raw.map(|r| (r.points, r.normals))
+                    .map_err(|e| e.to_string())
+            };
+            let want = outcome(read_ascii_serial(&header, &wanted, data));
+            for piece_bytes in [1, 6, 20, 64] {
+                let got = outcome(read_ascii_in_pieces(&header, &wanted, data, piece_bytes));
+                assert_eq!(got, want, "pieces of {piece_bytes} bytes: {file:?}");
+            }
+            errors += usize::from(want.is_err());
+        }
+        assert!(
+            (400..1600).contains(&errors),
+            "{errors} errors in 2000 cases"
+        );
+    }
 
     const HEAD: &str = "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z rgba normal_x normal_y normal_z\n\
         SIZE 4 8 4 4 4 4 4\nTYPE F F F U F F F\nCOUNT 1 1 1 1 1 1 1\nWIDTH 3\nHEIGHT 1\n\

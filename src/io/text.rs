@@ -20,16 +20,12 @@
 use anyhow::{bail, Result};
 use rayon::prelude::*;
 
-use super::{lines, show, strip_bom, text_of, Mesh, Point3};
+use super::{cut_after_newlines, lines, show, strip_bom, text_of, Mesh, Point3, PIECE_BYTES};
 
 /// Reads a text point list.
 pub fn read_text(bytes: &[u8]) -> Result<Mesh> {
     read_text_in_pieces(bytes, PIECE_BYTES)
 }
-
-/// Bytes per parallel piece: a 1M-point file parses in about 50 pieces, a
-/// small one in one.
-const PIECE_BYTES: usize = 1 << 20;
 
 fn read_text_in_pieces(bytes: &[u8], piece_bytes: usize) -> Result<Mesh> {
     let text = text_of(bytes)?;
@@ -77,28 +73,6 @@ fn split_header(text: &str) -> (Option<usize>, &str, usize) {
         _ => 1,
     };
     (Some(i), &text[end..], i)
-}
-
-/// `text` cut into pieces of about `piece_bytes`, each ending just after a
-/// `\n` (the last one wherever the text ends).
-fn cut_after_newlines(text: &str, piece_bytes: usize) -> Vec<&str> {
-    let mut pieces = Vec::new();
-    let mut rest = text;
-    while rest.len() > piece_bytes {
-        match rest.as_bytes()[piece_bytes..]
-            .iter()
-            .position(|&b| b == b'\n')
-        {
-            Some(i) => {
-                let (piece, after) = rest.split_at(piece_bytes + i + 1);
-                pieces.push(piece);
-                rest = after;
-            }
-            None => break,
-        }
-    }
-    pieces.push(rest);
-    pieces
 }
 
 /// What one piece of the text holds; line numbers count from its start.
