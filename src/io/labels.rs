@@ -74,60 +74,21 @@ pub fn write_ply(w: &mut dyn Write, data: Labelled) -> std::io::Result<()> {
     Ok(())
 }
 
-/// CSV with header `x,y,z,boundary,beta`, floats in shortest round-trip form.
-///
-/// Formatting the floats is most of the work (about 0.4 s for a million
-/// points on one thread), so lines are formatted in parallel, a window of
-/// pieces at a time (a bounded buffer, not the whole file), and written in
-/// order: the same bytes as one thread writes.
+/// CSV with header `x,y,z,boundary,beta`, floats in shortest round-trip form
+/// (lines formatted in parallel: [`super::write_formatted`]).
 pub fn write_csv(w: &mut dyn Write, data: Labelled) -> std::io::Result<()> {
-    write_csv_in_pieces(w, data, CSV_PIECE, CSV_WINDOW)
-}
-
-fn write_csv_in_pieces(
-    w: &mut dyn Write,
-    data: Labelled,
-    piece: usize,
-    window: usize,
-) -> std::io::Result<()> {
-    use rayon::prelude::*;
     writeln!(w, "x,y,z,boundary,beta")?;
     let n = data
         .points
         .len()
         .min(data.boundary.len())
         .min(data.beta.len());
-    let pieces: Vec<_> = (0..n)
-        .step_by(piece)
-        .map(|start| start..(start + piece).min(n))
-        .collect();
-    for window in pieces.chunks(window) {
-        let texts: Vec<Vec<u8>> = window
-            .par_iter()
-            .map(|range| csv_lines(data, range.clone()))
-            .collect();
-        for text in texts {
-            w.write_all(&text)?;
-        }
-    }
-    Ok(())
-}
-
-/// Points per piece of [`write_csv`], and pieces formatted at once (about
-/// 40 MB of text at a time).
-const CSV_PIECE: usize = 8192;
-const CSV_WINDOW: usize = 64;
-
-/// The CSV lines of points `range`.
-fn csv_lines(data: Labelled, range: std::ops::Range<usize>) -> Vec<u8> {
-    let mut text = Vec::with_capacity(range.len() * 80);
-    for i in range {
+    super::write_formatted(w, n, |out, i| {
         let p = data.points[i];
         let b = u8::from(data.boundary[i]);
         // Writing into a Vec cannot fail.
-        let _ = writeln!(text, "{},{},{},{},{}", p[0], p[1], p[2], b, data.beta[i]);
-    }
-    text
+        let _ = writeln!(out, "{},{},{},{},{}", p[0], p[1], p[2], b, data.beta[i]);
+    })
 }
 
 #[cfg(test)]
@@ -158,32 +119,6 @@ mod tests {
             out.len() - (out.windows(11).position(|w| w == b"end_header\n").unwrap() + 11),
             2 * 33
         );
-    }
-
-    #[test]
-    fn csv_in_parallel_pieces_is_the_one_thread_text() {
-        let n = 1000;
-        let points: Vec<Point3> = (0..n)
-            .map(|i| [i as f64 / 7.0, -1e-9 * i as f64, 1e12 + i as f64])
-            .collect();
-        let boundary: Vec<bool> = (0..n).map(|i| i % 3 == 0).collect();
-        let beta: Vec<f64> = (0..n).map(|i| 0.1 * i as f64).collect();
-        let data = Labelled {
-            points: &points,
-            boundary: &boundary,
-            beta: &beta,
-        };
-        let mut want = b"x,y,z,boundary,beta\n".to_vec();
-        for i in 0..n {
-            let p = points[i];
-            let b = u8::from(boundary[i]);
-            writeln!(want, "{},{},{},{},{}", p[0], p[1], p[2], b, beta[i]).unwrap();
-        }
-        for (piece, window) in [(1, 1), (7, 3), (64, 2), (CSV_PIECE, CSV_WINDOW)] {
-            let mut got = Vec::new();
-            write_csv_in_pieces(&mut got, data, piece, window).unwrap();
-            assert!(got == want, "pieces of {piece}, windows of {window}");
-        }
     }
 
     #[test]

@@ -186,14 +186,15 @@ pub fn write_obj(
         vertices.len(),
         faces.len()
     )?;
-    for p in vertices {
-        writeln!(w, "v {:?} {:?} {:?}", p[0], p[1], p[2])?;
-    }
-    for f in faces {
-        let [a, b, c] = f.map(|v| u64::from(v) + 1);
-        writeln!(w, "f {a} {b} {c}")?;
-    }
-    Ok(())
+    // Writing into a Vec cannot fail.
+    super::write_formatted(w, vertices.len(), |out, i| {
+        let p = vertices[i];
+        let _ = writeln!(out, "v {:?} {:?} {:?}", p[0], p[1], p[2]);
+    })?;
+    super::write_formatted(w, faces.len(), |out, i| {
+        let [a, b, c] = faces[i].map(|v| u64::from(v) + 1);
+        let _ = writeln!(out, "f {a} {b} {c}");
+    })
 }
 
 /// PLY, binary little-endian: `double x y z`, then the faces as
