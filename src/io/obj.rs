@@ -9,26 +9,90 @@
 
 use anyhow::{anyhow, bail, Result};
 
-use super::{lines, show, text_of, Mesh, Point3};
+use rayon::prelude::*;
+
+use super::{cut_after_newlines, lines, show, text_of, Mesh, Point3, PIECE_BYTES};
 
 /// Reads the vertices and faces of an OBJ file.
+///
+/// Pieces of the text are parsed in parallel: a first pass counts each
+/// piece's `v` lines, so that a negative reference (counted back from the
+/// latest vertex) resolves as in a one-pass reading; the pieces are joined
+/// in order and the error reported is the first in the file.
 pub fn read_obj(bytes: &[u8]) -> Result<Mesh> {
+    read_obj_in_pieces(bytes, PIECE_BYTES)
+}
+
+fn read_obj_in_pieces(bytes: &[u8], piece_bytes: usize) -> Result<Mesh> {
     let text = text_of(bytes)?;
+    let pieces = cut_after_newlines(text, piece_bytes);
+    let counts: Vec<usize> = pieces.par_iter().map(|p| vertex_lines(p)).collect();
+    let before = counts.iter().scan(0, |total, &n| {
+        let start = *total;
+        *total += n;
+        Some(start)
+    });
+    let parsed: Vec<ObjPiece> = pieces
+        .into_par_iter()
+        .zip(before.collect::<Vec<_>>())
+        .map(|(piece, before)| parse_piece(piece, before))
+        .collect();
     let mut mesh = Mesh::default();
-    for (i, line) in lines(text).enumerate() {
-        let mut words = line.split_whitespace();
-        let at = |e: anyhow::Error| anyhow!("line {}: {e}", i + 1);
-        match words.next() {
-            Some("v") => mesh.vertices.push(parse_vertex(words).map_err(at)?),
-            Some("f") => {
-                let faces = mesh.faces.get_or_insert_with(Vec::new);
-                parse_face(words, mesh.vertices.len(), faces).map_err(at)?;
-            }
-            _ => {}
+    let mut line0 = 0;
+    for piece in parsed {
+        if let Some((i, e)) = piece.error {
+            bail!("line {}: {e}", line0 + i);
         }
+        mesh.vertices.extend_from_slice(&piece.vertices);
+        if let Some(faces) = piece.faces {
+            mesh.faces
+                .get_or_insert_with(Vec::new)
+                .extend_from_slice(&faces);
+        }
+        line0 += piece.lines;
     }
     check_indices(&mesh, text)?;
     Ok(mesh)
+}
+
+/// The `v` lines of a piece of text.
+fn vertex_lines(text: &str) -> usize {
+    lines(text)
+        .filter(|line| line.split_whitespace().next() == Some("v"))
+        .count()
+}
+
+/// What one piece of an OBJ holds; line numbers count from its start.
+#[derive(Default)]
+struct ObjPiece {
+    vertices: Vec<Point3>,
+    /// `Some` once an `f` line is seen, even one that makes no triangle.
+    faces: Option<Vec<[u32; 3]>>,
+    lines: usize,
+    /// The piece's first error; parsing stops there.
+    error: Option<(usize, String)>,
+}
+
+/// Parses a piece that follows `before` vertices.
+fn parse_piece(text: &str, before: usize) -> ObjPiece {
+    let mut piece = ObjPiece::default();
+    for line in lines(text) {
+        piece.lines += 1;
+        let mut words = line.split_whitespace();
+        let parsed = match words.next() {
+            Some("v") => parse_vertex(words).map(|p| piece.vertices.push(p)),
+            Some("f") => {
+                let faces = piece.faces.get_or_insert_with(Vec::new);
+                parse_face(words, before + piece.vertices.len(), faces)
+            }
+            _ => Ok(()),
+        };
+        if let Err(e) = parsed {
+            piece.error = Some((piece.lines, e.to_string()));
+            break;
+        }
+    }
+    piece
 }
 
 /// Positive references may point forward, so they are checked at the end.
@@ -110,6 +174,66 @@ fn corner_index(word: &str, defined: usize) -> Result<u32> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The one-pass reading the pieces must match.
+    fn read_obj_serial(bytes: &[u8]) -> Result<Mesh> {
+        let text = text_of(bytes)?;
+        let mut mesh = Mesh::default();
+        for (i, line) in lines(text).enumerate() {
+            let mut words = line.split_whitespace();
+            let at = |e: anyhow::Error| anyhow!("line {}: {e}", i + 1);
+            match words.next() {
+                Some("v") => mesh.vertices.push(parse_vertex(words).map_err(at)?),
+                Some("f") => {
+                    let faces = mesh.faces.get_or_insert_with(Vec::new);
+                    parse_face(words, mesh.vertices.len(), faces).map_err(at)?;
+                }
+                _ => {}
+            }
+        }
+        check_indices(&mesh, text)?;
+        Ok(mesh)
+    }
+
+    /// Random OBJ texts (negative and forward references, polygons,
+    /// comments, every line ending, bad lines) read in pieces of a few
+    /// bytes give what the one-pass reading gives.
+    #[test]
+    fn pieces_read_as_one_pass_does() {
+        let mut rng = trim::synthetic::SplitMix64::new(41);
+        let mut below = |n: u64| (rng.next_u64() % n) as usize;
+        let ends = ["\n", "\r\n", "\r"];
+        let mut errors = 0;
+        for case in 0..2000 {
+            let mut text = String::new();
+            for l in 0..below(25) {
+                text += &match below(16) {
+                    0 => "# comment".to_string(),
+                    1 => "vn 0 0 1".to_string(),
+                    2 => "v 1 x 3".to_string(),
+                    3 => format!("f {} {} {}", below(6) + 1, below(6) + 1, below(6) + 1),
+                    4 => format!("f -1 -{} 1/2/3 {}//4", below(4) + 1, below(5) + 1),
+                    5 => "f 1 0 2".to_string(),
+                    6 => "f 1 2".to_string(),
+                    7 => String::new(),
+                    _ => format!("v {l} {case} {}", below(9)),
+                };
+                text += ends[below(3)];
+            }
+            let outcome =
+                |m: Result<Mesh>| m.map(|m| (m.vertices, m.faces)).map_err(|e| e.to_string());
+            let want = outcome(read_obj_serial(text.as_bytes()));
+            for piece_bytes in [1, 5, 16, 64] {
+                let got = outcome(read_obj_in_pieces(text.as_bytes(), piece_bytes));
+                assert_eq!(got, want, "pieces of {piece_bytes} bytes: {text:?}");
+            }
+            errors += usize::from(want.is_err());
+        }
+        assert!(
+            (400..1600).contains(&errors),
+            "{errors} errors in 2000 cases"
+        );
+    }
 
     #[test]
     fn faceless_cloud_keeps_every_vertex() {
