@@ -75,7 +75,7 @@ pub fn write_ply(w: &mut dyn Write, data: Labelled) -> std::io::Result<()> {
 }
 
 /// CSV with header `x,y,z,boundary,beta`, floats in shortest round-trip form
-/// (lines formatted in parallel: [`super::write_formatted`]).
+/// (lines formatted in parallel pieces, written in order).
 pub fn write_csv(w: &mut dyn Write, data: Labelled) -> std::io::Result<()> {
     writeln!(w, "x,y,z,boundary,beta")?;
     let n = data
