@@ -54,6 +54,11 @@ def derive_sources(work):
     rows = [line.split(",")[:3] for line in open(csv).read().splitlines()[1:]][:4000]
     with open(os.path.join(work, "cloud.xyz"), "w") as f:
         f.write("".join(" ".join(r) + "\n" for r in rows))
+    # Leica PTS: each scan after its point count, here two.
+    half = len(rows) // 2
+    with open(os.path.join(work, "cloud.pts"), "w") as f:
+        for block in (rows[:half], rows[half:]):
+            f.write(f"{len(block)}\n" + "".join(" ".join(r) + " 0 0 0 0\n" for r in block))
     with open(os.path.join(work, "cloud.obj"), "w") as f:
         f.write("".join("v " + " ".join(r) + "\n" for r in rows))
     header = (
@@ -69,7 +74,8 @@ def derive_sources(work):
     for ext in ("stl", "obj", "gltf", "glb", "ply"):
         run(["clean", JAGGED, os.path.join(work, f"mesh.{ext}")])
     clouds = [CLOUD] + [os.path.join(work, n) for n in
-                        ("cloud.csv", "cloud.xyz", "cloud.obj", "cloud_ascii.pcd", "cloud_binary.pcd")]
+                        ("cloud.csv", "cloud.xyz", "cloud.pts", "cloud.obj", "cloud_ascii.pcd",
+                         "cloud_binary.pcd")]
     meshes = [JAGGED, POISSON] + [os.path.join(work, f"mesh.{e}") for e in ("stl", "obj", "gltf", "glb", "ply")]
     return clouds, meshes
 

@@ -227,6 +227,19 @@ fn seed_files(dir: &Path) -> Vec<(String, Vec<u8>)> {
         "cloud.csv".into(),
         format!("x,y,z\n{}", text_cloud(&vertices, ",")).into_bytes(),
     ));
+    // Leica PTS: a point count before the points, here two scans.
+    let (first, second) = vertices.split_at(vertices.len() / 2);
+    seeds.push((
+        "scan.pts".into(),
+        format!(
+            "{}\n{}{}\n{}",
+            first.len(),
+            text_cloud(first, " "),
+            second.len(),
+            text_cloud(second, " ")
+        )
+        .into_bytes(),
+    ));
     seeds.push(("ascii.pcd".into(), pcd(&vertices, "ascii")));
     seeds.push(("binary.pcd".into(), pcd(&vertices, "binary")));
     seeds.push(("compressed.pcd".into(), pcd(&vertices, "binary_compressed")));

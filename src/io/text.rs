@@ -131,8 +131,9 @@ fn join_pieces(pieces: Vec<Piece>, lines_before: usize) -> Result<Vec<Point3>> {
         let next = counts.get(c + 1).map_or(points.len(), |&(_, _, at)| at);
         let follow = next - at;
         if u64::try_from(follow) != Ok(count) {
+            let points = if count == 1 { "point" } else { "points" };
             bail!(
-                "line {line}: the point count says {count} points, but {follow} follow \
+                "line {line}: the point count says {count} {points}, but {follow} follow \
                  (a truncated file?)"
             );
         }
@@ -306,6 +307,11 @@ mod tests {
             read(pts).unwrap(),
             vec![[1., 2., 3.], [4., 5., 6.], [7., 8., 9.]]
         );
+        let e = read("1\n").unwrap_err().to_string();
+        assert_eq!(
+            e,
+            "line 1: the point count says 1 point, but 0 follow (a truncated file?)"
+        );
         let e = read("3\n1 2 3\n4 5 6\n").unwrap_err().to_string();
         assert_eq!(
             e,
@@ -350,8 +356,9 @@ mod tests {
         for (c, &(line, count, at)) in counts.iter().enumerate() {
             let follow = counts.get(c + 1).map_or(points.len(), |&(_, _, at)| at) - at;
             if follow as u64 != count {
+                let points = if count == 1 { "point" } else { "points" };
                 bail!(
-                    "line {line}: the point count says {count} points, but {follow} follow \
+                    "line {line}: the point count says {count} {points}, but {follow} follow \
                      (a truncated file?)"
                 );
             }
