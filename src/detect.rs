@@ -222,7 +222,6 @@ fn stats(values: &[f64]) -> (f64, f64, f64, f64) {
     (min, mean, max, var.sqrt())
 }
 
-/// Milliseconds, rounded to 0.1 ms.
 /// A cloud read from a file and its boundary points, with the time of each
 /// step: the start of every command that works from a cloud.
 pub(crate) struct Detected {
@@ -249,6 +248,18 @@ pub(crate) fn read_and_detect_with(
     let started = Instant::now();
     let cloud = read_cloud(path)?;
     let read_time = started.elapsed();
+    detect_read_cloud(path, cloud, read_time, options, progress)
+}
+
+/// Runs BPD on `cloud`, read from `path` in `read_time`, with or without
+/// the progress bar; errors name the file.
+pub(crate) fn detect_read_cloud(
+    path: &Path,
+    cloud: Cloud,
+    read_time: Duration,
+    options: &BpdOptions,
+    progress: bool,
+) -> Result<Detected> {
     let started = Instant::now();
     let detection = if progress {
         detect_with_progress(&cloud.points, options)
@@ -273,6 +284,7 @@ pub(crate) fn same_file(a: &Path, b: &Path) -> bool {
     }
 }
 
+/// Milliseconds, rounded to 0.1 ms.
 pub(crate) fn millis(d: Duration) -> f64 {
     (d.as_secs_f64() * 1e4).round() / 10.0
 }

@@ -13,9 +13,9 @@ use trim::trimming::{trim_mesh, LoopFit, TrimReport};
 use trim::BpdOptions;
 
 use crate::cli::TrimArgs;
-use crate::detect::{millis, read_and_detect_with, Detected};
+use crate::detect::{detect_read_cloud, millis, Detected};
 use crate::io::mesh_out::write_mesh;
-use crate::io::read_mesh_with_faces;
+use crate::io::{read_cloud, read_mesh_with_faces};
 
 /// What the trimming prints and `--report` writes.
 #[derive(Debug, Clone, Serialize)]
@@ -115,20 +115,33 @@ pub fn trim_file(
     output: &Path,
     settings: &TrimSettings,
 ) -> Result<Report> {
+    // The two files are read at once (a binary PLY's reader runs on one
+    // thread); the mesh's error, if any, is reported first, as when it was
+    // read first.
     let started = Instant::now();
-    let mesh = read_mesh_with_faces(mesh_path, "give a mesh (the cloud goes second)")?;
+    let (mesh, cloud) = rayon::join(
+        || read_mesh_with_faces(mesh_path, "give a mesh (the cloud goes second)"),
+        || read_cloud(cloud_path),
+    );
+    let mesh = mesh?;
     // Checked here, before detection, so the error names the mesh: the
     // library's own check reports "MESH with CLOUD".
     trim::mesh::check_vertex_range(&mesh.vertices)
         .with_context(|| mesh_path.display().to_string())?;
-    let mesh_read_time = started.elapsed();
+    let cloud = cloud?;
+    let read_time = started.elapsed();
     let Detected {
         cloud,
         detection,
         read_time,
         detect_time,
-    } = read_and_detect_with(cloud_path, &settings.detection, settings.progress)?;
-    let read_time = mesh_read_time + read_time;
+    } = detect_read_cloud(
+        cloud_path,
+        cloud,
+        read_time,
+        &settings.detection,
+        settings.progress,
+    )?;
     let started = Instant::now();
     let edges = reconstruct_edges(
         &cloud.points,

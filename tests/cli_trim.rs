@@ -131,6 +131,12 @@ fn bad_inputs_fail_cleanly_and_write_nothing() {
         "out.xyz",
     );
     assert_clean_failure(&meshtrim(&["missing.ply", CLOUD, o], None), "missing.ply");
+    assert_clean_failure(&meshtrim(&[MESH, "missing.xyz", o], None), "missing.xyz");
+    // Both read at once; the mesh's error comes first, as when it was read
+    // first.
+    let both = meshtrim(&["missing.ply", "missing.xyz", o], None);
+    assert_clean_failure(&both, "missing.ply");
+    assert!(!String::from_utf8_lossy(&both.stderr).contains("missing.xyz"));
     // A cloud given as the mesh: it has no faces.
     assert_clean_failure(&meshtrim(&[CLOUD, CLOUD, o], None), "blade_small.ply");
     // A cloud far away from the mesh supports none of it.
