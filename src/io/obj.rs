@@ -27,14 +27,18 @@ fn read_obj_in_pieces(bytes: &[u8], piece_bytes: usize) -> Result<Mesh> {
     let text = text_of(bytes)?;
     let pieces = cut_after_newlines(text, piece_bytes);
     let counts: Vec<usize> = pieces.par_iter().map(|p| vertex_lines(p)).collect();
-    let before = counts.iter().scan(0, |total, &n| {
-        let start = *total;
-        *total += n;
-        Some(start)
-    });
+    // The vertices before each piece.
+    let before: Vec<usize> = counts
+        .iter()
+        .scan(0, |total, &n| {
+            let start = *total;
+            *total += n;
+            Some(start)
+        })
+        .collect();
     let parsed: Vec<ObjPiece> = pieces
         .into_par_iter()
-        .zip(before.collect::<Vec<_>>())
+        .zip(before)
         .map(|(piece, before)| parse_piece(piece, before))
         .collect();
     let mut mesh = Mesh::default();
