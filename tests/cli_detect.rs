@@ -473,3 +473,85 @@ fn pts_files_with_point_counts() {
         ),
     );
 }
+
+/// A cloud large enough that each text reader cuts it into several pieces
+/// (its files are 3–4 MB, the pieces 1 MiB) gives the same output as its
+/// binary PLY: XYZ, PTS, ASCII PCD and OBJ.
+#[test]
+fn large_text_clouds_read_in_pieces_as_the_binary_ply() {
+    // A gently curved sheet, 260 × 240 points, jittered by a fixed LCG.
+    let mut state = 12345u64;
+    let mut jitter = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.3
+    };
+    let points: Vec<[f64; 3]> = (0..260 * 240)
+        .map(|i| {
+            let (u, v) = ((i % 260) as f64 + jitter(), (i / 260) as f64 + jitter());
+            [
+                u * 0.731,
+                v * 0.731,
+                0.002 * (u - 130.0) * (v - 120.0) / 10.0,
+            ]
+        })
+        .collect();
+    let n = points.len();
+    let line = |p: &[f64; 3]| format!("{} {} {}", p[0], p[1], p[2]);
+    let mut ply = format!(
+        "ply\nformat binary_little_endian 1.0\nelement vertex {n}\n\
+         property double x\nproperty double y\nproperty double z\nend_header\n"
+    )
+    .into_bytes();
+    for p in &points {
+        for c in p {
+            ply.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    let lines = |prefix: &str, suffix: &str| -> String {
+        points
+            .iter()
+            .map(|p| format!("{prefix}{}{suffix}\n", line(p)))
+            .collect()
+    };
+    let pcd = format!(
+        "VERSION .7\nFIELDS x y z\nSIZE 8 8 8\nTYPE F F F\nCOUNT 1 1 1\nWIDTH {n}\n\
+         HEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {n}\nDATA ascii\n{}",
+        lines("", "")
+    );
+    let files = [
+        ("cloud.ply", ply),
+        ("cloud.xyz", lines("", "").into_bytes()),
+        (
+            "cloud.pts",
+            format!("{n}\r\n{}", lines("", " 0 10 20 30")).into_bytes(),
+        ),
+        ("cloud.pcd", pcd.into_bytes()),
+        ("cloud.obj", lines("v ", "").into_bytes()),
+    ];
+    let dir = tempfile::tempdir().unwrap();
+    let mut outputs = Vec::new();
+    for (name, bytes) in &files {
+        assert!(
+            name.ends_with(".ply") || bytes.len() > 3 << 20,
+            "{name}: {}",
+            bytes.len()
+        );
+        let input = dir.path().join(name);
+        std::fs::write(&input, bytes).unwrap();
+        let out = dir.path().join(format!("{name}.out.ply"));
+        let run = meshtrim(&["detect", path_str(&input), "-o", path_str(&out)]);
+        assert!(run.status.success(), "{name}: {}", stderr(&run));
+        outputs.push(std::fs::read(out).unwrap());
+    }
+    let labelled = read_labelled_ply(&outputs[0]);
+    assert_eq!(labelled.len(), n);
+    assert!(labelled.iter().any(|r| r.1 == 1) && labelled.iter().any(|r| r.1 == 0));
+    for ((name, _), out) in files.iter().zip(&outputs).skip(1) {
+        assert!(
+            out == &outputs[0],
+            "{name} gives another output than the binary PLY"
+        );
+    }
+}
