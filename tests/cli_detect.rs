@@ -479,14 +479,9 @@ fn pts_files_with_point_counts() {
 /// binary PLY: XYZ, PTS, ASCII PCD and OBJ.
 #[test]
 fn large_text_clouds_read_in_pieces_as_the_binary_ply() {
-    // A gently curved sheet, 260 × 240 points, jittered by a fixed LCG.
-    let mut state = 12345u64;
-    let mut jitter = || {
-        state = state
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.3
-    };
+    // A gently curved sheet, 260 × 240 points, jittered (seeded).
+    let mut rng = trim::synthetic::SplitMix64::new(12345);
+    let mut jitter = || rng.range(-0.15, 0.15);
     let points: Vec<[f64; 3]> = (0..260 * 240)
         .map(|i| {
             let (u, v) = ((i % 260) as f64 + jitter(), (i / 260) as f64 + jitter());
