@@ -234,25 +234,16 @@ pub(crate) struct Detected {
 /// Reads the cloud at `path` and runs BPD on it (with the progress bar),
 /// errors naming the file.
 pub(crate) fn read_and_detect(path: &Path, options: &BpdOptions) -> Result<Detected> {
-    read_and_detect_with(path, options, true)
-}
-
-/// [`read_and_detect`], with or without the detection's progress bar:
-/// `meshtrim batch` runs several files at once under one bar of its own, so
-/// its files' detections show none.
-pub(crate) fn read_and_detect_with(
-    path: &Path,
-    options: &BpdOptions,
-    progress: bool,
-) -> Result<Detected> {
     let started = Instant::now();
     let cloud = read_cloud(path)?;
     let read_time = started.elapsed();
-    detect_read_cloud(path, cloud, read_time, options, progress)
+    detect_read_cloud(path, cloud, read_time, options, true)
 }
 
 /// Runs BPD on `cloud`, read from `path` in `read_time`, with or without
-/// the progress bar; errors name the file.
+/// the progress bar (`meshtrim batch` runs several files at once under one
+/// bar of its own, so its files' detections show none); errors name the
+/// file.
 pub(crate) fn detect_read_cloud(
     path: &Path,
     cloud: Cloud,

@@ -204,35 +204,26 @@ mod tests {
     /// bytes give what the one-pass reading gives.
     #[test]
     fn pieces_read_as_one_pass_does() {
-        let mut rng = trim::synthetic::SplitMix64::new(41);
-        let mut below = |n: u64| (rng.next_u64() % n) as usize;
-        let ends = ["\n", "\r\n", "\r"];
-        let mut errors = 0;
-        for case in 0..2000 {
-            let mut text = String::new();
-            for l in 0..below(25) {
-                text += &match below(16) {
-                    0 => "# comment".to_string(),
-                    1 => "vn 0 0 1".to_string(),
-                    2 => "v 1 x 3".to_string(),
-                    3 => format!("f {} {} {}", below(6) + 1, below(6) + 1, below(6) + 1),
-                    4 => format!("f -1 -{} 1/2/3 {}//4", below(4) + 1, below(5) + 1),
-                    5 => "f 1 0 2".to_string(),
-                    6 => "f 1 2".to_string(),
-                    7 => String::new(),
-                    _ => format!("v {l} {case} {}", below(9)),
-                };
-                text += ends[below(3)];
-            }
-            let outcome =
-                |m: Result<Mesh>| m.map(|m| (m.vertices, m.faces)).map_err(|e| e.to_string());
-            let want = outcome(read_obj_serial(text.as_bytes()));
-            for piece_bytes in [1, 5, 16, 64] {
-                let got = outcome(read_obj_in_pieces(text.as_bytes(), piece_bytes));
-                assert_eq!(got, want, "pieces of {piece_bytes} bytes: {text:?}");
-            }
-            errors += usize::from(want.is_err());
-        }
+        let outcome = |m: Result<Mesh>| m.map(|m| (m.vertices, m.faces)).map_err(|e| e.to_string());
+        let errors = crate::io::piece_tests::compare_with_one_pass(
+            41,
+            2000,
+            25,
+            |_, _| String::new(),
+            |below, l, case| match below(16) {
+                0 => "# comment".to_string(),
+                1 => "vn 0 0 1".to_string(),
+                2 => "v 1 x 3".to_string(),
+                3 => format!("f {} {} {}", below(6) + 1, below(6) + 1, below(6) + 1),
+                4 => format!("f -1 -{} 1/2/3 {}//4", below(4) + 1, below(5) + 1),
+                5 => "f 1 0 2".to_string(),
+                6 => "f 1 2".to_string(),
+                7 => String::new(),
+                _ => format!("v {l} {case} {}", below(9)),
+            },
+            |text| outcome(read_obj_serial(text.as_bytes())),
+            |text, piece_bytes| outcome(read_obj_in_pieces(text.as_bytes(), piece_bytes)),
+        );
         assert!(
             (400..1600).contains(&errors),
             "{errors} errors in 2000 cases"

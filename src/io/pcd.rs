@@ -575,43 +575,42 @@ mod tests {
     /// bytes give what the one-pass reading gives.
     #[test]
     fn ascii_pieces_read_as_one_pass_does() {
-        let mut rng = trim::synthetic::SplitMix64::new(29);
-        let mut below = |n: u64| (rng.next_u64() % n) as usize;
-        let ends = ["\n", "\r\n", "\r"];
-        let mut errors = 0;
-        for case in 0..2000 {
-            let declared = below(12);
-            let head = format!(
-                "FIELDS x y z normal_x normal_y normal_z\nSIZE 4 4 4 4 4 4\nTYPE F F F F F F\n\
-                 COUNT 1 1 1 1 1 1\nWIDTH {declared}\nHEIGHT 1\nPOINTS {declared}\nDATA ascii\n"
-            );
-            let mut body = String::new();
-            for l in 0..below(15) {
-                body += &match below(20) {
-                    0 => String::new(),
-                    1 => "  \t".to_string(),
-                    2 => "1 2 3".to_string(),
-                    3 => "1 2 x 0 0 1".to_string(),
-                    4 => "1 2 3 0 0 y".to_string(),
-                    _ => format!("{l} {case} -{} 0 0 1 7", below(100)),
-                };
-                body += ends[below(3)];
+        // The file is a header with a random declared count, then the body;
+        // both readings get the body after the parsed header.
+        let read = |text: &str, piece_bytes: Option<usize>| {
+            let header = parse_header(text.as_bytes()).map_err(|e| e.to_string())?;
+            let wanted = wanted_fields(&header).map_err(|e| e.to_string())?;
+            let data = &text.as_bytes()[header.body_start..];
+            match piece_bytes {
+                None => read_ascii_serial(&header, &wanted, data),
+                Some(bytes) => read_ascii_in_pieces(&header, &wanted, data, bytes),
             }
-            let file = format!("{head}{body}");
-            let header = parse_header(file.as_bytes()).unwrap();
-            let wanted = wanted_fields(&header).unwrap();
-            let data = &file.as_bytes()[header.body_start..];
-            let outcome = |raw: Result<Raw>| {
-                raw.map(|r| (r.points, r.normals))
-                    .map_err(|e| e.to_string())
-            };
-            let want = outcome(read_ascii_serial(&header, &wanted, data));
-            for piece_bytes in [1, 6, 20, 64] {
-                let got = outcome(read_ascii_in_pieces(&header, &wanted, data, piece_bytes));
-                assert_eq!(got, want, "pieces of {piece_bytes} bytes: {file:?}");
-            }
-            errors += usize::from(want.is_err());
-        }
+            .map(|r| (r.points, r.normals))
+            .map_err(|e| e.to_string())
+        };
+        let errors = crate::io::piece_tests::compare_with_one_pass(
+            29,
+            2000,
+            15,
+            |below, _| {
+                let declared = below(12);
+                format!(
+                    "FIELDS x y z normal_x normal_y normal_z\nSIZE 4 4 4 4 4 4\n\
+                     TYPE F F F F F F\nCOUNT 1 1 1 1 1 1\nWIDTH {declared}\nHEIGHT 1\n\
+                     POINTS {declared}\nDATA ascii\n"
+                )
+            },
+            |below, l, case| match below(20) {
+                0 => String::new(),
+                1 => "  \t".to_string(),
+                2 => "1 2 3".to_string(),
+                3 => "1 2 x 0 0 1".to_string(),
+                4 => "1 2 3 0 0 y".to_string(),
+                _ => format!("{l} {case} -{} 0 0 1 7", below(100)),
+            },
+            |text| read(text, None),
+            |text, piece_bytes| read(text, Some(piece_bytes)),
+        );
         assert!(
             (400..1600).contains(&errors),
             "{errors} errors in 2000 cases"

@@ -340,10 +340,11 @@ mod tests {
         let mut points = Vec::new();
         let mut counts = Vec::new();
         let mut header = None;
+        let first_line = data_lines(text).next().map_or(0, |(j, _)| j);
         for (i, line) in data_lines(text) {
             let mut first = [""; 3];
             let found = read_fields(line, &mut first);
-            if i == data_lines(text).next().map_or(0, |(j, _)| j) && is_header(&first[..found]) {
+            if i == first_line && is_header(&first[..found]) {
                 header = Some(i);
                 continue;
             }
@@ -377,38 +378,29 @@ mod tests {
     /// what the one-pass reading gives.
     #[test]
     fn pieces_read_as_one_pass_does() {
-        let mut rng = trim::synthetic::SplitMix64::new(17);
-        let mut below = |n: u64| (rng.next_u64() % n) as usize;
-        let ends = ["\n", "\r\n", "\r"];
-        let mut errors = 0;
-        for case in 0..3000 {
-            let mut text = String::new();
-            let lines = below(30);
-            for l in 0..lines {
-                let line = match below(40) {
-                    0 => "x,y,z".to_string(),
-                    1 => String::new(),
-                    2 => "# comment 1 2 3".to_string(),
-                    3 => format!("{}", below(4)),
-                    4 => "1 2".to_string(),
-                    5 => "1 abc 3".to_string(),
-                    6 => "1\u{a0}2\u{3000}3".to_string(),
-                    7 => " 4;5 ,6 \t".to_string(),
-                    8 => "1 nan 3".to_string(),
-                    _ => format!("{} {},{} 9", l, below(1000), case),
-                };
-                text += &line;
-                text += ends[below(3)];
-            }
-            let want = read_text_serial(text.as_bytes()).map_err(|e| e.to_string());
-            for piece_bytes in [1, 5, 16, 64] {
-                let got = read_text_in_pieces(text.as_bytes(), piece_bytes)
-                    .map(|m| m.vertices)
-                    .map_err(|e| e.to_string());
-                assert_eq!(got, want, "pieces of {piece_bytes} bytes: {text:?}");
-            }
-            errors += usize::from(want.is_err());
-        }
+        let outcome = |r: Result<Vec<Point3>>| r.map_err(|e| e.to_string());
+        let errors = crate::io::piece_tests::compare_with_one_pass(
+            17,
+            3000,
+            30,
+            |_, _| String::new(),
+            |below, l, case| match below(40) {
+                0 => "x,y,z".to_string(),
+                1 => String::new(),
+                2 => "# comment 1 2 3".to_string(),
+                3 => format!("{}", below(4)),
+                4 => "1 2".to_string(),
+                5 => "1 abc 3".to_string(),
+                6 => "1\u{a0}2\u{3000}3".to_string(),
+                7 => " 4;5 ,6 \t".to_string(),
+                8 => "1 nan 3".to_string(),
+                _ => format!("{} {},{} 9", l, below(1000), case),
+            },
+            |text| outcome(read_text_serial(text.as_bytes())),
+            |text, piece_bytes| {
+                outcome(read_text_in_pieces(text.as_bytes(), piece_bytes).map(|m| m.vertices))
+            },
+        );
         // Both outcomes are exercised.
         assert!(
             (500..2500).contains(&errors),
