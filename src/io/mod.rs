@@ -432,18 +432,23 @@ pub(crate) fn cut_after_newlines(text: &str, piece_bytes: usize) -> Vec<&str> {
 /// taken for extra fields. Otherwise the same as `str::lines`.
 pub(crate) fn lines(text: &str) -> impl Iterator<Item = &str> {
     let mut rest = text;
-    std::iter::from_fn(move || {
-        if rest.is_empty() {
-            return None;
-        }
-        let (line, after) = match memchr::memchr2(b'\n', b'\r', rest.as_bytes()) {
-            Some(i) if rest[i..].starts_with("\r\n") => (&rest[..i], &rest[i + 2..]),
-            Some(i) => (&rest[..i], &rest[i + 1..]),
-            None => (rest, ""),
-        };
-        rest = after;
-        Some(line)
-    })
+    std::iter::from_fn(move || next_line(&mut rest))
+}
+
+/// The first line of `rest` as [`lines`] splits it, with `rest` moved past
+/// it and its ending; `None` when `rest` is empty.
+pub(crate) fn next_line<'a>(rest: &mut &'a str) -> Option<&'a str> {
+    if rest.is_empty() {
+        return None;
+    }
+    let text: &'a str = rest;
+    let (line, after) = match memchr::memchr2(b'\n', b'\r', text.as_bytes()) {
+        Some(i) if text[i..].starts_with("\r\n") => (&text[..i], &text[i + 2..]),
+        Some(i) => (&text[..i], &text[i + 1..]),
+        None => (text, ""),
+    };
+    *rest = after;
+    Some(line)
 }
 
 /// How the lines of a PLY or PCD header end, as its first line ends: `\n`

@@ -36,9 +36,11 @@ use std::io::Write;
 
 use anyhow::{anyhow, bail, Result};
 use byteorder::{BigEndian, ByteOrder, LittleEndian, WriteBytesExt};
+use rayon::prelude::*;
 
 use super::{
-    capacity, lines, mixed_line_ending, show, strip_bom, truncated, HeaderEol, Mesh, Point3,
+    capacity, cut_after_newlines, mixed_line_ending, next_line, show, strip_bom, truncated,
+    HeaderEol, Mesh, Point3, PIECE_BYTES,
 };
 
 /// A PLY scalar type.
@@ -154,17 +156,21 @@ struct Header {
 /// Reads a PLY file: vertices, optional normals and optional faces. A
 /// `range_grid` is skipped: this is the point-cloud reader.
 pub fn read_ply(bytes: &[u8]) -> Result<Mesh> {
-    read(bytes, false)
+    read(bytes, false, Some(PIECE_BYTES))
 }
 
 /// Reads a PLY file as a mesh: like [`read_ply`], but a file with a
 /// `range_grid` and no face element gets the grid's faces (see the module
 /// doc).
 pub fn read_ply_mesh(bytes: &[u8]) -> Result<Mesh> {
-    read(bytes, true)
+    read(bytes, true, Some(PIECE_BYTES))
 }
 
-fn read(bytes: &[u8], grid: bool) -> Result<Mesh> {
+/// `piece_bytes`: the size of the pieces in which the vertex element is
+/// parsed (ASCII) or decoded (binary) in parallel; `None` reads the
+/// vertices one value at a time, the reference the parallel reading is
+/// tested against.
+fn read(bytes: &[u8], grid: bool, piece_bytes: Option<usize>) -> Result<Mesh> {
     let bytes = strip_bom(bytes);
     let header = parse_header(bytes)?;
     let body = &bytes[header.body_start..];
@@ -172,12 +178,17 @@ fn read(bytes: &[u8], grid: bool) -> Result<Mesh> {
         Encoding::Ascii => {
             let text = std::str::from_utf8(body)
                 .map_err(|e| anyhow!("the ASCII body is not text (byte {})", e.valid_up_to()))?;
-            read_body(&header, &mut AsciiValues::new(text, header.lines), grid)
+            let mut values = AsciiValues::new(text, header.lines, piece_bytes);
+            read_body(&header, &mut values, grid)
         }
         Encoding::BinaryLe => {
-            read_body(&header, &mut BinaryValues::<LittleEndian>::new(body), grid)
+            let mut values = BinaryValues::<LittleEndian>::new(body, piece_bytes);
+            read_body(&header, &mut values, grid)
         }
-        Encoding::BinaryBe => read_body(&header, &mut BinaryValues::<BigEndian>::new(body), grid),
+        Encoding::BinaryBe => {
+            let mut values = BinaryValues::<BigEndian>::new(body, piece_bytes);
+            read_body(&header, &mut values, grid)
+        }
     }
 }
 
@@ -288,6 +299,22 @@ trait Values {
     fn end_record(&mut self, _element: &str, _i: usize) -> Result<()> {
         Ok(())
     }
+    /// Reads all records of `element`, whose properties are all scalars,
+    /// at once and in parallel: for each triple of property indices in
+    /// `columns`, that triple's values in every record, in order. `None`,
+    /// with nothing read, when the data is not laid out as this handles
+    /// (ASCII: one record per line; binary: the data ends early); the
+    /// caller then reads the records one value at a time, which gives the
+    /// same result or the first error in order.
+    fn read_rows(&mut self, element: &Element, columns: &[[usize; 3]]) -> Option<Rows>;
+}
+
+/// Records read at once by [`Values::read_rows`].
+struct Rows {
+    /// One list per triple of columns asked for.
+    triples: Vec<Vec<Point3>>,
+    /// The line of the first record, in ASCII data.
+    first_line: Option<usize>,
 }
 
 /// Whitespace-separated values, numbered by line for messages.
@@ -297,8 +324,9 @@ trait Values {
 /// value too many or too few (a line of 4 values for 3 properties would
 /// otherwise shift every later vertex by one value, silently).
 struct AsciiValues<'a> {
-    /// Ended by `\n`, `\r\n` or a lone `\r`, as in the other text readers.
-    lines: Box<dyn Iterator<Item = &'a str> + 'a>,
+    /// The text after the lines read so far; lines end with `\n`, `\r\n` or
+    /// a lone `\r`, as in the other text readers.
+    rest: &'a str,
     tokens: std::str::SplitAsciiWhitespace<'a>,
     line: usize,
     /// The current line's text, for counting its values in messages.
@@ -307,17 +335,20 @@ struct AsciiValues<'a> {
     taken: usize,
     /// The first line of the current record and its text.
     first: (usize, &'a str),
+    /// Pieces for [`Values::read_rows`]; `None` turns it off.
+    piece_bytes: Option<usize>,
 }
 
 impl<'a> AsciiValues<'a> {
-    fn new(text: &'a str, header_lines: usize) -> Self {
+    fn new(text: &'a str, header_lines: usize, piece_bytes: Option<usize>) -> Self {
         Self {
-            lines: Box::new(lines(text)),
+            rest: text,
             tokens: "".split_ascii_whitespace(),
             line: header_lines,
             text: "",
             taken: 0,
             first: (header_lines, ""),
+            piece_bytes,
         }
     }
 }
@@ -335,7 +366,7 @@ impl Values for AsciiValues<'_> {
                 self.taken += 1;
                 return Ok(Some(value));
             }
-            let Some(line) = self.lines.next() else {
+            let Some(line) = next_line(&mut self.rest) else {
                 return Ok(None);
             };
             self.line += 1;
@@ -366,19 +397,145 @@ impl Values for AsciiValues<'_> {
             self.taken
         )
     }
+
+    fn read_rows(&mut self, element: &Element, columns: &[[usize; 3]]) -> Option<Rows> {
+        let piece_bytes = self.piece_bytes?;
+        // A record must start a line; the last one ended with its line.
+        if self.tokens.clone().next().is_some() {
+            return None;
+        }
+        let (count, width) = (element.count, element.properties.len());
+        let (triples, end) = rows_in_pieces(self.rest, count, width, columns, piece_bytes)?;
+        let first_line = Some(self.line + 1);
+        self.rest = &self.rest[end..];
+        self.line += count;
+        Some(Rows {
+            triples,
+            first_line,
+        })
+    }
+}
+
+/// Pieces parsed at once by [`rows_in_pieces`]: enough to keep the cores
+/// busy, few enough that little is parsed past the element's end.
+const PIECES_PER_BATCH: usize = 8;
+
+/// The first `count` lines of `text` parsed in parallel as records of
+/// `width` values, keeping the triples of values at `columns`; with the
+/// byte offset just after the last record's line. `None` when a line
+/// before that does not hold exactly `width` numbers, or the text has
+/// fewer lines.
+fn rows_in_pieces(
+    text: &str,
+    count: usize,
+    width: usize,
+    columns: &[[usize; 3]],
+    piece_bytes: usize,
+) -> Option<(Vec<Vec<Point3>>, usize)> {
+    let mut triples = vec![Vec::with_capacity(capacity(count)); columns.len()];
+    if count == 0 {
+        return Some((triples, 0));
+    }
+    let mut rows = 0;
+    let pieces = cut_after_newlines(text, piece_bytes);
+    for batch in pieces.chunks(PIECES_PER_BATCH) {
+        let limit = count - rows;
+        let parsed: Vec<PieceRows> = batch
+            .par_iter()
+            .map(|piece| parse_rows(piece, width, columns, limit))
+            .collect();
+        for (piece, parsed) in batch.iter().zip(parsed) {
+            let take = parsed.rows.min(count - rows);
+            for (all, some) in triples.iter_mut().zip(&parsed.triples) {
+                all.extend_from_slice(&some[..take]);
+            }
+            rows += take;
+            if rows == count {
+                let start = piece.as_ptr() as usize - text.as_ptr() as usize;
+                return Some((triples, start + end_of_lines(piece, take)));
+            }
+            if !parsed.complete {
+                return None;
+            }
+        }
+    }
+    None
+}
+
+/// What [`parse_rows`] found in one piece.
+struct PieceRows {
+    triples: Vec<Vec<Point3>>,
+    rows: usize,
+    /// Whether every line of the piece was a record.
+    complete: bool,
+}
+
+/// Up to `limit` lines of `piece` as records of `width` numbers, stopping
+/// at the first line that is not one.
+fn parse_rows(piece: &str, width: usize, columns: &[[usize; 3]], limit: usize) -> PieceRows {
+    let mut triples = vec![Vec::new(); columns.len()];
+    let mut record = vec![0.0; width];
+    let mut rest = piece;
+    let mut rows = 0;
+    let mut complete = false;
+    while rows < limit {
+        let Some(line) = next_line(&mut rest) else {
+            complete = true;
+            break;
+        };
+        if !parse_record(line, &mut record) {
+            break;
+        }
+        for (triple, at) in triples.iter_mut().zip(columns) {
+            triple.push(at.map(|c| record[c]));
+        }
+        rows += 1;
+    }
+    PieceRows {
+        triples,
+        rows,
+        complete,
+    }
+}
+
+/// Whether `line` holds exactly `record.len()` numbers, read into `record`.
+fn parse_record(line: &str, record: &mut [f64]) -> bool {
+    let mut tokens = line.split_ascii_whitespace();
+    for value in record.iter_mut() {
+        match tokens.next().map(str::parse::<f64>) {
+            Some(Ok(v)) => *value = v,
+            _ => return false,
+        }
+    }
+    tokens.next().is_none()
+}
+
+/// The byte offset just after the first `n` lines of `text` and their
+/// endings.
+fn end_of_lines(text: &str, n: usize) -> usize {
+    let mut rest = text;
+    for _ in 0..n {
+        next_line(&mut rest);
+    }
+    text.len() - rest.len()
 }
 
 /// Packed binary values in byte order `B`.
 struct BinaryValues<'a, B> {
     data: &'a [u8],
     order: std::marker::PhantomData<B>,
+    /// The bytes of records [`Values::read_rows`] decodes per parallel
+    /// task; with `None` it declines, and records are read one value at a
+    /// time (the reference).
+    piece_bytes: Option<usize>,
 }
 
 impl<'a, B> BinaryValues<'a, B> {
-    fn new(data: &'a [u8]) -> Self {
+    fn new(data: &'a [u8], piece_bytes: Option<usize>) -> Self {
         Self {
             data,
             order: std::marker::PhantomData,
+            piece_bytes,
         }
     }
 }
@@ -396,6 +553,42 @@ impl<B: ByteOrder> Values for BinaryValues<'_, B> {
 
     fn line_prefix(&self) -> String {
         String::new()
+    }
+
+    fn read_rows(&mut self, element: &Element, columns: &[[usize; 3]]) -> Option<Rows> {
+        let piece_bytes = self.piece_bytes?;
+        let mut fields = Vec::with_capacity(element.properties.len());
+        let mut size = 0;
+        for property in &element.properties {
+            let Property::Scalar { ty, .. } = *property else {
+                return None;
+            };
+            fields.push((size, ty));
+            size += ty.size();
+        }
+        let bytes = element.count.checked_mul(size)?;
+        if size == 0 || self.data.len() < bytes {
+            return None;
+        }
+        let (data, rest) = self.data.split_at(bytes);
+        self.data = rest;
+        let records_per_task = (piece_bytes / size).max(1);
+        let triples = columns
+            .iter()
+            .map(|at| {
+                let at = at.map(|c| fields[c]);
+                let mut triple = Vec::new();
+                data.par_chunks_exact(size)
+                    .with_min_len(records_per_task)
+                    .map(|record| at.map(|(offset, ty)| ty.decode::<B>(&record[offset..])))
+                    .collect_into_vec(&mut triple);
+                triple
+            })
+            .collect();
+        Some(Rows {
+            triples,
+            first_line: None,
+        })
     }
 }
 
@@ -517,6 +710,16 @@ fn read_vertices(
     normal: Option<[usize; 3]>,
     mesh: &mut Mesh,
 ) -> Result<()> {
+    if element
+        .properties
+        .iter()
+        .all(|p| matches!(p, Property::Scalar { .. }))
+    {
+        let columns: Vec<[usize; 3]> = std::iter::once(xyz).chain(normal).collect();
+        if let Some(rows) = values.read_rows(element, &columns) {
+            return vertices_from_rows(rows, mesh);
+        }
+    }
     mesh.vertices.reserve(capacity(element.count));
     let mut normals = normal.map(|_| Vec::with_capacity(capacity(element.count)));
     read_element(element, values, None, |i, record| {
@@ -531,6 +734,25 @@ fn read_vertices(
         Ok(())
     })?;
     mesh.normals = normals;
+    Ok(())
+}
+
+/// The vertices (and normals) of records read at once; the same checks
+/// and messages as [`read_vertices`]'s.
+fn vertices_from_rows(rows: Rows, mesh: &mut Mesh) -> Result<()> {
+    let mut triples = rows.triples.into_iter();
+    mesh.vertices = triples.next().unwrap_or_default();
+    mesh.normals = triples.next();
+    let non_finite = |p: &Point3| p.iter().any(|c| !c.is_finite());
+    if let Some(i) = mesh.vertices.iter().position(non_finite) {
+        let line = rows
+            .first_line
+            .map_or(String::new(), |l| format!("line {}: ", l + i));
+        bail!(
+            "{line}vertex {i} has a non-finite coordinate {}",
+            show(&mesh.vertices[i])
+        );
+    }
     Ok(())
 }
 
@@ -1076,6 +1298,146 @@ mod tests {
             read_ply(text.as_bytes()).unwrap(),
             read_ply(ASCII.as_bytes()).unwrap()
         );
+    }
+
+    /// The vertex element read in pieces of 1–64 bytes gives what one
+    /// value at a time gives, error messages included, on random texts:
+    /// records of the wrong width, split over lines, blank lines, bad and
+    /// non-finite numbers, a camera element before and faces after.
+    #[test]
+    fn ascii_vertices_in_pieces_read_as_in_one_pass() {
+        let read = |text: &str, pieces| {
+            read(text.as_bytes(), false, pieces)
+                .map(|m| (m.vertices, m.normals, m.faces))
+                .map_err(|e| e.to_string())
+        };
+        let errors = crate::io::piece_tests::compare_with_one_pass(
+            31,
+            3000,
+            16,
+            |below, case| {
+                let normals = if case % 2 == 0 {
+                    "property float nx\nproperty float ny\nproperty double nz\n"
+                } else {
+                    ""
+                };
+                let camera = ["", "element camera 1\nproperty float a\n"][below(2)];
+                let faces = [
+                    "",
+                    "element face 2\nproperty list uchar int vertex_indices\n",
+                ][below(2)];
+                let body = if camera.is_empty() { "" } else { "0.5\n" };
+                format!(
+                    "ply\nformat ascii 1.0\n{camera}element vertex {}\nproperty float x\n\
+                     property uchar red\nproperty float y\nproperty float z\n{normals}\
+                     {faces}end_header\n{body}",
+                    below(12)
+                )
+            },
+            |below, l, case| match below(48) {
+                0 => String::new(),
+                1 => " \t".to_string(),
+                2 => "1 2 3".to_string(),
+                3 => "1 2 x 4".to_string(),
+                4 => "1 nan 3 4 0 0 1".to_string(),
+                5 => "1 2 inf 4".to_string(),
+                6 => "3 0 1 2".to_string(),
+                7 => "1 2".to_string(),
+                8 => "3 4 0 0 1 5 6 7 0 0".to_string(),
+                _ if case % 2 == 0 => format!("{l} {case} -{} 0.5 0 0 1", below(100)),
+                _ => format!("{l} {case} -{} 0.5", below(100)),
+            },
+            |text| read(text, None),
+            |text, piece_bytes| read(text, Some(piece_bytes)),
+        );
+        assert!(
+            (1800..2900).contains(&errors),
+            "{errors} errors in 3000 cases"
+        );
+    }
+
+    /// Binary vertices decoded in parallel give what one value at a time
+    /// gives, on random headers and bytes: every scalar type in both byte
+    /// orders, x, y, z anywhere among the properties, sometimes a list
+    /// property (which the parallel decoding declines), normals, faces
+    /// after, truncated data and non-finite floats (random bit patterns).
+    #[test]
+    fn binary_vertices_decoded_in_parallel_as_one_at_a_time() {
+        let types = [
+            "char", "uchar", "short", "ushort", "int", "uint", "float", "double",
+        ];
+        let mut rng = trim::synthetic::SplitMix64::new(37);
+        let mut below = |n: u64| (rng.next_u64() % n) as usize;
+        let mut errors = 0;
+        for case in 0..3000 {
+            let order = ["binary_little_endian", "binary_big_endian"][case % 2];
+            let mut names: Vec<String> = ["x", "y", "z"].map(String::from).to_vec();
+            if below(2) == 0 {
+                names.extend(["nx", "ny", "nz"].map(String::from));
+            }
+            for extra in 0..below(4) {
+                let at = below(names.len() as u64 + 1);
+                names.insert(at, format!("extra{extra}"));
+            }
+            let mut size = 0;
+            let mut header = format!("ply\nformat {order} 1.0\nelement vertex {}\n", below(40));
+            for name in &names {
+                if name.starts_with("extra") && below(8) == 0 {
+                    header += &format!("property list uchar int {name}\n");
+                    size += 5;
+                    continue;
+                }
+                // Coordinates and normals are floats in 3 of 4 cases.
+                let ty = if name.starts_with("extra") || below(4) == 0 {
+                    types[below(8)]
+                } else {
+                    ["float", "double"][below(2)]
+                };
+                size += Scalar::parse(ty).unwrap().size();
+                header += &format!("property {ty} {name}\n");
+            }
+            header += "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+            let mut bytes = header.into_bytes();
+            // About as many bytes as the vertices take, sometimes fewer.
+            let body = below(40 * size as u64 + 64);
+            bytes.extend((0..body).map(|_| if below(4) == 0 { 0 } else { below(256) as u8 }));
+            // Debug text, so that NaN normals compare equal.
+            let want = read(&bytes, false, None).map(|m| format!("{m:?}"));
+            let want = want.map_err(|e| e.to_string());
+            for piece_bytes in [1, 5, 16, 64, PIECE_BYTES] {
+                let got = read(&bytes, false, Some(piece_bytes)).map(|m| format!("{m:?}"));
+                let got = got.map_err(|e| e.to_string());
+                assert_eq!(got, want, "case {case}, pieces of {piece_bytes} bytes");
+            }
+            errors += usize::from(want.is_err());
+        }
+        assert!(
+            (300..2700).contains(&errors),
+            "{errors} errors in 3000 cases"
+        );
+    }
+
+    /// The parallel path itself: it reads exactly the element's lines,
+    /// whatever follows them, and declines a layout it does not handle.
+    #[test]
+    fn rows_in_pieces_reads_exactly_the_elements_lines() {
+        let text = "1 2 3\r\n4 5 6\r7 8 9\n3 0 1 2\n";
+        for piece_bytes in [1, 4, 64] {
+            let (triples, end) = rows_in_pieces(text, 3, 3, &[[2, 0, 1]], piece_bytes).unwrap();
+            assert_eq!(triples, [[[3., 1., 2.], [6., 4., 5.], [9., 7., 8.]]]);
+            assert_eq!(&text[end..], "3 0 1 2\n");
+            assert_eq!(
+                rows_in_pieces(text, 0, 3, &[[0; 3]], piece_bytes)
+                    .unwrap()
+                    .1,
+                0
+            );
+            // A fourth record would be a face line of 4 values; a blank
+            // line or a record over two lines is left to the stream reader.
+            assert!(rows_in_pieces(text, 4, 3, &[[0; 3]], piece_bytes).is_none());
+            assert!(rows_in_pieces("1 2 3\n\n4 5 6\n", 2, 3, &[[0; 3]], piece_bytes).is_none());
+            assert!(rows_in_pieces("1 2\n3\n", 1, 3, &[[0; 3]], piece_bytes).is_none());
+        }
     }
 
     #[test]
