@@ -541,8 +541,9 @@ struct ListLayout {
 }
 
 impl ListLayout {
-    /// The layout when the first record's list has length `len`; `None`
-    /// when another property is a list too.
+    /// The layout if every record's list is as long as the one in
+    /// `first`, the data's first record; `None` when that list has fewer
+    /// than 3 items (no triangle) or another property is a list too.
     fn of(
         element: &Element,
         list: usize,
@@ -565,12 +566,12 @@ impl ListLayout {
             }
         }
         let len = decode(count, first.get(count_at..count_at + count.size())?);
-        if !(3.0..=64.0).contains(&len) || len.fract() != 0.0 {
+        if !(3.0..=f64::from(u32::MAX)).contains(&len) || len.fract() != 0.0 {
             return None;
         }
         let len = len as usize;
         Some(ListLayout {
-            size: size + len * item.size(),
+            size: size + len.checked_mul(item.size())?,
             count_at,
             count,
             item,
