@@ -31,6 +31,20 @@
 //! On the four bunny scans, counter-clockwise in (column, row) already
 //! faces +z; the flip is for grids stored the other way up.
 //! [`read_ply`] (point clouds) skips the grid, like any other element.
+//!
+//! # Reading in parallel
+//!
+//! The reader walks the file one value at a time, which handles every
+//! layout PLY allows (an ASCII record over several lines, lists of any
+//! length). The large elements are read at once and in parallel where
+//! their layout allows it: the vertices when all their properties are
+//! scalars (ASCII: one record per line, parsed in pieces of about 1 MiB;
+//! binary: fixed-size records), and binary faces whose lists all have the
+//! same length (triangles, quads). Any other layout, and a line that is
+//! not a record or data that ends early, falls back to the value-at-a-time
+//! reading from the element's start; the checks made on what was read at
+//! once (finite coordinates, vertex indices) give the same messages. The
+//! tests compare the two readings on random files, errors included.
 
 use std::io::Write;
 
