@@ -326,9 +326,15 @@ trait Values {
     /// record's list has the same length n ≥ 3: the lists split into fans
     /// of n − 2 triangles from their first item, in order, as values.
     /// `None`, with nothing read, otherwise (as [`Values::read_rows`]).
-    fn read_fans(&mut self, _element: &Element, _list: usize) -> Option<Vec<[f64; 3]>> {
-        None
-    }
+    fn read_fans(&mut self, element: &Element, list: usize) -> Option<Fans>;
+}
+
+/// Lists read at once by [`Values::read_fans`].
+struct Fans {
+    /// `len − 2` triangles per list, in order.
+    triangles: Vec<[f64; 3]>,
+    /// The line of the first record, in ASCII data.
+    first_line: Option<usize>,
 }
 
 /// Records read at once by [`Values::read_rows`].
@@ -436,7 +442,47 @@ impl Values for AsciiValues<'_> {
             first_line,
         })
     }
+
+    /// A list alone on each line, all of the first line's length n: read
+    /// as records of n + 1 values, the length's column checked.
+    fn read_fans(&mut self, element: &Element, _list: usize) -> Option<Fans> {
+        let piece_bytes = self.piece_bytes?;
+        if element.properties.len() != 1 || self.tokens.clone().next().is_some() {
+            return None;
+        }
+        let mut rest = self.rest;
+        let first = next_line(&mut rest)?;
+        let len = first.split_ascii_whitespace().next()?.parse::<f64>().ok()?;
+        if !(3.0..=MAX_ASCII_LIST).contains(&len) || len.fract() != 0.0 {
+            return None;
+        }
+        let len = len as usize;
+        // The length thrice, then the fans' triangles from the first item.
+        let columns: Vec<[usize; 3]> = std::iter::once([0; 3])
+            .chain((1..len - 1).map(|w| [1, w + 1, w + 2]))
+            .collect();
+        let (count, width) = (element.count, len + 1);
+        let (triples, end) = rows_in_pieces(self.rest, count, width, &columns, piece_bytes)?;
+        let (lens, fans) = triples.split_first()?;
+        if lens.iter().any(|l| l[0] != len as f64) {
+            return None;
+        }
+        let first_line = Some(self.line + 1);
+        self.rest = &self.rest[end..];
+        self.line += count;
+        let triangles = (0..count)
+            .flat_map(|r| fans.iter().map(move |fan| fan[r]))
+            .collect();
+        Some(Fans {
+            triangles,
+            first_line,
+        })
+    }
 }
+
+/// The longest list [`AsciiValues::read_fans`] reads at once (its values
+/// are buffered per line); longer ones are read one value at a time.
+const MAX_ASCII_LIST: f64 = 1024.0;
 
 /// Pieces parsed at once by [`rows_in_pieces`]: enough to keep the cores
 /// busy, few enough that little is parsed past the element's end.
@@ -665,7 +711,7 @@ impl<B: ByteOrder> Values for BinaryValues<'_, B> {
         })
     }
 
-    fn read_fans(&mut self, element: &Element, list: usize) -> Option<Vec<[f64; 3]>> {
+    fn read_fans(&mut self, element: &Element, list: usize) -> Option<Fans> {
         let piece_bytes = self.piece_bytes?;
         if element.count == 0 {
             return None;
@@ -697,7 +743,10 @@ impl<B: ByteOrder> Values for BinaryValues<'_, B> {
             let fan_of = |r| (1..layout.len - 1).map(move |w| fan(r, w));
             records().flat_map_iter(fan_of).collect()
         };
-        Some(fans)
+        Some(Fans {
+            triangles: fans,
+            first_line: None,
+        })
     }
 }
 
@@ -898,14 +947,16 @@ fn read_faces(
 /// into fans; the same checks and messages as [`read_faces`]'s (the fans
 /// visit each list's items in order, so the first bad one is found
 /// first).
-fn faces_from_fans(fans: &[[f64; 3]], count: usize, faces: &mut Vec<[u32; 3]>) -> Result<()> {
+fn faces_from_fans(fans: &Fans, count: usize, faces: &mut Vec<[u32; 3]>) -> Result<()> {
+    let (first_line, fans) = (fans.first_line, &fans.triangles);
     let index =
         |v: f64| (v.fract() == 0.0 && (0.0..=f64::from(u32::MAX)).contains(&v)).then_some(v as u32);
     let is_bad = |v: &f64| index(*v).is_none();
     if let Some(t) = fans.par_iter().position_first(|c| c.iter().any(is_bad)) {
-        let per_face = fans.len() / count;
+        let face = t / (fans.len() / count);
         let v = fans[t].iter().copied().find(is_bad).unwrap_or_default();
-        bail!("face {} has a bad vertex index {v}", t / per_face);
+        let line = first_line.map_or(String::new(), |l| format!("line {}: ", l + face));
+        bail!("{line}face {face} has a bad vertex index {v}");
     }
     faces.par_extend(fans.par_iter().map(|c| c.map(|v| v as u32)));
     Ok(())
@@ -1648,6 +1699,61 @@ mod tests {
             for piece_bytes in [1, 5, 16, 64, PIECE_BYTES] {
                 let got = read(&bytes, true, Some(piece_bytes)).map_err(|e| e.to_string());
                 assert_eq!(got, want, "case {case}, pieces of {piece_bytes} bytes");
+            }
+            errors += usize::from(want.is_err());
+        }
+        assert!(
+            (300..2700).contains(&errors),
+            "{errors} errors in 3000 cases"
+        );
+    }
+
+    /// ASCII faces read at once give what one value at a time gives, on
+    /// random meshes: lists of 3, 4 or 5 items or of varying length, bad
+    /// and out-of-range indices, lines split or blank, truncation.
+    #[test]
+    fn ascii_faces_in_pieces_read_as_in_one_pass() {
+        let mut rng = trim::synthetic::SplitMix64::new(47);
+        let mut below = |n: u64| (rng.next_u64() % n) as usize;
+        let mut errors = 0;
+        for case in 0..3000 {
+            let (vertices, faces) = (1 + below(12), below(30));
+            let mut text = format!(
+                "ply\nformat ascii 1.0\nelement vertex {vertices}\nproperty float x\n\
+                 property float y\nproperty float z\nelement face {faces}\n\
+                 property list uchar int vertex_indices\nend_header\n"
+            );
+            for v in 0..vertices {
+                text += &format!("{v} {case} 0.5\n");
+            }
+            let len = [3, 3, 4, 5][below(4)];
+            for _ in 0..faces {
+                let n = if below(30) == 0 { below(6) } else { len };
+                let items: Vec<String> = (0..n)
+                    .map(|_| match below(300) {
+                        0 => "-1".to_string(),
+                        1 => "0.5".to_string(),
+                        2 => vertices.to_string(),
+                        _ => below(vertices as u64).to_string(),
+                    })
+                    .collect();
+                let sep = if below(100) == 0 { "\n" } else { " " };
+                text += &format!("{n}{sep}{}\n", items.join(" "));
+                if below(200) == 0 {
+                    text += "\n";
+                }
+            }
+            if below(8) == 0 {
+                text.truncate(text.len() - below(text.len() as u64 / 4));
+            }
+            let want = read(text.as_bytes(), true, None).map_err(|e| e.to_string());
+            for piece_bytes in [1, 5, 16, 64, PIECE_BYTES] {
+                let got = read(text.as_bytes(), true, Some(piece_bytes));
+                let got = got.map_err(|e| e.to_string());
+                assert_eq!(
+                    got, want,
+                    "case {case}, pieces of {piece_bytes} bytes: {text:?}"
+                );
             }
             errors += usize::from(want.is_err());
         }
