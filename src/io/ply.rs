@@ -432,8 +432,13 @@ impl Values for AsciiValues<'_> {
         if self.tokens.clone().next().is_some() {
             return None;
         }
-        let (count, width) = (element.count, element.properties.len());
-        let (triples, end) = rows_in_pieces(self.rest, count, width, columns, piece_bytes)?;
+        let record = LineRecord {
+            width: element.properties.len(),
+            lead: None,
+            columns,
+        };
+        let count = element.count;
+        let (triples, end) = rows_in_pieces(self.rest, count, &record, piece_bytes)?;
         let first_line = Some(self.line + 1);
         self.rest = &self.rest[end..];
         self.line += count;
@@ -456,23 +461,25 @@ impl Values for AsciiValues<'_> {
         if !(3.0..=MAX_ASCII_LIST).contains(&len) || len.fract() != 0.0 {
             return None;
         }
-        let len = len as usize;
-        // The length thrice, then the fans' triangles from the first item.
-        let columns: Vec<[usize; 3]> = std::iter::once([0; 3])
-            .chain((1..len - 1).map(|w| [1, w + 1, w + 2]))
-            .collect();
-        let (count, width) = (element.count, len + 1);
-        let (triples, end) = rows_in_pieces(self.rest, count, width, &columns, piece_bytes)?;
-        let (lens, fans) = triples.split_first()?;
-        if lens.iter().any(|l| l[0] != len as f64) {
-            return None;
-        }
+        // The fans' triangles from the list's first item.
+        let n = len as usize;
+        let columns: Vec<[usize; 3]> = (1..n - 1).map(|w| [1, w + 1, w + 2]).collect();
+        let record = LineRecord {
+            width: n + 1,
+            lead: Some(len),
+            columns: &columns,
+        };
+        let count = element.count;
+        let (mut fans, end) = rows_in_pieces(self.rest, count, &record, piece_bytes)?;
         let first_line = Some(self.line + 1);
         self.rest = &self.rest[end..];
         self.line += count;
-        let triangles = (0..count)
-            .flat_map(|r| fans.iter().map(move |fan| fan[r]))
-            .collect();
+        let triangles = match fans.len() {
+            1 => fans.pop().unwrap_or_default(),
+            _ => (0..count)
+                .flat_map(|r| fans.iter().map(move |fan| fan[r]))
+                .collect(),
+        };
         Some(Fans {
             triangles,
             first_line,
@@ -488,18 +495,27 @@ const MAX_ASCII_LIST: f64 = 1024.0;
 /// busy, few enough that little is parsed past the element's end.
 const PIECES_PER_BATCH: usize = 8;
 
-/// The first `count` lines of `text` parsed in parallel as records of
-/// `width` values, keeping the triples of values at `columns`; with the
-/// byte offset just after the last record's line. `None` when a line
-/// before that does not hold exactly `width` numbers, or the text has
-/// fewer lines.
+/// What a line must hold for [`rows_in_pieces`], and what is kept of it.
+struct LineRecord<'a> {
+    /// Exactly this many numbers.
+    width: usize,
+    /// The first of them equal to this (a list's length), if given.
+    lead: Option<f64>,
+    /// The triples of values kept, by index in the line.
+    columns: &'a [[usize; 3]],
+}
+
+/// The first `count` lines of `text` parsed in parallel as `record`s,
+/// keeping the triples of values at its columns; with the byte offset
+/// just after the last record's line. `None` when a line before that is
+/// not such a record, or the text has fewer lines.
 fn rows_in_pieces(
     text: &str,
     count: usize,
-    width: usize,
-    columns: &[[usize; 3]],
+    record: &LineRecord,
     piece_bytes: usize,
 ) -> Option<(Vec<Vec<Point3>>, usize)> {
+    let columns = record.columns;
     let mut triples = vec![Vec::with_capacity(capacity(count)); columns.len()];
     if count == 0 {
         return Some((triples, 0));
@@ -510,7 +526,7 @@ fn rows_in_pieces(
         let limit = count - rows;
         let parsed: Vec<PieceRows> = batch
             .par_iter()
-            .map(|piece| parse_rows(piece, width, columns, limit))
+            .map(|piece| parse_rows(piece, record, limit))
             .collect();
         for (piece, parsed) in batch.iter().zip(parsed) {
             let take = parsed.rows.min(count - rows);
@@ -538,11 +554,13 @@ struct PieceRows {
     complete: bool,
 }
 
-/// Up to `limit` lines of `piece` as records of `width` numbers, stopping
-/// at the first line that is not one.
-fn parse_rows(piece: &str, width: usize, columns: &[[usize; 3]], limit: usize) -> PieceRows {
+/// Up to `limit` lines of `piece` read as `record`s, stopping at the
+/// first line that is not one.
+fn parse_rows(piece: &str, record: &LineRecord, limit: usize) -> PieceRows {
+    let columns = record.columns;
+    let lead = record.lead;
     let mut triples = vec![Vec::new(); columns.len()];
-    let mut record = vec![0.0; width];
+    let mut record = vec![0.0; record.width];
     let mut rest = piece;
     let mut rows = 0;
     let mut complete = false;
@@ -551,7 +569,7 @@ fn parse_rows(piece: &str, width: usize, columns: &[[usize; 3]], limit: usize) -
             complete = true;
             break;
         };
-        if !parse_record(line, &mut record) {
+        if !parse_record(line, &mut record) || lead.is_some_and(|l| record[0] != l) {
             break;
         }
         for (triple, at) in triples.iter_mut().zip(columns) {
@@ -1769,20 +1787,38 @@ mod tests {
     fn rows_in_pieces_reads_exactly_the_elements_lines() {
         let text = "1 2 3\r\n4 5 6\r7 8 9\n3 0 1 2\n";
         for piece_bytes in [1, 4, 64] {
-            let (triples, end) = rows_in_pieces(text, 3, 3, &[[2, 0, 1]], piece_bytes).unwrap();
+            let record = |columns| LineRecord {
+                width: 3,
+                lead: None,
+                columns,
+            };
+            let columns = [[2, 0, 1]];
+            let (triples, end) = rows_in_pieces(text, 3, &record(&columns), piece_bytes).unwrap();
             assert_eq!(triples, [[[3., 1., 2.], [6., 4., 5.], [9., 7., 8.]]]);
             assert_eq!(&text[end..], "3 0 1 2\n");
             assert_eq!(
-                rows_in_pieces(text, 0, 3, &[[0; 3]], piece_bytes)
+                rows_in_pieces(text, 0, &record(&[[0; 3]]), piece_bytes)
                     .unwrap()
                     .1,
                 0
             );
             // A fourth record would be a face line of 4 values; a blank
             // line or a record over two lines is left to the stream reader.
-            assert!(rows_in_pieces(text, 4, 3, &[[0; 3]], piece_bytes).is_none());
-            assert!(rows_in_pieces("1 2 3\n\n4 5 6\n", 2, 3, &[[0; 3]], piece_bytes).is_none());
-            assert!(rows_in_pieces("1 2\n3\n", 1, 3, &[[0; 3]], piece_bytes).is_none());
+            assert!(rows_in_pieces(text, 4, &record(&[[0; 3]]), piece_bytes).is_none());
+            assert!(
+                rows_in_pieces("1 2 3\n\n4 5 6\n", 2, &record(&[[0; 3]]), piece_bytes).is_none()
+            );
+            assert!(rows_in_pieces("1 2\n3\n", 1, &record(&[[0; 3]]), piece_bytes).is_none());
+            // A list's length must be the one given.
+            let lists = LineRecord {
+                width: 4,
+                lead: Some(3.0),
+                columns: &[[1, 2, 3]],
+            };
+            let faces = "3 0 1 2\n3 2 1 0\n4 0 1 2\n";
+            let (fans, _) = rows_in_pieces(faces, 2, &lists, piece_bytes).unwrap();
+            assert_eq!(fans, [[[0., 1., 2.], [2., 1., 0.]]]);
+            assert!(rows_in_pieces(faces, 3, &lists, piece_bytes).is_none());
         }
     }
 
