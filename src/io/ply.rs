@@ -1564,10 +1564,7 @@ mod tests {
         let types = [
             "char", "uchar", "short", "ushort", "int", "uint", "float", "double",
         ];
-        let mut rng = trim::synthetic::SplitMix64::new(37);
-        let mut below = |n: u64| (rng.next_u64() % n) as usize;
-        let mut errors = 0;
-        for case in 0..3000 {
+        let errors = compare_readings(37, false, |below, case| {
             let order = ["binary_little_endian", "binary_big_endian"][case % 2];
             let mut names: Vec<String> = ["x", "y", "z"].map(String::from).to_vec();
             if below(2) == 0 {
@@ -1599,20 +1596,41 @@ mod tests {
             // About as many bytes as the vertices take, sometimes fewer.
             let body = below(40 * size as u64 + 64);
             bytes.extend((0..body).map(|_| if below(4) == 0 { 0 } else { below(256) as u8 }));
-            // Debug text, so that NaN normals compare equal.
-            let want = read(&bytes, false, None).map(|m| format!("{m:?}"));
-            let want = want.map_err(|e| e.to_string());
-            for piece_bytes in [1, 5, 16, 64, PIECE_BYTES] {
-                let got = read(&bytes, false, Some(piece_bytes)).map(|m| format!("{m:?}"));
-                let got = got.map_err(|e| e.to_string());
-                assert_eq!(got, want, "case {case}, pieces of {piece_bytes} bytes");
-            }
-            errors += usize::from(want.is_err());
-        }
+            bytes
+        });
         assert!(
             (300..2700).contains(&errors),
             "{errors} errors in 3000 cases"
         );
+    }
+
+    /// Reads 3,000 random files, `make(below, case)`, one value at a time
+    /// and in pieces of 1 byte to 1 MiB, as a mesh (`grid`) or a cloud,
+    /// and asserts the same outcome, errors included; compared as Debug
+    /// text, so that NaN normals are equal. Returns how many files failed
+    /// to read, for the caller to check that both outcomes were tried.
+    fn compare_readings(
+        seed: u64,
+        grid: bool,
+        mut make: impl FnMut(crate::io::piece_tests::Below, usize) -> Vec<u8>,
+    ) -> usize {
+        let mut rng = trim::synthetic::SplitMix64::new(seed);
+        let mut below = |n: u64| (rng.next_u64() % n) as usize;
+        let read = |bytes: &[u8], pieces| {
+            let mesh = read(bytes, grid, pieces).map(|m| format!("{m:?}"));
+            mesh.map_err(|e| e.to_string())
+        };
+        let mut errors = 0;
+        for case in 0..3000 {
+            let bytes = make(&mut below, case);
+            let want = read(&bytes, None);
+            for piece_bytes in [1, 5, 16, 64, PIECE_BYTES] {
+                let got = read(&bytes, Some(piece_bytes));
+                assert_eq!(got, want, "case {case}, pieces of {piece_bytes} bytes");
+            }
+            errors += usize::from(want.is_err());
+        }
+        errors
     }
 
     /// `v` in type `ty`, appended to `out` in byte order `B`.
@@ -1704,22 +1722,13 @@ mod tests {
     /// after the list, bad and out-of-range indices, truncated data.
     #[test]
     fn binary_faces_decoded_in_parallel_as_one_at_a_time() {
-        let mut rng = trim::synthetic::SplitMix64::new(41);
-        let mut below = |n: u64| (rng.next_u64() % n) as usize;
-        let mut errors = 0;
-        for case in 0..3000 {
-            let bytes = if case % 2 == 0 {
-                random_binary_mesh::<LittleEndian>("binary_little_endian", &mut below)
+        let errors = compare_readings(41, true, |below, case| {
+            if case % 2 == 0 {
+                random_binary_mesh::<LittleEndian>("binary_little_endian", below)
             } else {
-                random_binary_mesh::<BigEndian>("binary_big_endian", &mut below)
-            };
-            let want = read(&bytes, true, None).map_err(|e| e.to_string());
-            for piece_bytes in [1, 5, 16, 64, PIECE_BYTES] {
-                let got = read(&bytes, true, Some(piece_bytes)).map_err(|e| e.to_string());
-                assert_eq!(got, want, "case {case}, pieces of {piece_bytes} bytes");
+                random_binary_mesh::<BigEndian>("binary_big_endian", below)
             }
-            errors += usize::from(want.is_err());
-        }
+        });
         assert!(
             (300..2700).contains(&errors),
             "{errors} errors in 3000 cases"
@@ -1731,10 +1740,7 @@ mod tests {
     /// and out-of-range indices, lines split or blank, truncation.
     #[test]
     fn ascii_faces_in_pieces_read_as_in_one_pass() {
-        let mut rng = trim::synthetic::SplitMix64::new(47);
-        let mut below = |n: u64| (rng.next_u64() % n) as usize;
-        let mut errors = 0;
-        for case in 0..3000 {
+        let errors = compare_readings(47, true, |below, case| {
             let (vertices, faces) = (1 + below(12), below(30));
             let mut text = format!(
                 "ply\nformat ascii 1.0\nelement vertex {vertices}\nproperty float x\n\
@@ -1764,17 +1770,8 @@ mod tests {
             if below(8) == 0 {
                 text.truncate(text.len() - below(text.len() as u64 / 4));
             }
-            let want = read(text.as_bytes(), true, None).map_err(|e| e.to_string());
-            for piece_bytes in [1, 5, 16, 64, PIECE_BYTES] {
-                let got = read(text.as_bytes(), true, Some(piece_bytes));
-                let got = got.map_err(|e| e.to_string());
-                assert_eq!(
-                    got, want,
-                    "case {case}, pieces of {piece_bytes} bytes: {text:?}"
-                );
-            }
-            errors += usize::from(want.is_err());
-        }
+            text.into_bytes()
+        });
         assert!(
             (300..2700).contains(&errors),
             "{errors} errors in 3000 cases"
