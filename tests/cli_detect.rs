@@ -476,7 +476,9 @@ fn pts_files_with_point_counts() {
 
 /// A cloud large enough that each text reader cuts it into several pieces
 /// (its files are 3–4 MB, the pieces 1 MiB) gives the same output as its
-/// binary PLY: XYZ, PTS, ASCII PCD and OBJ.
+/// binary PLY: XYZ, PTS, ASCII PCD, OBJ and ASCII PLY (also with a face
+/// element, whose lines are read in pieces too); and binary and compressed
+/// PCD, decoded in parallel.
 #[test]
 fn large_text_clouds_read_in_pieces_as_the_binary_ply() {
     // A gently curved sheet, 260 × 240 points, jittered (seeded).
@@ -510,29 +512,70 @@ fn large_text_clouds_read_in_pieces_as_the_binary_ply() {
             .map(|p| format!("{prefix}{}{suffix}\n", line(p)))
             .collect()
     };
-    let pcd = format!(
-        "VERSION .7\nFIELDS x y z\nSIZE 8 8 8\nTYPE F F F\nCOUNT 1 1 1\nWIDTH {n}\n\
-         HEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {n}\nDATA ascii\n{}",
-        lines("", "")
+    // The grid's triangles, for a PLY mesh whose vertices are the cloud.
+    let faces: String = (0..259 * 239)
+        .map(|c| (c % 259 + c / 259 * 260) as usize)
+        .flat_map(|i| [[i, i + 1, i + 261], [i, i + 261, i + 260]])
+        .map(|[a, b, c]| format!("3 {a} {b} {c}\n"))
+        .collect();
+    let ascii_ply = |faces_header: &str, faces: &str| {
+        format!(
+            "ply\nformat ascii 1.0\nelement vertex {n}\nproperty double x\n\
+             property double y\nproperty double z\n{faces_header}end_header\n{}{faces}",
+            lines("", "")
+        )
+    };
+    let faces_header = format!(
+        "element face {}\nproperty list uchar int vertex_indices\n",
+        2 * 259 * 239
     );
+    let pcd_head = |fields: &str, sizes: &str, data: &str| {
+        let count = fields.split(' ').count();
+        let (types, counts) = (vec!["F"; count].join(" "), vec!["1"; count].join(" "));
+        format!(
+            "VERSION .7\nFIELDS {fields}\nSIZE {sizes}\nTYPE {types}\nCOUNT {counts}\n\
+             WIDTH {n}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {n}\nDATA {data}\n"
+        )
+    };
+    let mut binary_pcd = pcd_head("x y z", "8 8 8", "binary").into_bytes();
+    binary_pcd.extend(points.iter().flatten().flat_map(|c| c.to_le_bytes()));
+    // binary_compressed stores each field's values together; an intensity
+    // of zeros gives LZF something to pack (random doubles do not shrink).
+    let mut by_field: Vec<u8> = (0..3)
+        .flat_map(|k| points.iter().flat_map(move |p| p[k].to_le_bytes()))
+        .collect();
+    by_field.resize(by_field.len() + 4 * n, 0);
+    let packed = lzf::compress(&by_field).unwrap();
+    let head = pcd_head("x y z intensity", "8 8 8 4", "binary_compressed");
+    let mut compressed_pcd = head.into_bytes();
+    compressed_pcd.extend((packed.len() as u32).to_le_bytes());
+    compressed_pcd.extend((by_field.len() as u32).to_le_bytes());
+    compressed_pcd.extend(packed);
     let files = [
         ("cloud.ply", ply),
+        ("ascii.ply", ascii_ply("", "").into_bytes()),
+        (
+            "ascii_mesh.ply",
+            ascii_ply(&faces_header, &faces).into_bytes(),
+        ),
+        ("binary.pcd", binary_pcd),
+        ("compressed.pcd", compressed_pcd),
         ("cloud.xyz", lines("", "").into_bytes()),
         (
             "cloud.pts",
             format!("{n}\r\n{}", lines("", " 0 10 20 30")).into_bytes(),
         ),
-        ("cloud.pcd", pcd.into_bytes()),
+        (
+            "cloud.pcd",
+            (pcd_head("x y z", "8 8 8", "ascii") + &lines("", "")).into_bytes(),
+        ),
         ("cloud.obj", lines("v ", "").into_bytes()),
     ];
     let dir = tempfile::tempdir().unwrap();
     let mut outputs = Vec::new();
     for (name, bytes) in &files {
-        assert!(
-            name.ends_with(".ply") || bytes.len() > 3 << 20,
-            "{name}: {}",
-            bytes.len()
-        );
+        let text = !matches!(*name, "cloud.ply" | "binary.pcd" | "compressed.pcd");
+        assert!(!text || bytes.len() > 3 << 20, "{name}: {}", bytes.len());
         let input = dir.path().join(name);
         std::fs::write(&input, bytes).unwrap();
         let out = dir.path().join(format!("{name}.out.ply"));
