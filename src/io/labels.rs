@@ -8,6 +8,7 @@ use std::io::Write;
 
 use byteorder::{LittleEndian, WriteBytesExt};
 
+use super::float_text::push_f64;
 use super::Point3;
 
 /// Points with their boundary labels and local resolution β.
@@ -84,10 +85,13 @@ pub fn write_csv(w: &mut dyn Write, data: Labelled) -> std::io::Result<()> {
         .min(data.boundary.len())
         .min(data.beta.len());
     super::write_formatted(w, n, |out, i| {
-        let p = data.points[i];
-        let b = u8::from(data.boundary[i]);
-        // Writing into a Vec cannot fail.
-        let _ = writeln!(out, "{},{},{},{},{}", p[0], p[1], p[2], b, data.beta[i]);
+        for c in data.points[i] {
+            push_f64(out, c);
+            out.push(b',');
+        }
+        out.extend_from_slice(if data.boundary[i] { b"1," } else { b"0," });
+        push_f64(out, data.beta[i]);
+        out.push(b'\n');
     })
 }
 

@@ -20,6 +20,7 @@ use anyhow::{anyhow, bail, Context, Result};
 use byteorder::{LittleEndian, WriteBytesExt};
 
 use super::atomic::write_atomic;
+use super::float_text::push_f64_debug;
 use super::{gltf_io, show, stl, Point3};
 
 /// The mesh formats meshtrim writes.
@@ -186,13 +187,17 @@ pub fn write_obj(
         vertices.len(),
         faces.len()
     )?;
-    // Writing into a Vec cannot fail.
     super::write_formatted(w, vertices.len(), |out, i| {
-        let p = vertices[i];
-        let _ = writeln!(out, "v {:?} {:?} {:?}", p[0], p[1], p[2]);
+        out.push(b'v');
+        for c in vertices[i] {
+            out.push(b' ');
+            push_f64_debug(out, c);
+        }
+        out.push(b'\n');
     })?;
     super::write_formatted(w, faces.len(), |out, i| {
         let [a, b, c] = faces[i].map(|v| u64::from(v) + 1);
+        // Writing into a Vec cannot fail.
         let _ = writeln!(out, "f {a} {b} {c}");
     })
 }

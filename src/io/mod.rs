@@ -16,6 +16,7 @@
 
 pub mod atomic;
 pub mod edges_out;
+pub(crate) mod float_text;
 pub mod gltf_io;
 pub mod labels;
 pub mod mesh_out;
@@ -386,9 +387,13 @@ fn write_formatted_in_pieces(
         let texts: Vec<Vec<u8>> = window
             .par_iter()
             .map(|range| {
+                // Sized by the first record, so that the text seldom grows.
                 let mut text = Vec::new();
                 for i in range.clone() {
                     format(&mut text, i);
+                    if i == range.start {
+                        text.reserve(text.len() * range.len() * 9 / 8);
+                    }
                 }
                 text
             })
