@@ -101,8 +101,12 @@ impl Shortest {
                 shortest.point -= 1; // a leading zero
                 continue;
             }
-            shortest.buffer[shortest.len] = b;
-            shortest.len += 1;
+            // Past 17 significant digits a plain text holds only zeros
+            // (`1234567890123456.0`), which are dropped below anyway.
+            if shortest.len < shortest.buffer.len() {
+                shortest.buffer[shortest.len] = b;
+                shortest.len += 1;
+            }
         }
         while shortest.len > 0 && shortest.buffer[shortest.len - 1] == b'0' {
             shortest.len -= 1;
