@@ -456,6 +456,50 @@ pub(crate) fn next_line<'a>(rest: &mut &'a str) -> Option<&'a str> {
     Some(line)
 }
 
+/// The words of a line, split at whitespace as `str::split_whitespace`
+/// splits (Unicode's, as `char::is_whitespace` says), by bytes when the
+/// line is ASCII: no UTF-8 decoding per character.
+pub(crate) fn words(line: &str) -> Words<'_> {
+    if line.is_ascii() {
+        Words::Ascii(line)
+    } else {
+        Words::Unicode(line.split_whitespace())
+    }
+}
+
+/// The ASCII characters `char::is_whitespace` accepts: vertical tab
+/// included, unlike `u8::is_ascii_whitespace`.
+fn is_ascii_space(b: &u8) -> bool {
+    b.is_ascii_whitespace() || *b == 0x0b
+}
+
+/// The iterator of [`words`].
+pub(crate) enum Words<'a> {
+    /// The rest of an ASCII line.
+    Ascii(&'a str),
+    Unicode(std::str::SplitWhitespace<'a>),
+}
+
+impl<'a> Iterator for Words<'a> {
+    type Item = &'a str;
+
+    fn next(&mut self) -> Option<&'a str> {
+        match self {
+            Words::Ascii(rest) => {
+                let bytes = rest.as_bytes();
+                let start = bytes.iter().position(|b| !is_ascii_space(b))?;
+                let len = bytes[start..].iter().position(is_ascii_space);
+                let end = len.map_or(bytes.len(), |len| start + len);
+                // Every byte of an ASCII line starts a character.
+                let word = &rest[start..end];
+                *rest = &rest[end..];
+                Some(word)
+            }
+            Words::Unicode(split) => split.next(),
+        }
+    }
+}
+
 /// How the lines of a PLY or PCD header end, as its first line ends: `\n`
 /// (after an optional `\r`) or a lone `\r` (classic Mac OS).
 ///
@@ -588,6 +632,27 @@ pub(crate) mod piece_tests {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `words` splits as `str::split_whitespace` does, on random lines of
+    /// letters, every ASCII control and space character, and a few
+    /// non-ASCII ones (a no-break space, an ideographic space, an é).
+    #[test]
+    fn words_split_as_split_whitespace_does() {
+        let mut rng = trim::synthetic::SplitMix64::new(61);
+        let alphabet: Vec<char> = (0u8..=32)
+            .map(char::from)
+            .chain(['a', 'b', '1', '.', '-', '\u{a0}', '\u{3000}', 'é', '\u{7f}'])
+            .collect();
+        for _ in 0..20_000 {
+            let len = (rng.next_u64() % 12) as usize;
+            let line: String = (0..len)
+                .map(|_| alphabet[(rng.next_u64() % alphabet.len() as u64) as usize])
+                .collect();
+            let ours: Vec<&str> = words(&line).collect();
+            let std: Vec<&str> = line.split_whitespace().collect();
+            assert_eq!(ours, std, "{line:?}");
+        }
+    }
 
     #[test]
     fn content_beats_extension() {
