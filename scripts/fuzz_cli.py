@@ -73,11 +73,35 @@ def derive_sources(work):
             f.write(struct.pack("<3f", *map(float, r)))
     for ext in ("stl", "obj", "gltf", "glb", "ply"):
         run(["clean", JAGGED, os.path.join(work, f"mesh.{ext}")])
+    write_ascii_meshes(work)
     clouds = [CLOUD] + [os.path.join(work, n) for n in
                         ("cloud.csv", "cloud.xyz", "cloud.pts", "cloud.obj", "cloud_ascii.pcd",
                          "cloud_binary.pcd")]
     meshes = [JAGGED, POISSON] + [os.path.join(work, f"mesh.{e}") for e in ("stl", "obj", "gltf", "glb", "ply")]
+    meshes += [os.path.join(work, n) for n in ("mesh_ascii.stl", "mesh_ascii.ply")]
     return clouds, meshes
+
+
+def write_ascii_meshes(work):
+    """The binary STL written by `clean` as ASCII STL and ASCII PLY."""
+    data = open(os.path.join(work, "mesh.stl"), "rb").read()
+    (n,) = struct.unpack_from("<I", data, 80)
+    triangles = [struct.unpack_from("<12f", data, 84 + 50 * t)[3:] for t in range(n)]
+    with open(os.path.join(work, "mesh_ascii.stl"), "w") as f:
+        f.write("solid fuzz\n")
+        for t in triangles:
+            f.write("facet normal 0 0 0\n outer loop\n")
+            for k in range(3):
+                f.write("  vertex %r %r %r\n" % t[3 * k:3 * k + 3])
+            f.write(" endloop\nendfacet\n")
+        f.write("endsolid fuzz\n")
+    corners = [t[3 * k:3 * k + 3] for t in triangles for k in range(3)]
+    with open(os.path.join(work, "mesh_ascii.ply"), "w") as f:
+        f.write(f"ply\nformat ascii 1.0\nelement vertex {len(corners)}\nproperty float x\n"
+                f"property float y\nproperty float z\nelement face {n}\n"
+                "property list uchar int vertex_indices\nend_header\n")
+        f.write("".join("%r %r %r\n" % c for c in corners))
+        f.write("".join(f"3 {3 * t} {3 * t + 1} {3 * t + 2}\n" for t in range(n)))
 
 
 def commands(path, is_mesh, work):
