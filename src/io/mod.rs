@@ -469,7 +469,7 @@ pub(crate) fn words(line: &str) -> Words<'_> {
 
 /// The ASCII characters `char::is_whitespace` accepts: vertical tab
 /// included, unlike `u8::is_ascii_whitespace`.
-fn is_ascii_space(b: &u8) -> bool {
+pub(crate) fn is_ascii_space(b: &u8) -> bool {
     b.is_ascii_whitespace() || *b == 0x0b
 }
 

@@ -492,6 +492,10 @@ fn read_compressed(header: &Header, wanted: &Wanted, body: &[u8]) -> Result<Raw>
     }))
 }
 
+/// Points decoded per parallel task, at least: fewer would cost more in
+/// scheduling than in decoding.
+const POINTS_PER_TASK: usize = 1 << 14;
+
 /// The wanted fields of `n` binary points, `value(i, f)` being field `f`
 /// of point `i`; decoded in parallel, in order. The caller has checked
 /// that the data holds `n` points.
@@ -500,7 +504,7 @@ fn decode_points(wanted: &Wanted, n: usize, value: impl Fn(usize, usize) -> f64 
         let mut out = Vec::new();
         (0..n)
             .into_par_iter()
-            .with_min_len(1 << 14)
+            .with_min_len(POINTS_PER_TASK)
             .map(|i| [value(i, x), value(i, y), value(i, z)])
             .collect_into_vec(&mut out);
         out

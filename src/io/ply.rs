@@ -39,8 +39,8 @@
 //! length). The large elements are read at once and in parallel where
 //! their layout allows it: the vertices when all their properties are
 //! scalars (ASCII: one record per line, parsed in pieces of about 1 MiB;
-//! binary: fixed-size records), and binary faces whose lists all have the
-//! same length (triangles, quads). Any other layout, and a line that is
+//! binary: fixed-size records), and faces whose lists all have the same
+//! length (triangles, quads; ASCII: a list alone on each line). Any other layout, and a line that is
 //! not a record or data that ends early, falls back to the value-at-a-time
 //! reading from the element's start; the checks made on what was read at
 //! once (finite coordinates, vertex indices) give the same messages. The
@@ -180,9 +180,9 @@ pub fn read_ply_mesh(bytes: &[u8]) -> Result<Mesh> {
     read(bytes, true, Some(PIECE_BYTES))
 }
 
-/// `piece_bytes`: the size of the pieces in which the vertex element is
-/// parsed (ASCII) or decoded (binary) in parallel; `None` reads the
-/// vertices one value at a time, the reference the parallel reading is
+/// `piece_bytes`: the size of the pieces in which the vertex and face
+/// elements are parsed (ASCII) or decoded (binary) in parallel; `None`
+/// reads them one value at a time, the reference the parallel reading is
 /// tested against.
 fn read(bytes: &[u8], grid: bool, piece_bytes: Option<usize>) -> Result<Mesh> {
     let bytes = strip_bom(bytes);

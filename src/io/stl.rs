@@ -181,9 +181,19 @@ fn read_ascii_in_pieces(bytes: &[u8], piece_bytes: usize) -> Result<Mesh> {
         .into_par_iter()
         .map(Lines::read)
         .collect();
-    let kinds = pieces.iter().flat_map(|piece| piece.kinds.iter().copied());
+    // Each vertex line takes the next point, in any state, so that the
+    // points stay with their lines.
     let mut vertices = pieces.iter().flat_map(Lines::vertices);
-    walk(text, kinds, || vertices.next().unwrap_or(Ok([0.0; 3])))
+    let lines_read = pieces
+        .iter()
+        .flat_map(|piece| piece.kinds.iter().copied())
+        .map(|kind| {
+            (
+                kind,
+                (kind == Kind::Vertex).then(|| vertices.next()).flatten(),
+            )
+        });
+    walk(text, lines_read)
 }
 
 /// What the grammar needs of a piece's lines, read once: each line's first
@@ -262,43 +272,42 @@ impl Kind {
     }
 }
 
-/// The `solid` grammar over the file's lines, in order, `next_vertex`
-/// giving each `vertex` line's point in turn; messages quote a wrong line
-/// from `text`.
+/// The `solid` grammar over the file's lines, in order: each line's kind,
+/// with its point (or what is wrong with it) for a `vertex` line; messages
+/// quote a wrong line from `text`.
 fn walk(
     text: &str,
-    kinds: impl Iterator<Item = Kind>,
-    mut next_vertex: impl FnMut() -> Result<Point3, String>,
+    lines_read: impl Iterator<Item = (Kind, Option<Result<Point3, String>>)>,
 ) -> Result<Mesh> {
     let mut merger = Merger::new(text.len() / 200);
     let mut state = State::Outside;
     let mut corners: Vec<Point3> = Vec::with_capacity(3);
     let mut facets = 0usize;
     let mut last = 0;
-    for (i, kind) in kinds.enumerate() {
+    for (i, (kind, vertex)) in lines_read.enumerate() {
         last = i + 1;
         let at = |e: String| anyhow!("line {}: {e}", i + 1);
         let expected = |what: &str| {
             let found = lines(text).nth(i).unwrap_or_default().trim();
             at(format!("expected {what}, found '{found}'"))
         };
-        // Every vertex line takes its point, so that the next one gets its.
-        let vertex = (kind == Kind::Vertex).then(&mut next_vertex);
-        state = match (state, kind) {
-            (_, Kind::Blank) => state,
-            (State::Outside, Kind::Solid) => State::Solid,
-            (State::Outside, _) => return Err(expected("'solid'")),
-            (State::Solid, Kind::Facet(true)) => State::Facet,
-            (State::Solid, Kind::Facet(false)) => return Err(expected("'facet normal nx ny nz'")),
-            (State::Solid, Kind::EndSolid) => State::Outside,
-            (State::Solid, _) => return Err(expected("'facet normal' or 'endsolid'")),
-            (State::Facet, Kind::Outer(true)) => State::Loop,
-            (State::Facet, _) => return Err(expected("'outer loop'")),
-            (State::Loop, Kind::Vertex) => {
-                corners.push(vertex.unwrap_or(Ok([0.0; 3])).map_err(at)?);
+        state = match (state, kind, vertex) {
+            (_, Kind::Blank, _) => state,
+            (State::Outside, Kind::Solid, _) => State::Solid,
+            (State::Outside, _, _) => return Err(expected("'solid'")),
+            (State::Solid, Kind::Facet(true), _) => State::Facet,
+            (State::Solid, Kind::Facet(false), _) => {
+                return Err(expected("'facet normal nx ny nz'"))
+            }
+            (State::Solid, Kind::EndSolid, _) => State::Outside,
+            (State::Solid, _, _) => return Err(expected("'facet normal' or 'endsolid'")),
+            (State::Facet, Kind::Outer(true), _) => State::Loop,
+            (State::Facet, _, _) => return Err(expected("'outer loop'")),
+            (State::Loop, Kind::Vertex, Some(p)) => {
+                corners.push(p.map_err(at)?);
                 State::Loop
             }
-            (State::Loop, Kind::EndLoop) => {
+            (State::Loop, Kind::EndLoop, _) => {
                 if corners.len() != 3 {
                     return Err(at(format!(
                         "facet {facets} has {} vertices, a triangle needs 3",
@@ -310,9 +319,9 @@ fn walk(
                 facets += 1;
                 State::EndLoop
             }
-            (State::Loop, _) => return Err(expected("'vertex x y z' or 'endloop'")),
-            (State::EndLoop, Kind::EndFacet) => State::Solid,
-            (State::EndLoop, _) => return Err(expected("'endfacet'")),
+            (State::Loop, _, _) => return Err(expected("'vertex x y z' or 'endloop'")),
+            (State::EndLoop, Kind::EndFacet, _) => State::Solid,
+            (State::EndLoop, _, _) => return Err(expected("'endfacet'")),
         };
     }
     match state {

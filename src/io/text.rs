@@ -209,13 +209,9 @@ fn read_fields<'a>(line: &'a str, out: &mut [&'a str; 3]) -> usize {
 }
 
 /// The ASCII characters `read_fields` splits at: comma, semicolon and the
-/// ASCII characters `char::is_whitespace` accepts (vertical tab included,
-/// unlike `u8::is_ascii_whitespace`).
+/// ASCII characters `char::is_whitespace` accepts.
 fn is_ascii_separator(b: u8) -> bool {
-    matches!(
-        b,
-        b',' | b';' | b' ' | b'\t' | b'\n' | b'\x0b' | b'\x0c' | b'\r'
-    )
+    b == b',' || b == b';' || super::is_ascii_space(&b)
 }
 
 fn is_header(first: &[&str]) -> bool {
