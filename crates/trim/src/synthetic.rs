@@ -58,6 +58,8 @@
 
 use std::f64::consts::PI;
 
+use kiddo::{ImmutableKdTree, SquaredEuclidean};
+
 use crate::cloud::dist2;
 
 pub mod jagged;
@@ -871,7 +873,7 @@ pub fn decimated_blade(spacing: f64, seed: u64) -> SyntheticCloud {
         SpacingField::Uniform(spacing / 4.0),
         seed,
     );
-    let kept = poisson_disk_thinning(&dense.points, DECIMATION_RADIUS * spacing, seed);
+    let kept = poisson_disk_thinning(&dense.points, |_| DECIMATION_RADIUS * spacing, seed);
     let uv = pick(&dense.uv, &kept);
     SyntheticCloud {
         points: pick(&dense.points, &kept),
@@ -888,39 +890,38 @@ fn pick<T: Copy>(values: &[T], kept: &[usize]) -> Vec<T> {
     kept.iter().map(|&i| values[i]).collect()
 }
 
-/// Indices (increasing) of the points kept by Poisson-disk elimination
-/// with disk `radius`, visiting `points` in an order shuffled by `seed`.
-fn poisson_disk_thinning(points: &[P3], radius: f64, seed: u64) -> Vec<usize> {
+/// Indices (increasing) of the points kept by Poisson-disk elimination,
+/// visiting `points` in an order shuffled by `seed`: a point is kept unless
+/// a point kept before it lies closer than its own disk radius
+/// (`radius_of(i)`, which may vary smoothly over the cloud).
+fn poisson_disk_thinning(points: &[P3], radius_of: impl Fn(usize) -> f64, seed: u64) -> Vec<usize> {
     let mut order: Vec<usize> = (0..points.len()).collect();
     let mut rng = SplitMix64::new(seed ^ 0x7468_696e);
     for i in (1..order.len()).rev() {
         let j = (rng.next_u64() % (i as u64 + 1)) as usize;
         order.swap(i, j);
     }
-    let cell_of = |p: P3| p.map(|c| (c / radius).floor() as i64);
-    let mut cells: crate::hash::HashMap<[i64; 3], Vec<usize>> = Default::default();
-    let r2 = radius * radius;
-    let taken = |cells: &crate::hash::HashMap<[i64; 3], Vec<usize>>, p: P3| {
-        let c = cell_of(p);
-        (-1..=1).any(|dx| {
-            (-1..=1).any(|dy| {
-                (-1..=1).any(|dz| {
-                    cells
-                        .get(&[c[0] + dx, c[1] + dy, c[2] + dz])
-                        .is_some_and(|list| list.iter().any(|&j| dist2(points[j], p) < r2))
-                })
-            })
-        })
-    };
-    let mut kept = Vec::new();
+    // The kept points are a subset of `points`, so a tree of all of them,
+    // built once, answers "is a kept point within the disk?" for any
+    // radius, where a grid would need cells as large as the largest disk.
+    let tree: ImmutableKdTree<f64, 3> =
+        ImmutableKdTree::new_from_slice(points).expect("dense samples fit in u32");
+    let mut is_kept = vec![false; points.len()];
     for i in order {
-        if !taken(&cells, points[i]) {
-            cells.entry(cell_of(points[i])).or_default().push(i);
-            kept.push(i);
-        }
+        let r2 = radius_of(i).powi(2);
+        let mut taken = false;
+        tree.query(&points[i])
+            .within::<SquaredEuclidean<f64>>(r2)
+            .unsorted()
+            .visit(|found| {
+                let j = found.item as usize;
+                // Strictly closer than the disk, whatever the tree's rule
+                // at the rim.
+                taken |= is_kept[j] && dist2(points[j], points[i]) < r2;
+            });
+        is_kept[i] = !taken;
     }
-    kept.sort_unstable();
-    kept
+    (0..points.len()).filter(|&i| is_kept[i]).collect()
 }
 
 /// [`blade`] with the sampling jitter's half-width chosen (a fraction of
@@ -942,26 +943,72 @@ pub fn blade_with_jitter(spacing: f64, jitter: f64, seed: u64) -> SyntheticCloud
 /// (3.4 → 34 mm is the paper's cloud e), and one hole of radius
 /// 9·`min_spacing` at u = 120 mm, where the pitch is ≈ 1.6·`min_spacing`.
 pub fn variable_density(min_spacing: f64, seed: u64) -> SyntheticCloud {
-    let field = SpacingField::Graded {
+    jittered(
+        format!("variable density {min_spacing}–{} mm", 10.0 * min_spacing),
+        BLADE,
+        variable_density_region(min_spacing),
+        variable_density_field(min_spacing),
+        seed,
+    )
+}
+
+/// [`variable_density`]'s pitch: ×10 geometrically along the span.
+fn variable_density_field(min_spacing: f64) -> SpacingField {
+    SpacingField::Graded {
         h0: min_spacing,
         h1: 10.0 * min_spacing,
         u0: 0.0,
         u1: 600.0,
-    };
-    let region = Region {
+    }
+}
+
+/// [`variable_density`]'s region: the blade with one hole of radius
+/// 9·`min_spacing` at u = 120 mm.
+fn variable_density_region(min_spacing: f64) -> Region {
+    Region {
         outer: blade_outline(),
         holes: vec![Circle {
             centre: [120.0, 0.0],
             radius: 9.0 * min_spacing,
         }],
-    };
-    jittered(
-        format!("variable density {min_spacing}–{} mm", 10.0 * min_spacing),
+    }
+}
+
+/// [`variable_density`]'s blade (the same ×10 grading and hole) made as
+/// [`decimated_blade`] is: a jittered blade graded at a quarter of the
+/// pitch, thinned by Poisson-disk elimination with a disk of
+/// [`DECIMATION_RADIUS`] times the local pitch. Blue noise whose
+/// resolution varies smoothly by ×10, with no lattice columns left.
+pub fn decimated_variable_density(min_spacing: f64, seed: u64) -> SyntheticCloud {
+    let field = variable_density_field(min_spacing);
+    let dense_field = variable_density_field(min_spacing / 4.0);
+    let dense = jittered(
+        format!(
+            "variable density {min_spacing}–{} mm, decimated",
+            10.0 * min_spacing
+        ),
         BLADE,
-        region,
-        field,
+        variable_density_region(min_spacing),
+        dense_field,
         seed,
-    )
+    );
+    let kept = poisson_disk_thinning(
+        &dense.points,
+        |i| DECIMATION_RADIUS * field.at(dense.uv[i][0]),
+        seed,
+    );
+    let uv = pick(&dense.uv, &kept);
+    SyntheticCloud {
+        points: pick(&dense.points, &kept),
+        normals: pick(&dense.normals, &kept),
+        spacing: uv
+            .iter()
+            .map(|&at| field.at(at[0]) * BLADE.stretch(at))
+            .collect(),
+        uv,
+        field,
+        ..dense
+    }
 }
 
 /// An unjittered, axis-aligned square lattice of pitch h on the plane
@@ -1157,6 +1204,43 @@ mod tests {
             let along = dot(d, c.normals[i]).abs();
             assert!((along - len).abs() < 1e-9);
         }
+    }
+
+    #[test]
+    fn graded_decimation_keeps_each_point_its_own_disk_from_the_others() {
+        let cloud = decimated_variable_density(3.4, 5);
+        assert_eq!(cloud.points, decimated_variable_density(3.4, 5).points);
+        let radius = |i: usize| DECIMATION_RADIUS * cloud.field.at(cloud.uv[i][0]);
+        let n = cloud.len();
+        let (mut nearest_root, mut nearest_tip) = (f64::INFINITY, f64::INFINITY);
+        for i in 0..n {
+            for j in i + 1..n {
+                // Whichever of the two was visited later kept clear of the
+                // other by its own disk.
+                let d = dist2(cloud.points[i], cloud.points[j]).sqrt();
+                assert!(d >= radius(i).min(radius(j)), "{i}, {j}: {d}");
+            }
+            let u = cloud.uv[i][0];
+            let spacing_ratio = cloud.spacing[i] / cloud.field.at(u);
+            assert!((1.0..1.1).contains(&spacing_ratio), "{spacing_ratio}");
+            if u < 20.0 {
+                nearest_root = nearest_root.min(radius(i));
+            } else if u > 580.0 {
+                nearest_tip = nearest_tip.min(radius(i));
+            }
+        }
+        // The disk, so the resolution, grows about ×10 along the span.
+        assert!(nearest_tip.is_finite(), "no point near the tip");
+        assert!(
+            nearest_tip / nearest_root > 8.0,
+            "{nearest_root} → {nearest_tip}"
+        );
+        // About as many points as the graded lattice.
+        let lattice = variable_density(3.4, 5).len() as f64;
+        assert!(
+            (0.7..1.2).contains(&(n as f64 / lattice)),
+            "{n} against {lattice}"
+        );
     }
 
     #[test]
