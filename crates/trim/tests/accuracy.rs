@@ -342,13 +342,18 @@ fn noise_20_percent_loses_nothing_75_percent_adds_nothing() {
 /// spacings deep, at a sampling gap wider than its β). Measured over five
 /// noise patterns (`--example noise_decimated`, docs/results.md), 7 of 40
 /// cases reach the paper's Ω ≥ 25 % and Ψ ≥ 75 %, against none of the
-/// jittered lattice blades.
+/// jittered lattice blades. Against the truth (no stretch of the true
+/// border loses its last detected point; no point beyond one spacing of it
+/// turns boundary) the paper's numbers must hold at every resolution, on
+/// at least one of the two samplings (6 of the 8 blades reach them with
+/// this noise pattern; 32 of 40 cases over five patterns).
 #[test]
 fn noise_on_blades_decimated_as_the_papers_were() {
     let options = BpdOptions::default();
     let mut meets_paper = Vec::new();
     let mut failures = Vec::new();
     for (h, seed) in [4.0, 8.0, 16.0, 34.0].into_iter().zip(10..) {
+        let mut meets_paper_against_truth = false;
         for cloud in [seed, seed + 90].map(|s| synthetic::decimated_blade(h, s)) {
             let r = noise_robustness(&cloud, &percent_sweep(5.0, 75.0), &options, 7).unwrap();
             eprintln!(
@@ -363,10 +368,17 @@ fn noise_on_blades_decimated_as_the_papers_were() {
             if r.omega.percent >= 20.0 && r.psi.percent >= 75.0 {
                 meets_paper.push(cloud.name.clone());
             }
+            meets_paper_against_truth |=
+                r.omega_truth.percent >= 25.0 && r.psi_truth.percent >= 75.0;
             failures.extend(flips_beyond_the_first_rows(
                 &cloud,
                 &options,
                 Deep::NewBoundary,
+            ));
+        }
+        if !meets_paper_against_truth {
+            failures.push(format!(
+                "{h} mm: neither sampling reaches Ω ≥ 25 %, Ψ ≥ 75 % against the truth"
             ));
         }
     }
