@@ -13,13 +13,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 n=${1:-1000000}
-if ! dpkg -s libusb-1.0-0 >/dev/null 2>&1; then
-    apt-get install -y -q libusb-1.0-0 >/dev/null
-fi
-if [ ! -x bench-venv/bin/python ] || ! bench-venv/bin/python -c "import open3d" 2>/dev/null; then
-    python3 -m venv bench-venv
-    bench-venv/bin/pip install -q open3d-cpu==0.20.0
-fi
+source bench/open3d_env.sh
 cargo build --release -q --example bench_bpd --example bench_read
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
