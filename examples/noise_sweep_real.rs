@@ -5,13 +5,15 @@
 //! noise-free detection is lost, Ψ the largest p at which no interior one
 //! turns boundary (against the noise-free detection: real scans have no
 //! ground truth). Default options (`ANISO_OFF=1`: without the anisotropy
-//! map). Prints a markdown table.
+//! map; `VIEW_ALONG=X,Y,Z`: projected along that line of sight, as
+//! `--view-along`). Prints a markdown table.
 //!
 //! `cargo run --release --example noise_sweep_real [FILES...]` (default: the
 //! two Kinect blade scans and two Stanford range scans of `../shared/data`)
 
 use std::path::PathBuf;
 
+use trim::bpd::View;
 use trim::frame::fit_plane;
 use trim::neighbours::NeighbourIndex;
 use trim::synthetic::SplitMix64;
@@ -38,6 +40,7 @@ fn main() -> anyhow::Result<()> {
         let cloud = meshtrim::io::read_cloud(file)?.points;
         let options = BpdOptions {
             anisotropy: std::env::var_os("ANISO_OFF").is_none(),
+            view: view_along()?,
             ..BpdOptions::default()
         };
         let clean = detect_boundary(&cloud, &options)?;
@@ -93,6 +96,21 @@ fn main() -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// The line of sight given in `VIEW_ALONG` ("X,Y,Z"), if any.
+fn view_along() -> anyhow::Result<Option<View>> {
+    let Ok(text) = std::env::var("VIEW_ALONG") else {
+        return Ok(None);
+    };
+    let parts = text
+        .split(',')
+        .map(|c| c.trim().parse::<f64>())
+        .collect::<Result<Vec<f64>, _>>()?;
+    match parts[..] {
+        [x, y, z] => Ok(Some(View::Along([x, y, z]))),
+        _ => anyhow::bail!("VIEW_ALONG={text:?}: expected X,Y,Z"),
+    }
 }
 
 /// The unit normal of every point's k-neighbourhood plane.
