@@ -216,15 +216,32 @@ fn run(
     let passes = 2;
     let report = |pass: usize| move |done: usize| progress((pass * n + done) / passes);
     let hoods = neighbourhoods(spatial, options, how, &report(0));
-    let vectors = hoods.sampling.as_deref();
-    let verdicts = per_position(&hoods, how, &report(passes - 1), |s, p| {
-        analyse_point(&hoods, p, vectors, s, how)
-    });
-    let links = links_in_input_order(&site_of, &hoods.order, &verdicts);
-    let mut detection =
-        spread_to_input(&site_of, &hoods.order, &verdicts, |v| (v.decision, v.beta));
-    detection.links = links;
+    let tests = &report(passes - 1);
+    // The default neighbourhood's links fit in one word's bits.
+    let detection = if hoods.k <= SLOT_BITS_CAPACITY {
+        analyse_all::<SlotBits>(&hoods, &site_of, how, tests)
+    } else {
+        analyse_all::<Vec<u32>>(&hoods, &site_of, how, tests)
+    };
     Ok(detection)
+}
+
+/// The tests at every position, and their results in input order.
+fn analyse_all<L: LinkSlots>(
+    hoods: &Neighbourhoods,
+    site_of: &[u32],
+    how: TestImpl,
+    progress: &(dyn Fn(usize) + Sync),
+) -> Detection {
+    let vectors = hoods.sampling.as_deref();
+    let verdicts = per_position(hoods, how, progress, |s, p| {
+        analyse_point::<L>(hoods, p, vectors, s, how)
+    });
+    let links = links_in_input_order(site_of, hoods, &verdicts);
+    let mut detection =
+        spread_to_input(site_of, &hoods.order, &verdicts, |v| (v.decision, v.beta));
+    detection.links = links;
+    detection
 }
 
 /// The local resolution β_i = μ_i + 2σ_i of every point (section 2,
@@ -546,7 +563,12 @@ fn block_len(n: usize) -> usize {
 }
 
 /// The links found at each position, as pairs of input indices.
-fn links_in_input_order(site_of: &[u32], order: &[u32], verdicts: &[Verdict]) -> Vec<[u32; 2]> {
+fn links_in_input_order<L: LinkSlots>(
+    site_of: &[u32],
+    hoods: &Neighbourhoods,
+    verdicts: &[Verdict<L>],
+) -> Vec<[u32; 2]> {
+    let order = &hoods.order;
     let mut first_input = vec![u32::MAX; order.len()];
     for (input, &site) in site_of.iter().enumerate().rev() {
         first_input[site as usize] = input as u32;
@@ -554,15 +576,14 @@ fn links_in_input_order(site_of: &[u32], order: &[u32], verdicts: &[Verdict]) ->
     let input_of = |position: u32| first_input[order[position as usize] as usize];
     // Each pair as one integer, smaller index above: sorted, the order of
     // the pairs, in less than half the time that sorting the pairs took.
-    let mut links: Vec<u64> = verdicts
-        .iter()
-        .enumerate()
-        .flat_map(|(p, v)| {
-            let a = input_of(p as u32);
-            v.links.iter().map(move |&q| (a, input_of(q)))
-        })
-        .map(|(a, b)| (u64::from(a.min(b)) << 32) | u64::from(a.max(b)))
-        .collect();
+    let mut links: Vec<u64> = Vec::new();
+    for (p, v) in verdicts.iter().enumerate() {
+        let (a, members) = (input_of(p as u32), hoods.at(p));
+        v.links.for_each(|slot| {
+            let b = input_of(members[slot as usize]);
+            links.push((u64::from(a.min(b)) << 32) | u64::from(a.max(b)));
+        });
+    }
     if links.len() < PASS_PIECE {
         links.sort_unstable();
     } else {
@@ -616,12 +637,66 @@ enum TestImpl {
 }
 
 /// What the analysis finds at one point.
-struct Verdict {
+struct Verdict<L> {
     decision: Decision,
     beta: f64,
-    /// Positions of the neighbours along the boundary (empty unless the
-    /// circle test decided; allocated only then).
-    links: Vec<u32>,
+    /// The neighbours along the boundary, by their slot in the point's
+    /// neighbourhood (none unless the circle test decided).
+    links: L,
+}
+
+/// A set of neighbourhood slots: a point's boundary links.
+trait LinkSlots: Send + Sync {
+    /// The slots `slots`, each below the neighbourhood size.
+    fn of(slots: impl Iterator<Item = u32>) -> Self;
+    /// No slot.
+    fn none() -> Self;
+    /// Calls `f` with every slot, in increasing order.
+    fn for_each(&self, f: impl FnMut(u32));
+}
+
+/// Slots as the bits of one word, for neighbourhoods of up to 64 points
+/// (the default is 30): the verdicts stay small and no point's links
+/// allocate.
+type SlotBits = u64;
+
+/// How many slots a [`SlotBits`] holds.
+const SLOT_BITS_CAPACITY: usize = SlotBits::BITS as usize;
+
+impl LinkSlots for SlotBits {
+    fn of(slots: impl Iterator<Item = u32>) -> Self {
+        slots.fold(0, |bits, slot| bits | 1 << slot)
+    }
+
+    fn none() -> Self {
+        0
+    }
+
+    fn for_each(&self, mut f: impl FnMut(u32)) {
+        let mut bits = *self;
+        while bits != 0 {
+            f(bits.trailing_zeros());
+            bits &= bits - 1;
+        }
+    }
+}
+
+/// Slots listed, for larger neighbourhoods (`--k` above 64): a boundary
+/// point's list is allocated.
+impl LinkSlots for Vec<u32> {
+    fn of(slots: impl Iterator<Item = u32>) -> Self {
+        let mut list: Vec<u32> = slots.collect();
+        list.sort_unstable();
+        list
+    }
+
+    fn none() -> Self {
+        Vec::new()
+    }
+
+    fn for_each(&self, f: impl FnMut(u32)) {
+        self.iter().copied().for_each(f);
+    }
 }
 
 /// Per-thread buffers: nothing is allocated per interior point once they
@@ -675,14 +750,13 @@ fn projected_beta(
     beta_of(&s.distances)
 }
 
-fn analyse_point(
+fn analyse_point<L: LinkSlots>(
     hoods: &Neighbourhoods,
     p: usize,
     vectors: Option<&[Sampling]>,
     s: &mut Scratch,
     how: TestImpl,
-) -> Verdict {
-    let members = hoods.at(p);
+) -> Verdict<L> {
     let beta = projected_beta(hoods, p, vectors, s);
     // Neighbours that project onto P_i itself carry no direction.
     s.neighbours.clear();
@@ -704,15 +778,12 @@ fn analyse_point(
             circle::empty_circle_reference(&s.projected, beta)
         }
     };
-    let mut links = Vec::new();
-    if by_circle && cell_says {
+    let links = if by_circle && cell_says {
         circle::boundary_links(&s.neighbours, beta, &mut s.cell, &mut s.along);
-        links.extend(
-            s.along
-                .iter()
-                .map(|&j| members[s.slots[j as usize] as usize]),
-        );
-    }
+        L::of(s.along.iter().map(|&j| s.slots[j as usize]))
+    } else {
+        L::none()
+    };
     let decision = if by_circle {
         Decision::EmptyCircle
     } else if polar::surrounding_path_is_open(&s.neighbours, &mut s.polar) {
@@ -806,6 +877,30 @@ mod tests {
                     "seed {seed} anisotropy {anisotropy} {view:?}: labels differ at {differ:?}"
                 );
             }
+        }
+    }
+
+    #[test]
+    fn links_as_bits_and_as_lists_are_the_same_links() {
+        for (seed, k) in [(1, 8), (2, 30), (3, 64)] {
+            let pts = random_sheet(seed, 40, 0.1, 1.0);
+            let options = BpdOptions {
+                k,
+                ..BpdOptions::default()
+            };
+            let Prepared { site_of, spatial } = prepare(&pts, &options).unwrap();
+            let hoods = neighbourhoods(spatial, &options, TestImpl::Fast, &|_| {});
+            let analyse = |bits: bool| {
+                let how = TestImpl::Fast;
+                if bits {
+                    analyse_all::<SlotBits>(&hoods, &site_of, how, &|_| {})
+                } else {
+                    analyse_all::<Vec<u32>>(&hoods, &site_of, how, &|_| {})
+                }
+            };
+            let (bits, lists) = (analyse(true), analyse(false));
+            assert!(bits.links.len() > 100, "k {k}: {} links", bits.links.len());
+            assert_eq!(bits, lists, "k {k}");
         }
     }
 
