@@ -53,9 +53,19 @@ pub fn fit_plane(points: &[Point3], members: &[u32]) -> Frame {
 // Baseline and AVX2 variants, chosen at run time (crate doc, "Vector kernels").
 #[multiversion::multiversion(targets("x86_64+avx2"))]
 pub fn fit_plane_normal(points: &[Point3], members: &[u32]) -> Frame {
-    let normal = canonical_sign(smallest_eigenvector(&covariance(points, members)));
-    let (u, v) = orthogonal_complement(normal);
-    Frame { u, v, normal }
+    Frame::of_normal(canonical_sign(smallest_eigenvector(&covariance(
+        points, members,
+    ))))
+}
+
+impl Frame {
+    /// The frame of [`fit_plane_normal`] for the unit `normal`: in-plane
+    /// axes that follow from the normal's components alone, so a caller
+    /// that keeps only the normal gets the same frame, bit for bit.
+    pub fn of_normal(normal: Point3) -> Self {
+        let (u, v) = orthogonal_complement(normal);
+        Frame { u, v, normal }
+    }
 }
 
 /// The covariance of `members`' positions (unnormalised).

@@ -26,7 +26,7 @@ use crate::anisotropy::{
     SamplingMoment,
 };
 use crate::cloud::{
-    check_finite, check_not_degenerate, cross, merge_duplicates, sub, Point3, Sites, PASS_PIECE,
+    check_finite, check_not_degenerate, merge_duplicates, sub, Point3, Sites, PASS_PIECE,
 };
 use crate::error::CloudError;
 use crate::frame::{fit_plane_normal, project_sheared, ray_shear, Frame, Point2};
@@ -238,8 +238,7 @@ fn analyse_all<L: LinkSlots>(
         analyse_point::<L>(hoods, p, vectors, s, how)
     });
     let links = links_in_input_order(site_of, hoods, &verdicts);
-    let mut detection =
-        spread_to_input(site_of, &hoods.order, &verdicts, |v| (v.decision, v.beta));
+    let mut detection = spread_to_input(site_of, &hoods.order, &verdicts, |v| (v.decision, v.beta));
     detection.links = links;
     detection
 }
@@ -448,23 +447,19 @@ fn neighbourhoods(
 }
 
 /// A point's sampling moment and the plane of its neighbourhood, kept from
-/// the k-NN pass for the tests. The plane's v axis is not stored: it is
-/// n × u, as [`fit_plane_normal`] computes it (96 bytes per point, not
-/// 120).
+/// the k-NN pass for the tests. Only the plane's normal is stored: its
+/// axes follow from it, as [`fit_plane_normal`] computes them (72 bytes
+/// per point, not 120).
 #[derive(Debug, Clone, Copy, Default)]
 struct Sampling {
     moment: SamplingMoment,
-    u: Point3,
+    /// The plane's normal ([`Frame::of_normal`] gives its axes).
     normal: Point3,
 }
 
 impl Sampling {
     fn frame(&self) -> Frame {
-        Frame {
-            u: self.u,
-            v: cross(self.normal, self.u),
-            normal: self.normal,
-        }
+        Frame::of_normal(self.normal)
     }
 }
 
@@ -481,7 +476,6 @@ fn sampling_at(
     project_sheared(points, members, &frame, shear, projected);
     Sampling {
         moment: sampling_moment(&own_sampling_vectors(projected, &frame)),
-        u: frame.u,
         normal: frame.normal,
     }
 }
