@@ -22,57 +22,75 @@ use trim::evaluate::{ideal_first_layer, precision_recall, Accuracy};
 use trim::synthetic::{self, SyntheticCloud};
 use trim::{detect_boundary, BpdOptions};
 
-/// A cloud as given to both detectors: its points, moved by `rotated`
-/// when set (scores are taken on the original points, where the truth is).
+/// A cloud as given to both detectors: its points with out-of-plane
+/// noise of `noise` (a fraction of the local resolution, the paper's p;
+/// `SyntheticCloud::with_noise`, pattern 7), then rotated when `rotated`
+/// is set. Scores are taken on the original points, where the truth is.
 struct Case {
     key: String,
     cloud: SyntheticCloud,
+    noise: f64,
     rotated: bool,
 }
 
 impl Case {
     fn points(&self) -> Vec<[f64; 3]> {
+        let noisy = self.cloud.with_noise(self.noise, 7);
         if self.rotated {
-            self.cloud
-                .points
-                .iter()
-                .map(|&p| generic_rotation(p))
-                .collect()
+            noisy.into_iter().map(generic_rotation).collect()
         } else {
-            self.cloud.points.clone()
+            noisy
         }
     }
 
     fn name(&self) -> String {
-        if self.rotated {
-            format!("{}, rotated", self.cloud.name)
-        } else {
-            self.cloud.name.clone()
+        let mut name = self.cloud.name.clone();
+        if self.noise > 0.0 {
+            name += &format!(", noise {} %", self.noise * 100.0);
         }
+        if self.rotated {
+            name += ", rotated";
+        }
+        name
     }
 }
 
-/// Every cloud, and a generically rotated copy of those that lie in the
-/// plane z = 0: Open3D finds no boundary there (its normals or its angle
-/// test degenerate), so the rotated copy shows what it finds otherwise.
+/// Every cloud; a generically rotated copy of those that lie in the plane
+/// z = 0 (Open3D finds no boundary there, so the rotated copy shows what
+/// it finds otherwise); and the decimated 8 mm blade and variable-density
+/// blade with the paper's noise at 25 % and 75 %.
 fn cases() -> Vec<Case> {
     let mut cases = Vec::new();
+    let mut rotated = Vec::new();
+    let mut noisy = Vec::new();
     for (key, cloud) in clouds() {
-        let flat = cloud.points.iter().all(|p| p[2] == 0.0);
-        if flat {
-            cases.push(Case {
+        if cloud.points.iter().all(|p| p[2] == 0.0) {
+            rotated.push(Case {
                 key: format!("{key}_rotated"),
                 cloud: cloud.clone(),
+                noise: 0.0,
                 rotated: true,
             });
+        }
+        if key == "blade_8_decimated" || key == "variable_density_decimated" {
+            for percent in [25, 75] {
+                noisy.push(Case {
+                    key: format!("{key}_noise_{percent}"),
+                    cloud: cloud.clone(),
+                    noise: f64::from(percent) / 100.0,
+                    rotated: false,
+                });
+            }
         }
         cases.push(Case {
             key,
             cloud,
+            noise: 0.0,
             rotated: false,
         });
     }
-    cases.sort_by_key(|c| c.rotated);
+    cases.extend(rotated);
+    cases.extend(noisy);
     cases
 }
 
