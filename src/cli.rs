@@ -296,7 +296,8 @@ impl TrimArgs {
 /// Arguments of `meshtrim detect`.
 #[derive(Debug, Clone, Args)]
 pub struct DetectArgs {
-    /// Input point cloud: .ply, .pcd, .obj, .xyz/.txt/.csv/.asc/.pts.
+    /// Input point cloud: .ply, .pcd, .obj, .xyz/.txt/.csv/.asc/.pts, or a
+    /// mesh (.stl, .gltf, .glb) whose vertices are the cloud.
     pub cloud: PathBuf,
     /// Write the points with their labels: OUT.ply (binary) or OUT.csv.
     /// Missing parent directories are created.
@@ -326,7 +327,8 @@ impl DetectArgs {
 /// Arguments of `meshtrim edges`.
 #[derive(Debug, Clone, Args)]
 pub struct EdgesArgs {
-    /// Input point cloud: .ply, .pcd, .obj, .xyz/.txt/.csv/.asc/.pts.
+    /// Input point cloud: .ply, .pcd, .obj, .xyz/.txt/.csv/.asc/.pts, or a
+    /// mesh (.stl, .gltf, .glb) whose vertices are the cloud.
     pub cloud: PathBuf,
     /// Write the loops and edges: OUT.json (everything), OUT.obj (the
     /// smoothed edges as polylines) or OUT.svg (a picture). Missing parent
