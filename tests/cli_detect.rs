@@ -5,31 +5,13 @@ use std::process::{Command, Output};
 
 use byteorder::{ByteOrder, LittleEndian};
 
-const FIXTURE: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/fixtures/meshes/blade_holes.ply"
-);
+mod common;
+use common::{meshtrim_env, path_str, stderr, BLADE_HOLES};
 
-/// Runs meshtrim with `args` and extra environment variables.
-fn meshtrim_env(args: &[&str], env: &[(&str, &str)]) -> Output {
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_meshtrim"));
-    cmd.args(args);
-    for (k, v) in env {
-        cmd.env(k, v);
-    }
-    cmd.output().expect("the meshtrim binary runs")
-}
+const FIXTURE: &str = BLADE_HOLES;
 
 fn meshtrim(args: &[&str]) -> Output {
     meshtrim_env(args, &[])
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
-
-fn path_str(p: &Path) -> &str {
-    p.to_str().expect("temp paths are UTF-8")
 }
 
 /// The records of a `detect` PLY output: (x, y, z, boundary, beta).

@@ -1,38 +1,20 @@
 //! End-to-end tests of `meshtrim edges`, running the built binary.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 use serde_json::Value;
 
-const FIXTURE: &str = concat!(
-    env!("CARGO_MANIFEST_DIR"),
-    "/fixtures/meshes/blade_holes.ply"
-);
+mod common;
+use common::{meshtrim_env, path_str, stderr, BLADE_HOLES};
+
+const FIXTURE: &str = BLADE_HOLES;
 
 /// Points in the fixture (see fixtures/meshes/README.md).
 const FIXTURE_POINTS: usize = 7219;
 
-/// Runs meshtrim with `args` and extra environment variables.
-fn meshtrim_env(args: &[&str], env: &[(&str, &str)]) -> Output {
-    let mut cmd = Command::new(env!("CARGO_BIN_EXE_meshtrim"));
-    cmd.args(args);
-    for (k, v) in env {
-        cmd.env(k, v);
-    }
-    cmd.output().expect("the meshtrim binary runs")
-}
-
 fn meshtrim(args: &[&str]) -> Output {
     meshtrim_env(args, &[])
-}
-
-fn stderr(out: &Output) -> String {
-    String::from_utf8_lossy(&out.stderr).into_owned()
-}
-
-fn path_str(p: &Path) -> &str {
-    p.to_str().expect("temp paths are UTF-8")
 }
 
 /// Runs `edges` on the fixture into `dir/name` with `extra` arguments;

@@ -20,16 +20,44 @@ pub fn shared_data(rel: &str) -> PathBuf {
     root.join(rel)
 }
 
+/// The fixture cloud the `detect` and `edges` tests run on.
+#[allow(dead_code)]
+pub const BLADE_HOLES: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/fixtures/meshes/blade_holes.ply"
+);
+
 /// Runs the `meshtrim` binary with `args`, on `threads` rayon threads when
 /// given.
 #[allow(dead_code)] // each test binary uses its own share of the helpers
 pub fn meshtrim(args: &[&str], threads: Option<&str>) -> std::process::Output {
+    match threads {
+        Some(t) => meshtrim_env(args, &[("RAYON_NUM_THREADS", t)]),
+        None => meshtrim_env(args, &[]),
+    }
+}
+
+/// Runs the `meshtrim` binary with `args` and extra environment variables.
+#[allow(dead_code)]
+pub fn meshtrim_env(args: &[&str], env: &[(&str, &str)]) -> std::process::Output {
     let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_meshtrim"));
     cmd.args(args);
-    if let Some(t) = threads {
-        cmd.env("RAYON_NUM_THREADS", t);
+    for (key, value) in env {
+        cmd.env(key, value);
     }
-    cmd.output().expect("run meshtrim")
+    cmd.output().expect("the meshtrim binary runs")
+}
+
+/// A run's stderr as text.
+#[allow(dead_code)]
+pub fn stderr(out: &std::process::Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+/// A temporary path as the `&str` an argument list takes.
+#[allow(dead_code)]
+pub fn path_str(p: &std::path::Path) -> &str {
+    p.to_str().expect("temp paths are UTF-8")
 }
 
 /// Asserts a run failed cleanly: exit status 1, one `error: ` message that
