@@ -6,9 +6,7 @@ use std::process::{Command, Output};
 use byteorder::{ByteOrder, LittleEndian};
 
 mod common;
-use common::{meshtrim_env, path_str, stderr, BLADE_HOLES};
-
-const FIXTURE: &str = BLADE_HOLES;
+use common::{meshtrim_env, path_str, stderr, BLADE_HOLES as FIXTURE};
 
 fn meshtrim(args: &[&str]) -> Output {
     meshtrim_env(args, &[])

@@ -6,9 +6,7 @@ use std::process::Output;
 use serde_json::Value;
 
 mod common;
-use common::{meshtrim_env, path_str, stderr, BLADE_HOLES};
-
-const FIXTURE: &str = BLADE_HOLES;
+use common::{meshtrim_env, path_str, stderr, BLADE_HOLES as FIXTURE};
 
 /// Points in the fixture (see fixtures/meshes/README.md).
 const FIXTURE_POINTS: usize = 7219;
