@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # Accuracy against a peer: meshtrim's BPD and Open3D's boundary detection
 # on the synthetic clouds with ground truth of docs/results.md's accuracy
-# table, both scored by trim::evaluate (precision: detected points within
-# one intended spacing of the true boundary; recall: the share of the true
-# boundary's length with a detected point that close).
+# table, both scored by the test kit's evaluation (precision: detected
+# points within one intended spacing of the true boundary; recall: the
+# share of the true boundary's length with a detected point that close).
 #
 #   bash bench/accuracy.sh
 #

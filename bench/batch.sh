@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Batch benchmark (issue 5): `meshtrim batch` cleaning COUNT generated jagged
+# Batch benchmark: `meshtrim batch` cleaning COUNT generated jagged
 # meshes of about TRIANGLES triangles, with 1 and 2 jobs, against the same
 # batch done the way a shop does it today: a Python loop over PyMeshLab
 # (border selection + MeshLab's 1D boundary Laplacian, three steps; see

@@ -8,8 +8,8 @@
 # Debian's libusb-1.0-0. Prints a markdown table with wall times, meshtrim's
 # peak memory and the speed ratio Open3D / meshtrim. Open3D needs a search
 # radius; it runs with two (bench/open3d_boundary.py): 3 mean nearest-
-# neighbour spacings (issue 2's rule, the headline ratio) and the mean
-# distance to the 30th neighbour, which on a line scan is the smallest of
+# neighbour spacings (the speed target's rule, the headline ratio) and the
+# mean distance to the 30th neighbour, which on a line scan is the smallest of
 # the two that reaches the next scan line (with the first, Open3D labels
 # every point of a line scan boundary). The tools run in
 # alternating rounds (BENCH_ROUNDS, default 3 up to 1.5M points, 1 above);

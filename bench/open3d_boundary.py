@@ -7,7 +7,8 @@ same work meshtrim's `detect` does.
     python open3d_boundary.py CLOUD.ply [spacings|knn30]
 
 The search radius (Open3D has no threshold-free choice) is either
-- `spacings` (default, issue 2's rule): 3 mean nearest-neighbour spacings;
+- `spacings` (default, the speed target's rule): 3 mean nearest-neighbour
+  spacings;
 - `knn30`: the mean distance to the 30th nearest neighbour, the radius in
   which `max_nn = 30` is filled. On an isotropic cloud that is about 3
   grid pitches too; on a line scan, whose nearest neighbours all lie on
