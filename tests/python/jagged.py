@@ -1,7 +1,7 @@
 """Jagged meshes of the synthetic clouds, built independently of the Rust
-generator (``crates/trim/src/synthetic/jagged.rs``): what scanner software
+generator (``crates/testkit/src/synthetic/jagged.rs``): what scanner software
 makes of a cloud, with the cloud's known boundary as ground truth for
-``meshtrim clean`` (issue 5).
+``meshtrim clean``.
 
 :func:`jagged_mesh` triangulates the samples in their parameter domain with
 ``scipy.spatial.Delaunay`` and keeps a triangle when its centroid lies in

@@ -1,9 +1,9 @@
 """Synthetic validation clouds with known boundaries (numpy only).
 
-The shapes are those of the Rust generators in ``crates/trim/src/synthetic.rs``
-(so the Python validation and the Rust accuracy tests measure the same
-parts); the random draws differ (numpy's PCG64 instead of splitmix64), so the
-points are not byte-identical to the Rust ones.
+The shapes are those of the Rust test kit's generators
+(``crates/testkit/src/synthetic.rs``), so the Python validation and the Rust
+accuracy tests measure the same parts; the random draws differ (numpy's PCG64
+instead of splitmix64), so the points are not byte-identical to the Rust ones.
 
 Every generator returns a :class:`Cloud`: points on a parametric surface
 S(u, v) over a region of the (u, v) plane (an outer polygon minus circular
@@ -282,7 +282,7 @@ def curved_disc(spacing: float = 1.5, seed: int = 1) -> Cloud:
     return _make(f"curved disc h={spacing:g}", saddle(0.004), region, spacing, seed, 100.0)
 
 
-# The validation suite's cases by name (issue 4's list: blade-like surface
+# The validation suite's cases by name (blade-like surface
 # with three holes at two resolutions, notched plate, curved disc with a
 # hole); the trim and clean suites both run them.
 VALIDATION_CASES = {
@@ -294,7 +294,7 @@ VALIDATION_CASES = {
 
 
 def validation_clouds(seed: int = 1) -> list[Cloud]:
-    """The clouds of the validation suite (issue 4)."""
+    """The clouds of the validation suite."""
     return [
         blade(4.0, seed),
         blade(8.0, seed),

@@ -1,4 +1,4 @@
-"""Validation of `meshtrim clean` with independent tools (issue 5).
+"""Validation of `meshtrim clean` with independent tools.
 
 Synthetic cases (blade with three holes at 4 and 8 mm, notched plate,
 curved disc with a hole): the jittered cloud is triangulated here, with
@@ -46,8 +46,7 @@ disc          0.390/1.002  0.123/0.606  0.9706/0.9954  11.45/21.52
 smallest new angle 15.8-24.5 degrees.
 
 Real scans (loops split at pinched vertices, as meshtrim counts them),
-measured after the band fixes (one bad border no longer spoils its
-neighbours; turned-over skirts replaced; gaps refined):
+measured:
 
 =======  =====  =========  ==================  ==============
 scan     loops  smoothed   min angle new       new faces < 5

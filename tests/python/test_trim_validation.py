@@ -1,4 +1,4 @@
-"""Validation of the trimming command against PyMeshLab, as issue 4 lists:
+"""Validation of the trimming command against PyMeshLab:
 for each synthetic cloud (blade with three holes at 4 and 8 mm, notched
 plate, curved disc with a hole) -> screened Poisson (PyMeshLab, normals from
 compute_normal_for_point_clouds) -> `meshtrim MESH CLOUD OUT` -> checks on
@@ -157,12 +157,13 @@ def test_bunny_base_holes(tmp_path):
     # Within 1.5 local spacings of the cloud (measured 1.24): no envelope
     # is left. The bound is local because the base is sampled about twice
     # as sparsely as the median; in median spacings the cut through a base
-    # gap lies 1.95-2.13 away (docs/edges.md, "Gap fillers").
+    # gap lies 1.95-2.13 away (docs/edges.md, "Limits").
     assert poisson.max_distance_in_local_spacings(out_v, pts) <= 1.5
     assert poisson.is_edge_manifold(of)
     # The rest of the scanned surface stays: the zippered mesh's own area
-    # (holes and all). Until stop 17 the walls of small loops round sparse
-    # spots cut away about 30 % of it (area ratio 0.69).
+    # (holes and all). Removing every piece beyond the walls of the small
+    # loops round sparse spots would cut away about 30 % of it (area ratio
+    # 0.69); the support test keeps what the cloud covers.
     kept = mesh_area(out_v, np.asarray(of)) / mesh_area(pts, np.asarray(scan_faces))
     assert 0.97 <= kept <= 1.03, kept
 
@@ -192,11 +193,11 @@ def test_range_scan_trimmed_along_the_line_of_sight(tmp_path):
 def test_kinect_blade_trim_stays_within_the_clouds_reach(tmp_path, scan, view):
     """The real Kinect scans of the blade-shaped panel: where a ragged
     border does not close into a loop, no wall cuts the Poisson envelope
-    off, and until stop 21 slabs of it stayed, up to 85 local spacings from
-    the cloud (BladeScan2, default; BladeScan1 along z: 75). The cut along
-    the cloud's reach (2 β) ends them: measured 2.6-4.7 spacings, the
-    panel's 259,000-359,000 mm² kept (the envelope was 1,050,000-1,090,000;
-    the slabs made 476,000-509,000)."""
+    off; without the cut along the cloud's reach (2 β) slabs of it would
+    stay, up to 85 local spacings from the cloud (BladeScan2, default;
+    BladeScan1 along z: 75). With it: measured 2.6-4.7 spacings, the
+    panel's 259,000-359,000 mm² kept (the envelope is 1,050,000-1,090,000;
+    the slabs would make 476,000-509,000)."""
     cloud = shared_data(f"blade_scan_kinect/{scan}")
     points_path = tmp_path / "points.ply"
     run_meshtrim("detect", cloud, "-o", points_path)
