@@ -1,6 +1,6 @@
 //! Accuracy of meshtrim's BPD and of a peer (Open3D) on the synthetic
 //! clouds with ground truth of `docs/results.md`'s accuracy table, scored
-//! the same way (`trim::evaluate`). Used by `bench/accuracy.sh`:
+//! the same way (`testkit::evaluate`). Used by `bench/accuracy.sh`:
 //!
 //! ```text
 //! cargo run --release --example accuracy_peer -- write DIR
@@ -18,8 +18,10 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::{bail, Context};
-use trim::evaluate::{ideal_first_layer, precision_recall, Accuracy};
-use trim::synthetic::{self, SyntheticCloud};
+use testkit::{
+    evaluate::{ideal_first_layer, precision_recall, Accuracy},
+    synthetic::{self, SyntheticCloud},
+};
 use trim::{detect_boundary, BpdOptions};
 
 /// A cloud as given to both detectors: its points with out-of-plane

@@ -54,13 +54,12 @@ fn main() -> anyhow::Result<()> {
     }
     let found = found.ok_or_else(|| anyhow::anyhow!("no detection ran"))?;
     let start = Instant::now();
-    let edges =
-        trim::edges::reconstruct_edges(&cloud, &found, &trim::edges::EdgeOptions::default());
+    let edges = trim::reconstruct_edges(&cloud, &found, &trim::EdgeOptions::default());
     let edges_ms = start.elapsed().as_secs_f64() * 1e3;
     let by_path = found
         .decision
         .iter()
-        .filter(|&&d| d == trim::bpd::Decision::OpenPath)
+        .filter(|&&d| d == trim::Decision::OpenPath)
         .count();
     println!(
         "{{\"kind\":\"{kind}\",\"points\":{},\"boundary\":{},\"by_path_test\":{by_path},\"detect_ms\":{ms:.1},\"first_ms\":{:.1},\"loops\":{},\"edges_ms\":{edges_ms:.1},\"peak_rss_mb\":{:.1}}}",

@@ -6,14 +6,14 @@
 //! COUNT−1. The shape cycles through the blade, the notched plate and the
 //! curved disc with a hole by index, the seed is the index, and the pitch
 //! is chosen so that each mesh has about TARGET_TRIANGLES faces (default
-//! 50,000); see `trim::synthetic::jagged`. The same arguments give the
+//! 50,000); see `testkit::synthetic::jagged`. The same arguments give the
 //! same files.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use meshtrim::io::write_mesh;
-use trim::synthetic::jagged::{jagged_mesh, sized_cloud, Shape};
+use testkit::synthetic::jagged::{jagged_mesh, sized_cloud, Shape};
 
 const DEFAULT_TRIANGLES: usize = 50_000;
 

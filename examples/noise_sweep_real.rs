@@ -13,11 +13,8 @@
 
 use std::path::PathBuf;
 
-use trim::bpd::View;
-use trim::frame::fit_plane;
-use trim::neighbours::NeighbourIndex;
-use trim::synthetic::SplitMix64;
-use trim::{detect_boundary, BpdOptions, Point3};
+use testkit::synthetic::SplitMix64;
+use trim::{detect_boundary, fit_plane, BpdOptions, NeighbourIndex, Point3, View};
 
 const DEFAULT_SCANS: &[&str] = &[
     "blade_scan_kinect/BladeScan1.csv",

@@ -6,9 +6,9 @@
 use std::path::Path;
 use std::time::Instant;
 
-use trim::bpd::View as Scanner;
-use trim::edges::{reconstruct_edges, EdgeOptions, Edges};
-use trim::{detect_boundary, BpdOptions, Point3};
+use trim::{
+    detect_boundary, reconstruct_edges, BpdOptions, EdgeOptions, Edges, Point3, View as Scanner,
+};
 
 /// How to look at a scan: along its best-fit normal, or along an axis.
 #[derive(Clone, Copy)]
@@ -217,7 +217,7 @@ fn view_axes(points: &[Point3], view: View) -> ([Point3; 2], Point3) {
         }
         View::Plane => {
             let members: Vec<u32> = (0..points.len() as u32).collect();
-            let f = trim::frame::fit_plane(points, &members);
+            let f = trim::fit_plane(points, &members);
             ([f.u, f.v], f.normal)
         }
     }

@@ -90,7 +90,7 @@ fn main() -> anyhow::Result<()> {
 /// A view: best-fit plane axes of `vertices`, tilted by 35° about u.
 fn view_of(vertices: &[Point3]) -> impl Fn(Point3) -> Point3 {
     let members: Vec<u32> = (0..vertices.len() as u32).collect();
-    let f = trim::frame::fit_plane(vertices, &members);
+    let f = trim::fit_plane(vertices, &members);
     let (c, s) = (35f64.to_radians().cos(), 35f64.to_radians().sin());
     let v = [0, 1, 2].map(|i| c * f.v[i] + s * f.normal[i]);
     let n = [0, 1, 2].map(|i| -s * f.v[i] + c * f.normal[i]);

@@ -1,14 +1,13 @@
 //! Counts the jumps of the edge tours on the real range scans: tour steps
 //! longer than 3 β that no BPD link supports (see
-//! `trim::edge_metrics::tour_jumps`).
+//! `testkit::edge_metrics::tour_jumps`).
 //!
 //! `cargo run --release --example tour_jumps`
 
 use std::path::Path;
 
-use trim::edge_metrics::tour_jumps;
-use trim::edges::{reconstruct_edges, EdgeOptions};
-use trim::{detect_boundary, BpdOptions};
+use testkit::edge_metrics::tour_jumps;
+use trim::{detect_boundary, reconstruct_edges, BpdOptions, EdgeOptions};
 
 const SCANS: &[&str] = &["stanford_bunny/bun000.ply", "meshlab_scans/face000.ply"];
 

@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use serde::Serialize;
-use trim::clean::{clean_mesh, CleanOptions, CleanReport};
+use trim::{clean_mesh, CleanOptions, CleanReport};
 
 use crate::cli::CleanArgs;
 use crate::detect::millis;
@@ -124,7 +124,7 @@ fn clean(input: &Path, output: &Path, settings: &CleanSettings) -> Result<Report
     let options = settings.bpd_options();
     // Only β is needed: the mesh knows its border (BPD's labels would be
     // thrown away), and β alone takes about half the time.
-    let beta = trim::bpd::local_resolution(&mesh.vertices, &options)
+    let beta = trim::local_resolution(&mesh.vertices, &options)
         .with_context(|| format!("{}: the mesh's vertices", input.display()))?;
     let resolution_time = started.elapsed();
     let started = Instant::now();

@@ -8,8 +8,7 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
-use trim::bpd::View;
-use trim::BpdOptions;
+use trim::{BpdOptions, View};
 
 /// Boundary detection, edge smoothing and trimming of meshes from 3D scans.
 ///

@@ -135,7 +135,7 @@ pub(crate) fn detect_with_progress(
         }
         bar.set_position(done as u64);
     };
-    let result = trim::bpd::detect_boundary_with_progress(points, options, &progress);
+    let result = trim::detect_boundary_with_progress(points, options, &progress);
     bar.finish_and_clear();
     result
 }
@@ -255,7 +255,7 @@ pub(crate) fn detect_read_cloud(
     let detection = if progress {
         detect_with_progress(&cloud.points, options)
     } else {
-        trim::bpd::detect_boundary(&cloud.points, options)
+        trim::detect_boundary(&cloud.points, options)
     }
     .with_context(|| path.display().to_string())?;
     Ok(Detected {

@@ -6,8 +6,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{bail, Result};
 use serde::Serialize;
-use trim::edges::{reconstruct_edges, EdgeOptions, Edges};
-use trim::Detection;
+use trim::{reconstruct_edges, Detection, EdgeOptions, Edges};
 
 use crate::cli::EdgesArgs;
 use crate::console;

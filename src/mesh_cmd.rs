@@ -6,8 +6,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use serde::Serialize;
-use trim::delaunay::{delaunay_mesh_with_report, DelaunayReport};
-use trim::edges::{reconstruct_edges, EdgeOptions};
+use trim::{delaunay_mesh_with_report, reconstruct_edges, DelaunayReport, EdgeOptions};
 
 use crate::cli::MeshArgs;
 use crate::detect::{millis, read_and_detect, Detected};

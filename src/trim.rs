@@ -8,9 +8,9 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use serde::Serialize;
-use trim::edges::{reconstruct_edges, EdgeOptions};
-use trim::trimming::{trim_mesh, LoopFit, TrimReport};
-use trim::BpdOptions;
+use trim::{
+    reconstruct_edges, trim_mesh, BpdOptions, EdgeOptions, LoopFit, TrimOptions, TrimReport,
+};
 
 use crate::cli::TrimArgs;
 use crate::detect::{detect_read_cloud, millis, Detected};
@@ -126,8 +126,7 @@ pub fn trim_file(
     let mesh = mesh?;
     // Checked here, before detection, so the error names the mesh: the
     // library's own check reports "MESH with CLOUD".
-    trim::mesh::check_vertex_range(&mesh.vertices)
-        .with_context(|| mesh_path.display().to_string())?;
+    trim::check_vertex_range(&mesh.vertices).with_context(|| mesh_path.display().to_string())?;
     let cloud = cloud?;
     let read_time = started.elapsed();
     let Detected {
@@ -152,8 +151,14 @@ pub fn trim_file(
     );
     let edges_time = started.elapsed();
     let started = Instant::now();
-    let (out, trimmed) = trim_mesh(&mesh, &cloud.points, &detection, &edges)
-        .with_context(|| format!("{} with {}", mesh_path.display(), cloud_path.display()))?;
+    let (out, trimmed) = trim_mesh(
+        &mesh,
+        &cloud.points,
+        &detection,
+        &edges,
+        &TrimOptions::default(),
+    )
+    .with_context(|| format!("{} with {}", mesh_path.display(), cloud_path.display()))?;
     let trim_time = started.elapsed();
     let started = Instant::now();
     write_mesh(output, &out.vertices, &out.faces)?;

@@ -47,7 +47,7 @@ fn cleans_the_fixture_and_reports() {
     let written = meshtrim::io::read_mesh(&out).unwrap();
     let faces = written.faces.unwrap();
     assert_eq!(faces.len() as u64, json["faces_out"].as_u64().unwrap());
-    let mesh = trim::mesh::Mesh {
+    let mesh = trim::Mesh {
         vertices: written.vertices,
         faces,
     };

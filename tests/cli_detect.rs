@@ -462,7 +462,7 @@ fn pts_files_with_point_counts() {
 #[test]
 fn large_text_clouds_read_in_pieces_as_the_binary_ply() {
     // A gently curved sheet, 260 × 240 points, jittered (seeded).
-    let mut rng = trim::synthetic::SplitMix64::new(12345);
+    let mut rng = testkit::synthetic::SplitMix64::new(12345);
     let mut jitter = || rng.range(-0.15, 0.15);
     let points: Vec<[f64; 3]> = (0..260 * 240)
         .map(|i| {

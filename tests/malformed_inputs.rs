@@ -8,7 +8,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::Path;
 
 use meshtrim::io::{read_cloud, read_mesh, write_mesh};
-use trim::synthetic::SplitMix64;
+use testkit::synthetic::SplitMix64;
 
 /// Mutated copies per seed file.
 const MUTATIONS: usize = 4000;

@@ -53,7 +53,7 @@ fn stanford_bunny() {
 fn bunny_range_grid_is_a_mesh() {
     let mesh = read_mesh(&data("stanford_bunny/bun000.ply")).unwrap_or_else(|e| panic!("{e:#}"));
     let faces = mesh.faces.clone().expect("the range_grid gives faces");
-    let mesh = trim::mesh::Mesh {
+    let mesh = trim::Mesh {
         vertices: mesh.vertices,
         faces,
     };
@@ -120,12 +120,12 @@ fn first_bunny_vertex_is_exact() {
 
 /// Edge tours on the real range scans do not jump across the surface: no
 /// tour step longer than 3β that no BPD link supports. Before tours were
-/// cut at their jumps (`trim::edges::split`), bun000 had 16 such steps
+/// cut at their jumps (`trim::split`), bun000 had 16 such steps
 /// (longest 57.4 β) and face000 40 (longest 169.5 β); measured after: 0.
 #[test]
 fn edge_tours_on_range_scans_do_not_jump() {
-    use trim::edge_metrics::tour_jumps;
-    use trim::edges::{reconstruct_edges, EdgeOptions};
+    use testkit::edge_metrics::tour_jumps;
+    use trim::{reconstruct_edges, EdgeOptions};
     for (rel, max_jumps) in [
         ("stanford_bunny/bun000.ply", 0),
         ("meshlab_scans/face000.ply", 0),
@@ -151,8 +151,7 @@ fn edge_tours_on_range_scans_do_not_jump() {
 /// 64 loops of at most 16 points.
 #[test]
 fn a_range_scan_seen_from_its_camera_has_one_outer_loop() {
-    use trim::bpd::View;
-    use trim::edges::{reconstruct_edges, EdgeOptions};
+    use trim::{reconstruct_edges, EdgeOptions, View};
     let cloud = read_cloud(&data("pcl_test/milk.pcd")).unwrap_or_else(|e| panic!("{e:#}"));
     let options = trim::BpdOptions {
         view: Some(View::From([0.0; 3])),

@@ -15,8 +15,7 @@ use std::fmt::Write as _;
 use std::io::Write;
 
 use serde::Serialize;
-use trim::edges::Edges;
-use trim::frame::{fit_plane, Frame};
+use trim::{fit_plane, Edges, Frame};
 
 use super::Point3;
 
@@ -467,7 +466,7 @@ fn num(x: f64) -> String {
 
 #[cfg(test)]
 mod tests {
-    use trim::edges::{Edge, Loop};
+    use trim::{Edge, Loop};
 
     use super::*;
 

@@ -231,7 +231,7 @@ mod tests {
     /// exact decimal arithmetic found every one an exact tie.
     #[test]
     fn random_values_as_std_writes_them() {
-        let mut rng = trim::synthetic::SplitMix64::new(53);
+        let mut rng = testkit::synthetic::SplitMix64::new(53);
         let mut ties = 0;
         for i in 0..600_000 {
             let v = match i % 3 {

@@ -18,6 +18,7 @@ pub mod atomic;
 pub mod edges_out;
 pub(crate) mod float_text;
 pub mod gltf_io;
+mod hash;
 pub mod labels;
 pub mod mesh_out;
 pub mod obj;
@@ -121,12 +122,12 @@ pub fn read_mesh(path: &Path) -> Result<Mesh> {
 
 /// Reads a mesh that must have faces (for the commands that cut or clean
 /// one); a file without faces is an error naming the file and `hint`.
-pub fn read_mesh_with_faces(path: &Path, hint: &str) -> Result<trim::mesh::Mesh> {
+pub fn read_mesh_with_faces(path: &Path, hint: &str) -> Result<trim::Mesh> {
     let read = read_mesh(path)?;
     let Some(faces) = read.faces else {
         bail!("{}: the file has no faces: {hint}", path.display());
     };
-    Ok(trim::mesh::Mesh {
+    Ok(trim::Mesh {
         vertices: read.vertices,
         faces,
     })
@@ -608,7 +609,7 @@ pub(crate) mod piece_tests {
         one_pass: impl Fn(&str) -> Result<T, String>,
         in_pieces: impl Fn(&str, usize) -> Result<T, String>,
     ) -> usize {
-        let mut rng = trim::synthetic::SplitMix64::new(seed);
+        let mut rng = testkit::synthetic::SplitMix64::new(seed);
         let mut below = |n: u64| (rng.next_u64() % n) as usize;
         let ends = ["\n", "\r\n", "\r"];
         let mut errors = 0;
@@ -638,7 +639,7 @@ mod tests {
     /// non-ASCII ones (a no-break space, an ideographic space, an é).
     #[test]
     fn words_split_as_split_whitespace_does() {
-        let mut rng = trim::synthetic::SplitMix64::new(61);
+        let mut rng = testkit::synthetic::SplitMix64::new(61);
         let alphabet: Vec<char> = (0u8..=32)
             .map(char::from)
             .chain(['a', 'b', '1', '.', '-', '\u{a0}', '\u{3000}', 'é', '\u{7f}'])

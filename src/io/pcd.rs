@@ -705,7 +705,7 @@ mod tests {
     /// agree.
     #[test]
     fn random_clouds_read_alike_in_all_three_encodings() {
-        let mut rng = trim::synthetic::SplitMix64::new(43);
+        let mut rng = testkit::synthetic::SplitMix64::new(43);
         let mut below = |n: u64| (rng.next_u64() % n) as usize;
         for case in 0..60 {
             let n = if case % 10 == 0 {

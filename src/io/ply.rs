@@ -1614,7 +1614,7 @@ mod tests {
         grid: bool,
         mut make: impl FnMut(crate::io::piece_tests::Below, usize) -> Vec<u8>,
     ) -> usize {
-        let mut rng = trim::synthetic::SplitMix64::new(seed);
+        let mut rng = testkit::synthetic::SplitMix64::new(seed);
         let mut below = |n: u64| (rng.next_u64() % n) as usize;
         let read = |bytes: &[u8], pieces| {
             let mesh = read(bytes, grid, pieces).map(|m| format!("{m:?}"));

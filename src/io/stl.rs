@@ -12,8 +12,8 @@
 //! when its header starts with `solid`, as some exporters write), else a
 //! file starting with `solid` is ASCII, else it is binary and too short.
 
+use crate::io::hash::HashMap;
 use std::io::Write;
-use trim::hash::HashMap;
 
 use anyhow::{anyhow, bail, Result};
 use byteorder::{ByteOrder, LittleEndian, WriteBytesExt};

@@ -27,10 +27,10 @@
 //! ([`sampling_tensor_of_moments`]; [`sampling_tensor`] projects every
 //! vector and is the reference).
 
-use crate::cloud::{dot, Point3};
 use crate::frame::{Frame, Point2};
-use crate::neighbours::tie_key;
+use crate::geom::{dot, Point3};
 use crate::resolution::dist2;
+use crate::spatial::neighbours::tie_key;
 
 /// A 2×2 linear map, row-major: `[[a, b], [c, d]]`.
 pub type Map2 = [[f64; 2]; 2];
@@ -74,6 +74,7 @@ pub fn own_sampling_vectors(projected: &[Point2], frame: &Frame) -> SamplingVect
     [lift(e1), lift(e2)]
 }
 
+#[cfg(test)]
 /// T of P_i's neighbourhood (unnormalised sum): the members' sampling
 /// vectors projected on P_i's plane.
 pub fn sampling_tensor<'a>(
@@ -197,6 +198,7 @@ fn nearest_vector(pts: &[Point2], j: usize, away_from: Option<Point2>) -> Option
     best.map(|(_, e)| e)
 }
 
+#[cfg(test)]
 fn add_outer(t: &mut [f64; 3], e: Point2) {
     t[0] += e[0] * e[0];
     t[1] += e[0] * e[1];
@@ -271,7 +273,7 @@ mod tests {
     /// vectors, to rounding, on random frames and vectors.
     #[test]
     fn tensor_of_moments_is_the_tensor_of_projections() {
-        let mut rng = crate::synthetic::SplitMix64::new(9);
+        let mut rng = testkit::SplitMix64::new(9);
         for _ in 0..2000 {
             let mut r = || [0; 3].map(|_| rng.range(-2.0, 2.0));
             let unit = |a: Point3| {
@@ -279,10 +281,10 @@ mod tests {
                 a.map(|c| c / l)
             };
             let n = unit(r());
-            let u = unit(crate::cloud::cross(n, r()));
+            let u = unit(crate::geom::cross(n, r()));
             let frame = Frame {
                 u,
-                v: crate::cloud::cross(n, u),
+                v: crate::geom::cross(n, u),
                 normal: n,
             };
             let members: Vec<SamplingVectors> = (0..30).map(|_| [r(), r()]).collect();

@@ -69,39 +69,41 @@ use spade::{
     AngleLimit, Point2 as SpadePoint, PositionInTriangulation, RefinementParameters, Triangulation,
 };
 
-use crate::cloud::{cross, dist2, dot, norm2, sub, Point3};
-use crate::delaunay::{
-    inside_faces, median, obstacle, orient, untwist, Cdt, DelaunayReport, Node, Ring, SegmentGrid,
-    STEINER,
-};
 use crate::edges::cluster::MIN_LOOP_POINTS;
 use crate::edges::loop_from_tour;
 use crate::error::MeshError;
 use crate::frame::fit_plane;
+use crate::geom::{cross, dist2, dot, norm2, sub, Point3};
+use crate::geom::{median, orient};
 use crate::mesh::{lowest_first, Mesh};
-use crate::neighbours::NeighbourIndex;
+use crate::planar::{
+    inside_faces, obstacle, untwist, Cdt, Node, Ring, SegmentGrid, Tangle, STEINER,
+};
+use crate::spatial::neighbours::NeighbourIndex;
 
+/// The segment grid's cells are no smaller than this many β.
+const GRID_CELL: f64 = 0.1;
 /// Vertices closer than this many β to a smoothed loop are replaced.
-pub const MARGIN: f64 = 0.5;
+const MARGIN: f64 = 0.5;
 /// Largest share of a smoothed loop's vertices that untwisting it may drop
 /// (where the low-pass filter pulls the two sides of a deep, narrow notch
 /// across each other, the notch is cut off).
-pub const MAX_UNTWIST: f64 = 0.15;
+const MAX_UNTWIST: f64 = 0.15;
 /// Consecutive smoothed loop vertices closer than this many β are merged:
 /// where a zig-zag border is smoothed, its vertices bunch up, and a short
 /// border segment against interior vertices a spacing away makes a
 /// sliver.
-pub const MIN_GAP: f64 = 0.4;
+const MIN_GAP: f64 = 0.4;
 /// Refinement of the gap: new faces' smallest angle aimed at (degrees) …
-pub const REFINE_ANGLE: f64 = 20.0;
+const REFINE_ANGLE: f64 = 20.0;
 /// … leaving faces below this many β² alone.
-pub const REFINE_MIN_AREA: f64 = 0.05;
+const REFINE_MIN_AREA: f64 = 0.05;
 /// Times the faces round crossing walls are removed before a band gives up.
-pub const WALL_REPAIRS: usize = 8;
+const WALL_REPAIRS: usize = 8;
 /// Rings of faces around a border the band starts with …
-pub const FIRST_DEPTH: u32 = 3;
+const FIRST_DEPTH: u32 = 3;
 /// … and the most it grows to.
-pub const MAX_DEPTH: u32 = 30;
+const MAX_DEPTH: u32 = 30;
 
 /// Options of the cleanup.
 #[derive(Debug, Clone, PartialEq)]
@@ -496,13 +498,8 @@ impl Band {
         let mesh = cx.mesh;
         let projection = Projection::of(cx, &self.faces);
         let mut rings = projected_rings(cx, group, &projection);
-        let grid = untwist(
-            &mut rings,
-            cx.beta_median,
-            MAX_UNTWIST,
-            &mut DelaunayReport::default(),
-        )
-        .map_err(|e| untwist_failure(e, &rings))?;
+        let (grid, _) = untwist(&mut rings, GRID_CELL * cx.beta_median, MAX_UNTWIST)
+            .map_err(|tangle| untwist_failure(tangle, &rings))?;
         let stay = self.staying_vertices(cx, group, &projection, &grid, &rings);
         let removed = self.cut_faces(mesh, &projection, &grid, &stay);
         let turned = self.turned_faces(mesh, &projection);
@@ -816,7 +813,7 @@ impl GapTriangulation {
         if let Some(&h) = self.handle_of.get(&id) {
             return Ok(h);
         }
-        if let PositionInTriangulation::OnVertex(_) = self.cdt.locate(crate::delaunay::point(p)) {
+        if let PositionInTriangulation::OnVertex(_) = self.cdt.locate(crate::planar::point(p)) {
             return Err(coincide(ring));
         }
         let h = self
@@ -1304,9 +1301,9 @@ impl Topology {
 
 /// The loop to leave when the smoothed loops cross: the one that crosses
 /// itself, or the smaller of two that cross each other.
-fn untwist_failure(error: MeshError, rings: &[Ring]) -> Retry {
-    match error {
-        MeshError::LoopNotSimple {
+fn untwist_failure(tangle: Tangle, rings: &[Ring]) -> Retry {
+    match tangle {
+        Tangle::SelfCrossing {
             index,
             vertices,
             dropped,
@@ -1316,14 +1313,13 @@ fn untwist_failure(error: MeshError, rings: &[Ring]) -> Retry {
             ),
             vec![index],
         ),
-        MeshError::LoopsCross { a, b } => {
+        Tangle::Crossing { a, b } => {
             let smaller = if rings[a].len() <= rings[b].len() { a } else { b };
             leave(
                 "its smoothed loop crosses the smoothed loop of another border",
                 vec![smaller],
             )
         }
-        other => leave(other.to_string(), Vec::new()),
     }
 }
 
@@ -1461,8 +1457,8 @@ mod tests {
         }
     }
     use crate::bpd::{detect_boundary, BpdOptions};
-    use crate::synthetic::SplitMix64;
     use spade::{DelaunayTriangulation, Point2 as SpadePoint};
+    use testkit::SplitMix64;
 
     /// A jittered grid of pitch 1 over a disc of radius `r` with a hole of
     /// radius `hole` at the centre, triangulated by Delaunay, keeping the

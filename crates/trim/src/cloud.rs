@@ -11,9 +11,9 @@
 use rayon::prelude::*;
 
 use crate::error::CloudError;
+use crate::geom::{cross, dist2, norm2, sub};
 
-/// A point in 3D, in the cloud's own units.
-pub type Point3 = [f64; 3];
+pub use crate::geom::Point3;
 
 /// The distinct points of a cloud and the map from input points to them.
 #[derive(Debug, Clone)]
@@ -25,6 +25,7 @@ pub struct Sites {
 }
 
 impl Sites {
+    #[cfg(test)]
     /// Number of input points that were copies of an earlier point.
     pub fn duplicates(&self) -> usize {
         self.site_of.len() - self.points.len()
@@ -208,30 +209,6 @@ pub fn check_not_degenerate(points: &[Point3]) -> Result<(), CloudError> {
         });
     }
     Ok(())
-}
-
-pub(crate) fn sub(a: Point3, b: Point3) -> Point3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-pub(crate) fn dot(a: Point3, b: Point3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-pub(crate) fn cross(a: Point3, b: Point3) -> Point3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-pub(crate) fn norm2(a: Point3) -> f64 {
-    dot(a, a)
-}
-
-pub(crate) fn dist2(a: Point3, b: Point3) -> f64 {
-    norm2(sub(a, b))
 }
 
 #[cfg(test)]

@@ -15,7 +15,7 @@
 //! 3. **Loops made valid.** Each smoothed loop becomes one closed polyline
 //!    (each open edge without its last point, the next edge's corner), with
 //!    its smoothed 3D positions. In the projection, consecutive vertices
-//!    closer than [`MERGE`]·β are merged, and the loops must be simple and
+//!    closer than 10⁻⁶β are merged, and the loops must be simple and
 //!    must not touch one another: a loop that crosses itself is repaired
 //!    by dropping the vertices of the shorter side of the crossing (a
 //!    twist, or a spike that turns straight back), as long as that takes at
@@ -41,7 +41,7 @@
 //!    (inside the outer border and outside the holes) are kept. Co-circular
 //!    quads (the lattice rectangles of quantised clouds), where either
 //!    diagonal is Delaunay, take the one through their lowest id
-//!    ([`diagonals`]), and the faces are listed in the order of their ids,
+//!    ([`canonical_diagonals`]), and the faces are listed in the order of their ids,
 //!    so that moving the cloud, which rounds its coordinates, changes
 //!    nothing. They are
 //!    lifted back to 3D: cloud points keep their exact coordinates, loop
@@ -66,46 +66,44 @@
 use crate::hash::{HashMap, HashSet};
 
 use rayon::prelude::*;
-use spade::handles::{FixedFaceHandle, FixedVertexHandle, InnerTag};
-use spade::{
-    ConstrainedDelaunayTriangulation, HasPosition, Intersection, LineIntersectionIterator, Point2,
-    PositionInTriangulation, Triangulation,
-};
+use spade::handles::FixedVertexHandle;
+use spade::{PositionInTriangulation, Triangulation};
 
 use crate::bpd::Detection;
-use crate::cloud::{cross, dot, norm2, sub, Point3};
 use crate::edges::Edges;
 use crate::error::MeshError;
 use crate::frame::{fit_plane, Frame};
+use crate::geom::{cross, dot, norm2, sub, Point3};
 use crate::mesh::{lowest_first, Mesh};
-use crate::morton::{octree_runs, spatial_order, split_by_runs, MortonCells, MortonGrid};
-use crate::neighbours::{NeighbourIndex, RunScratch};
+use crate::spatial::morton::{octree_runs, spatial_order, split_by_runs, MortonCells, MortonGrid};
+use crate::spatial::neighbours::{NeighbourIndex, RunScratch};
 
-pub mod diagonals;
-use diagonals::canonical_diagonals;
+use crate::geom::median;
+use crate::planar::{
+    canonical_diagonals, cocircular, inside_faces, obstacle, point, untwist, Cdt, Node, Ring,
+    SegmentGrid, Tangle,
+};
 
 /// Neighbourhood size of the local normals of the height-field check.
-pub const NORMAL_K: usize = 30;
+const NORMAL_K: usize = 30;
 /// Most points per k-NN run of the local normals (as BPD's runs).
 const NORMAL_RUN: usize = 32;
 /// A local normal with |nᵢ·n| below this stands on edge over the plane.
-pub const STEEP_COS: f64 = 0.1;
+const STEEP_COS: f64 = 0.1;
 /// Largest accepted share of such points.
-pub const STEEP_SHARE: f64 = 0.01;
+const STEEP_SHARE: f64 = 0.01;
 /// A triangle whose normal makes a mean |n_t·nᵥ| below this with its
 /// vertices' local normals does not follow the surface.
-pub const MISFIT_COS: f64 = 0.5;
+const MISFIT_COS: f64 = 0.5;
 /// Largest accepted share of such triangles.
-pub const MISFIT_SHARE: f64 = 0.01;
+const MISFIT_SHARE: f64 = 0.01;
 /// Cloud points closer to a loop than this many local resolutions β are
 /// left out.
-pub const EXCLUDE: f64 = 0.1;
-/// Consecutive loop vertices closer than this many β (in 2D) are merged.
-pub const MERGE: f64 = 1e-6;
+const EXCLUDE: f64 = 0.1;
 /// Largest share of a loop's vertices that untwisting it may drop.
-pub const MAX_REPAIR: f64 = 0.05;
+const MAX_REPAIR: f64 = 0.05;
 /// Faces smaller than this many β² are counted as degenerate.
-pub const DEGENERATE: f64 = 1e-12;
+const DEGENERATE: f64 = 1e-12;
 
 /// What the Delaunay path did.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -131,7 +129,7 @@ pub struct DelaunayReport {
     /// Faces below [`DEGENERATE`]·β² (kept, counted).
     pub degenerate_faces: usize,
     /// Diagonals of co-circular quads flipped to their canonical side
-    /// ([`diagonals`]).
+    /// ([`canonical_diagonals`]).
     pub diagonals_flipped: usize,
     /// For each smoothed loop, its vertices in the output, in loop order.
     pub loops: Vec<Vec<u32>>,
@@ -318,7 +316,20 @@ fn valid_rings(
         ring.p2 = ring.p3.iter().map(|&p| plane.to2(p)).collect();
         report.loop_vertices_merged += ring.merge_coincident();
     }
-    let grid = untwist(&mut rings, beta_median, MAX_REPAIR, report)?;
+    let (grid, dropped) =
+        untwist(&mut rings, EXCLUDE * beta_median, MAX_REPAIR).map_err(|tangle| match tangle {
+            Tangle::SelfCrossing {
+                index,
+                vertices,
+                dropped,
+            } => MeshError::LoopNotSimple {
+                index,
+                vertices,
+                dropped,
+            },
+            Tangle::Crossing { a, b } => MeshError::LoopsCross { a, b },
+        })?;
+    report.loop_vertices_dropped += dropped;
     Ok((rings, grid))
 }
 
@@ -484,7 +495,7 @@ impl LoopCdt {
 
     /// Step 6, **kept faces, lifted**: the odd faces ([`inside_faces`]),
     /// counter-clockwise seen from the plane normal's side, co-circular
-    /// quads given their canonical diagonal ([`diagonals`]) and listed in
+    /// quads given their canonical diagonal ([`canonical_diagonals`]) and listed in
     /// the order of their ids, so that moving the cloud, which rounds its
     /// coordinates, changes nothing. Lifted back to 3D: cloud points keep
     /// their exact coordinates, loop vertices take their smoothed 3D
@@ -594,7 +605,7 @@ impl LoopCdt {
                 return false;
             };
             let [a, b] = [forward.from().fix(), forward.to().fix()];
-            diagonals::cocircular(at(a), at(b), at(c.fix()), at(d.fix()))
+            cocircular(at(a), at(b), at(c.fix()), at(d.fix()))
         })
     }
 
@@ -723,65 +734,6 @@ fn is_misfit(nt: Point3, len: f64, vertex_normals: [Point3; 3]) -> bool {
     fit < MISFIT_COS
 }
 
-pub(crate) type Cdt = ConstrainedDelaunayTriangulation<Node>;
-
-/// A triangulation vertex: a cloud point (id < n) or a loop vertex
-/// (id − n into the loop vertices).
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Node {
-    pub(crate) position: Point2<f64>,
-    pub(crate) id: u32,
-}
-
-impl Node {
-    pub(crate) fn new(p: [f64; 2], id: u32) -> Self {
-        Node {
-            position: point(p),
-            id,
-        }
-    }
-}
-
-/// Id of a vertex inserted by refinement until it gets its own.
-pub(crate) const STEINER: u32 = u32::MAX;
-
-impl From<Point2<f64>> for Node {
-    fn from(position: Point2<f64>) -> Self {
-        Node {
-            position,
-            id: STEINER,
-        }
-    }
-}
-
-impl HasPosition for Node {
-    type Scalar = f64;
-    fn position(&self) -> Point2<f64> {
-        self.position
-    }
-}
-
-/// A spade point; coordinates too small for spade's predicates are zero.
-pub(crate) fn point(p: [f64; 2]) -> Point2<f64> {
-    let flush = |c: f64| {
-        if c.abs() < spade::MIN_ALLOWED_VALUE {
-            0.0
-        } else {
-            c
-        }
-    };
-    Point2::new(flush(p[0]), flush(p[1]))
-}
-
-pub(crate) fn median(values: &[f64]) -> f64 {
-    let mut v: Vec<f64> = values.iter().copied().filter(|b| b.is_finite()).collect();
-    if v.is_empty() {
-        return 1.0;
-    }
-    let mid = v.len() / 2;
-    *v.select_nth_unstable_by(mid, f64::total_cmp).1
-}
-
 /// The error for loop `l` meeting the vertex `other` (a vertex id).
 fn crossing(l: usize, vertices: usize, other: u32, n: usize, loop_of: &[u32]) -> MeshError {
     let b = (other as usize)
@@ -799,438 +751,6 @@ fn crossing(l: usize, vertices: usize, other: u32, n: usize, loop_of: &[u32]) ->
             a: b.min(l),
             b: b.max(l),
         }
-    }
-}
-
-/// What stands in the way of a constraint from `a` to `b`: a constraint
-/// edge it crosses or overlaps, or a vertex it passes through (its id).
-pub(crate) fn obstacle(cdt: &Cdt, a: FixedVertexHandle, b: FixedVertexHandle) -> Option<u32> {
-    if a == b {
-        return Some(cdt.vertex(a).data().id);
-    }
-    for intersection in LineIntersectionIterator::new_from_handles(cdt, a, b) {
-        match intersection {
-            Intersection::EdgeIntersection(e) if e.is_constraint_edge() => {
-                return Some(e.from().data().id)
-            }
-            Intersection::EdgeOverlap(e) if e.is_constraint_edge() => {
-                return Some(e.from().data().id)
-            }
-            Intersection::VertexIntersection(v) if v.fix() != a && v.fix() != b => {
-                return Some(v.data().id)
-            }
-            _ => {}
-        }
-    }
-    None
-}
-
-/// The inner faces with odd parity: a flood fill from the outside that
-/// flips parity across each constraint edge.
-pub(crate) fn inside_faces(cdt: &Cdt) -> Vec<FixedFaceHandle<InnerTag>> {
-    let mut parity: Vec<Option<bool>> = vec![None; cdt.num_all_faces()];
-    let mut stack = Vec::new();
-    for e in cdt.convex_hull() {
-        for side in [e, e.rev()] {
-            if let Some(inner) = side.face().as_inner() {
-                if parity[inner.fix().index()].is_none() {
-                    let odd = side.is_constraint_edge();
-                    parity[inner.fix().index()] = Some(odd);
-                    stack.push((inner.fix(), odd));
-                }
-            }
-        }
-    }
-    while let Some((f, odd)) = stack.pop() {
-        for e in cdt.face(f).adjacent_edges() {
-            if let Some(next) = e.rev().face().as_inner() {
-                if parity[next.fix().index()].is_none() {
-                    let p = odd ^ e.is_constraint_edge();
-                    parity[next.fix().index()] = Some(p);
-                    stack.push((next.fix(), p));
-                }
-            }
-        }
-    }
-    cdt.fixed_inner_faces()
-        .filter(|f| parity[f.index()] == Some(true))
-        .collect()
-}
-
-/// One smoothed loop as a closed polyline.
-#[derive(Debug, Clone)]
-pub(crate) struct Ring {
-    pub(crate) p3: Vec<Point3>,
-    pub(crate) p2: Vec<[f64; 2]>,
-    /// The boundary point each vertex was smoothed from.
-    pub(crate) reference: Vec<u32>,
-    pub(crate) beta: Vec<f64>,
-}
-
-impl Ring {
-    pub(crate) fn from_loop(lp: &crate::edges::Loop, beta: &[f64]) -> Self {
-        let n = lp.boundary_points.len().max(1);
-        let mut ring = Ring {
-            p3: Vec::new(),
-            p2: Vec::new(),
-            reference: Vec::new(),
-            beta: Vec::new(),
-        };
-        for (k, edge) in lp.edges.iter().enumerate() {
-            let from = lp.corners.get(k).copied().unwrap_or(0);
-            let take = if edge.closed {
-                edge.points.len()
-            } else {
-                edge.points.len().saturating_sub(1)
-            };
-            for (j, &p) in edge.points.iter().take(take).enumerate() {
-                let r = lp.boundary_points.get((from + j) % n).copied().unwrap_or(0);
-                ring.p3.push(p);
-                ring.reference.push(r);
-                ring.beta.push(beta.get(r as usize).copied().unwrap_or(0.0));
-            }
-        }
-        ring
-    }
-
-    pub(crate) fn len(&self) -> usize {
-        self.p2.len()
-    }
-
-    fn retain(&mut self, keep: &[bool]) {
-        let mut k = keep.iter();
-        self.p3.retain(|_| *k.next().unwrap_or(&true));
-        let mut k = keep.iter();
-        self.p2.retain(|_| *k.next().unwrap_or(&true));
-        let mut k = keep.iter();
-        self.reference.retain(|_| *k.next().unwrap_or(&true));
-        let mut k = keep.iter();
-        self.beta.retain(|_| *k.next().unwrap_or(&true));
-    }
-
-    /// Merges each vertex into its predecessor when they coincide in 2D
-    /// (within [`MERGE`]·β); returns how many went.
-    pub(crate) fn merge_coincident(&mut self) -> usize {
-        let m = self.len();
-        let mut keep = vec![true; m];
-        let mut last = 0;
-        for (j, k) in keep.iter_mut().enumerate().skip(1) {
-            if dist2d(self.p2[j], self.p2[last]) <= MERGE * self.beta[j] {
-                *k = false;
-            } else {
-                last = j;
-            }
-        }
-        // The closing segment.
-        while last > 0 && dist2d(self.p2[last], self.p2[0]) <= MERGE * self.beta[last] {
-            keep[last] = false;
-            last = (0..last).rev().find(|&j| keep[j]).unwrap_or(0);
-        }
-        let dropped = keep.iter().filter(|&&k| !k).count();
-        self.retain(&keep);
-        dropped
-    }
-
-    /// Signed area in 2D (positive counter-clockwise).
-    pub(crate) fn area(&self) -> f64 {
-        let m = self.len();
-        let o = self.p2.first().copied().unwrap_or([0.0; 2]);
-        (0..m)
-            .map(|j| {
-                let (a, b) = (self.p2[j], self.p2[(j + 1) % m]);
-                (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
-            })
-            .sum::<f64>()
-            * 0.5
-    }
-}
-
-fn dist2d(a: [f64; 2], b: [f64; 2]) -> f64 {
-    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt()
-}
-
-pub(crate) fn orient(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
-    (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
-}
-
-/// True if closed segments ab and cd share a point.
-pub(crate) fn segments_meet(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> bool {
-    let (d1, d2) = (orient(c, d, a), orient(c, d, b));
-    let (d3, d4) = (orient(a, b, c), orient(a, b, d));
-    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
-        && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
-    {
-        return true;
-    }
-    let within = |p: [f64; 2], q: [f64; 2], r: [f64; 2]| {
-        r[0] >= p[0].min(q[0])
-            && r[0] <= p[0].max(q[0])
-            && r[1] >= p[1].min(q[1])
-            && r[1] <= p[1].max(q[1])
-    };
-    (d1 == 0.0 && within(c, d, a))
-        || (d2 == 0.0 && within(c, d, b))
-        || (d3 == 0.0 && within(a, b, c))
-        || (d4 == 0.0 && within(a, b, d))
-}
-
-/// Repairs self-crossing loops (see the module doc) and checks that the
-/// loops do not meet; returns the segment grid of the valid loops.
-pub(crate) fn untwist(
-    rings: &mut [Ring],
-    beta_median: f64,
-    max_repair: f64,
-    report: &mut DelaunayReport,
-) -> Result<SegmentGrid, MeshError> {
-    let original: Vec<usize> = rings.iter().map(Ring::len).collect();
-    let mut dropped = vec![0usize; rings.len()];
-    loop {
-        for (l, ring) in rings.iter().enumerate() {
-            if ring.len() < 3 {
-                return Err(MeshError::LoopNotSimple {
-                    index: l,
-                    vertices: original[l],
-                    dropped: original[l] - ring.len(),
-                });
-            }
-        }
-        let grid = SegmentGrid::new(rings, EXCLUDE * beta_median);
-        let Some((s, t)) = grid.first_crossing() else {
-            report.loop_vertices_dropped += dropped.iter().sum::<usize>();
-            return Ok(grid);
-        };
-        let ((l, i), (k, j)) = (grid.owner[s as usize], grid.owner[t as usize]);
-        if l != k {
-            return Err(MeshError::LoopsCross {
-                a: l.min(k) as usize,
-                b: l.max(k) as usize,
-            });
-        }
-        let l = l as usize;
-        let m = rings[l].len();
-        let (i, j) = (i.min(j) as usize, i.max(j) as usize);
-        // Drop vertices i+1..=j, or j+1..=i round the end: the fewer.
-        let mut keep = vec![true; m];
-        if j - i <= m - (j - i) {
-            keep[i + 1..=j].iter_mut().for_each(|k| *k = false);
-        } else {
-            keep[j + 1..].iter_mut().for_each(|k| *k = false);
-            keep[..=i].iter_mut().for_each(|k| *k = false);
-        }
-        let gone = keep.iter().filter(|&&k| !k).count();
-        dropped[l] += gone;
-        let limit = ((max_repair * original[l] as f64) as usize).max(4);
-        if dropped[l] > limit {
-            return Err(MeshError::LoopNotSimple {
-                index: l,
-                vertices: original[l],
-                dropped: dropped[l],
-            });
-        }
-        rings[l].retain(&keep);
-    }
-}
-
-/// The loops' segments in a uniform grid, for parity, proximity and
-/// crossing queries in 2D.
-pub(crate) struct SegmentGrid {
-    a: Vec<[f64; 2]>,
-    b: Vec<[f64; 2]>,
-    /// (loop, index of the segment's first vertex in it).
-    owner: Vec<(u32, u32)>,
-    sizes: Vec<u32>,
-    x0: f64,
-    y0: f64,
-    cell: f64,
-    nx: usize,
-    ny: usize,
-    cells: Vec<Vec<u32>>,
-}
-
-impl SegmentGrid {
-    fn new(rings: &[Ring], min_cell: f64) -> Self {
-        let mut g = SegmentGrid {
-            a: Vec::new(),
-            b: Vec::new(),
-            owner: Vec::new(),
-            sizes: rings.iter().map(|r| r.len() as u32).collect(),
-            x0: 0.0,
-            y0: 0.0,
-            cell: 1.0,
-            nx: 1,
-            ny: 1,
-            cells: Vec::new(),
-        };
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        let mut length = 0.0;
-        for (l, ring) in rings.iter().enumerate() {
-            let m = ring.len();
-            for i in 0..m {
-                let (a, b) = (ring.p2[i], ring.p2[(i + 1) % m]);
-                for c in 0..2 {
-                    lo[c] = lo[c].min(a[c]);
-                    hi[c] = hi[c].max(a[c]);
-                }
-                length += dist2d(a, b);
-                g.a.push(a);
-                g.b.push(b);
-                g.owner.push((l as u32, i as u32));
-            }
-        }
-        let segments = g.a.len();
-        if segments == 0 {
-            g.cells = vec![Vec::new()];
-            return g;
-        }
-        let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]).max(f64::MIN_POSITIVE);
-        let mut cell = (2.0 * length / segments as f64)
-            .max(min_cell)
-            .max(extent * 1e-9);
-        let dims = |cell: f64| {
-            (
-                ((hi[0] - lo[0]) / cell).floor() as usize + 1,
-                ((hi[1] - lo[1]) / cell).floor() as usize + 1,
-            )
-        };
-        while {
-            let (nx, ny) = dims(cell);
-            nx.saturating_mul(ny) > 4 * segments + 16
-        } {
-            cell *= 1.5;
-        }
-        (g.nx, g.ny) = dims(cell);
-        g.x0 = lo[0];
-        g.y0 = lo[1];
-        g.cell = cell;
-        g.cells = vec![Vec::new(); g.nx * g.ny];
-        for s in 0..segments {
-            let (a, b) = (g.a[s], g.b[s]);
-            let (c0, c1) = (g.col(a[0].min(b[0])), g.col(a[0].max(b[0])));
-            let (r0, r1) = (g.row(a[1].min(b[1])), g.row(a[1].max(b[1])));
-            for r in r0..=r1 {
-                for c in c0..=c1 {
-                    g.cells[r * g.nx + c].push(s as u32);
-                }
-            }
-        }
-        g
-    }
-
-    fn col(&self, x: f64) -> usize {
-        (((x - self.x0) / self.cell).floor().max(0.0) as usize).min(self.nx - 1)
-    }
-
-    fn row(&self, y: f64) -> usize {
-        (((y - self.y0) / self.cell).floor().max(0.0) as usize).min(self.ny - 1)
-    }
-
-    /// True if `p` is inside an odd number of loops (ray to +x).
-    pub(crate) fn parity(&self, p: [f64; 2]) -> bool {
-        if self.a.is_empty()
-            || p[1] < self.y0
-            || p[1] > self.y0 + self.cell * self.ny as f64
-            || p[0] > self.x0 + self.cell * self.nx as f64
-        {
-            return false;
-        }
-        let r = self.row(p[1]);
-        let mut odd = false;
-        for c in self.col(p[0])..self.nx {
-            for &s in &self.cells[r * self.nx + c] {
-                let (a, b) = (self.a[s as usize], self.b[s as usize]);
-                if (a[1] > p[1]) != (b[1] > p[1]) {
-                    let t = (p[1] - a[1]) / (b[1] - a[1]);
-                    let x = (a[0] + t * (b[0] - a[0])).clamp(a[0].min(b[0]), a[0].max(b[0]));
-                    if x > p[0] && self.col(x) == c {
-                        odd = !odd;
-                    }
-                }
-            }
-        }
-        odd
-    }
-
-    /// True if a segment passes within `radius` of `p`.
-    pub(crate) fn near(&self, p: [f64; 2], radius: f64) -> bool {
-        if self.a.is_empty() {
-            return false;
-        }
-        let (c0, c1) = (self.col(p[0] - radius), self.col(p[0] + radius));
-        let (r0, r1) = (self.row(p[1] - radius), self.row(p[1] + radius));
-        for r in r0..=r1 {
-            for c in c0..=c1 {
-                for &s in &self.cells[r * self.nx + c] {
-                    let (a, b) = (self.a[s as usize], self.b[s as usize]);
-                    let ab = [b[0] - a[0], b[1] - a[1]];
-                    let len2 = ab[0] * ab[0] + ab[1] * ab[1];
-                    let t = if len2 > 0.0 {
-                        (((p[0] - a[0]) * ab[0] + (p[1] - a[1]) * ab[1]) / len2).clamp(0.0, 1.0)
-                    } else {
-                        0.0
-                    };
-                    let q = [a[0] + t * ab[0], a[1] + t * ab[1]];
-                    if dist2d(p, q) < radius {
-                        return true;
-                    }
-                }
-            }
-        }
-        false
-    }
-
-    /// True if a loop segment meets the segment from `p` to `q`.
-    pub(crate) fn crosses(&self, p: [f64; 2], q: [f64; 2]) -> bool {
-        if self.a.is_empty() {
-            return false;
-        }
-        let (c0, c1) = (self.col(p[0].min(q[0])), self.col(p[0].max(q[0])));
-        let (r0, r1) = (self.row(p[1].min(q[1])), self.row(p[1].max(q[1])));
-        (r0..=r1).any(|r| {
-            (c0..=c1).any(|c| {
-                self.cells[r * self.nx + c]
-                    .iter()
-                    .any(|&s| segments_meet(self.a[s as usize], self.b[s as usize], p, q))
-            })
-        })
-    }
-
-    /// Some pair of segments that meet other than at their shared vertex
-    /// (or that share one and turn straight back).
-    fn first_crossing(&self) -> Option<(u32, u32)> {
-        for cell in &self.cells {
-            for (x, &s) in cell.iter().enumerate() {
-                for &t in &cell[x + 1..] {
-                    let (ls, is) = self.owner[s as usize];
-                    let (lt, it) = self.owner[t as usize];
-                    let (sa, sb) = (self.a[s as usize], self.b[s as usize]);
-                    let (ta, tb) = (self.a[t as usize], self.b[t as usize]);
-                    if ls == lt {
-                        let m = self.sizes[ls as usize];
-                        let (first, second) = if (is + 1) % m == it {
-                            ((sa, sb), (ta, tb))
-                        } else if (it + 1) % m == is {
-                            ((ta, tb), (sa, sb))
-                        } else {
-                            if segments_meet(sa, sb, ta, tb) {
-                                return Some((s, t));
-                            }
-                            continue;
-                        };
-                        // Adjacent: a spike turns straight back.
-                        let (p, q, r) = (first.0, first.1, second.1);
-                        let back = (q[0] - p[0]) * (r[0] - q[0]) + (q[1] - p[1]) * (r[1] - q[1]);
-                        if m > 3 && orient(p, q, r) == 0.0 && back < 0.0 {
-                            return Some((s, t));
-                        }
-                        continue;
-                    }
-                    if segments_meet(sa, sb, ta, tb) {
-                        return Some((s, t));
-                    }
-                }
-            }
-        }
-        None
     }
 }
 
@@ -1283,85 +803,5 @@ mod tests {
                 "case {case}"
             );
         }
-    }
-
-    fn ring(p2: Vec<[f64; 2]>) -> Ring {
-        Ring {
-            p3: p2.iter().map(|p| [p[0], p[1], 0.0]).collect(),
-            reference: vec![0; p2.len()],
-            beta: vec![1.0; p2.len()],
-            p2,
-        }
-    }
-
-    /// A square of side `s` at `o`, 4·k vertices counter-clockwise.
-    fn square(o: [f64; 2], s: f64, k: usize) -> Vec<[f64; 2]> {
-        let t = |i: usize| s * i as f64 / k as f64;
-        let mut p = Vec::new();
-        p.extend((0..k).map(|i| [o[0] + t(i), o[1]]));
-        p.extend((0..k).map(|i| [o[0] + s, o[1] + t(i)]));
-        p.extend((0..k).map(|i| [o[0] + s - t(i), o[1] + s]));
-        p.extend((0..k).map(|i| [o[0], o[1] + s - t(i)]));
-        p
-    }
-
-    #[test]
-    fn a_small_twist_is_untwisted() {
-        let mut p = square([0.0, 0.0], 10.0, 20);
-        // A bow tie: segments 4→5 and 6→7 cross.
-        p[5] = [3.0, 0.5];
-        p[6] = [2.0, 0.5];
-        let mut rings = vec![ring(p)];
-        let mut report = DelaunayReport::default();
-        let grid = untwist(&mut rings, 1.0, MAX_REPAIR, &mut report).unwrap();
-        assert!(grid.first_crossing().is_none());
-        assert_eq!(report.loop_vertices_dropped, 2);
-        assert!(grid.parity([5.0, 5.0]) && !grid.parity([11.0, 5.0]));
-    }
-
-    #[test]
-    fn a_figure_eight_is_not_repaired() {
-        let mut p = square([0.0, 0.0], 10.0, 20);
-        // Swap the top side's x: the loop crosses itself in the middle.
-        for q in p.iter_mut().skip(40).take(20) {
-            q[0] = 10.0 - q[0];
-        }
-        let mut rings = vec![ring(p)];
-        let mut report = DelaunayReport::default();
-        assert!(matches!(
-            untwist(&mut rings, 1.0, MAX_REPAIR, &mut report),
-            Err(MeshError::LoopNotSimple { index: 0, .. })
-        ));
-    }
-
-    #[test]
-    fn crossing_loops_are_reported() {
-        let mut rings = vec![
-            ring(square([0.0, 0.0], 10.0, 10)),
-            ring(square([8.0, 8.0], 5.0, 5)),
-        ];
-        let mut report = DelaunayReport::default();
-        assert!(matches!(
-            untwist(&mut rings, 1.0, MAX_REPAIR, &mut report),
-            Err(MeshError::LoopsCross { a: 0, b: 1 })
-        ));
-        assert!(MeshError::LoopsCross { a: 0, b: 1 }
-            .to_string()
-            .contains("loops 0 and 1"));
-    }
-
-    #[test]
-    fn parity_sees_holes_and_patches() {
-        let rings = vec![
-            ring(square([0.0, 0.0], 10.0, 10)),
-            ring(square([3.0, 3.0], 4.0, 4)),
-            ring(square([20.0, 0.0], 5.0, 5)),
-        ];
-        let grid = SegmentGrid::new(&rings, 0.1);
-        assert!(grid.parity([1.0, 1.0]));
-        assert!(!grid.parity([5.0, 5.0]));
-        assert!(!grid.parity([15.0, 1.0]));
-        assert!(grid.parity([22.0, 2.0]));
-        assert!(grid.near([10.05, 5.0], 0.1) && !grid.near([10.2, 5.0], 0.1));
     }
 }

@@ -10,7 +10,7 @@
 
 use nalgebra::Matrix3;
 
-use crate::cloud::{dot, sub, Point3};
+use crate::geom::{dot, sub, Point3};
 
 /// A point in a neighbourhood's plane, relative to the investigated point.
 pub type Point2 = [f64; 2];
@@ -38,7 +38,7 @@ pub fn fit_plane(points: &[Point3], members: &[u32]) -> Frame {
     let (_, [normal, _, u]) = symmetric_eigen3(&covariance(points, members));
     let u = canonical_sign(u);
     let normal = canonical_sign(normal);
-    let v = crate::cloud::cross(normal, u);
+    let v = crate::geom::cross(normal, u);
     Frame { u, v, normal }
 }
 
@@ -239,7 +239,7 @@ fn spectrum(a: &Matrix3<f64>) -> Spectrum {
 /// a × b for orthonormal a and b, renormalised so that rounding does not
 /// leave it a few ulps off unit length (an axis comes out exact).
 fn unit_cross(a: Point3, b: Point3) -> Point3 {
-    let c = crate::cloud::cross(a, b);
+    let c = crate::geom::cross(a, b);
     let length = dot(c, c).sqrt();
     c.map(|x| x / length)
 }
@@ -264,9 +264,9 @@ fn eigenvector_of_simple(rows: [Point3; 3], value: f64) -> Point3 {
         row[i] -= value;
     }
     let candidates = [
-        crate::cloud::cross(r[0], r[1]),
-        crate::cloud::cross(r[0], r[2]),
-        crate::cloud::cross(r[1], r[2]),
+        crate::geom::cross(r[0], r[1]),
+        crate::geom::cross(r[0], r[2]),
+        crate::geom::cross(r[1], r[2]),
     ];
     let (best, length2) = candidates
         .iter()
@@ -327,7 +327,7 @@ fn orthogonal_complement(w: Point3) -> (Point3, Point3) {
         let length = (w[1] * w[1] + w[2] * w[2]).sqrt();
         [0.0, w[2] / length, -w[1] / length]
     };
-    (u, crate::cloud::cross(w, u))
+    (u, crate::geom::cross(w, u))
 }
 
 /// Flips a unit vector so its largest component is positive, so the frame
@@ -665,7 +665,7 @@ mod tests {
             ] {
                 assert!((dot(a, b) - want).abs() < 1e-12, "case {case}");
             }
-            let n_cross_u = crate::cloud::cross(n, frame.u);
+            let n_cross_u = crate::geom::cross(n, frame.u);
             assert!(
                 (0..3).all(|i| (n_cross_u[i] - frame.v[i]).abs() < 1e-12),
                 "case {case}"
@@ -688,7 +688,7 @@ mod tests {
     fn plane_of_a_tilted_grid_has_its_normal() {
         let n = [1.0, 2.0, 2.0].map(|c: f64| c / 3.0);
         let a = [2.0 / 3.0, 1.0 / 3.0, -2.0 / 3.0];
-        let b = crate::cloud::cross(n, a);
+        let b = crate::geom::cross(n, a);
         let pts: Vec<Point3> = (0..25)
             .map(|i| {
                 let (s, t) = ((i % 5) as f64, (i / 5) as f64 * 0.7);
@@ -701,7 +701,7 @@ mod tests {
         let mut q = Vec::new();
         project(&pts, &members, &f, &mut q);
         // Projection preserves in-plane distances.
-        let d3 = crate::cloud::dist2(pts[3], pts[17]).sqrt();
+        let d3 = crate::geom::dist2(pts[3], pts[17]).sqrt();
         let d2 = ((q[3][0] - q[17][0]).powi(2) + (q[3][1] - q[17][1]).powi(2)).sqrt();
         assert!((d3 - d2).abs() < 1e-12);
     }

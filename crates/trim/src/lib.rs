@@ -1,18 +1,45 @@
 //! # meshtrim's algorithm library
 //!
-//! Pure functions over points and meshes, no file I/O and no printing. The
+//! Pure functions over points and meshes: no file I/O, no printing. The
 //! pipeline follows Mineo, Pierce and Summan (2019), "Novel algorithms for 3D
 //! surface point cloud boundary detection and edge reconstruction":
 //!
-//! 1. [`cloud`] validates the input and merges exact duplicates.
-//! 2. [`neighbours`] finds the k nearest neighbours of every point (section 2).
-//! 3. [`frame`] fits the best plane of each neighbourhood (PCA) and projects
-//!    it to 2D; [`anisotropy`] undoes anisotropic sampling (meshtrim's
-//!    extension); [`resolution`] gives the local resolution β_i = μ_i + 2σ_i.
-//! 4. [`bpd`] labels boundary points: the empty-circle test, then the
-//!    surrounding-path test (section 2, eqs. 1–5).
+//! ```text
+//! cloud ─→ neighbours ─→ BPD ─→ edges ─┬─→ trim      (a reconstructed mesh cut along the edges)
+//!                                      ├─→ Delaunay  (a mesh of the cloud itself, bounded by them)
+//!                                      └─→ clean     (a scan's own jagged border replaced by them)
+//! ```
 //!
-//! Edge reconstruction (section 3) and trimming build on these.
+//! 1. **The cloud** is validated (finite, in range, not on a point or a
+//!    line) and exact duplicates are merged.
+//! 2. **Neighbours**: the k nearest neighbours of every point, in a
+//!    Morton-ordered k-d tree (section 2). [`NeighbourIndex`] gives them.
+//! 3. **Boundary point detection** ([`detect_boundary`], section 2, eqs.
+//!    1–5): each neighbourhood's best-fit plane ([`fit_plane`]), the local
+//!    resolution β_i = μ_i + 2σ_i, meshtrim's anisotropy map (which undoes
+//!    anisotropic sampling), then the empty-circle test and the
+//!    surrounding-path test. No threshold to tune. The result is a
+//!    [`Detection`]: labels, β, and the boundary links.
+//! 4. **Edge reconstruction** ([`reconstruct_edges`], section 3, the
+//!    paper's RBS): boundary points grouped into closed [`Loop`]s, ordered,
+//!    split at corners, each [`Edge`] smoothed by a spatial-FFT low-pass
+//!    filter whose cut-off follows β (eqs. 6–8), then moved out to the
+//!    estimated physical edge (meshtrim's extension).
+//! 5. Then one of three ways to a mesh with a smooth border:
+//!    - **Trimming** ([`trim_mesh`]): a mesh reconstructed from the cloud
+//!      (screened Poisson) is cut exactly along the smoothed loops, and what
+//!      the cloud does not support is removed.
+//!    - **The Delaunay path** ([`delaunay_mesh`]): a constrained Delaunay
+//!      triangulation of the cloud in its best-fit plane, bounded by the
+//!      smoothed loops (spade).
+//!    - **Cleanup** ([`clean_mesh`]): a triangulated scan, whose own
+//!      vertices are the cloud, gets its jagged border replaced by the
+//!      smoothed one, the gap filled with new faces on the surface.
+//!
+//! Every stage has an options struct whose `Default` is the paper's method
+//! with meshtrim's extensions, and returns a report of what it did. Errors
+//! say what is wrong with the input in the library's terms (parameters,
+//! not command-line flags).
 //!
 //! ## Vector kernels
 //!
@@ -20,32 +47,39 @@
 //! and projection, sampling vectors, β, both tests) carry
 //! `#[multiversion(targets("x86_64+avx2"))]`: each is compiled twice, for
 //! baseline x86-64 and for AVX2, and the first call picks the variant the
-//! CPU runs. The binary still runs on any x86-64 and uses 4-wide vectors
-//! where it can. Both variants give the same bits: they use only IEEE
+//! CPU runs. Both variants give the same bits: they use only IEEE
 //! operations that round exactly (add, multiply, divide, square root,
 //! comparisons), and Rust never fuses a multiply and an add on its own, so
-//! no FMA is emitted (checked: the detect CSVs of the 17 real scans in
-//! `../shared/data` are byte-identical to a baseline-only build's).
+//! no FMA is emitted.
 
-pub mod anisotropy;
-pub mod bpd;
-pub mod clean;
-pub mod closest_face;
-pub mod cloud;
-pub mod delaunay;
-pub mod edge_metrics;
-pub mod edges;
-pub mod error;
-pub mod evaluate;
-pub mod frame;
-pub mod hash;
-pub mod mesh;
-pub mod morton;
-pub mod neighbours;
-pub mod resolution;
-pub mod synthetic;
-pub mod trimming;
+mod anisotropy;
+mod bpd;
+mod clean;
+mod cloud;
+mod delaunay;
+mod edges;
+mod error;
+mod frame;
+mod geom;
+mod hash;
+mod mesh;
+mod planar;
+mod resolution;
+mod spatial;
 
-pub use bpd::{detect_boundary, BpdOptions, Detection};
+mod trimming;
+
+pub use bpd::{
+    detect_boundary, detect_boundary_with_progress, local_resolution, BpdOptions, Detection, View,
+};
+#[doc(hidden)]
+pub use bpd::{detect_boundary_reference, Decision};
+pub use clean::{clean_mesh, CleanOptions, CleanReport, LeftLoops};
 pub use cloud::Point3;
+pub use delaunay::{delaunay_mesh, delaunay_mesh_with_report, DelaunayReport};
+pub use edges::{reconstruct_edges, Edge, EdgeOptions, Edges, Loop};
 pub use error::{CloudError, MeshError};
+pub use frame::{fit_plane, Frame};
+pub use mesh::{check_vertex_range, Mesh};
+pub use spatial::neighbours::NeighbourIndex;
+pub use trimming::{trim_mesh, LoopFit, TrimOptions, TrimReport};

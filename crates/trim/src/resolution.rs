@@ -109,6 +109,7 @@ pub struct Columns {
     column_best: Vec<f64>,
 }
 
+#[cfg(test)]
 /// [`nearest_distances`] measuring each pair once, the plain way; the
 /// reference for tests.
 pub fn nearest_distances_reference(pts: &[Point2], out: &mut Vec<f64>) {

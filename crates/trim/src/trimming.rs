@@ -18,7 +18,7 @@
 //!    the polyline across faces, cannot leave a crack or a dangling piece:
 //!    every mesh edge is cut at most once, by one rule, and the cut is as
 //!    smooth as the field, which is as smooth as the FFT edge.
-//! 2. **Snapping.** A vertex with |f| below [`SNAP`] local spacings is
+//! 2. **Snapping.** A vertex with |f| below [`TrimOptions::snap`] local spacings is
 //!    moved onto the cut (f := 0): otherwise the cut would pass a hair's
 //!    breadth from it and leave a sliver triangle.
 //! 3. **The cut.** Faces with all f ≤ 0 lie inside, faces with all f ≥ 0
@@ -31,7 +31,7 @@
 //!    ragged depth-camera border, a loop tour that broke), no wall stands
 //!    between the part and the envelope beyond it, and both would fall into
 //!    one piece that the cloud supports. So the cut mesh is cut a second
-//!    time, the same way, along g(v) = d(v) − [`REACH`]·β: d the distance
+//!    time, the same way, along g(v) = d(v) − [`TrimOptions::reach`]·β: d the distance
 //!    to the nearest cloud point, β that point's local resolution. What
 //!    lies beyond (g > 0) is out of every cloud point's reach and goes. By
 //!    BPD's own rule no point inside the part is that far from the cloud
@@ -62,29 +62,46 @@ use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
 
 use crate::bpd::Detection;
-use crate::closest_face::FaceIndex;
-use crate::cloud::{dist2, dot, norm2, sub, Point3};
 use crate::edges::offset::{edge_sides, outward};
 use crate::edges::Edges;
 use crate::error::MeshError;
+use crate::geom::UnionFind;
+use crate::geom::{dist2, dot, norm2, sub, Point3};
 use crate::mesh::{sorted_edges_of, Mesh};
-use crate::neighbours::NeighbourIndex;
+use crate::spatial::closest_face::FaceIndex;
+use crate::spatial::neighbours::NeighbourIndex;
 
-/// Vertices closer to the cut than this many local spacings are moved
-/// onto it.
-pub const SNAP: f64 = 0.1;
+/// Options of trimming. The defaults are the measured ones of
+/// docs/trimming.md; each is a multiple of the local resolution β or a
+/// share, so none depends on the cloud's units.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrimOptions {
+    /// Vertices closer to the cut than this many local spacings are moved
+    /// onto it, so that the cut passes through them instead of leaving a
+    /// sliver beside them (step 2 of the module doc). Default 0.1.
+    pub snap: f64,
+    /// The kept surface ends this many local resolutions β from the cloud
+    /// (step 4): as far as a cloud point's projection reaches in the
+    /// support test (step 5), beyond which no point can support a face.
+    /// On the Poisson trims of the real scans whose loops close, the kept
+    /// surface lies within 2β of the cloud except for 0.02–0.1 % of its
+    /// area, along the smoothed cut. Default 2.
+    pub reach: f64,
+    /// A piece of the cut mesh is kept when the cloud points projecting
+    /// onto it reach this share of what its area holds (step 5). Default
+    /// 0.5.
+    pub support: f64,
+}
 
-/// The kept surface ends this many local resolutions β from the cloud
-/// (step 4 of the module doc): as far as a cloud point's projection
-/// reaches in the support test (step 5), beyond which no point can
-/// support a face. Measured on the Poisson trims of the real scans whose
-/// loops close, the kept surface lay within 2β of the cloud except for
-/// 0.02–0.1 % of its area, along the smoothed cut (docs/trimming.md).
-pub const REACH: f64 = 2.0;
-
-/// A piece of the cut mesh is kept when the cloud points projecting onto
-/// it reach this share of what its area holds.
-pub const SUPPORT: f64 = 0.5;
+impl Default for TrimOptions {
+    fn default() -> Self {
+        Self {
+            snap: 0.1,
+            reach: 2.0,
+            support: 0.5,
+        }
+    }
+}
 
 /// What trimming did.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -107,7 +124,7 @@ pub struct TrimReport {
     /// Vertices snapped onto the cut.
     pub vertices_snapped: usize,
     /// Parts of faces dropped because no cloud point lies within reach of
-    /// them (see [`REACH`]): envelope that no wall cuts off, where a
+    /// them (see [`TrimOptions::reach`]): envelope that no wall cuts off, where a
     /// border did not close into a loop.
     pub faces_out_of_reach: usize,
     /// Area of the input mesh.
@@ -138,6 +155,7 @@ pub fn trim_mesh(
     cloud: &[Point3],
     detection: &Detection,
     edges: &Edges,
+    options: &TrimOptions,
 ) -> Result<(Mesh, TrimReport), MeshError> {
     mesh.validate()?;
     let walls = Walls::new(cloud, detection, edges);
@@ -146,12 +164,12 @@ pub fn trim_mesh(
         .par_iter()
         .map(|&v| walls.signed_distance(v))
         .collect();
-    let (field, mut snapped_count) = snapped_field(&to_walls);
+    let (field, mut snapped_count) = snapped_field(&to_walls, options.snap);
     // The cut runs on one thread; the cloud's tree for the second cut is
     // built on the other meanwhile.
     let (first_cut, reach) = rayon::join(
         || cut_both_sides(mesh, &field),
-        || Reach::new(cloud, &detection.beta),
+        || Reach::new(cloud, &detection.beta, options.reach),
     );
     let faces_split = first_cut.split;
     let (
@@ -162,9 +180,9 @@ pub fn trim_mesh(
             ..
         },
         out_of_reach,
-    ) = within_reach(first_cut, &reach);
+    ) = within_reach(first_cut, &reach, options.snap);
     snapped_count += out_of_reach.snapped;
-    let support = supported_faces(&cut, &beyond, cloud, &detection.beta)?;
+    let support = supported_faces(&cut, &beyond, cloud, &detection.beta, options.support)?;
     let keep = support.keep;
     let mut survived = vec![false; mesh.faces.len()];
     for (&o, &k) in origin.iter().zip(&keep) {
@@ -203,14 +221,14 @@ struct OutOfReach {
 /// smaller than that, and the Poisson surface pokes that far out of reach
 /// in little domes over a scan's crevices. Faces and their origins are
 /// those of `cut`'s input mesh.
-fn within_reach(cut: Cut, reach: &Reach) -> (Cut, OutOfReach) {
+fn within_reach(cut: Cut, reach: &Reach, snap: f64) -> (Cut, OutOfReach) {
     let excess: Vec<(f64, f64)> = cut
         .mesh
         .vertices
         .par_iter()
         .map(|&v| reach.excess(v))
         .collect();
-    let (field, snapped_count) = snapped_field(&excess);
+    let (field, snapped_count) = snapped_field(&excess, snap);
     // Where every loop closed, nothing is out of reach and the cut below
     // would copy `cut` face for face: skip it.
     if field.iter().all(|&g| g <= 0.0) {
@@ -277,15 +295,15 @@ fn keep_unresolved_spots(mesh: &Mesh, beta: &[f64], out_of_reach: &mut [bool]) {
 }
 
 /// The field of a cut from each vertex's (value, local spacing), and how
-/// many values were snapped to 0: a vertex closer to the cut than [`SNAP`]
+/// many values were snapped to 0: a vertex closer to the cut than `snap`
 /// local spacings is moved onto it (f := 0), so that the cut passes
 /// through it instead of leaving a sliver beside it.
-fn snapped_field(values: &[(f64, f64)]) -> (Vec<f64>, usize) {
+fn snapped_field(values: &[(f64, f64)], snap: f64) -> (Vec<f64>, usize) {
     let mut snapped = 0;
     let field = values
         .iter()
         .map(|&(f, spacing)| {
-            if f != 0.0 && f.abs() < SNAP * spacing {
+            if f != 0.0 && f.abs() < snap * spacing {
                 snapped += 1;
                 0.0
             } else {
@@ -299,18 +317,21 @@ fn snapped_field(values: &[(f64, f64)]) -> (Vec<f64>, usize) {
 /// The cloud's reach: how far from the cloud the kept surface may lie.
 struct Reach<'a> {
     beta: &'a [f64],
+    /// β's that end the kept surface.
+    reach: f64,
     tree: Option<ImmutableKdTree<f64, 3>>,
 }
 
 impl<'a> Reach<'a> {
-    fn new(cloud: &[Point3], beta: &'a [f64]) -> Self {
+    fn new(cloud: &[Point3], beta: &'a [f64], reach: f64) -> Self {
         Reach {
             beta,
+            reach,
             tree: ImmutableKdTree::new_from_slice(cloud).ok(),
         }
     }
 
-    /// g(v) = d − REACH·β, with d the distance from v to the nearest cloud
+    /// g(v) = d − reach·β, with d the distance from v to the nearest cloud
     /// point and β that point's local resolution; and β, which snaps g.
     /// g > 0 where v is out of the cloud's reach.
     fn excess(&self, v: Point3) -> (f64, f64) {
@@ -324,7 +345,7 @@ impl<'a> Reach<'a> {
             .nearest_one::<SquaredEuclidean<f64>>()
             .execute();
         let beta = self.beta[nearest.item as usize];
-        (nearest.distance.sqrt() - REACH * beta, beta)
+        (nearest.distance.sqrt() - self.reach * beta, beta)
     }
 }
 
@@ -631,6 +652,7 @@ fn supported_faces(
     beyond: &[bool],
     cloud: &[Point3],
     beta: &[f64],
+    support: f64,
 ) -> Result<Support, MeshError> {
     if cut.faces.is_empty() {
         return Err(MeshError::Unsupported);
@@ -662,7 +684,7 @@ fn supported_faces(
     // points that landed on it.
     let keep: Vec<bool> = (0..pieces)
         .map(|k| {
-            hits[k] > 0 && hits[k] as f64 >= SUPPORT * area[k] / (cell_area[k] / hits[k] as f64)
+            hits[k] > 0 && hits[k] as f64 >= support * area[k] / (cell_area[k] / hits[k] as f64)
         })
         .collect();
     if !keep.iter().any(|&k| k) {
@@ -686,18 +708,18 @@ fn supported_faces(
 fn face_pieces(faces: &[[u32; 3]], beyond: &[bool]) -> Vec<u32> {
     let n = faces.len();
     let edges = sorted_edges_of(faces);
-    let mut parent: Vec<u32> = (0..n as u32).collect();
+    let mut sets = UnionFind::new(n);
     for same_edge in edges.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
         for side in [false, true] {
             let mut on_side = same_edge.iter().filter(|e| beyond[e.2 as usize] == side);
             if let Some(first) = on_side.next() {
                 for other in on_side {
-                    join(&mut parent, first.2, other.2);
+                    sets.union(first.2, other.2);
                 }
             }
         }
     }
-    piece_ids(&mut parent)
+    piece_ids(&mut sets, n)
 }
 
 /// [`face_pieces`] with a hash map of edges, the plain way; the reference
@@ -705,14 +727,14 @@ fn face_pieces(faces: &[[u32; 3]], beyond: &[bool]) -> Vec<u32> {
 #[cfg(test)]
 fn face_pieces_reference(faces: &[[u32; 3]], beyond: &[bool]) -> Vec<u32> {
     let n = faces.len();
-    let mut parent: Vec<u32> = (0..n as u32).collect();
+    let mut sets = UnionFind::new(n);
     let mut first_on_edge: HashMap<(u32, u32, bool), u32> = HashMap::default();
     for (f, face) in faces.iter().enumerate() {
         for k in 0..3 {
             let (a, b) = (face[k], face[(k + 1) % 3]);
             match first_on_edge.entry((a.min(b), a.max(b), beyond[f])) {
                 std::collections::hash_map::Entry::Occupied(e) => {
-                    join(&mut parent, *e.get(), f as u32);
+                    sets.union(*e.get(), f as u32);
                 }
                 std::collections::hash_map::Entry::Vacant(e) => {
                     e.insert(f as u32);
@@ -720,23 +742,16 @@ fn face_pieces_reference(faces: &[[u32; 3]], beyond: &[bool]) -> Vec<u32> {
             }
         }
     }
-    piece_ids(&mut parent)
-}
-
-/// Joins the sets of `a` and `b` under the smaller root.
-fn join(parent: &mut [u32], a: u32, b: u32) {
-    let (ra, rb) = (find(parent, a), find(parent, b));
-    parent[ra.max(rb) as usize] = ra.min(rb);
+    piece_ids(&mut sets, n)
 }
 
 /// Piece ids 0, 1, … in the order of each set's first member.
-fn piece_ids(parent: &mut [u32]) -> Vec<u32> {
-    let n = parent.len();
+fn piece_ids(sets: &mut UnionFind, n: usize) -> Vec<u32> {
     let mut id = vec![u32::MAX; n];
     let mut next = 0;
     (0..n)
         .map(|f| {
-            let r = find(parent, f as u32) as usize;
+            let r = sets.find(f as u32) as usize;
             if id[r] == u32::MAX {
                 id[r] = next;
                 next += 1;
@@ -744,15 +759,6 @@ fn piece_ids(parent: &mut [u32]) -> Vec<u32> {
             id[r]
         })
         .collect()
-}
-
-fn find(parent: &mut [u32], mut i: u32) -> u32 {
-    while parent[i as usize] != i {
-        let grand = parent[parent[i as usize] as usize];
-        parent[i as usize] = grand;
-        i = grand;
-    }
-    i
 }
 
 #[cfg(test)]
@@ -855,7 +861,7 @@ mod tests {
     }
 
     /// The reach's field by kiddo's tree equals the plain one: the nearest
-    /// point by scanning them all, its β, g = d − REACH·β.
+    /// point by scanning them all, its β, g = d − 2β.
     #[test]
     fn the_reach_matches_a_scan_of_every_point() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(21);
@@ -866,7 +872,7 @@ mod tests {
             let beta: Vec<f64> = (0..cloud.len())
                 .map(|_| rng.random_range(0.1..2.0))
                 .collect();
-            let reach = Reach::new(&cloud, &beta);
+            let reach = Reach::new(&cloud, &beta, 2.0);
             for _ in 0..200 {
                 let v = [0, 1, 2].map(|_| rng.random_range(-15.0..15.0));
                 let (d2, nearest) = cloud
@@ -875,7 +881,7 @@ mod tests {
                     .map(|(i, &p)| (dist2(v, p), i))
                     .min_by(|a, b| a.0.total_cmp(&b.0))
                     .unwrap();
-                let want = (d2.sqrt() - REACH * beta[nearest], beta[nearest]);
+                let want = (d2.sqrt() - 2.0 * beta[nearest], beta[nearest]);
                 assert_eq!(reach.excess(v), want, "at {v:?}");
             }
         }

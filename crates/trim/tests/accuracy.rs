@@ -1,9 +1,11 @@
 //! Accuracy of BPD on synthetic clouds with ground truth
-//! (`trim::synthetic`, scored by `trim::evaluate`). Run with `--nocapture`
+//! (`testkit::synthetic`, scored by `testkit::evaluate`). Run with `--nocapture`
 //! to see the measured numbers.
 
-use trim::evaluate::{ideal_first_layer, noise_robustness, percent_sweep, precision_recall};
-use trim::synthetic::{self, SyntheticCloud};
+use testkit::{
+    evaluate::{ideal_first_layer, noise_robustness, percent_sweep, precision_recall},
+    synthetic::{self, SyntheticCloud},
+};
 use trim::{detect_boundary, BpdOptions};
 
 const TARGET: f64 = 0.98;
@@ -406,7 +408,7 @@ fn flips_beyond_the_first_rows(
     options: &BpdOptions,
     deep: Deep,
 ) -> Vec<String> {
-    let index = trim::evaluate::BoundaryIndex::new(cloud);
+    let index = testkit::evaluate::BoundaryIndex::new(cloud);
     let clean = detect_boundary(&cloud.points, options).unwrap().boundary;
     let boundary_count = clean.iter().filter(|&&b| b).count();
     let mut failures = Vec::new();

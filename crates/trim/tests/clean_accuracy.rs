@@ -1,13 +1,13 @@
 //! Border cleanup against ground truth (issue 5): jagged Delaunay meshes of
 //! jittered synthetic clouds with known borders, cleaned by
-//! [`trim::clean::clean_mesh`]; the cleaned border must lie within 0.25
+//! [`trim::clean_mesh`]; the cleaned border must lie within 0.25
 //! local spacings of the true border on average.
 
-use trim::bpd::{detect_boundary, BpdOptions};
-use trim::clean::{clean_mesh, CleanOptions, CleanReport};
-use trim::mesh::Mesh;
-use trim::synthetic::jagged::{border_error, jagged_mesh};
-use trim::synthetic::{self, SyntheticCloud};
+use testkit::{
+    synthetic::jagged::{border_error, jagged_mesh},
+    synthetic::{self, SyntheticCloud},
+};
+use trim::{clean_mesh, detect_boundary, BpdOptions, CleanOptions, CleanReport, Mesh};
 
 struct Case {
     truth: SyntheticCloud,
@@ -263,7 +263,7 @@ fn random_jagged_meshes_are_cleaned() {
 }
 
 fn clean_mesh_of(input: &Mesh) -> (Mesh, CleanReport) {
-    let beta = trim::bpd::local_resolution(&input.vertices, &BpdOptions::default()).unwrap();
+    let beta = trim::local_resolution(&input.vertices, &BpdOptions::default()).unwrap();
     clean_mesh(input, &beta, &CleanOptions::default()).unwrap()
 }
 

@@ -4,12 +4,14 @@
 
 use std::collections::HashSet;
 
-use trim::delaunay::{delaunay_mesh, delaunay_mesh_with_report, DelaunayReport};
-use trim::edges::{reconstruct_edges, EdgeOptions};
-use trim::evaluate::BoundaryIndex;
-use trim::mesh::Mesh;
-use trim::synthetic::{self, SyntheticCloud};
-use trim::{detect_boundary, BpdOptions, MeshError, Point3};
+use testkit::{
+    evaluate::BoundaryIndex,
+    synthetic::{self, SyntheticCloud},
+};
+use trim::{
+    delaunay_mesh, delaunay_mesh_with_report, detect_boundary, reconstruct_edges, BpdOptions,
+    DelaunayReport, EdgeOptions, Mesh, MeshError, Point3,
+};
 
 fn meshed(points: &[Point3]) -> Result<(Mesh, DelaunayReport), MeshError> {
     let detection = detect_boundary(points, &BpdOptions::default()).unwrap();

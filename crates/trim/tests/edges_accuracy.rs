@@ -1,10 +1,11 @@
 //! Accuracy of edge reconstruction on synthetic clouds with ground truth.
 //! Run with `--nocapture` to see the measured numbers.
 
-use trim::edge_metrics::{match_corners, polyline_to_truth_in_spacings, true_corners};
-use trim::edges::{reconstruct_edges, EdgeOptions, Edges};
-use trim::synthetic::{self, SyntheticCloud};
-use trim::{detect_boundary, BpdOptions, Point3};
+use testkit::{
+    edge_metrics::{match_corners, polyline_to_truth_in_spacings, true_corners},
+    synthetic::{self, SyntheticCloud},
+};
+use trim::{detect_boundary, reconstruct_edges, BpdOptions, EdgeOptions, Edges, Point3};
 
 /// Mean and largest distance of all smoothed edges to the true boundary,
 /// in local spacings.

@@ -17,15 +17,14 @@
 //!   larger than the input, the same on every run.
 
 use proptest::prelude::*;
-use trim::bpd::detect_boundary_reference;
-use trim::clean::{clean_mesh, CleanOptions};
-use trim::delaunay::delaunay_mesh;
-use trim::edges::{reconstruct_edges, EdgeOptions};
-use trim::mesh::Mesh;
-use trim::synthetic::jagged::jagged_mesh;
-use trim::synthetic::{jittered_grid, Circle, Region, SpacingField, Surface};
-use trim::trimming::trim_mesh;
-use trim::{detect_boundary, BpdOptions, Point3};
+use testkit::{
+    synthetic::jagged::jagged_mesh,
+    synthetic::{jittered_grid, Circle, Region, SpacingField, Surface},
+};
+use trim::{
+    clean_mesh, delaunay_mesh, detect_boundary, detect_boundary_reference, reconstruct_edges,
+    trim_mesh, BpdOptions, CleanOptions, EdgeOptions, Mesh, Point3, TrimOptions,
+};
 
 /// A jittered patch of about `20 × 14 / h²` points on a gently curved
 /// surface, with one hole; `seed` chooses the surface, the hole and the
@@ -114,7 +113,7 @@ fn config(cases: u32) -> ProptestConfig {
 
 /// The permutation of 0..n drawn from `seed` (Fisher–Yates).
 fn permutation(n: usize, seed: u64) -> Vec<usize> {
-    let mut rng = trim::synthetic::SplitMix64::new(seed);
+    let mut rng = testkit::synthetic::SplitMix64::new(seed);
     let mut order: Vec<usize> = (0..n).collect();
     for i in (1..n).rev() {
         let j = (rng.next_u64() % (i as u64 + 1)) as usize;
@@ -245,7 +244,7 @@ proptest! {
 /// same surface, with its vertices jittered.
 fn overshooting_mesh(seed: u64, margin: f64, step: f64) -> Mesh {
     let surface = surface(seed);
-    let mut rng = trim::synthetic::SplitMix64::new(seed ^ 0xabcd);
+    let mut rng = testkit::synthetic::SplitMix64::new(seed ^ 0xabcd);
     let (nu, nv) = (
         ((20.0 + 2.0 * margin) / step) as u32,
         ((14.0 + 2.0 * margin) / step) as u32,
@@ -282,7 +281,7 @@ proptest! {
         let detection = detect_boundary(&cloud, &BpdOptions::default()).unwrap();
         let edges = reconstruct_edges(&cloud, &detection, &EdgeOptions::default());
         let mesh = overshooting_mesh(seed, margin, step);
-        let (out, report) = trim_mesh(&mesh, &cloud, &detection, &edges).unwrap();
+        let (out, report) = trim_mesh(&mesh, &cloud, &detection, &edges, &TrimOptions::default()).unwrap();
         prop_assert!(out.validate().is_ok());
         prop_assert!(out.vertices.iter().flatten().all(|c| c.is_finite()));
         prop_assert_eq!(report.faces_in, mesh.faces.len());
@@ -293,7 +292,7 @@ proptest! {
         // the mesh by at least most of the margin band.
         let band = 2.0 * margin * (20.0 + 14.0);
         prop_assert!(report.area_out < report.area_in - 0.5 * band);
-        let (again, _) = trim_mesh(&mesh, &cloud, &detection, &edges).unwrap();
+        let (again, _) = trim_mesh(&mesh, &cloud, &detection, &edges, &TrimOptions::default()).unwrap();
         prop_assert_eq!(&again.faces, &out.faces);
         prop_assert_eq!(&again.vertices, &out.vertices);
     }
@@ -309,7 +308,7 @@ proptest! {
         let job = |cloud: &[Point3], mesh: &Mesh| {
             let detection = detect_boundary(cloud, &BpdOptions::default()).unwrap();
             let edges = reconstruct_edges(cloud, &detection, &EdgeOptions::default());
-            let (out, _) = trim_mesh(mesh, cloud, &detection, &edges).unwrap();
+            let (out, _) = trim_mesh(mesh, cloud, &detection, &edges, &TrimOptions::default()).unwrap();
             (detection.boundary, edges.loops.len(), out)
         };
         let (labels, loops, out) = job(&cloud, &mesh);
@@ -328,9 +327,9 @@ proptest! {
         shift in prop_oneof![Just(1e3), Just(1e5)],
     ) {
         let truth = if disc {
-            trim::synthetic::curved_disc_with_hole(spacing + 1.0, seed)
+            testkit::synthetic::curved_disc_with_hole(spacing + 1.0, seed)
         } else {
-            trim::synthetic::notched_plate(spacing, seed)
+            testkit::synthetic::notched_plate(spacing, seed)
         };
         let mesh = jagged_mesh(&truth);
         let job = |mesh: &Mesh| {
@@ -382,7 +381,7 @@ proptest! {
         let job = |cloud: &[Point3]| {
             let detection = detect_boundary(cloud, &BpdOptions::default()).unwrap();
             let edges = reconstruct_edges(cloud, &detection, &EdgeOptions::default());
-            trim_mesh(&mesh, cloud, &detection, &edges).unwrap().0
+            trim_mesh(&mesh, cloud, &detection, &edges, &TrimOptions::default()).unwrap().0
         };
         let (out, out2) = (job(&cloud), job(&shuffled));
         prop_assert_eq!(&out.faces, &out2.faces);

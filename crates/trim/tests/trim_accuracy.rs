@@ -2,12 +2,14 @@
 //! the part, caps its hole and has an unsupported far sheet is cut back to
 //! the smoothed boundary. Run with `--nocapture` for the numbers.
 
-use trim::edges::{reconstruct_edges, EdgeOptions};
-use trim::evaluate::BoundaryIndex;
-use trim::mesh::Mesh;
-use trim::synthetic::{self, SyntheticCloud};
-use trim::trimming::trim_mesh;
-use trim::{detect_boundary, BpdOptions, Point3};
+use testkit::{
+    evaluate::BoundaryIndex,
+    synthetic::{self, SyntheticCloud},
+};
+use trim::{
+    detect_boundary, reconstruct_edges, trim_mesh, BpdOptions, EdgeOptions, Mesh, Point3,
+    TrimOptions,
+};
 
 /// A square grid of pitch `h` over [x0, x1] × [y0, y1] at height z,
 /// facing +z (or −z when `down`).
@@ -43,10 +45,17 @@ fn true_area_of_notched_plate(h: f64) -> f64 {
     (60.0 * 40.0 - 15.0 * 15.0) * h * h - std::f64::consts::PI * 25.0 * h * h
 }
 
-fn trimmed(cloud: &SyntheticCloud, mesh: &Mesh) -> (Mesh, trim::trimming::TrimReport) {
+fn trimmed(cloud: &SyntheticCloud, mesh: &Mesh) -> (Mesh, trim::TrimReport) {
     let detection = detect_boundary(&cloud.points, &BpdOptions::default()).unwrap();
     let edges = reconstruct_edges(&cloud.points, &detection, &EdgeOptions::default());
-    trim_mesh(mesh, &cloud.points, &detection, &edges).unwrap()
+    trim_mesh(
+        mesh,
+        &cloud.points,
+        &detection,
+        &edges,
+        &TrimOptions::default(),
+    )
+    .unwrap()
 }
 
 /// The notched plate (spacing 1) and a mesh that overshoots it by 5
@@ -120,7 +129,14 @@ fn envelope_that_no_wall_cuts_off_ends_at_the_clouds_reach() {
         .max_by_key(|&l| edges.loops[l].boundary_points.len())
         .unwrap();
     edges.loops.remove(outer);
-    let (out, report) = trim_mesh(&mesh, &cloud.points, &detection, &edges).unwrap();
+    let (out, report) = trim_mesh(
+        &mesh,
+        &cloud.points,
+        &detection,
+        &edges,
+        &TrimOptions::default(),
+    )
+    .unwrap();
     // Every kept vertex within reach of the cloud. The cut runs straight
     // across each face between the field's zeros at its edges, so it may
     // pass up to half a face diagonal (0.5 here) farther out.
@@ -135,7 +151,7 @@ fn envelope_that_no_wall_cuts_off_ends_at_the_clouds_reach() {
                 .map(|(i, p)| (i, (0..3).map(|c| (v[c] - p[c]).powi(2)).sum::<f64>()))
                 .min_by(|a, b| a.1.total_cmp(&b.1))
                 .unwrap();
-            d2.sqrt() - trim::trimming::REACH * detection.beta[i]
+            d2.sqrt() - TrimOptions::default().reach * detection.beta[i]
         })
         .fold(f64::NEG_INFINITY, f64::max);
     eprintln!("farthest vertex {farthest:.3} beyond reach, {report:?}");
@@ -145,7 +161,7 @@ fn envelope_that_no_wall_cuts_off_ends_at_the_clouds_reach() {
     // fringe within reach of its outer border (perimeter 200 spacings).
     let plate = true_area_of_notched_plate(1.0);
     let beta_max = detection.beta.iter().copied().fold(0.0, f64::max);
-    let fringe = 200.0 * trim::trimming::REACH * beta_max;
+    let fringe = 200.0 * TrimOptions::default().reach * beta_max;
     assert!(
         out.area() > plate && out.area() < plate + fringe,
         "area {} against the plate's {plate} and the fringe {fringe}",
@@ -208,7 +224,8 @@ fn only_gaps_the_cloud_resolves_open_holes_beyond_its_reach() {
     let mut edges = reconstruct_edges(&points, &detection, &EdgeOptions::default());
     edges.loops.clear();
     let mesh = grid(0.0, 59.0, 0.0, 59.0, 0.4, 0.0, false);
-    let (out, report) = trim_mesh(&mesh, &points, &detection, &edges).unwrap();
+    let (out, report) =
+        trim_mesh(&mesh, &points, &detection, &edges, &TrimOptions::default()).unwrap();
     // Loops inside the sheet's own border.
     let inner = |l: &&Vec<u32>| {
         l.iter().all(|&v| {

@@ -25,14 +25,13 @@ use crate::anisotropy::{
     apply, own_sampling_vectors, sampling_moment, sampling_tensor_of_moments, whitening_map,
     SamplingMoment,
 };
-use crate::cloud::{
-    check_finite, check_not_degenerate, merge_duplicates, sub, Point3, Sites, PASS_PIECE,
-};
+use crate::cloud::{check_finite, check_not_degenerate, merge_duplicates, Sites, PASS_PIECE};
 use crate::error::CloudError;
 use crate::frame::{fit_plane_normal, project_sheared, ray_shear, Frame, Point2};
-use crate::morton::{octree_runs, spatial_order, split_by_runs, MortonCells, MortonGrid};
-use crate::neighbours::{NeighbourIndex, RunScratch};
+use crate::geom::{sub, Point3};
 use crate::resolution::{beta_of, nearest_distances, Columns};
+use crate::spatial::morton::{octree_runs, spatial_order, split_by_runs, MortonCells, MortonGrid};
+use crate::spatial::neighbours::{NeighbourIndex, RunScratch};
 
 /// Options of boundary point detection.
 #[derive(Debug, Clone, PartialEq)]

@@ -20,6 +20,8 @@
 //! an empty 2-core (a chain, a lone point) are dropped and counted, and so
 //! are 2-cores of three points: a loop needs four (see [`MIN_LOOP_POINTS`]).
 
+use crate::geom::UnionFind;
+
 /// Boundaries found among the boundary points.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub struct Clusters {
@@ -183,11 +185,9 @@ fn two_core(boundary: &[bool], links: &[[u32; 2]]) -> Vec<bool> {
 
 /// Connected components of the `alive` points under `links`.
 fn components(n: usize, alive: &[bool], links: &[[u32; 2]]) -> (Vec<Vec<u32>>, Vec<Vec<[u32; 2]>>) {
-    let mut parent: Vec<u32> = (0..n as u32).collect();
+    let mut sets = UnionFind::new(n);
     for &[a, b] in links {
-        let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
-        // The smaller index becomes the root, so roots are deterministic.
-        parent[ra.max(rb) as usize] = ra.min(rb);
+        sets.union(a, b);
     }
     let mut slot_of_root = vec![u32::MAX; n];
     let mut clusters: Vec<Vec<u32>> = Vec::new();
@@ -195,7 +195,7 @@ fn components(n: usize, alive: &[bool], links: &[[u32; 2]]) -> (Vec<Vec<u32>>, V
         if !alive[i as usize] {
             continue;
         }
-        let root = find(&mut parent, i) as usize;
+        let root = sets.find(i) as usize;
         if slot_of_root[root] == u32::MAX {
             slot_of_root[root] = clusters.len() as u32;
             clusters.push(Vec::new());
@@ -204,7 +204,7 @@ fn components(n: usize, alive: &[bool], links: &[[u32; 2]]) -> (Vec<Vec<u32>>, V
     }
     let mut cluster_links = vec![Vec::new(); clusters.len()];
     for &[a, b] in links {
-        let root = find(&mut parent, a) as usize;
+        let root = sets.find(a) as usize;
         cluster_links[slot_of_root[root] as usize].push([a.min(b), a.max(b)]);
     }
     for l in cluster_links.iter_mut() {
@@ -212,15 +212,6 @@ fn components(n: usize, alive: &[bool], links: &[[u32; 2]]) -> (Vec<Vec<u32>>, V
         l.dedup();
     }
     (clusters, cluster_links)
-}
-
-fn find(parent: &mut [u32], mut i: u32) -> u32 {
-    while parent[i as usize] != i {
-        let grand = parent[parent[i as usize] as usize];
-        parent[i as usize] = grand;
-        i = grand;
-    }
-    i
 }
 
 #[cfg(test)]

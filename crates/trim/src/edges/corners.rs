@@ -34,7 +34,7 @@
 //! a hole of radius ≈ β found by four points is one closed edge, as in the
 //! paper's Figure 4.
 
-use crate::cloud::{cross, dist2, norm2, sub, Point3};
+use crate::geom::{cross, dist2, norm2, sub, Point3};
 
 /// Positions (into `loop_points`) of the corners of a closed loop,
 /// ascending. `beta[i]` is the local resolution at `loop_points[i]`.

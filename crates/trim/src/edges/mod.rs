@@ -12,7 +12,6 @@
 //! 5. optionally, each smoothed loop is moved out to where the surface
 //!    really ends.
 
-pub mod baseline;
 pub mod cluster;
 pub mod corners;
 pub mod offset;
@@ -23,8 +22,8 @@ pub mod split;
 use rayon::prelude::*;
 
 use crate::bpd::Detection;
-use crate::cloud::{dist2, sub, Point3};
-use crate::neighbours::{tie_key, NeighbourIndex};
+use crate::geom::{dist2, sub, Point3};
+use crate::spatial::neighbours::{tie_key, NeighbourIndex};
 
 /// Options of edge reconstruction.
 #[derive(Debug, Clone, PartialEq)]

@@ -21,9 +21,9 @@
 //! smoothed loop is moved by r/2 along its outward normal in the surface's
 //! tangent plane.
 
-use crate::cloud::{cross, dot, norm2, sub, Point3};
 use crate::frame::fit_plane;
-use crate::neighbours::NeighbourIndex;
+use crate::geom::{cross, dot, norm2, sub, Point3};
+use crate::spatial::neighbours::NeighbourIndex;
 
 /// Loop points on each side averaged into each estimate.
 pub const WINDOW: usize = 5;

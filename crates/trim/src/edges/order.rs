@@ -18,7 +18,8 @@
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use std::num::NonZeroUsize;
 
-use crate::cloud::{dist2, Point3};
+use crate::geom::UnionFind;
+use crate::geom::{dist2, Point3};
 
 /// Clusters up to this size get the exact shortest tour.
 pub const EXACT_MAX: usize = 8;
@@ -167,7 +168,7 @@ fn greedy_tour(pts: &[Point3], candidates: &[Vec<u32>], links: &[[u32; 2]]) -> V
     edges.dedup_by(|x, y| x.1 == y.1 && x.2 == y.2);
     let mut adjacency = vec![[u32::MAX; 2]; n];
     let mut degree = vec![0u8; n];
-    let mut parent: Vec<u32> = (0..n as u32).collect();
+    let mut sets = UnionFind::new(n);
     let mut added = 0;
     let add = |a: u32, b: u32, adjacency: &mut [[u32; 2]], degree: &mut [u8]| {
         adjacency[a as usize][degree[a as usize] as usize] = b;
@@ -177,9 +178,8 @@ fn greedy_tour(pts: &[Point3], candidates: &[Vec<u32>], links: &[[u32; 2]]) -> V
     };
     for &(_, a, b) in &edges {
         if degree[a as usize] < 2 && degree[b as usize] < 2 {
-            let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
-            if ra != rb && added + 1 < n {
-                parent[ra.max(rb) as usize] = ra.min(rb);
+            if sets.find(a) != sets.find(b) && added + 1 < n {
+                sets.union(a, b);
                 add(a, b, &mut adjacency, &mut degree);
                 added += 1;
             }
@@ -193,14 +193,13 @@ fn greedy_tour(pts: &[Point3], candidates: &[Vec<u32>], links: &[[u32; 2]]) -> V
         for (x, &a) in ends.iter().enumerate() {
             for &b in &ends[x + 1..] {
                 let d = dist(pts, a, b);
-                if d < best.0 && find(&mut parent, a) != find(&mut parent, b) {
+                if d < best.0 && sets.find(a) != sets.find(b) {
                     best = (d, a, b);
                 }
             }
         }
         let (_, a, b) = best;
-        let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
-        parent[ra.max(rb) as usize] = ra.min(rb);
+        sets.union(a, b);
         add(a, b, &mut adjacency, &mut degree);
         added += 1;
     }
@@ -223,15 +222,6 @@ fn walk_path(adjacency: &[[u32; 2]], start: u32) -> Vec<u32> {
         tour.push(at);
     }
     tour
-}
-
-fn find(parent: &mut [u32], mut i: u32) -> u32 {
-    while parent[i as usize] != i {
-        let grand = parent[parent[i as usize] as usize];
-        parent[i as usize] = grand;
-        i = grand;
-    }
-    i
 }
 
 /// Applies improving 2-opt and Or-opt moves until there are none.

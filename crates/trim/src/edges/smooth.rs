@@ -82,7 +82,7 @@ use std::sync::Arc;
 use rustfft::num_complex::Complex;
 use rustfft::{Fft, FftPlanner};
 
-use crate::cloud::{dist2, Point3};
+use crate::geom::{dist2, Point3};
 
 /// Edges with fewer points are returned unchanged.
 const MIN_POINTS: usize = 3;
@@ -401,8 +401,8 @@ fn filter_and_evaluate(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::synthetic::SplitMix64;
     use std::f64::consts::PI;
+    use testkit::SplitMix64;
 
     /// One component filtered at one β (step 3 alone).
     fn lowpass_one(signal: &[f64], period: f64, beta: f64) -> Vec<f64> {

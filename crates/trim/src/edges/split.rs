@@ -5,8 +5,8 @@
 //! the one closed tour through all its points must then jump across the
 //! surface somewhere. A step of a tour is *supported* when its two points
 //! are at most 3β apart (β the larger local resolution of the two) or BPD
-//! linked them; a *jump* is an unsupported step
-//! ([`tour_jumps`](crate::edge_metrics::tour_jumps) counts them). A tour without jumps is kept as it is.
+//! linked them; a *jump* is an unsupported step. A tour without jumps is
+//! kept as it is.
 //! Otherwise it is cut at every jump into pieces that follow the borders,
 //! and the pieces' ends are joined again, nearest pair first, by supported
 //! steps only (an end joins at most one other end, possibly the other end
@@ -25,7 +25,8 @@ use std::collections::BinaryHeap;
 
 use crate::hash::{HashMap, HashSet};
 
-use crate::cloud::{dist2, Point3};
+use crate::geom::UnionFind;
+use crate::geom::{dist2, Point3};
 
 use super::cluster::MIN_LOOP_POINTS;
 use super::order::canonical;
@@ -95,12 +96,15 @@ fn join_ends(points: &[Point3], pieces: &[Vec<u32>], ok: impl Fn(u32, u32) -> bo
     let mut partner = vec![usize::MAX; 2 * pieces.len()];
     let mut closed = vec![false; pieces.len()];
     // Chains as union–find over pieces.
-    let mut parent: Vec<usize> = (0..pieces.len()).collect();
+    let mut chains = UnionFind::new(pieces.len());
     for (e, f) in supported_end_pairs(points, pieces, ok) {
         if partner[e] != usize::MAX || partner[f] != usize::MAX {
             continue;
         }
-        let (re, rf) = (root(&mut parent, e / 2), root(&mut parent, f / 2));
+        let (re, rf) = (
+            chains.find((e / 2) as u32) as usize,
+            chains.find((f / 2) as u32) as usize,
+        );
         if re == rf {
             if closed[re] {
                 continue;
@@ -110,7 +114,7 @@ fn join_ends(points: &[Point3], pieces: &[Vec<u32>], ok: impl Fn(u32, u32) -> bo
             if closed[re] || closed[rf] {
                 continue;
             }
-            parent[re.max(rf)] = re.min(rf);
+            chains.union(re as u32, rf as u32);
         }
         partner[e] = f;
         partner[f] = e;
@@ -141,15 +145,6 @@ fn supported_end_pairs(
     }
     pairs.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2)));
     pairs.into_iter().map(|(_, e, f)| (e, f)).collect()
-}
-
-/// The union–find root of piece `i`, halving the path on the way.
-fn root(parent: &mut [usize], mut i: usize) -> usize {
-    while parent[i] != i {
-        parent[i] = parent[parent[i]];
-        i = parent[i];
-    }
-    i
 }
 
 /// The chains of joined pieces: the closed ones of at least
@@ -414,7 +409,6 @@ impl Ord for Length {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::edge_metrics::tour_jumps;
     use crate::edges::{cluster::cluster_boundary, order::closed_tour};
 
     /// Two concentric rings (radius 10 and 5, spacing ≈ 1) joined at two
@@ -451,6 +445,16 @@ mod tests {
         (points, links, outer_n, inner_n)
     }
 
+    /// Steps of a closed tour that no link supports and that are longer
+    /// than the jump length.
+    fn jumps(points: &[Point3], beta: &[f64], links: &[[u32; 2]], tour: &[u32]) -> usize {
+        let next = tour.iter().cycle().skip(1);
+        tour.iter()
+            .zip(next)
+            .filter(|&(&a, &b)| !supported(points, beta, links, a, b))
+            .count()
+    }
+
     #[test]
     fn two_borders_joined_twice_give_two_loops_without_jumps() {
         let (points, links, outer_n, inner_n) = rings_joined_twice();
@@ -458,11 +462,11 @@ mod tests {
         let clusters = cluster_boundary(&vec![true; points.len()], &links);
         assert_eq!(clusters.clusters.len(), 1);
         let tour = closed_tour(&points, &clusters.clusters[0], &clusters.links[0]);
-        assert!(tour_jumps(&points, &beta, &links, &tour).count > 0);
+        assert!(jumps(&points, &beta, &links, &tour) > 0);
         let (loops, _dropped) = split_at_jumps(&points, &beta, &clusters.links[0], tour);
         assert_eq!(loops.len(), 2, "{loops:?}");
         for l in &loops {
-            assert_eq!(tour_jumps(&points, &beta, &links, l).count, 0, "{l:?}");
+            assert_eq!(jumps(&points, &beta, &links, l), 0, "{l:?}");
         }
         // One loop round each ring.
         let on = |l: &Vec<u32>, from: usize, n: usize| {

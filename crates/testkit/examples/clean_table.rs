@@ -5,10 +5,11 @@
 //!
 //! `cargo run --release -p meshtrim-trim --example clean_table`
 
-use trim::bpd::{detect_boundary, BpdOptions};
-use trim::clean::{clean_mesh, CleanOptions};
-use trim::synthetic::jagged::{border_error, jagged_mesh};
-use trim::synthetic::{self, SyntheticCloud};
+use testkit::{
+    synthetic::jagged::{border_error, jagged_mesh},
+    synthetic::{self, SyntheticCloud},
+};
+use trim::{clean_mesh, detect_boundary, BpdOptions, CleanOptions};
 
 fn main() {
     type Make = fn(u64) -> SyntheticCloud;

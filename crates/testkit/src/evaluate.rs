@@ -65,9 +65,8 @@
 
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 
-use crate::bpd::{detect_boundary, BpdOptions};
-use crate::error::CloudError;
 use crate::synthetic::{SyntheticCloud, P3};
+use trim::{detect_boundary, BpdOptions, CloudError};
 
 /// The true boundary of a synthetic cloud on the surface, for distance
 /// queries.

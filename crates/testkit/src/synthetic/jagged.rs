@@ -44,9 +44,9 @@ use std::collections::HashMap;
 use spade::{DelaunayTriangulation, HasPosition, Point2, Triangulation};
 
 use super::{jittered, notched_plate_region, Region, SpacingField, Surface, SyntheticCloud, P3};
-use crate::cloud::{cross, dot, sub};
 use crate::evaluate::BoundaryIndex;
-use crate::mesh::Mesh;
+use crate::vec3::{cross, dot, sub};
+use trim::Mesh;
 
 /// Largest kept circumradius, in local pitches (see the module doc).
 pub const MAX_CIRCUMRADIUS: f64 = 2.0;

@@ -18,7 +18,8 @@ use rayon::prelude::*;
 
 use voracious_radix_sort::RadixSort;
 
-use crate::cloud::{dist2, Point3, PASS_PIECE};
+use crate::cloud::PASS_PIECE;
+use crate::geom::{dist2, Point3};
 
 /// Bits per axis of a cell coordinate.
 const BITS: u32 = 21;

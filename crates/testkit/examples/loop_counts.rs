@@ -9,9 +9,8 @@
 
 use std::collections::BTreeMap;
 
-use trim::edges::{reconstruct_edges, EdgeOptions};
-use trim::synthetic::{self, SyntheticCloud};
-use trim::{detect_boundary, BpdOptions};
+use testkit::synthetic::{self, SyntheticCloud};
+use trim::{detect_boundary, reconstruct_edges, BpdOptions, EdgeOptions};
 
 type Maker = Box<dyn Fn(u64) -> SyntheticCloud>;
 

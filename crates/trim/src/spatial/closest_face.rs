@@ -20,7 +20,7 @@ use parry3d_f64::query::PointQuery;
 use parry3d_f64::shape::Triangle;
 use rayon::prelude::*;
 
-use crate::cloud::{norm2, Point3};
+use crate::geom::{norm2, Point3};
 use crate::mesh::Mesh;
 
 /// Faces per leaf.

@@ -1,17 +1,19 @@
 //! Ω/Ψ on blades *decimated* to their resolution, as the paper's clouds
-//! were ([`trim::synthetic::decimated_blade`]: Poisson-disk elimination of
+//! were ([`testkit::synthetic::decimated_blade`]: Poisson-disk elimination of
 //! a dense jittered blade), at 4, 8, 16 and 34 mm, two sampling seeds, the
 //! anisotropy map on and off, five noise patterns each; then the same for
 //! the variable-density blade decimated alike
-//! ([`trim::synthetic::decimated_variable_density`], 3.4 → 34 mm, the
+//! ([`testkit::synthetic::decimated_variable_density`], 3.4 → 34 mm, the
 //! paper's cloud e), sampling seeds 5–10. Prints a markdown table: β's mean
 //! and spread (the paper's Table 1 rows), then Ω and Ψ by the paper's rule
 //! and against the truth, one value per noise pattern.
 //!
 //! `cargo run --release -p meshtrim-trim --example noise_decimated`
 
-use trim::evaluate::{noise_robustness, percent_sweep, NoiseRobustness};
-use trim::synthetic;
+use testkit::{
+    evaluate::{noise_robustness, percent_sweep, NoiseRobustness},
+    synthetic,
+};
 use trim::BpdOptions;
 
 fn main() {

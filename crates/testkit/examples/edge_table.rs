@@ -12,11 +12,12 @@
 
 use std::time::Instant;
 
-use trim::edge_metrics::{points_to_polyline, polyline_to_truth_in_spacings, DistanceStats};
-use trim::edges::baseline::{polynomial_edge, smoothing_spline_edge};
-use trim::edges::{reconstruct_edges, EdgeOptions, Edges};
-use trim::synthetic::{self, SyntheticCloud};
-use trim::{detect_boundary, BpdOptions, Point3};
+use testkit::{
+    baseline::{polynomial_edge, smoothing_spline_edge},
+    edge_metrics::{points_to_polyline, polyline_to_truth_in_spacings, DistanceStats},
+    synthetic::{self, SyntheticCloud},
+};
+use trim::{detect_boundary, reconstruct_edges, BpdOptions, EdgeOptions, Edges, Point3};
 
 /// One smoothed edge with the raw boundary points it was fitted to.
 struct Piece {

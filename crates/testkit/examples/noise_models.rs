@@ -20,9 +20,8 @@
 //!
 //! `cargo run --release -p meshtrim-trim --example noise_models`
 
-use trim::neighbours::NeighbourIndex;
-use trim::synthetic::{self, SyntheticCloud, P3};
-use trim::{detect_boundary, BpdOptions, Detection};
+use testkit::synthetic::{self, SyntheticCloud, P3};
+use trim::{detect_boundary, BpdOptions, Detection, NeighbourIndex};
 
 const SEED: u64 = 7;
 
@@ -80,7 +79,7 @@ fn pca_normals(points: &[P3]) -> Vec<P3> {
     (0..points.len())
         .map(|i| {
             index.nearest(i, 30, &mut members);
-            let n = trim::frame::fit_plane(points, &members).normal;
+            let n = trim::fit_plane(points, &members).normal;
             let largest = (0..3)
                 .max_by(|&a, &b| n[a].abs().total_cmp(&n[b].abs()))
                 .unwrap_or(2);

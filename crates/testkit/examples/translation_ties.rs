@@ -8,7 +8,7 @@
 //!
 //! `cargo run --release -p meshtrim-trim --example translation_ties`
 
-use trim::synthetic::{jittered_grid, Circle, Region, SpacingField, Surface};
+use testkit::synthetic::{jittered_grid, Circle, Region, SpacingField, Surface};
 use trim::{detect_boundary, BpdOptions, Point3};
 
 fn main() {

@@ -1,12 +1,14 @@
 //! How much Ω and Ψ depend on the draw: the noise sweep (1 % steps to
 //! 200 %, default options) on blades at 4, 8 and 16 mm, two sampling seeds
 //! each, five noise patterns each. Prints one markdown row per cloud, each
-//! cell Ω / Ψ / Ω vs truth / Ψ vs truth in % (see `trim::evaluate`).
+//! cell Ω / Ψ / Ω vs truth / Ψ vs truth in % (see `testkit::evaluate`).
 //!
 //! `cargo run --release -p meshtrim-trim --example noise_seed_spread`
 
-use trim::evaluate::{noise_robustness, percent_sweep};
-use trim::synthetic;
+use testkit::{
+    evaluate::{noise_robustness, percent_sweep},
+    synthetic,
+};
 use trim::BpdOptions;
 fn main() {
     let sweep = percent_sweep(1.0, 200.0);

@@ -17,8 +17,8 @@ use std::ops::Range;
 
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 
-use crate::cloud::Point3;
-use crate::morton::MortonCells;
+use crate::geom::Point3;
+use crate::spatial::morton::MortonCells;
 
 /// A k-NN index over a slice of distinct points.
 pub struct NeighbourIndex<'a> {
@@ -167,7 +167,7 @@ impl<'a> NeighbourIndex<'a> {
         loop {
             found.clear();
             cells.within(self.points, p, radius, |j| {
-                let d2 = crate::cloud::dist2(p, self.points[j as usize]);
+                let d2 = crate::geom::dist2(p, self.points[j as usize]);
                 found.push((j as usize != i, tie_key(d2), self.rank(j), j));
             });
             let everything = found.len() == self.points.len();
@@ -295,7 +295,7 @@ impl NeighbourIndex<'_> {
         // distance, and the last shell scanned is only 1/SHELLS of them.
         s.shell_scale = SHELLS as f64 / (radius * radius);
         let shell_of =
-            |q: Point3| ((crate::cloud::dist2(centre, q) * s.shell_scale) as usize).min(SHELLS - 1);
+            |q: Point3| ((crate::geom::dist2(centre, q) * s.shell_scale) as usize).min(SHELLS - 1);
         let mut starts = [0u32; SHELLS + 1];
         s.shells.clear();
         s.shells.extend(s.rank_and_index.iter().map(|&ri| {
@@ -330,7 +330,7 @@ impl NeighbourIndex<'_> {
                 *m += c / n;
             }
         }
-        let key = |p: &usize| crate::cloud::dist2(mean, self.points[*p]);
+        let key = |p: &usize| crate::geom::dist2(mean, self.points[*p]);
         run.min_by(|a, b| key(a).total_cmp(&key(b)))
             .expect("run is not empty")
     }
@@ -387,7 +387,7 @@ fn select_within(
     // cleared per query.
     let mut len = 0;
     for (&q, &position) in s.coords[..end].iter().zip(&s.positions) {
-        let d = crate::cloud::dist2(p, q);
+        let d = crate::geom::dist2(p, q);
         s.keyed[len] = (tie_key(d) << POSITION_BITS) | u64::from(position);
         len += usize::from(d <= reach2);
     }
@@ -501,20 +501,21 @@ pub(crate) fn tie_key(d2: f64) -> u64 {
 const TIE_BITS: u32 = 26;
 
 fn dist(a: Point3, b: Point3) -> f64 {
-    crate::cloud::dist2(a, b).sqrt()
+    crate::geom::dist2(a, b).sqrt()
 }
 
 fn magnitude(p: Point3) -> f64 {
     p.iter().fold(0.0, |m, c| m.max(c.abs()))
 }
 
+#[cfg(test)]
 /// Reference k-NN by sorting all distances; for tests.
 pub fn nearest_brute_force(points: &[Point3], i: usize, k: usize) -> Vec<u32> {
     let p = points[i];
     let mut all: Vec<(bool, u64, u32)> = points
         .iter()
         .enumerate()
-        .map(|(j, q)| (j != i, tie_key(crate::cloud::dist2(p, *q)), j as u32))
+        .map(|(j, q)| (j != i, tie_key(crate::geom::dist2(p, *q)), j as u32))
         .collect();
     all.sort_unstable();
     all.into_iter().take(k).map(|t| t.2).collect()
@@ -615,7 +616,7 @@ mod tests {
     /// index: by runs (gathers, and the fallbacks given a radius) and by
     /// single queries (which find their own radius).
     fn assert_morton_matches_brute_force(raw: &[Point3]) {
-        use crate::morton::{spatial_order, MortonCells, MortonGrid};
+        use crate::spatial::morton::{spatial_order, MortonCells, MortonGrid};
         let grid = MortonGrid::of(raw);
         let (order, keys) = spatial_order(raw, &grid);
         let points: Vec<Point3> = order.iter().map(|&i| raw[i as usize]).collect();
@@ -658,7 +659,7 @@ mod tests {
     /// cannot grow; the query must still end, with the point itself.
     #[test]
     fn morton_index_answers_k_1() {
-        use crate::morton::{spatial_order, MortonCells, MortonGrid};
+        use crate::spatial::morton::{spatial_order, MortonCells, MortonGrid};
         let pts = sheet_and_grid(14, 300);
         let grid = MortonGrid::of(&pts);
         let (order, keys) = spatial_order(&pts, &grid);

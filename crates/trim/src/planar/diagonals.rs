@@ -14,7 +14,7 @@
 
 use crate::hash::{HashMap, HashSet};
 
-use super::orient;
+use crate::geom::orient;
 
 /// Quads whose in-circle determinant is below this, relative to the
 /// fourth power of their size, count as co-circular. Far above the rounding

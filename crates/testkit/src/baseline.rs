@@ -72,7 +72,8 @@
 
 use nalgebra::DMatrix;
 
-use crate::cloud::{dist2, Point3};
+use crate::vec3::dist2;
+use trim::Point3;
 
 /// Inputs with fewer points are returned unchanged.
 pub const MIN_POINTS: usize = 4;

@@ -60,7 +60,7 @@ use std::f64::consts::PI;
 
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 
-use crate::cloud::dist2;
+use crate::vec3::dist2;
 
 pub mod jagged;
 
@@ -546,7 +546,7 @@ pub struct RangeScan {
     /// The reported points (each moved along its line of sight).
     pub points: Vec<P3>,
     /// The scanner's line of sight.
-    pub view: crate::bpd::View,
+    pub view: trim::View,
 }
 
 /// Two range scans of `truth` whose line of sight is inclined 40° to its
@@ -562,12 +562,12 @@ pub fn range_scans(truth: &SyntheticCloud, spacing: f64) -> [RangeScan; 2] {
         RangeScan {
             scanner: "orthographic",
             points: truth.with_quantised_depth(sight, 1.5 * spacing),
-            view: crate::bpd::View::Along(sight),
+            view: trim::View::Along(sight),
         },
         RangeScan {
             scanner: "from a camera",
             points: truth.with_quantised_range(camera, 1.5 * spacing),
-            view: crate::bpd::View::From(camera),
+            view: trim::View::From(camera),
         },
     ]
 }

@@ -4,8 +4,10 @@
 //!
 //! `cargo run --release -p meshtrim-trim --example noise_sweep`
 
-use trim::evaluate::{noise_robustness, percent_sweep, precision_recall};
-use trim::synthetic;
+use testkit::{
+    evaluate::{noise_robustness, percent_sweep, precision_recall},
+    synthetic,
+};
 use trim::{detect_boundary, BpdOptions};
 
 fn main() {

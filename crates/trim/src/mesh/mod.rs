@@ -3,9 +3,10 @@
 
 use crate::hash::HashMap;
 
-use crate::cloud::{cross, norm2, out_of_range, sub, Point3};
+use crate::cloud::out_of_range;
 use crate::cloud::{MAX_COORDINATE, MIN_LARGEST_COORDINATE};
 use crate::error::MeshError;
+use crate::geom::{cross, norm2, sub, Point3};
 
 /// An indexed triangle mesh.
 #[derive(Debug, Clone, PartialEq, Default)]

@@ -7,10 +7,11 @@
 //!
 //! `cargo run --release -p meshtrim-trim --example range_scan`
 
-use trim::bpd::View;
-use trim::evaluate::precision_recall;
-use trim::synthetic::{blade_with_jitter, tilted, SyntheticCloud, P3};
-use trim::{detect_boundary, BpdOptions};
+use testkit::{
+    evaluate::precision_recall,
+    synthetic::{blade_with_jitter, tilted, SyntheticCloud, P3},
+};
+use trim::{detect_boundary, BpdOptions, View};
 
 fn main() {
     println!("| cloud | incidence | depth | map | P / R along the normal | P / R along the line of sight |");

@@ -24,9 +24,10 @@
 
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 
-use crate::cloud::{dist2, dot, norm2, sub, Point3};
 use crate::evaluate::BoundaryIndex;
 use crate::synthetic::SyntheticCloud;
+use crate::vec3::{dist2, dot, norm2, sub};
+use trim::Point3;
 
 /// Turning angle above which a vertex of a true boundary is a corner
 /// ([`true_corners`]), in degrees.

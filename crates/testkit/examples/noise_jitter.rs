@@ -5,8 +5,10 @@
 //!
 //! `cargo run --release -p meshtrim-trim --example noise_jitter`
 
-use trim::evaluate::{noise_robustness, percent_sweep};
-use trim::synthetic;
+use testkit::{
+    evaluate::{noise_robustness, percent_sweep},
+    synthetic,
+};
 use trim::BpdOptions;
 
 fn main() {
@@ -26,7 +28,7 @@ fn main() {
                     .iter()
                     .map(|&s| noise_robustness(&cloud, &sweep, &options, s).expect("valid cloud"))
                     .collect();
-                let column = |f: &dyn Fn(&trim::evaluate::NoiseRobustness) -> String| {
+                let column = |f: &dyn Fn(&testkit::evaluate::NoiseRobustness) -> String| {
                     runs.iter().map(f).collect::<Vec<_>>().join(" / ")
                 };
                 println!(

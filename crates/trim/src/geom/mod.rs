@@ -1,0 +1,22 @@
+//! Geometry shared by every stage: vector arithmetic on points, planar
+//! predicates, medians and union-find.
+
+mod predicates;
+mod union_find;
+mod vec3;
+
+pub(crate) use predicates::{orient, segments_meet};
+pub(crate) use union_find::UnionFind;
+pub use vec3::Point3;
+pub(crate) use vec3::{cross, dist2, dot, norm2, sub};
+
+/// The median of the finite values (the upper one of an even count), or 1
+/// when there is none: a scale that is never zero or NaN.
+pub(crate) fn median(values: &[f64]) -> f64 {
+    let mut v: Vec<f64> = values.iter().copied().filter(|b| b.is_finite()).collect();
+    if v.is_empty() {
+        return 1.0;
+    }
+    let mid = v.len() / 2;
+    *v.select_nth_unstable_by(mid, f64::total_cmp).1
+}

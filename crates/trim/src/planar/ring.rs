@@ -1,0 +1,254 @@
+//! Smoothed loops as closed polylines, and their repair where they cross
+//! themselves in a projection.
+
+use super::SegmentGrid;
+use crate::edges::Loop;
+use crate::geom::Point3;
+
+/// Consecutive vertices of a ring closer than this many β in the
+/// projection are merged: they would make zero-length constraints.
+const MERGE: f64 = 1e-6;
+
+/// Why smoothed loops cannot bound a triangulation in a projection.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Tangle {
+    /// Ring `index` crosses itself, and the repair would drop `dropped` of
+    /// its `vertices` vertices.
+    SelfCrossing {
+        index: usize,
+        vertices: usize,
+        dropped: usize,
+    },
+    /// Rings `a` and `b` (a < b) cross or touch.
+    Crossing { a: usize, b: usize },
+}
+
+/// One smoothed loop as a closed polyline.
+#[derive(Debug, Clone)]
+pub(crate) struct Ring {
+    pub(crate) p3: Vec<Point3>,
+    pub(crate) p2: Vec<[f64; 2]>,
+    /// The boundary point each vertex was smoothed from.
+    pub(crate) reference: Vec<u32>,
+    pub(crate) beta: Vec<f64>,
+}
+
+impl Ring {
+    pub(crate) fn from_loop(lp: &Loop, beta: &[f64]) -> Self {
+        let n = lp.boundary_points.len().max(1);
+        let mut ring = Ring {
+            p3: Vec::new(),
+            p2: Vec::new(),
+            reference: Vec::new(),
+            beta: Vec::new(),
+        };
+        for (k, edge) in lp.edges.iter().enumerate() {
+            let from = lp.corners.get(k).copied().unwrap_or(0);
+            let take = if edge.closed {
+                edge.points.len()
+            } else {
+                edge.points.len().saturating_sub(1)
+            };
+            for (j, &p) in edge.points.iter().take(take).enumerate() {
+                let r = lp.boundary_points.get((from + j) % n).copied().unwrap_or(0);
+                ring.p3.push(p);
+                ring.reference.push(r);
+                ring.beta.push(beta.get(r as usize).copied().unwrap_or(0.0));
+            }
+        }
+        ring
+    }
+
+    pub(crate) fn len(&self) -> usize {
+        self.p2.len()
+    }
+
+    pub(crate) fn retain(&mut self, keep: &[bool]) {
+        let mut k = keep.iter();
+        self.p3.retain(|_| *k.next().unwrap_or(&true));
+        let mut k = keep.iter();
+        self.p2.retain(|_| *k.next().unwrap_or(&true));
+        let mut k = keep.iter();
+        self.reference.retain(|_| *k.next().unwrap_or(&true));
+        let mut k = keep.iter();
+        self.beta.retain(|_| *k.next().unwrap_or(&true));
+    }
+
+    /// Merges each vertex into its predecessor when they coincide in 2D
+    /// (within [`MERGE`]·β); returns how many went.
+    pub(crate) fn merge_coincident(&mut self) -> usize {
+        let m = self.len();
+        let mut keep = vec![true; m];
+        let mut last = 0;
+        for (j, k) in keep.iter_mut().enumerate().skip(1) {
+            if dist2d(self.p2[j], self.p2[last]) <= MERGE * self.beta[j] {
+                *k = false;
+            } else {
+                last = j;
+            }
+        }
+        // The closing segment.
+        while last > 0 && dist2d(self.p2[last], self.p2[0]) <= MERGE * self.beta[last] {
+            keep[last] = false;
+            last = (0..last).rev().find(|&j| keep[j]).unwrap_or(0);
+        }
+        let dropped = keep.iter().filter(|&&k| !k).count();
+        self.retain(&keep);
+        dropped
+    }
+
+    /// Signed area in 2D (positive counter-clockwise).
+    pub(crate) fn area(&self) -> f64 {
+        let m = self.len();
+        let o = self.p2.first().copied().unwrap_or([0.0; 2]);
+        (0..m)
+            .map(|j| {
+                let (a, b) = (self.p2[j], self.p2[(j + 1) % m]);
+                (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+            })
+            .sum::<f64>()
+            * 0.5
+    }
+}
+
+pub(super) fn dist2d(a: [f64; 2], b: [f64; 2]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)).sqrt()
+}
+
+/// Repairs self-crossing loops and checks that the loops do not meet;
+/// returns the segment grid of the valid loops (cells no smaller than
+/// `min_cell`) and how many vertices the repairs dropped. A loop that
+/// crosses itself loses the vertices of the shorter side of the crossing
+/// (a twist, or a spike that turns straight back), as long as that takes
+/// at most `max_repair` of its vertices (4 may always go).
+pub(crate) fn untwist(
+    rings: &mut [Ring],
+    min_cell: f64,
+    max_repair: f64,
+) -> Result<(SegmentGrid, usize), Tangle> {
+    let original: Vec<usize> = rings.iter().map(Ring::len).collect();
+    let mut dropped = vec![0usize; rings.len()];
+    loop {
+        for (l, ring) in rings.iter().enumerate() {
+            if ring.len() < 3 {
+                return Err(Tangle::SelfCrossing {
+                    index: l,
+                    vertices: original[l],
+                    dropped: original[l] - ring.len(),
+                });
+            }
+        }
+        let grid = SegmentGrid::new(rings, min_cell);
+        let Some((s, t)) = grid.first_crossing() else {
+            return Ok((grid, dropped.iter().sum()));
+        };
+        let ((l, i), (k, j)) = (grid.owner[s as usize], grid.owner[t as usize]);
+        if l != k {
+            return Err(Tangle::Crossing {
+                a: l.min(k) as usize,
+                b: l.max(k) as usize,
+            });
+        }
+        let l = l as usize;
+        let m = rings[l].len();
+        let (i, j) = (i.min(j) as usize, i.max(j) as usize);
+        // Drop vertices i+1..=j, or j+1..=i round the end: the fewer.
+        let mut keep = vec![true; m];
+        if j - i <= m - (j - i) {
+            keep[i + 1..=j].iter_mut().for_each(|k| *k = false);
+        } else {
+            keep[j + 1..].iter_mut().for_each(|k| *k = false);
+            keep[..=i].iter_mut().for_each(|k| *k = false);
+        }
+        let gone = keep.iter().filter(|&&k| !k).count();
+        dropped[l] += gone;
+        let limit = ((max_repair * original[l] as f64) as usize).max(4);
+        if dropped[l] > limit {
+            return Err(Tangle::SelfCrossing {
+                index: l,
+                vertices: original[l],
+                dropped: dropped[l],
+            });
+        }
+        rings[l].retain(&keep);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ring(p2: Vec<[f64; 2]>) -> Ring {
+        Ring {
+            p3: p2.iter().map(|p| [p[0], p[1], 0.0]).collect(),
+            reference: vec![0; p2.len()],
+            beta: vec![1.0; p2.len()],
+            p2,
+        }
+    }
+
+    /// A square of side `s` at `o`, 4·k vertices counter-clockwise.
+    fn square(o: [f64; 2], s: f64, k: usize) -> Vec<[f64; 2]> {
+        let t = |i: usize| s * i as f64 / k as f64;
+        let mut p = Vec::new();
+        p.extend((0..k).map(|i| [o[0] + t(i), o[1]]));
+        p.extend((0..k).map(|i| [o[0] + s, o[1] + t(i)]));
+        p.extend((0..k).map(|i| [o[0] + s - t(i), o[1] + s]));
+        p.extend((0..k).map(|i| [o[0], o[1] + s - t(i)]));
+        p
+    }
+
+    #[test]
+    fn a_small_twist_is_untwisted() {
+        let mut p = square([0.0, 0.0], 10.0, 20);
+        // A bow tie: segments 4→5 and 6→7 cross.
+        p[5] = [3.0, 0.5];
+        p[6] = [2.0, 0.5];
+        let mut rings = vec![ring(p)];
+        let (grid, dropped) = untwist(&mut rings, 0.1, 0.05).unwrap();
+        assert!(grid.first_crossing().is_none());
+        assert_eq!(dropped, 2);
+        assert!(grid.parity([5.0, 5.0]) && !grid.parity([11.0, 5.0]));
+    }
+
+    #[test]
+    fn a_figure_eight_is_not_repaired() {
+        let mut p = square([0.0, 0.0], 10.0, 20);
+        // Swap the top side's x: the loop crosses itself in the middle.
+        for q in p.iter_mut().skip(40).take(20) {
+            q[0] = 10.0 - q[0];
+        }
+        let mut rings = vec![ring(p)];
+        assert!(matches!(
+            untwist(&mut rings, 0.1, 0.05),
+            Err(Tangle::SelfCrossing { index: 0, .. })
+        ));
+    }
+
+    #[test]
+    fn crossing_loops_are_reported() {
+        let mut rings = vec![
+            ring(square([0.0, 0.0], 10.0, 10)),
+            ring(square([8.0, 8.0], 5.0, 5)),
+        ];
+        assert!(matches!(
+            untwist(&mut rings, 0.1, 0.05),
+            Err(Tangle::Crossing { a: 0, b: 1 })
+        ));
+    }
+
+    #[test]
+    fn parity_sees_holes_and_patches() {
+        let rings = vec![
+            ring(square([0.0, 0.0], 10.0, 10)),
+            ring(square([3.0, 3.0], 4.0, 4)),
+            ring(square([20.0, 0.0], 5.0, 5)),
+        ];
+        let grid = SegmentGrid::new(&rings, 0.1);
+        assert!(grid.parity([1.0, 1.0]));
+        assert!(!grid.parity([5.0, 5.0]));
+        assert!(!grid.parity([15.0, 1.0]));
+        assert!(grid.parity([22.0, 2.0]));
+        assert!(grid.near([10.05, 5.0], 0.1) && !grid.near([10.2, 5.0], 0.1));
+    }
+}

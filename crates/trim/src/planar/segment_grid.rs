@@ -1,0 +1,207 @@
+//! The loops' segments in a uniform grid.
+
+use super::ring::{dist2d, Ring};
+use crate::geom::{orient, segments_meet};
+
+/// The loops' segments in a uniform grid, for parity, proximity and
+/// crossing queries in 2D.
+pub(crate) struct SegmentGrid {
+    a: Vec<[f64; 2]>,
+    b: Vec<[f64; 2]>,
+    /// (loop, index of the segment's first vertex in it).
+    pub(crate) owner: Vec<(u32, u32)>,
+    sizes: Vec<u32>,
+    x0: f64,
+    y0: f64,
+    cell: f64,
+    nx: usize,
+    ny: usize,
+    cells: Vec<Vec<u32>>,
+}
+
+impl SegmentGrid {
+    pub(crate) fn new(rings: &[Ring], min_cell: f64) -> Self {
+        let mut g = SegmentGrid {
+            a: Vec::new(),
+            b: Vec::new(),
+            owner: Vec::new(),
+            sizes: rings.iter().map(|r| r.len() as u32).collect(),
+            x0: 0.0,
+            y0: 0.0,
+            cell: 1.0,
+            nx: 1,
+            ny: 1,
+            cells: Vec::new(),
+        };
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        let mut length = 0.0;
+        for (l, ring) in rings.iter().enumerate() {
+            let m = ring.len();
+            for i in 0..m {
+                let (a, b) = (ring.p2[i], ring.p2[(i + 1) % m]);
+                for c in 0..2 {
+                    lo[c] = lo[c].min(a[c]);
+                    hi[c] = hi[c].max(a[c]);
+                }
+                length += dist2d(a, b);
+                g.a.push(a);
+                g.b.push(b);
+                g.owner.push((l as u32, i as u32));
+            }
+        }
+        let segments = g.a.len();
+        if segments == 0 {
+            g.cells = vec![Vec::new()];
+            return g;
+        }
+        let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]).max(f64::MIN_POSITIVE);
+        let mut cell = (2.0 * length / segments as f64)
+            .max(min_cell)
+            .max(extent * 1e-9);
+        let dims = |cell: f64| {
+            (
+                ((hi[0] - lo[0]) / cell).floor() as usize + 1,
+                ((hi[1] - lo[1]) / cell).floor() as usize + 1,
+            )
+        };
+        while {
+            let (nx, ny) = dims(cell);
+            nx.saturating_mul(ny) > 4 * segments + 16
+        } {
+            cell *= 1.5;
+        }
+        (g.nx, g.ny) = dims(cell);
+        g.x0 = lo[0];
+        g.y0 = lo[1];
+        g.cell = cell;
+        g.cells = vec![Vec::new(); g.nx * g.ny];
+        for s in 0..segments {
+            let (a, b) = (g.a[s], g.b[s]);
+            let (c0, c1) = (g.col(a[0].min(b[0])), g.col(a[0].max(b[0])));
+            let (r0, r1) = (g.row(a[1].min(b[1])), g.row(a[1].max(b[1])));
+            for r in r0..=r1 {
+                for c in c0..=c1 {
+                    g.cells[r * g.nx + c].push(s as u32);
+                }
+            }
+        }
+        g
+    }
+
+    fn col(&self, x: f64) -> usize {
+        (((x - self.x0) / self.cell).floor().max(0.0) as usize).min(self.nx - 1)
+    }
+
+    fn row(&self, y: f64) -> usize {
+        (((y - self.y0) / self.cell).floor().max(0.0) as usize).min(self.ny - 1)
+    }
+
+    /// True if `p` is inside an odd number of loops (ray to +x).
+    pub(crate) fn parity(&self, p: [f64; 2]) -> bool {
+        if self.a.is_empty()
+            || p[1] < self.y0
+            || p[1] > self.y0 + self.cell * self.ny as f64
+            || p[0] > self.x0 + self.cell * self.nx as f64
+        {
+            return false;
+        }
+        let r = self.row(p[1]);
+        let mut odd = false;
+        for c in self.col(p[0])..self.nx {
+            for &s in &self.cells[r * self.nx + c] {
+                let (a, b) = (self.a[s as usize], self.b[s as usize]);
+                if (a[1] > p[1]) != (b[1] > p[1]) {
+                    let t = (p[1] - a[1]) / (b[1] - a[1]);
+                    let x = (a[0] + t * (b[0] - a[0])).clamp(a[0].min(b[0]), a[0].max(b[0]));
+                    if x > p[0] && self.col(x) == c {
+                        odd = !odd;
+                    }
+                }
+            }
+        }
+        odd
+    }
+
+    /// True if a segment passes within `radius` of `p`.
+    pub(crate) fn near(&self, p: [f64; 2], radius: f64) -> bool {
+        if self.a.is_empty() {
+            return false;
+        }
+        let (c0, c1) = (self.col(p[0] - radius), self.col(p[0] + radius));
+        let (r0, r1) = (self.row(p[1] - radius), self.row(p[1] + radius));
+        for r in r0..=r1 {
+            for c in c0..=c1 {
+                for &s in &self.cells[r * self.nx + c] {
+                    let (a, b) = (self.a[s as usize], self.b[s as usize]);
+                    let ab = [b[0] - a[0], b[1] - a[1]];
+                    let len2 = ab[0] * ab[0] + ab[1] * ab[1];
+                    let t = if len2 > 0.0 {
+                        (((p[0] - a[0]) * ab[0] + (p[1] - a[1]) * ab[1]) / len2).clamp(0.0, 1.0)
+                    } else {
+                        0.0
+                    };
+                    let q = [a[0] + t * ab[0], a[1] + t * ab[1]];
+                    if dist2d(p, q) < radius {
+                        return true;
+                    }
+                }
+            }
+        }
+        false
+    }
+
+    /// True if a loop segment meets the segment from `p` to `q`.
+    pub(crate) fn crosses(&self, p: [f64; 2], q: [f64; 2]) -> bool {
+        if self.a.is_empty() {
+            return false;
+        }
+        let (c0, c1) = (self.col(p[0].min(q[0])), self.col(p[0].max(q[0])));
+        let (r0, r1) = (self.row(p[1].min(q[1])), self.row(p[1].max(q[1])));
+        (r0..=r1).any(|r| {
+            (c0..=c1).any(|c| {
+                self.cells[r * self.nx + c]
+                    .iter()
+                    .any(|&s| segments_meet(self.a[s as usize], self.b[s as usize], p, q))
+            })
+        })
+    }
+
+    /// Some pair of segments that meet other than at their shared vertex
+    /// (or that share one and turn straight back).
+    pub(crate) fn first_crossing(&self) -> Option<(u32, u32)> {
+        for cell in &self.cells {
+            for (x, &s) in cell.iter().enumerate() {
+                for &t in &cell[x + 1..] {
+                    let (ls, is) = self.owner[s as usize];
+                    let (lt, it) = self.owner[t as usize];
+                    let (sa, sb) = (self.a[s as usize], self.b[s as usize]);
+                    let (ta, tb) = (self.a[t as usize], self.b[t as usize]);
+                    if ls == lt {
+                        let m = self.sizes[ls as usize];
+                        let (first, second) = if (is + 1) % m == it {
+                            ((sa, sb), (ta, tb))
+                        } else if (it + 1) % m == is {
+                            ((ta, tb), (sa, sb))
+                        } else {
+                            if segments_meet(sa, sb, ta, tb) {
+                                return Some((s, t));
+                            }
+                            continue;
+                        };
+                        // Adjacent: a spike turns straight back.
+                        let (p, q, r) = (first.0, first.1, second.1);
+                        let back = (q[0] - p[0]) * (r[0] - q[0]) + (q[1] - p[1]) * (r[1] - q[1]);
+                        if m > 3 && orient(p, q, r) == 0.0 && back < 0.0 {
+                            return Some((s, t));
+                        }
+                        continue;
+                    }
+                    if segments_meet(sa, sb, ta, tb) {
+                        return Some((s, t));
+                    }
+                }
+            }
+        }
+        None
+    }
+}
