@@ -3,24 +3,21 @@
 //! Everything that touches files or the terminal lives here; the algorithms
 //! live in the `trim` library crate, which does no I/O.
 //!
-//! - [`io`] reads point clouds and meshes (PLY, PCD, OBJ, XYZ/CSV text) and
-//!   writes results atomically.
-//! - [`cli`] defines the command line and runs its subcommands.
-//! - [`detect`] is the `meshtrim detect` subcommand.
-//! - [`edges`] is the `meshtrim edges` subcommand.
-//! - [`clean_cmd`] is `meshtrim clean`.
-//! - [`batch`] is `meshtrim batch`: many meshes at once.
-//! - [`console`] prints summaries to stdout; a closed pipe is not an error.
+//! - [`io`] reads point clouds and meshes (PLY, PCD, OBJ, STL, glTF,
+//!   XYZ/CSV text) and writes results atomically.
+//! - [`commands`]: one module per command (`detect`, `edges`, `trim`,
+//!   `mesh`, `clean`, `batch`), each with its own arguments and `run`.
+//! - [`cli`] assembles the commands' arguments into the top-level parser;
+//!   only `main` uses it.
+//! - `stages` turns the shared options into the library's and runs the
+//!   first stages (read, detect) for every command; `report` and
+//!   `console` print and write reports.
 //! - [`alloc`] tunes the memory allocator for repeated large buffers.
 
 pub mod alloc;
-pub mod batch;
-pub mod clean_cmd;
 pub mod cli;
-pub mod console;
-pub mod detect;
-pub mod edges;
+pub mod commands;
+mod console;
 pub mod io;
-pub mod mesh_cmd;
-pub mod report;
-pub mod trim;
+mod report;
+mod stages;

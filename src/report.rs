@@ -55,12 +55,21 @@ pub fn check_outputs(output: &Path, report: Option<&Path>, inputs: &[&Path]) -> 
         }
     }
     for input in inputs {
-        let overwrites = |out: &Path| crate::detect::same_file(out, input);
+        let overwrites = |out: &Path| same_file(out, input);
         if overwrites(output) || report.is_some_and(overwrites) {
             bail!("{}: an output would overwrite this input", input.display());
         }
     }
     Ok(())
+}
+
+/// True when `a` and `b` name the same existing file (an output must never
+/// overwrite an input).
+pub(crate) fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
 }
 
 #[cfg(test)]

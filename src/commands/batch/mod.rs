@@ -16,20 +16,57 @@ pub use plan::{CloudMatch, Job, Shard};
 pub use report::{Mode, Outcome, ReportFormat, Row, Status};
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{anyhow, bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
-use crate::clean_cmd::clean_file;
-use crate::cli::BatchArgs;
+use super::clean::clean_file;
+use super::trim::{trim_file, TrimSettings};
+use crate::commands::args::StageArgs;
 use crate::console;
-use crate::detect::millis;
-use crate::trim::{trim_file, TrimSettings};
+use crate::stages::{millis, Stages};
+
+/// Arguments of `meshtrim batch`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct Args {
+    /// Meshes (.stl, .ply, .obj, .gltf, .glb): files, directories (walked
+    /// recursively) and glob patterns (quote them: 'scans/*.ply'). A mesh
+    /// S.ext is trimmed when a cloud S.cloud.EXT or S.EXT with EXT one of
+    /// pcd xyz txt csv asc pts sits beside it, and cleaned otherwise;
+    /// clouds are never inputs themselves.
+    #[arg(required = true, value_name = "INPUTS")]
+    pub inputs: Vec<PathBuf>,
+    /// Where the outputs go: the input's path below the directory argument
+    /// it was found in (or its file name), same extension.
+    #[arg(long, value_name = "DIR")]
+    pub out_dir: PathBuf,
+    /// Look for the clouds here (mirroring the inputs' sub-directories)
+    /// instead of beside the meshes.
+    #[arg(long, value_name = "DIR")]
+    pub cloud_dir: Option<PathBuf>,
+    /// Files processed at once, and threads in all [default: all cores].
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
+    pub jobs: Option<u16>,
+    /// Write a line per file to FILE.csv or FILE.json.
+    #[arg(long, value_name = "FILE.csv|FILE.json")]
+    pub report: Option<PathBuf>,
+    /// Skip inputs whose output exists (resumes an interrupted batch).
+    #[arg(long)]
+    pub skip_existing: bool,
+    /// Process only the K-th of N deterministic shards of the sorted input
+    /// list (1-based), e.g. one per machine or array task.
+    #[arg(long, value_name = "K/N")]
+    pub shard: Option<Shard>,
+    /// Detection and edge options.
+    #[command(flatten)]
+    pub stages: StageArgs,
+}
 
 /// Runs `meshtrim batch`.
-pub fn run(args: &BatchArgs) -> Result<()> {
+pub fn run(args: &Args) -> Result<()> {
     let report_format = args
         .report
         .as_deref()
@@ -73,16 +110,17 @@ pub fn run(args: &BatchArgs) -> Result<()> {
 /// Processes the jobs on a pool of `--jobs` threads (default: rayon's, all
 /// cores or RAYON_NUM_THREADS), printing a line per file as it finishes;
 /// the rows come back in input order.
-fn process_all(jobs: &[Job], args: &BatchArgs) -> Result<Vec<Row>> {
+fn process_all(jobs: &[Job], args: &Args) -> Result<Vec<Row>> {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.jobs.map_or(0, usize::from))
         .build()
         .context("cannot start the worker threads")?;
+    let stages = args.stages.stages();
     let bar = batch_bar(jobs.len());
     let rows = pool.install(|| {
         jobs.par_iter()
             .map(|job| {
-                let row = process(job, args);
+                let row = process(job, args.skip_existing, &stages);
                 // Printed above the bar, which is redrawn below it.
                 // Best effort: a failing stdout must not stop the files;
                 // the summary below reports it.
@@ -109,7 +147,7 @@ fn batch_bar(files: usize) -> ProgressBar {
 
 /// One file, whatever happens: skipped, done, failed, or panicked (the
 /// panic is caught and reported as the file's failure).
-fn process(job: &Job, args: &BatchArgs) -> Row {
+fn process(job: &Job, skip_existing: bool, stages: &Stages) -> Row {
     let started = Instant::now();
     let mode = match job.cloud {
         CloudMatch::None => Mode::Clean,
@@ -129,10 +167,10 @@ fn process(job: &Job, args: &BatchArgs) -> Row {
         write_ms: None,
         total_ms: 0.0,
     };
-    if args.skip_existing && job.output.exists() {
+    if skip_existing && job.output.exists() {
         return row;
     }
-    let result = catch_unwind(AssertUnwindSafe(|| work(job, args)))
+    let result = catch_unwind(AssertUnwindSafe(|| work(job, stages)))
         .unwrap_or_else(|panic| Err(anyhow!("internal error: {}", panic_text(&*panic))));
     match result {
         Ok(o) => {
@@ -154,10 +192,10 @@ fn process(job: &Job, args: &BatchArgs) -> Row {
 }
 
 /// Cleans or trims one file, writing its output atomically.
-fn work(job: &Job, args: &BatchArgs) -> Result<Outcome> {
+fn work(job: &Job, stages: &Stages) -> Result<Outcome> {
     match &job.cloud {
         CloudMatch::None => {
-            let o = clean_file(&job.input, &job.output, &args.stages)?;
+            let o = clean_file(&job.input, &job.output, stages)?;
             Ok(Outcome {
                 loops: o.loops,
                 faces_in: o.faces_in,
@@ -169,8 +207,7 @@ fn work(job: &Job, args: &BatchArgs) -> Result<Outcome> {
         }
         CloudMatch::One(cloud) => {
             let settings = TrimSettings {
-                detection: args.stages.bpd_options(),
-                no_offset: args.stages.no_offset,
+                stages: stages.clone(),
                 progress: false,
             };
             let r = trim_file(&job.input, cloud, &job.output, &settings)?;

@@ -4,18 +4,72 @@
 //! supports, write the mesh, report.
 
 use std::path::Path;
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use serde::Serialize;
-use trim::{
-    reconstruct_edges, trim_mesh, BpdOptions, EdgeOptions, LoopFit, TrimOptions, TrimReport,
-};
+use trim::{reconstruct_edges, trim_mesh, LoopFit, TrimOptions, TrimReport};
 
-use crate::cli::TrimArgs;
-use crate::detect::{detect_read_cloud, millis, Detected};
+use crate::commands::args::{parse_direction, parse_k, parse_vector, StageArgs, ViewArgs};
 use crate::io::mesh_out::write_mesh;
 use crate::io::{read_cloud, read_mesh_with_faces};
+use crate::stages::{detect_read_cloud, millis, Detected, Stages};
+
+/// Arguments of the trimming (`meshtrim MESH CLOUD OUT`).
+#[derive(Debug, Clone, clap::Args)]
+pub struct Args {
+    /// The mesh to trim: .obj, .ply, .stl, .gltf or .glb.
+    #[arg(required = true)]
+    pub mesh: PathBuf,
+    /// The point cloud the mesh was reconstructed from (any cloud format
+    /// `detect` reads).
+    #[arg(required = true)]
+    pub cloud: PathBuf,
+    /// The trimmed mesh: .obj, .ply (binary), .stl (binary), .gltf or .glb.
+    /// Missing parent directories are created.
+    #[arg(required = true)]
+    pub output: PathBuf,
+    /// Also write the report as JSON to this file.
+    #[arg(long, value_name = "FILE.json")]
+    pub report: Option<PathBuf>,
+    /// Neighbourhood size of boundary detection, the point itself included.
+    #[arg(long, default_value_t = 30, value_parser = parse_k)]
+    pub k: usize,
+    /// Use the paper's isotropic detection, without the sampling-tensor map.
+    #[arg(long)]
+    pub no_anisotropy: bool,
+    /// Use the paper's edges, through the boundary points, instead of the
+    /// estimated physical edge half a row beyond them.
+    #[arg(long)]
+    pub no_offset: bool,
+    /// The scanner's line of sight X,Y,Z (see `meshtrim detect --help`).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_direction, allow_hyphen_values = true, conflicts_with = "view_from")]
+    pub view_along: Option<[f64; 3]>,
+    /// The scanner's position X,Y,Z (see `meshtrim detect --help`).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vector, allow_hyphen_values = true)]
+    pub view_from: Option<[f64; 3]>,
+    /// Print the report as one JSON object.
+    #[arg(long)]
+    pub json: bool,
+}
+
+impl Args {
+    /// The detection and edge options. (The main job's arguments spell
+    /// them out: clap cannot tell whether a flattened group inside the
+    /// optional top-level arguments was given.)
+    pub fn stage_args(&self) -> StageArgs {
+        StageArgs {
+            k: self.k,
+            no_anisotropy: self.no_anisotropy,
+            no_offset: self.no_offset,
+            view: ViewArgs {
+                view_along: self.view_along,
+                view_from: self.view_from,
+            },
+        }
+    }
+}
 
 /// What the trimming prints and `--report` writes.
 #[derive(Debug, Clone, Serialize)]
@@ -84,21 +138,18 @@ pub struct BorderFit {
 /// What trimming one mesh is told, beside its paths.
 #[derive(Debug, Clone)]
 pub struct TrimSettings {
-    /// Boundary detection's options.
-    pub detection: BpdOptions,
-    /// Cut along the smoothed boundary points instead of the estimated edge.
-    pub no_offset: bool,
+    /// Detection's and edge reconstruction's options.
+    pub stages: Stages,
     /// Whether detection may show its own progress bar (not in a batch,
     /// which has one bar for all files).
     pub progress: bool,
 }
 
 /// Runs the trimming.
-pub fn run(args: &TrimArgs) -> Result<()> {
+pub fn run(args: &Args) -> Result<()> {
     check_paths(args)?;
     let settings = TrimSettings {
-        detection: args.stages().bpd_options(),
-        no_offset: args.stages().no_offset,
+        stages: args.stage_args().stages(),
         progress: true,
     };
     let report = trim_file(&args.mesh, &args.cloud, &args.output, &settings)?;
@@ -138,17 +189,11 @@ pub fn trim_file(
         cloud_path,
         cloud,
         read_time,
-        &settings.detection,
+        &settings.stages.detection,
         settings.progress,
     )?;
     let started = Instant::now();
-    let edges = reconstruct_edges(
-        &cloud.points,
-        &detection,
-        &EdgeOptions {
-            offset: !settings.no_offset,
-        },
-    );
+    let edges = reconstruct_edges(&cloud.points, &detection, &settings.stages.edges);
     let edges_time = started.elapsed();
     let started = Instant::now();
     let (out, trimmed) = trim_mesh(
@@ -175,7 +220,7 @@ pub fn trim_file(
 
 /// Refuses unknown output formats and outputs that would overwrite an
 /// input, before any work.
-fn check_paths(args: &TrimArgs) -> Result<()> {
+fn check_paths(args: &Args) -> Result<()> {
     crate::report::check_outputs(
         &args.output,
         args.report.as_deref(),

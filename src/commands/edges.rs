@@ -2,18 +2,39 @@
 //! smooth its edges, write them, report.
 
 use std::path::Path;
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use anyhow::{bail, Result};
 use serde::Serialize;
-use trim::{reconstruct_edges, Detection, EdgeOptions, Edges};
+use trim::{reconstruct_edges, Detection, Edges};
 
-use crate::cli::EdgesArgs;
+use crate::commands::args::StageArgs;
 use crate::console;
-use crate::detect::{millis, read_and_detect, same_file, Detected};
 use crate::io::atomic::write_atomic;
 use crate::io::edges_out::{EdgeData, EdgesFormat};
 use crate::io::Cloud;
+use crate::report::same_file;
+use crate::stages::{millis, read_and_detect, Detected};
+
+/// Arguments of `meshtrim edges`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct Args {
+    /// Input point cloud: .ply, .pcd, .obj, .xyz/.txt/.csv/.asc/.pts, or a
+    /// mesh (.stl, .gltf, .glb) whose vertices are the cloud.
+    pub cloud: PathBuf,
+    /// Write the loops and edges: OUT.json (everything), OUT.obj (the
+    /// smoothed edges as polylines) or OUT.svg (a picture). Missing parent
+    /// directories are created.
+    #[arg(short, long, value_name = "OUT")]
+    pub output: PathBuf,
+    /// Detection and edge options.
+    #[command(flatten)]
+    pub stages: StageArgs,
+    /// Print the summary as one JSON object.
+    #[arg(long)]
+    pub json: bool,
+}
 
 /// What `edges` prints: the counts of each stage and the timings.
 #[derive(Debug, Clone, Serialize)]
@@ -46,20 +67,18 @@ pub struct Summary {
 }
 
 /// Runs `meshtrim edges`.
-pub fn run(args: &EdgesArgs) -> Result<()> {
+pub fn run(args: &Args) -> Result<()> {
     // Check the output before the (possibly long) work.
     let format = check_output(&args.output, &args.cloud)?;
+    let stages = args.stages.stages();
     let Detected {
         cloud,
         detection,
         read_time,
         detect_time,
-    } = read_and_detect(&args.cloud, &args.stages.bpd_options())?;
+    } = read_and_detect(&args.cloud, &stages.detection)?;
     let started = Instant::now();
-    let edge_options = EdgeOptions {
-        offset: !args.stages.no_offset,
-    };
-    let edges = reconstruct_edges(&cloud.points, &detection, &edge_options);
+    let edges = reconstruct_edges(&cloud.points, &detection, &stages.edges);
     let edges_time = started.elapsed();
     let data = EdgeData {
         points: &cloud.points,
@@ -93,7 +112,7 @@ fn check_output(out: &Path, input: &Path) -> Result<EdgesFormat> {
 
 impl Summary {
     fn new(
-        args: &EdgesArgs,
+        args: &Args,
         cloud: &Cloud,
         detection: &Detection,
         edges: &Edges,

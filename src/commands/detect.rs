@@ -1,19 +1,50 @@
 //! `meshtrim detect`: read a cloud, label its boundary points, report.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
-use anyhow::{bail, Context, Result};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use anyhow::{bail, Result};
 use serde::Serialize;
-use trim::{BpdOptions, CloudError, Detection};
+use trim::{BpdOptions, Detection};
 
-use crate::cli::DetectArgs;
+use crate::commands::args::{bpd_options, parse_k, ViewArgs};
 use crate::console;
 use crate::io::atomic::write_atomic;
 use crate::io::labels::{LabelFormat, Labelled};
-use crate::io::{read_cloud, Cloud, Point3};
+use crate::io::Point3;
+use crate::report::same_file;
+use crate::stages::{millis, read_and_detect, Detected};
+
+/// Arguments of `meshtrim detect`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct Args {
+    /// Input point cloud: .ply, .pcd, .obj, .xyz/.txt/.csv/.asc/.pts, or a
+    /// mesh (.stl, .gltf, .glb) whose vertices are the cloud.
+    pub cloud: PathBuf,
+    /// Write the points with their labels: OUT.ply (binary) or OUT.csv.
+    /// Missing parent directories are created.
+    #[arg(short, long, value_name = "OUT")]
+    pub output: Option<PathBuf>,
+    /// Neighbourhood size, the point itself included.
+    #[arg(long, default_value_t = 30, value_parser = parse_k)]
+    pub k: usize,
+    /// Use the paper's isotropic tests, without the sampling-tensor map.
+    #[arg(long)]
+    pub no_anisotropy: bool,
+    /// Where a range scanner saw the cloud from.
+    #[command(flatten)]
+    pub view: ViewArgs,
+    /// Print the summary as one JSON object.
+    #[arg(long)]
+    pub json: bool,
+}
+
+impl Args {
+    /// Boundary detection's options.
+    pub fn bpd_options(&self) -> BpdOptions {
+        bpd_options(self.k, self.no_anisotropy, &self.view)
+    }
+}
 
 /// What `detect` prints: the counts and timings of the paper's Table 1.
 #[derive(Debug, Clone, Serialize)]
@@ -55,7 +86,7 @@ pub struct Summary {
 }
 
 /// Runs `meshtrim detect`.
-pub fn run(args: &DetectArgs) -> Result<()> {
+pub fn run(args: &Args) -> Result<()> {
     // Check the output before the (possibly long) detection.
     let output = args
         .output
@@ -111,38 +142,9 @@ fn write_labels(
     write_atomic(path, |w| format.write(w, data))
 }
 
-/// BPD with a progress bar on stderr. The bar appears only once the run has
-/// taken a second, so quick runs print nothing, and indicatif hides it when
-/// stderr is not a terminal.
-pub(crate) fn detect_with_progress(
-    points: &[Point3],
-    options: &BpdOptions,
-) -> Result<Detection, CloudError> {
-    // The library counts distinct points, not known before it merges
-    // duplicates; the bar's length is all points, so with duplicates it stops
-    // short of full, and it is cleared at the end anyway.
-    let bar =
-        ProgressBar::with_draw_target(Some(points.len() as u64), ProgressDrawTarget::hidden());
-    bar.set_style(
-        ProgressStyle::with_template("detecting boundary {bar:40} {pos}/{len} points, {eta} left")
-            .expect("the template is valid"),
-    );
-    let started = Instant::now();
-    let shown = AtomicBool::new(false);
-    let progress = |done: usize| {
-        if started.elapsed() > Duration::from_secs(1) && !shown.swap(true, Ordering::Relaxed) {
-            bar.set_draw_target(ProgressDrawTarget::stderr());
-        }
-        bar.set_position(done as u64);
-    };
-    let result = trim::detect_boundary_with_progress(points, options, &progress);
-    bar.finish_and_clear();
-    result
-}
-
 impl Summary {
     fn new(
-        args: &DetectArgs,
+        args: &Args,
         cloud: &crate::io::Cloud,
         detection: &Detection,
         read_time: Duration,
@@ -220,64 +222,6 @@ fn stats(values: &[f64]) -> (f64, f64, f64, f64) {
     let mean = values.iter().sum::<f64>() / n;
     let var = values.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / n;
     (min, mean, max, var.sqrt())
-}
-
-/// A cloud read from a file and its boundary points, with the time of each
-/// step: the start of every command that works from a cloud.
-pub(crate) struct Detected {
-    pub cloud: Cloud,
-    pub detection: Detection,
-    pub read_time: Duration,
-    pub detect_time: Duration,
-}
-
-/// Reads the cloud at `path` and runs BPD on it (with the progress bar),
-/// errors naming the file.
-pub(crate) fn read_and_detect(path: &Path, options: &BpdOptions) -> Result<Detected> {
-    let started = Instant::now();
-    let cloud = read_cloud(path)?;
-    let read_time = started.elapsed();
-    detect_read_cloud(path, cloud, read_time, options, true)
-}
-
-/// Runs BPD on `cloud`, read from `path` in `read_time`, with or without
-/// the progress bar (`meshtrim batch` runs several files at once under one
-/// bar of its own, so its files' detections show none); errors name the
-/// file.
-pub(crate) fn detect_read_cloud(
-    path: &Path,
-    cloud: Cloud,
-    read_time: Duration,
-    options: &BpdOptions,
-    progress: bool,
-) -> Result<Detected> {
-    let started = Instant::now();
-    let detection = if progress {
-        detect_with_progress(&cloud.points, options)
-    } else {
-        trim::detect_boundary(&cloud.points, options)
-    }
-    .with_context(|| path.display().to_string())?;
-    Ok(Detected {
-        cloud,
-        detection,
-        read_time,
-        detect_time: started.elapsed(),
-    })
-}
-
-/// True when `a` and `b` name the same existing file (an output must never
-/// overwrite an input).
-pub(crate) fn same_file(a: &Path, b: &Path) -> bool {
-    match (a.canonicalize(), b.canonicalize()) {
-        (Ok(a), Ok(b)) => a == b,
-        _ => false,
-    }
-}
-
-/// Milliseconds, rounded to 0.1 ms.
-pub(crate) fn millis(d: Duration) -> f64 {
-    (d.as_secs_f64() * 1e4).round() / 10.0
 }
 
 #[cfg(test)]

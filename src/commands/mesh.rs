@@ -2,15 +2,35 @@
 //! cloud's boundary, triangulate the cloud in its best-fit plane with the
 //! smoothed loops as constraints (spade), lift back, write, report.
 
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use serde::Serialize;
-use trim::{delaunay_mesh_with_report, reconstruct_edges, DelaunayReport, EdgeOptions};
+use trim::{delaunay_mesh_with_report, reconstruct_edges, DelaunayReport};
 
-use crate::cli::MeshArgs;
-use crate::detect::{millis, read_and_detect, Detected};
+use crate::commands::args::StageArgs;
 use crate::io::mesh_out::write_mesh;
+use crate::stages::{millis, read_and_detect, Detected};
+
+/// Arguments of `meshtrim mesh`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct Args {
+    /// Input point cloud (any format `detect` reads).
+    pub cloud: PathBuf,
+    /// The mesh: .obj, .ply (binary), .stl (binary), .gltf or .glb.
+    /// Missing parent directories are created.
+    pub output: PathBuf,
+    /// Also write the report as JSON to this file.
+    #[arg(long, value_name = "FILE.json")]
+    pub report: Option<PathBuf>,
+    /// Detection and edge options.
+    #[command(flatten)]
+    pub stages: StageArgs,
+    /// Print the report as one JSON object.
+    #[arg(long)]
+    pub json: bool,
+}
 
 /// What `mesh` prints and `--report` writes.
 #[derive(Debug, Clone, Serialize)]
@@ -51,21 +71,19 @@ pub struct Report {
 }
 
 /// Runs `meshtrim mesh`.
-pub fn run(args: &MeshArgs) -> Result<()> {
+pub fn run(args: &Args) -> Result<()> {
     // Before the (possibly long) work: the output format, the report's
     // name, and neither may overwrite the cloud.
     crate::report::check_outputs(&args.output, args.report.as_deref(), &[&args.cloud])?;
+    let stages = args.stages.stages();
     let Detected {
         cloud,
         detection,
         read_time,
         detect_time,
-    } = read_and_detect(&args.cloud, &args.stages.bpd_options())?;
+    } = read_and_detect(&args.cloud, &stages.detection)?;
     let started = Instant::now();
-    let edge_options = EdgeOptions {
-        offset: !args.stages.no_offset,
-    };
-    let edges = reconstruct_edges(&cloud.points, &detection, &edge_options);
+    let edges = reconstruct_edges(&cloud.points, &detection, &stages.edges);
     let edges_time = started.elapsed();
     let started = Instant::now();
     let (mesh, made) = delaunay_mesh_with_report(&cloud.points, &detection, &edges)
@@ -81,7 +99,7 @@ pub fn run(args: &MeshArgs) -> Result<()> {
 
 impl Report {
     fn new(
-        args: &MeshArgs,
+        args: &Args,
         points: usize,
         faces: usize,
         made: &DelaunayReport,

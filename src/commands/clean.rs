@@ -5,20 +5,36 @@
 //! library replaces the border by its smoothed edge.
 
 use std::path::Path;
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use serde::Serialize;
 use trim::{clean_mesh, CleanOptions, CleanReport};
 
-use crate::cli::CleanArgs;
-use crate::detect::millis;
+use crate::commands::args::StageArgs;
 use crate::io::mesh_out::write_mesh;
 use crate::io::read_mesh_with_faces;
+use crate::stages::{millis, Stages};
 
-/// What one cleanup needs besides its files: the detection and edge
-/// options.
-pub type CleanSettings = crate::cli::Stages;
+/// Arguments of `meshtrim clean`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct Args {
+    /// The mesh: .obj, .ply, .stl, .gltf or .glb.
+    pub input: PathBuf,
+    /// The cleaned mesh: .obj, .ply (binary), .stl (binary), .gltf or
+    /// .glb. Missing parent directories are created.
+    pub output: PathBuf,
+    /// Also write the report as JSON to this file.
+    #[arg(long, value_name = "FILE.json")]
+    pub report: Option<PathBuf>,
+    /// Detection and edge options.
+    #[command(flatten)]
+    pub stages: StageArgs,
+    /// Print the report as one JSON object.
+    #[arg(long)]
+    pub json: bool,
+}
 
 /// The summary of one cleanup (for `batch`).
 #[derive(Debug, Clone, PartialEq)]
@@ -95,16 +111,16 @@ pub struct LeftLoops {
 }
 
 /// Runs `meshtrim clean`.
-pub fn run(args: &CleanArgs) -> Result<()> {
+pub fn run(args: &Args) -> Result<()> {
     crate::report::check_outputs(&args.output, args.report.as_deref(), &[&args.input])?;
-    let report = clean(&args.input, &args.output, &args.stages)?;
+    let report = clean(&args.input, &args.output, &args.stages.stages())?;
     crate::report::emit(&report, args.report.as_deref(), args.json)
 }
 
 /// Cleans one file without printing (the unit of `batch`).
-pub fn clean_file(input: &Path, output: &Path, settings: &CleanSettings) -> Result<CleanOutcome> {
+pub fn clean_file(input: &Path, output: &Path, stages: &Stages) -> Result<CleanOutcome> {
     crate::report::check_outputs(output, None, &[input])?;
-    let r = clean(input, output, settings)?;
+    let r = clean(input, output, stages)?;
     Ok(CleanOutcome {
         loops: r.loops_smoothed,
         faces_in: r.faces_in,
@@ -116,20 +132,19 @@ pub fn clean_file(input: &Path, output: &Path, settings: &CleanSettings) -> Resu
 }
 
 /// Reads, finds the local resolution, cleans, writes.
-fn clean(input: &Path, output: &Path, settings: &CleanSettings) -> Result<Report> {
+fn clean(input: &Path, output: &Path, stages: &Stages) -> Result<Report> {
     let started = Instant::now();
     let mesh = read_mesh_with_faces(input, "`clean` smooths the border of a mesh")?;
     let read_time = started.elapsed();
     let started = Instant::now();
-    let options = settings.bpd_options();
     // Only β is needed: the mesh knows its border (BPD's labels would be
     // thrown away), and β alone takes about half the time.
-    let beta = trim::local_resolution(&mesh.vertices, &options)
+    let beta = trim::local_resolution(&mesh.vertices, &stages.detection)
         .with_context(|| format!("{}: the mesh's vertices", input.display()))?;
     let resolution_time = started.elapsed();
     let started = Instant::now();
     let options = CleanOptions {
-        offset: !settings.no_offset,
+        offset: stages.edges.offset,
     };
     let (out, cleaned) =
         clean_mesh(&mesh, &beta, &options).with_context(|| input.display().to_string())?;

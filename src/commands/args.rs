@@ -1,0 +1,119 @@
+//! Argument groups that several commands share: the stages' options and
+//! the scanner's view, with their value parsers.
+
+use clap::Args;
+use trim::{BpdOptions, EdgeOptions, View};
+
+use crate::stages::Stages;
+
+/// The options of detection and edge reconstruction that every command
+/// after `detect` shares.
+#[derive(Debug, Clone, PartialEq, Args)]
+pub struct StageArgs {
+    /// Neighbourhood size of boundary detection, the point itself included.
+    #[arg(long, default_value_t = 30, value_parser = parse_k)]
+    pub k: usize,
+    /// Use the paper's isotropic detection, without the sampling-tensor map.
+    #[arg(long)]
+    pub no_anisotropy: bool,
+    /// Use the paper's edges, through the boundary points, instead of the
+    /// estimated physical edge half a row beyond them.
+    #[arg(long)]
+    pub no_offset: bool,
+    /// Where a range scanner saw the cloud from.
+    #[command(flatten)]
+    pub view: ViewArgs,
+}
+
+impl StageArgs {
+    /// The stages' options.
+    pub fn stages(&self) -> Stages {
+        Stages {
+            detection: bpd_options(self.k, self.no_anisotropy, &self.view),
+            edges: EdgeOptions {
+                offset: !self.no_offset,
+            },
+        }
+    }
+}
+
+/// Where a range scanner (a depth camera, a laser line or structured-light
+/// scanner) saw the cloud from, when it is known. Such scanners err along
+/// their line of sight; with it, detection projects each neighbourhood
+/// along it instead of along the neighbourhood's normal, so that depth
+/// noise and the terraces of a quantised depth do not open gaps where the
+/// surface is inclined to the scanner (docs/bpd.md, "Scanner's line of
+/// sight").
+#[derive(Debug, Clone, Copy, PartialEq, Default, Args)]
+pub struct ViewArgs {
+    /// The scanner's line of sight as a direction X,Y,Z in the cloud's
+    /// frame (either sense), for a distant scanner or a frame whose axis it
+    /// looked along, e.g. 0,0,1.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_direction, allow_hyphen_values = true, conflicts_with = "view_from")]
+    pub view_along: Option<[f64; 3]>,
+    /// The scanner's position X,Y,Z in the cloud's frame (a depth camera's
+    /// centre: 0,0,0 for a cloud in the camera's own frame); the line of
+    /// sight to each point runs from there.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vector, allow_hyphen_values = true)]
+    pub view_from: Option<[f64; 3]>,
+}
+
+impl ViewArgs {
+    /// The view, if one was given.
+    pub fn view(&self) -> Option<View> {
+        self.view_along
+            .map(View::Along)
+            .or(self.view_from.map(View::From))
+    }
+}
+
+/// Boundary detection's options from the command line's.
+pub(crate) fn bpd_options(k: usize, no_anisotropy: bool, view: &ViewArgs) -> BpdOptions {
+    BpdOptions {
+        k,
+        anisotropy: !no_anisotropy,
+        view: view.view(),
+    }
+}
+
+/// `--k`: a whole number of at least [`BpdOptions::MIN_K`]. Checked here,
+/// not only by detection, so that a value it would refuse is a usage error
+/// before any file is read, not once per file of a batch.
+pub(crate) fn parse_k(text: &str) -> Result<usize, String> {
+    let k: usize = text.parse().map_err(|e| format!("{e}"))?;
+    let min = BpdOptions::MIN_K;
+    if k < min {
+        return Err(format!(
+            "k = {k} is too small: boundary detection needs k >= {min} \
+             (the point itself and at least {} neighbours)",
+            min - 1
+        ));
+    }
+    Ok(k)
+}
+
+/// Three finite numbers separated by commas.
+pub(crate) fn parse_vector(text: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    let [x, y, z] = parts.as_slice() else {
+        return Err(format!(
+            "expected three numbers X,Y,Z separated by commas, got {} part(s)",
+            parts.len()
+        ));
+    };
+    let number = |s: &str| match s.parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(_) => Err(format!("`{s}` is not a finite number")),
+        Err(_) => Err(format!("`{s}` is not a number")),
+    };
+    Ok([number(x)?, number(y)?, number(z)?])
+}
+
+/// A line of sight: [`parse_vector`], not zero.
+pub(crate) fn parse_direction(text: &str) -> Result<[f64; 3], String> {
+    let v = parse_vector(text)?;
+    if v == [0.0; 3] {
+        return Err("a direction cannot be 0,0,0".into());
+    }
+    Ok(v)
+}

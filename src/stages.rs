@@ -1,0 +1,99 @@
+//! The first stages every command runs, and the options of all stages:
+//! the shared arguments become the library's options here; a cloud is read
+//! and its boundary detected (with a progress bar on a terminal), with the
+//! time of each step.
+
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use trim::{BpdOptions, CloudError, Detection, EdgeOptions};
+
+use crate::io::{read_cloud, Cloud, Point3};
+
+/// The options of detection and edge reconstruction, as the library takes
+/// them: what a command (or each file of a batch) runs with.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Stages {
+    /// Boundary detection's options.
+    pub detection: BpdOptions,
+    /// Edge reconstruction's options.
+    pub edges: EdgeOptions,
+}
+
+/// A cloud read from a file and its boundary points, with the time of each
+/// step: the start of every command that works from a cloud.
+pub(crate) struct Detected {
+    pub cloud: Cloud,
+    pub detection: Detection,
+    pub read_time: Duration,
+    pub detect_time: Duration,
+}
+
+/// Reads the cloud at `path` and runs BPD on it (with the progress bar),
+/// errors naming the file.
+pub(crate) fn read_and_detect(path: &Path, options: &BpdOptions) -> Result<Detected> {
+    let started = Instant::now();
+    let cloud = read_cloud(path)?;
+    let read_time = started.elapsed();
+    detect_read_cloud(path, cloud, read_time, options, true)
+}
+
+/// Runs BPD on `cloud`, read from `path` in `read_time`, with or without
+/// the progress bar (`meshtrim batch` runs several files at once under one
+/// bar of its own, so its files' detections show none); errors name the
+/// file.
+pub(crate) fn detect_read_cloud(
+    path: &Path,
+    cloud: Cloud,
+    read_time: Duration,
+    options: &BpdOptions,
+    progress: bool,
+) -> Result<Detected> {
+    let started = Instant::now();
+    let detection = if progress {
+        detect_with_progress(&cloud.points, options)
+    } else {
+        trim::detect_boundary(&cloud.points, options)
+    }
+    .with_context(|| path.display().to_string())?;
+    Ok(Detected {
+        cloud,
+        detection,
+        read_time,
+        detect_time: started.elapsed(),
+    })
+}
+
+/// Milliseconds, rounded to 0.1 ms.
+pub(crate) fn millis(d: Duration) -> f64 {
+    (d.as_secs_f64() * 1e4).round() / 10.0
+}
+
+/// BPD with a progress bar on stderr. The bar appears only once the run has
+/// taken a second, so quick runs print nothing, and indicatif hides it when
+/// stderr is not a terminal.
+fn detect_with_progress(points: &[Point3], options: &BpdOptions) -> Result<Detection, CloudError> {
+    // The library counts distinct points, not known before it merges
+    // duplicates; the bar's length is all points, so with duplicates it stops
+    // short of full, and it is cleared at the end anyway.
+    let bar =
+        ProgressBar::with_draw_target(Some(points.len() as u64), ProgressDrawTarget::hidden());
+    bar.set_style(
+        ProgressStyle::with_template("detecting boundary {bar:40} {pos}/{len} points, {eta} left")
+            .expect("the template is valid"),
+    );
+    let started = Instant::now();
+    let shown = AtomicBool::new(false);
+    let progress = |done: usize| {
+        if started.elapsed() > Duration::from_secs(1) && !shown.swap(true, Ordering::Relaxed) {
+            bar.set_draw_target(ProgressDrawTarget::stderr());
+        }
+        bar.set_position(done as u64);
+    };
+    let result = trim::detect_boundary_with_progress(points, options, &progress);
+    bar.finish_and_clear();
+    result
+}
