@@ -272,8 +272,8 @@ fn an_stl_sliver_with_two_equal_corners_is_dropped_and_counted() {
     assert_eq!(json["faces_in"], u64::from(count) + 1);
 }
 
-/// A triangle written twice is dropped and counted; it used to stop the
-/// cleanup with "3 edges are shared by more than two faces".
+/// A triangle written twice is dropped and counted, not an error that
+/// stops the cleanup ("3 edges are shared by more than two faces").
 #[test]
 fn an_stl_triangle_written_twice_is_dropped_and_counted() {
     let dir = tempfile::tempdir().unwrap();
@@ -290,8 +290,8 @@ fn an_stl_triangle_written_twice_is_dropped_and_counted() {
 /// of their x flipped, as a damaged file would): a wall of one band's gap
 /// then runs into the smoothed loop itself, and the vertex in its way is
 /// one of the loop's new vertices, which the mesh does not have. That
-/// panicked (index out of bounds, found by mutating the fixtures); now the
-/// loop is left as it is, with the reason.
+/// must not panic (an index out of bounds, found by mutating the
+/// fixtures): the loop is left as it is, with the reason.
 #[test]
 fn a_wall_blocked_by_the_smoothed_loop_leaves_the_loop() {
     let dir = tempfile::tempdir().unwrap();

@@ -160,7 +160,7 @@ fn existing_output_is_replaced_atomically() {
 /// A reader that has gone away (`meshtrim … | head -c 0`) does not make a
 /// command panic: its files are written and it succeeds. The pipe's read
 /// end is closed before the run, so every write to stdout fails with a
-/// broken pipe (`println!` panicked there until stop 12).
+/// broken pipe (on which `println!` panics).
 #[test]
 fn a_closed_stdout_pipe_is_not_a_panic() {
     let dir = tempfile::tempdir().unwrap();
@@ -291,8 +291,8 @@ fn all_points_identical() {
 }
 
 /// A `--k` below 4 is a usage error (exit 2) before any file is read, in
-/// every command: it used to be found by detection after reading the
-/// input (exit 1), and a batch read and failed every file on it.
+/// every command: not an error of detection after reading the input
+/// (exit 1), nor, in a batch, one that every file is read and fails on.
 #[test]
 fn k_too_small_is_a_usage_error() {
     let missing = "no-such-input.ply";

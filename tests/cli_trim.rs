@@ -132,7 +132,7 @@ fn bad_inputs_fail_cleanly_and_write_nothing() {
     );
     assert_clean_failure(&meshtrim(&["missing.ply", CLOUD, o], None), "missing.ply");
     assert_clean_failure(&meshtrim(&[MESH, "missing.xyz", o], None), "missing.xyz");
-    // Both read at once; the mesh's error comes first, as when it was read
+    // Both read at once; the mesh's error comes first, as if it were read
     // first.
     let both = meshtrim(&["missing.ply", "missing.xyz", o], None);
     assert_clean_failure(&both, "missing.ply");

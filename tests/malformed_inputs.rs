@@ -85,9 +85,9 @@ fn mutated_files_give_errors_not_panics() {
     );
 }
 
-/// Files that once panicked, hung or were misread, with what the error
-/// must say. Each is read as a cloud on a thread with a deadline, so a
-/// hang fails the test instead of stalling it.
+/// Files that could make a reader panic, hang or misread them, with what
+/// the error must say. Each is read as a cloud on a thread with a
+/// deadline, so a hang fails the test instead of stalling it.
 #[test]
 fn known_bad_files_give_clear_errors() {
     let dir = tempfile::tempdir().expect("temporary directory");

@@ -116,7 +116,7 @@ fn stl_and_gltf_are_recognised_by_content_under_other_names() {
 
 /// A binary STL's 80-byte header is free text: one that starts like an
 /// OBJ or PCD file must still read as STL, as a cloud as well as a mesh
-/// (it was sniffed as OBJ or PCD and refused).
+/// (not be sniffed as OBJ or PCD and refused).
 #[test]
 fn stl_headers_that_look_like_other_formats_read_as_stl() {
     let dir = tempfile::tempdir().unwrap();
@@ -303,7 +303,7 @@ fn gltf_buffer_beside_the_file() {
 
 /// A buffer URI may name any file, not only a regular one: a FIFO (whose
 /// opening waits for a writer forever), a device that never ends such as
-/// `/dev/zero` (reached by an absolute or `..` path; the read used to fill
+/// `/dev/zero` (reached by an absolute or `..` path; reading it would fill
 /// the memory) or a directory must each give an error at once.
 #[cfg(unix)]
 #[test]
@@ -402,11 +402,11 @@ fn instanced_gltf(vertices: usize, indices: Option<usize>, nodes: usize) -> Stri
 }
 
 /// Every node that uses a mesh gets its own copy of the mesh's vertices,
-/// so a file of a few hundred kilobytes could ask for gigabytes: 10,002
-/// nodes each placing one 9,999-vertex accessor made 100 million vertices
+/// so a file of a few hundred kilobytes can ask for gigabytes: 10,002
+/// nodes each placing one 9,999-vertex accessor make 100 million vertices
 /// (2.4 GB), and 10,001 nodes each placing 20,000 triangles of one-byte
-/// indices 200 million triangles, allocated as they were read. The totals
-/// are now counted first and refused above the documented limits.
+/// indices 200 million triangles. The totals are counted before anything
+/// is allocated, and refused above the documented limits.
 #[test]
 fn gltf_instancing_beyond_the_limit_is_refused_before_allocating() {
     let dir = tempfile::tempdir().unwrap();
@@ -437,10 +437,11 @@ fn gltf_instancing_beyond_the_limit_is_refused_before_allocating() {
     );
 }
 
-/// `"uri": ""` in a `.gltf` names no buffer. It used to be joined to the
-/// file's directory and read: `cannot read '…/': not a regular file`, or
-/// `cannot read '': No such file or directory` for a file in the current
-/// directory, which hid that the URI was empty.
+/// `"uri": ""` in a `.gltf` names no buffer, and the error says so.
+/// Joined to the file's directory and read, it would give `cannot read
+/// '…/': not a regular file`, or `cannot read '': No such file or
+/// directory` for a file in the current directory, which hides that the
+/// URI is empty.
 #[test]
 fn gltf_buffer_with_an_empty_uri() {
     let dir = tempfile::tempdir().unwrap();
@@ -462,8 +463,8 @@ fn gltf_buffer_with_an_empty_uri() {
 /// Buffer URIs are relative references resolved against the document's
 /// directory, `..` included (asset pipelines share buffers that way);
 /// URIs with a scheme other than `data:` are refused, each with its own
-/// message (`file:` used to be called a remote URI, and `http:x` without
-/// `//` was read as a file name).
+/// message (`file:` is not called a remote URI, and `http:x` without
+/// `//` is not read as a file name).
 #[test]
 fn gltf_buffer_uris_relative_parent_and_schemes() {
     let dir = tempfile::tempdir().unwrap();
@@ -509,8 +510,8 @@ fn gltf_buffer_uris_relative_parent_and_schemes() {
 }
 
 /// A glTF whose meshes no node uses, or with no meshes at all, has nothing
-/// to read; both used to say `no vertices in the file`, which read like a
-/// mesh without vertices.
+/// to read; each case has its own error, not `no vertices in the file`,
+/// which reads like a mesh without vertices.
 #[test]
 fn gltf_without_mesh_instances_says_why() {
     let dir = tempfile::tempdir().unwrap();
@@ -533,10 +534,10 @@ fn gltf_without_mesh_instances_says_why() {
     assert!(error(&path).ends_with("the file has no meshes"));
 }
 
-/// glTF rotations are unit quaternions. One of length 2 used to be read
-/// as it stood, which distorts the mesh instead of turning it (the
-/// rotation formula assumes a unit quaternion); it is now an error naming
-/// the node, while one within rounding of unit length is normalised.
+/// glTF rotations are unit quaternions. One of length 2, read as it
+/// stands, would distort the mesh instead of turning it (the rotation
+/// formula assumes a unit quaternion), so it is an error naming the node,
+/// while one within rounding of unit length is normalised.
 #[test]
 fn gltf_rotation_must_be_a_unit_quaternion() {
     let dir = tempfile::tempdir().unwrap();
@@ -564,8 +565,8 @@ fn gltf_rotation_must_be_a_unit_quaternion() {
 }
 
 /// PLY and PCD headers whose lines end with a lone carriage return
-/// (classic Mac OS) used to fail: `no 'end_header' line`, `no DATA line`,
-/// and a PLY under another extension was not recognised at all. Binary
+/// (classic Mac OS) read without `no 'end_header' line` or `no DATA line`,
+/// and such a PLY is recognised under another extension too. Binary
 /// data follows a header and may start with a `\n` byte (here the first
 /// byte of x), which must not be taken for the end of a `\r\n`.
 #[test]
@@ -630,10 +631,10 @@ fn ply_and_pcd_headers_with_lone_carriage_returns() {
 }
 
 /// A PLY or PCD header whose first line ends with `\n` and a later one
-/// with a lone `\r` ran that line into the next: a PCD `FIELDS` line took
-/// the `SIZE` and `TYPE` lines' words for 11 field names and failed on the
-/// data (`line 7: expected 11 values, found 3`). The header line is now
-/// named. A lone `\r` in a comment is left alone.
+/// with a lone `\r` is an error naming that header line. Run into the
+/// next, the line would make a PCD `FIELDS` line take the `SIZE` and
+/// `TYPE` lines' words for 11 field names and fail on the data (`line 7:
+/// expected 11 values, found 3`). A lone `\r` in a comment is left alone.
 #[test]
 fn ply_and_pcd_headers_with_mixed_line_endings() {
     let dir = tempfile::tempdir().unwrap();
@@ -655,10 +656,10 @@ fn ply_and_pcd_headers_with_mixed_line_endings() {
 }
 
 /// Lines ended by a lone carriage return (classic Mac OS, Excel for Mac's
-/// "CSV (Macintosh)") read like lines ended by a newline. They used to read
-/// as one long line: an OBJ mesh became one vertex and no faces, a text
-/// cloud one point (the other values ignored as extra fields), an ASCII
-/// STL "ends inside a solid".
+/// "CSV (Macintosh)") read like lines ended by a newline. Read as one long
+/// line, an OBJ mesh would be one vertex and no faces, a text cloud one
+/// point (the other values ignored as extra fields), and an ASCII STL
+/// would "end inside a solid".
 #[test]
 fn lone_carriage_returns_end_lines() {
     let dir = tempfile::tempdir().unwrap();

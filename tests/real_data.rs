@@ -119,9 +119,9 @@ fn first_bunny_vertex_is_exact() {
 }
 
 /// Edge tours on the real range scans do not jump across the surface: no
-/// tour step longer than 3β that no BPD link supports. Before tours were
-/// cut at their jumps (`trim::split`), bun000 had 16 such steps
-/// (longest 57.4 β) and face000 40 (longest 169.5 β); measured after: 0.
+/// tour step longer than 3β that no BPD link supports. Tours not cut at
+/// their jumps (`crates/trim/src/edges/split.rs`) have 16 such steps on
+/// bun000 (longest 57.4 β) and 40 on face000 (longest 169.5 β); cut, none.
 #[test]
 fn edge_tours_on_range_scans_do_not_jump() {
     use testkit::edge_metrics::tour_jumps;

@@ -167,7 +167,7 @@ pub fn trim_file(
     settings: &TrimSettings,
 ) -> Result<Report> {
     // The two files are read at once (a binary PLY's reader runs on one
-    // thread); the mesh's error, if any, is reported first, as when it was
+    // thread); the mesh's error, if any, is reported first, as if it were
     // read first.
     let started = Instant::now();
     let (mesh, cloud) = rayon::join(

@@ -140,7 +140,7 @@ pub fn check_mesh(format: MeshFormat, vertices: &[Point3], faces: &[[u32; 3]]) -
 /// Refuses a mesh too small for `f32`: when its largest |coordinate| is
 /// below f32's smallest normal number, every coordinate becomes 0 or a
 /// subnormal with a few bits, so the file would hold a point or a
-/// distorted shape (a mesh at 1e-50 was written as all (0, 0, 0)). Single
+/// distorted shape (a mesh at 1e-50 would be all (0, 0, 0)). Single
 /// tiny coordinates in a larger mesh are fine: their rounding stays below
 /// f32's precision at the mesh's size.
 fn check_f32_underflow(format: MeshFormat, vertices: &[Point3]) -> Result<()> {

@@ -257,7 +257,7 @@ mod tests {
     fn a_reference_past_u32_is_named_as_written() {
         let e = |t: &str| read_obj(t.as_bytes()).unwrap_err().to_string();
         // The reference as written, though it does not fit in u32 once
-        // 1-based (it used to wrap to "vertex 0"); the line of a later fan.
+        // 1-based (not wrapped to "vertex 0"); the line of a later fan.
         assert_eq!(
             e("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 1\n# c\nf 1 2 4294967296\n"),
             "line 6: triangle 2 refers to vertex 4294967296, but there are only 3 vertices"

@@ -1387,7 +1387,8 @@ mod tests {
     use super::*;
     use rand::{RngExt, SeedableRng};
 
-    /// [`edge_defects`] by hashing every edge, as it was first written.
+    /// [`edge_defects`] by hashing every edge: the plain way, kept as the
+    /// reference.
     fn edge_defects_reference(mesh: &Mesh) -> (usize, usize) {
         let mut directed: HashMap<(u32, u32), u32> = HashMap::default();
         let mut undirected: HashMap<(u32, u32), u32> = HashMap::default();
@@ -1404,8 +1405,8 @@ mod tests {
         )
     }
 
-    /// [`patches_breaking_manifold`] by hashing every directed edge, as it
-    /// was first written.
+    /// [`patches_breaking_manifold`] by hashing every directed edge: the
+    /// plain way, kept as the reference.
     fn patches_breaking_manifold_reference(
         mesh: &Mesh,
         origin: &[Option<usize>],
@@ -1627,9 +1628,9 @@ mod tests {
     }
 
     /// Faces with two equal corners (a binary STL's sliver, merged) are
-    /// dropped and counted; they used to stop the cleanup (reported first
-    /// as a non-manifold edge, then as an error of their own). The rest of
-    /// the mesh is cleaned exactly as it would be without them.
+    /// dropped and counted, neither reported as non-manifold edges nor an
+    /// error of their own that stops the cleanup. The rest of the mesh is
+    /// cleaned exactly as it would be without them.
     #[test]
     fn faces_naming_a_vertex_twice_are_dropped() {
         let (mesh, beta, options, want) = annulus_cleaned();
@@ -1646,8 +1647,8 @@ mod tests {
     }
 
     /// A face written twice with the same corners in the same turn is
-    /// dropped and counted (it used to read as 3 non-manifold edges); one
-    /// in the opposite turn stays, and its edges are still reported.
+    /// dropped and counted (not read as 3 non-manifold edges); one in the
+    /// opposite turn stays, and its edges are still reported.
     #[test]
     fn repeated_faces_are_dropped_when_they_turn_the_same_way() {
         let (mesh, beta, options, want) = annulus_cleaned();

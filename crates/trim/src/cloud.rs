@@ -165,8 +165,8 @@ pub fn merge_duplicates(points: &[Point3]) -> Result<Sites, CloudError> {
 /// Collinearity is judged relative to the cloud's extent, so the verdict does
 /// not depend on units or position within the supported range; beyond it
 /// the squares below overflow or underflow (300 random points at 1e160
-/// were "one line", at 1e-300 "one point"), so such clouds are refused as
-/// out of range ([`check_range`]), the same error detection gives.
+/// would be "one line", at 1e-300 "one point"), so such clouds are refused
+/// as out of range ([`check_range`]), the same error detection gives.
 pub fn check_not_degenerate(points: &[Point3]) -> Result<(), CloudError> {
     check_range(points)?;
     let distinct = points.len();

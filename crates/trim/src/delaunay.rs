@@ -1,5 +1,5 @@
 //! The Delaunay path: a mesh built from the cloud itself, bounded by the
-//! smoothed loops (issue 4, "Delaunay path").
+//! smoothed loops.
 //!
 //! 1. **Projection.** The whole cloud is projected onto its best-fit plane
 //!    (PCA of all points, [`fit_plane`]), in the frame's (u, v) axes

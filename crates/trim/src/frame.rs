@@ -107,8 +107,8 @@ fn covariance(points: &[Point3], members: &[u32]) -> Matrix3<f64> {
 /// the three are orthonormal even when two eigenvalues coincide.
 ///
 /// BPD fits a plane per point, and nalgebra's general iterative solver
-/// was a tenth of its time; [`symmetric_eigen3`] agrees with it (see the
-/// tests) in about a third of the time.
+/// would take a tenth of its time; [`symmetric_eigen3`] agrees with it
+/// (see the tests) in about a third of the time.
 pub fn symmetric_eigen3(a: &Matrix3<f64>) -> ([f64; 3], [Point3; 3]) {
     let (rows, shape) = match spectrum(a) {
         Spectrum::Zero => return ([0.0; 3], AXES),
@@ -543,10 +543,10 @@ mod tests {
     }
 
     /// The shear depends on the ray's direction only, not its length, bit
-    /// for bit: `--view-along 1e308,1e308,1e308` used to overflow the
-    /// shear to infinity (1012 boundary points on the blade fixture
-    /// instead of 311 along 1,1,1), and a ray of subnormal components lost
-    /// its bits.
+    /// for bit: `--view-along 1e308,1e308,1e308` must not overflow the
+    /// shear to infinity (an infinite shear finds 1012 boundary points on
+    /// the blade fixture instead of 311 along 1,1,1), nor a ray of
+    /// subnormal components lose its bits.
     #[test]
     fn the_shear_ignores_the_length_of_the_ray() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);

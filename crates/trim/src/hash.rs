@@ -1,7 +1,7 @@
 //! Hash maps and sets over vertex, face and edge indices.
 //!
 //! std's default hasher (SipHash, seeded per process) resists crafted keys,
-//! which indices read from a mesh need not; it was about a tenth of
+//! which indices read from a mesh need not; it would take about a tenth of
 //! `meshtrim clean`'s time. foldhash's fast hasher with a fixed seed is
 //! several times cheaper on integer keys, and fixed, so iteration order is
 //! the same in every run (no result depends on it anyway: outputs are

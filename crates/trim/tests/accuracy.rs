@@ -126,7 +126,7 @@ fn variable_density_x10() {
     assert_accurate(&synthetic::variable_density(3.4, 5));
 }
 
-/// The issue's variable-density case with blue-noise sampling
+/// The variable-density case with blue-noise sampling
 /// ([`synthetic::decimated_variable_density`]): 3.4 → 34 mm, where the
 /// ideal layer scores 1.0, so BPD must reach the target itself, with no
 /// slack, on each of three sampling seeds.
@@ -289,7 +289,7 @@ fn labels_are_invariant_under_rotation_translation_and_scale() {
 }
 
 /// The paper's noise test (Ω, Ψ against the noise-free detection, swept in
-/// steps of 5 % up to 75 %). As the issue asks, 20 % noise must lose no
+/// steps of 5 % up to 75 %). The requirement: 20 % noise must lose no
 /// boundary point and 75 % add no false one on at least one case; all cases
 /// are printed. On jittered clouds a single point whose empty circle is
 /// within a fraction of a percent of β decides Ω and Ψ, so the test also

@@ -1,7 +1,7 @@
-//! Border cleanup against ground truth (issue 5): jagged Delaunay meshes of
-//! jittered synthetic clouds with known borders, cleaned by
-//! [`trim::clean_mesh`]; the cleaned border must lie within 0.25
-//! local spacings of the true border on average.
+//! Border cleanup against ground truth: jagged Delaunay meshes of jittered
+//! synthetic clouds with known borders, cleaned by [`trim::clean_mesh`];
+//! the cleaned border must lie within 0.25 local spacings of the true
+//! border on average.
 
 use testkit::{
     synthetic::jagged::{border_error, jagged_mesh},

@@ -106,9 +106,9 @@ fn blade_at_4_8_16_mm() {
 
 /// A fine blade with wide jitter (±0.3 of the pitch; 1 mm pitch): its
 /// sampling has gaps at the resolution limit, and at this seed one of them
-/// has two of its four points labelled boundary. The gap fillers closed
-/// the four into a fifth loop round a hole that is not there (found by
-/// `examples/loop_counts.rs`; 19 of 20 seeds were right).
+/// has two of its four points labelled boundary. The gap fillers must not
+/// close the four into a fifth loop round a hole that is not there (the
+/// seed is one that `crates/testkit/examples/loop_counts.rs` finds).
 #[test]
 fn a_gap_of_the_sampling_is_no_hole() {
     let cloud = synthetic::blade_with_jitter(1.0, 0.3, 1007);

@@ -96,7 +96,7 @@ fn region(seed: u64) -> Region {
 
 /// `cases` cases (or `PROPTEST_CASES`) from a fixed seed, so that every
 /// run, CI's included, tries the same clouds; a wider search is
-/// `PROPTEST_CASES=5000` (5,000 cases of each passed at stop 9).
+/// `PROPTEST_CASES=5000`.
 fn config(cases: u32) -> ProptestConfig {
     let from_env = ProptestConfig::default();
     let cases = if std::env::var_os("PROPTEST_CASES").is_some() {

@@ -276,9 +276,9 @@ fn cloud_stem(path: &Path) -> Option<&str> {
 
 /// A `.ply` or `.obj` file that sits beside a mesh of the same stem with
 /// another mesh extension (`part.ply` beside `part.stl`) and holds no
-/// faces is that mesh's cloud, not an input: the issue's "a cloud with the
-/// same stem and a cloud extension". Only the header (PLY) or the lines
-/// (OBJ) are read.
+/// faces is that mesh's cloud, not an input: a cloud with the same stem
+/// and a cloud extension. Only the header (PLY) or the lines (OBJ) are
+/// read.
 fn paired_cloud(path: &Path) -> bool {
     let ext = extension(path);
     if !matches!(ext.as_str(), "ply" | "obj") || cloud_stem(path).is_some() {
@@ -487,8 +487,9 @@ mod tests {
 
     /// An OBJ beside a mesh of its stem is that mesh's cloud only if the
     /// OBJ reader finds no face in it. Face lines that are indented, or
-    /// ended by a lone \r, were missed: the mesh was taken for a cloud,
-    /// not processed, and its sibling trimmed by it instead of cleaned.
+    /// ended by a lone \r, count too; missed, they would leave the mesh
+    /// taken for a cloud, not processed, and its sibling trimmed by it
+    /// instead of cleaned.
     #[test]
     fn obj_faces_are_found_as_the_reader_finds_them() {
         let dir = tempfile::tempdir().unwrap();

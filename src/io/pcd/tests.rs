@@ -293,9 +293,9 @@ fn absurd_counts_are_errors_not_allocations() {
 
 #[test]
 fn zero_or_huge_xyz_counts_are_header_errors() {
-    // Each encoding once: COUNT 0 used to index past the tokens
+    // Each encoding once: COUNT 0 must not index past the tokens
     // (ascii), decode from an empty slice (binary) or make a zero
-    // stride (COUNT 0 0 0); a huge COUNT overflowed SIZE × COUNT.
+    // stride (COUNT 0 0 0); a huge COUNT must not overflow SIZE × COUNT.
     for data in [
         "ascii\n1 2\n3 4\n",
         "binary\nabcdefgh",

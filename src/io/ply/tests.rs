@@ -255,7 +255,8 @@ fn faces_win_over_a_range_grid() {
 }
 
 /// An element without properties and a huge count, before and after
-/// the vertices, in both encodings: it used to loop 2^64 times.
+/// the vertices, in both encodings: skipped at once, not by looping
+/// 2^64 times.
 #[test]
 fn elements_without_properties_are_skipped_at_once() {
     let junk = "element junk 18446744073709551615\n";
@@ -283,7 +284,8 @@ fn elements_without_properties_are_skipped_at_once() {
 
 #[test]
 fn a_record_must_end_where_its_line_ends() {
-    // One value too many, or too few: every later vertex used to shift.
+    // One value too many, or too few, is an error: read on, it would
+    // shift every later vertex.
     let extra = ASCII.replace("1 0 0 0 0 1 0\n", "1 0 0 0 0 1 0 5\n");
     assert_eq!(
         err(extra.as_bytes()),

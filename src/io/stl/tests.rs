@@ -2,7 +2,8 @@
 
 use super::*;
 
-/// The one-pass reading the pieces must match (the reader before stop 25).
+/// The one-pass reader, kept as the reference that reading in pieces must
+/// match.
 fn read_ascii_one_pass(bytes: &[u8]) -> Result<Mesh> {
     let text = std::str::from_utf8(bytes).map_err(|e| {
         anyhow!(
@@ -128,10 +129,10 @@ fn truncated_binary_names_the_triangle() {
 }
 
 /// Lines read in pieces of 1–64 bytes give what the one-pass reading
-/// gives, error messages included, on random
-/// texts: solids of whole facets, with now and then a bad vertex (too
-/// few or many numbers, a word, NaN), a missing or stray line, tabs,
-/// vertical tabs and Unicode spaces between words.
+/// gives, error messages included, on random texts: solids of whole
+/// facets, with now and then a bad vertex (too few or many numbers, a
+/// word, NaN), a missing or stray line, tabs, vertical tabs and Unicode
+/// spaces between words.
 #[test]
 fn vertex_lines_in_pieces_read_as_in_one_pass() {
     let facet = [

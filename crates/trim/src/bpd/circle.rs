@@ -150,10 +150,11 @@ pub fn largest_empty_circle_exceeds(nb: &[Point2], beta: f64, s: &mut CellScratc
 /// Otherwise it is clipped afresh from a box `LINK_BOX` times wider: for
 /// a point on the hull the cell is unbounded, and its edges that lie
 /// between the test's box and that box's corners (all farther than β)
-/// were kept or lost with the box's turn in the plane, so the links turned
-/// with the plane's axes. In the wide box only edges more than 2²⁰
-/// neighbourhood radii away could still be, which needs three neighbours
-/// collinear to within a millionth of the radius without being collinear.
+/// would be kept or lost with the box's turn in the plane, so the links
+/// would turn with the plane's axes. In the wide box only edges more than
+/// 2²⁰ neighbourhood radii away could still be, which needs three
+/// neighbours collinear to within a millionth of the radius without being
+/// collinear.
 pub fn boundary_links(nb: &[Point2], beta: f64, s: &mut CellScratch, out: &mut Vec<u32>) {
     if s.poly.iter().any(|&(_, label)| label == BOX_EDGE) {
         clip_wide(nb, beta, s);

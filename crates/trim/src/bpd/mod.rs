@@ -510,10 +510,10 @@ fn blocks_of_runs<J>(
 /// [`octree_runs`]): enough to share one range query among them, few
 /// enough that the run stays small next to a neighbourhood. 32 against 16:
 /// the same time at 12k points, 2 % less at 1M (fewer tree queries where
-/// the tree no longer fits in the cache). 48 against 32 (stop 23): the
-/// k-NN pass at 12k points 6.2 ms against 6.6 (two threads; 11.9 against
-/// 12.3 on one) for the same instruction count within 0.1 %, and the same
-/// time at 100k and 1M; 40 and 56 measured like 48.
+/// the tree no longer fits in the cache). 48 against 32: the k-NN pass at
+/// 12k points 6.2 ms against 6.6 (two threads; 11.9 against 12.3 on one)
+/// for the same instruction count within 0.1 %, and the same time at 100k
+/// and 1M; 40 and 56 measured like 48.
 const RUN: usize = 48;
 
 /// Runs `f` at every position of the spatial order, in blocks (parallel for
@@ -568,7 +568,7 @@ fn links_in_input_order<L: LinkSlots>(
     }
     let input_of = |position: u32| first_input[order[position as usize] as usize];
     // Each pair as one integer, smaller index above: sorted, the order of
-    // the pairs, in less than half the time that sorting the pairs took.
+    // the pairs, in less than half the time that sorting the pairs takes.
     let mut links: Vec<u64> = Vec::new();
     for (p, v) in verdicts.iter().enumerate() {
         let (a, members) = (input_of(p as u32), hoods.at(p));

@@ -302,7 +302,7 @@ fn wrap_positive(d: f64) -> f64 {
 
 /// atan2(y, x) in [−π, π], within a few ulps of the library's, without
 /// branches or calls so the loop over a neighbourhood vectorises (the
-/// library call was a third of the test's time). Cephes' atan: the ratio
+/// library call takes a third of the test's time). Cephes' atan: the ratio
 /// of the smaller to the larger coordinate, t ∈ [0, 1], is moved below
 /// 0.66 by atan t = π/4 + atan((t − 1)/(t + 1)), then a degree 4/5
 /// rational approximation in t².

@@ -241,9 +241,9 @@ fn gap_fillers(detection: &Detection) -> Vec<bool> {
 /// has two of the points round it labelled boundary (their own β is a
 /// little below the gap's empty circle) and two not: the fillers then close
 /// the four into a loop round a hole that is not there, and trimming or
-/// meshing cut it out (the 100k benchmark sheet had one, the 1M sheet
-/// five). The paper's smallest hole is found by four points, so a loop
-/// needs four detected ones.
+/// meshing would cut it out (the 100k benchmark sheet has one, the 1M
+/// sheet five). The paper's smallest hole is found by four points, so a
+/// loop needs four detected ones.
 fn drop_tours_made_by_fillers(tours: &mut Vec<Vec<u32>>, detected: &[bool]) -> usize {
     let before = tours.len();
     tours.retain(|tour| {

@@ -293,9 +293,9 @@ mod tests {
     }
 
     /// A face that names a vertex twice has an "edge" from that vertex to
-    /// itself, used once: it is no border. It used to become a loop of one
-    /// interior vertex, which the trim report measured as a border vertex
-    /// far from every smoothed edge.
+    /// itself, used once: it is no border. Taken for one, it would make a
+    /// loop of one interior vertex, which the trim report would measure as
+    /// a border vertex far from every smoothed edge.
     #[test]
     fn an_edge_from_a_vertex_to_itself_is_no_border() {
         let inner = 2 * 5 + 2;

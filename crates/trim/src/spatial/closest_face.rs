@@ -1,16 +1,15 @@
 //! The closest face of a triangle mesh to a point, within a distance: the
-//! query of the trimming stage's support test (issue 4: "keep the regions
-//! where the cloud's points project"), where a million cloud points are
+//! query of the trimming stage's support test (the regions where the
+//! cloud's points project are kept), where a million cloud points are
 //! projected on a mesh of up to a few million faces.
 //!
-//! A bounding-volume hierarchy of our own (the issue allows "your own
-//! BVH"): the faces ordered as a balanced kd-tree over their centroids
-//! (median splits on the longest axis, in parallel), groups of `LEAF`
-//! consecutive faces as leaves, and each level above pairing consecutive
-//! boxes of the level below, so the tree needs no pointers. Building it
-//! is several times cheaper than parry's binned SAH hierarchy, which parry
-//! builds on one thread and which took longer than all the projections on
-//! a 3M-triangle mesh. The distance to each
+//! A bounding-volume hierarchy of our own: the faces ordered as a balanced
+//! kd-tree over their centroids (median splits on the longest axis, in
+//! parallel), groups of `LEAF` consecutive faces as leaves, and each level
+//! above pairing consecutive boxes of the level below, so the tree needs
+//! no pointers. Building it is several times cheaper than parry's binned
+//! SAH hierarchy, which parry builds on one thread and which takes longer
+//! than all the projections on a 3M-triangle mesh. The distance to each
 //! triangle is parry's exact point-triangle projection; the answer is the
 //! face at the smallest distance, the lower index on a tie, tested against
 //! parry's `TriMesh` on random meshes.

@@ -39,7 +39,7 @@ impl<'a> NeighbourIndex<'a> {
     /// Builds the index. `points` must be finite and have fewer than 2^32 entries.
     pub fn new(points: &'a [Point3]) -> Self {
         // kiddo builds in parallel only from 2¹⁸ points by default; the
-        // serial build was a tenth of BPD's time at 100k points. The
+        // serial build takes a tenth of BPD's time at 100k points. The
         // queries' answers do not depend on the tree's layout (ties are
         // cut by rank), so the split is free to differ.
         let tree = ImmutableKdTree::builder()
