@@ -3,7 +3,7 @@
 //! (mean / largest, in local spacings) before and after `clean_mesh`, with
 //! and without the outward offset, over several seeds.
 //!
-//! `cargo run --release -p meshtrim-trim --example clean_table`
+//! `cargo run --release -p meshtrim-testkit --example clean_table`
 
 use testkit::{
     synthetic::jagged::{border_error, jagged_mesh},

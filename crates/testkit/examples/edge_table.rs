@@ -3,7 +3,7 @@
 //! the paper's two baselines, a third-order polynomial per edge and a cubic
 //! smoothing spline, all fitted to the same ordered boundary points.
 //!
-//! `cargo run --release -p meshtrim-trim --example edge_table`
+//! `cargo run --release -p meshtrim-testkit --example edge_table`
 //!
 //! Columns: the paper's metric (distance from the boundary points to their
 //! edge: mean, max, STD, in local spacings) and the distance from the edge

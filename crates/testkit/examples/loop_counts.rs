@@ -1,7 +1,7 @@
 //! How often edge reconstruction finds exactly the true number of borders
 //! on seeded synthetic clouds (every border one loop, no extra loop).
 //!
-//! `cargo run --release -p meshtrim-trim --example loop_counts [SEEDS]`
+//! `cargo run --release -p meshtrim-testkit --example loop_counts [SEEDS]`
 //!
 //! One row per kind of cloud: how many of SEEDS sampling seeds (default 20;
 //! seeds 1000, 1001, …) gave the true loop count, and the counts that came

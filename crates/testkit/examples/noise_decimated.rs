@@ -8,7 +8,7 @@
 //! and spread (the paper's Table 1 rows), then Ω and Ψ by the paper's rule
 //! and against the truth, one value per noise pattern.
 //!
-//! `cargo run --release -p meshtrim-trim --example noise_decimated`
+//! `cargo run --release -p meshtrim-testkit --example noise_decimated`
 
 use testkit::{
     evaluate::{noise_robustness, percent_sweep, NoiseRobustness},

@@ -3,7 +3,7 @@
 //! parameter domain), 0.05 and 0.15 (the default) of the pitch, five noise
 //! patterns each. Prints a markdown table.
 //!
-//! `cargo run --release -p meshtrim-trim --example noise_jitter`
+//! `cargo run --release -p meshtrim-testkit --example noise_jitter`
 
 use testkit::{
     evaluate::{noise_robustness, percent_sweep},

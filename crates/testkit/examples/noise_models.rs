@@ -18,7 +18,7 @@
 //! All readings use one noise pattern (the signs and magnitudes of A's
 //! draws), scaled by p.
 //!
-//! `cargo run --release -p meshtrim-trim --example noise_models`
+//! `cargo run --release -p meshtrim-testkit --example noise_models`
 
 use testkit::synthetic::{self, SyntheticCloud, P3};
 use trim::{detect_boundary, BpdOptions, Detection, NeighbourIndex};

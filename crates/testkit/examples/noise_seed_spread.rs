@@ -3,7 +3,7 @@
 //! each, five noise patterns each. Prints one markdown row per cloud, each
 //! cell Ω / Ψ / Ω vs truth / Ψ vs truth in % (see `testkit::evaluate`).
 //!
-//! `cargo run --release -p meshtrim-trim --example noise_seed_spread`
+//! `cargo run --release -p meshtrim-testkit --example noise_seed_spread`
 
 use testkit::{
     evaluate::{noise_robustness, percent_sweep},

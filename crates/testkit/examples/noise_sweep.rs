@@ -2,7 +2,7 @@
 //! blade clouds at 4, 8, 16 and 34 mm and the ×10 variable-density cloud,
 //! with the anisotropy map on and off. Prints a markdown table.
 //!
-//! `cargo run --release -p meshtrim-trim --example noise_sweep`
+//! `cargo run --release -p meshtrim-testkit --example noise_sweep`
 
 use testkit::{
     evaluate::{noise_robustness, percent_sweep, precision_recall},

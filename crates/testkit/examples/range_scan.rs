@@ -5,7 +5,7 @@
 //! normal) and with the projection along the line of sight
 //! (`BpdOptions::view`).
 //!
-//! `cargo run --release -p meshtrim-trim --example range_scan`
+//! `cargo run --release -p meshtrim-testkit --example range_scan`
 
 use testkit::{
     evaluate::precision_recall,

@@ -6,7 +6,7 @@
 //! detected at the origin and shifted along (1, 1, 1), and the labels
 //! compared. `ANISO_OFF=1` runs without the anisotropy map.
 //!
-//! `cargo run --release -p meshtrim-trim --example translation_ties`
+//! `cargo run --release -p meshtrim-testkit --example translation_ties`
 
 use testkit::synthetic::{jittered_grid, Circle, Region, SpacingField, Surface};
 use trim::{detect_boundary, BpdOptions, Point3};
