@@ -6,6 +6,8 @@ use crate::hash::HashMap;
 use crate::cloud::out_of_range;
 use crate::cloud::{MAX_COORDINATE, MIN_LARGEST_COORDINATE};
 use crate::error::MeshError;
+
+pub(crate) mod topology;
 use crate::geom::{cross, norm2, sub, Point3};
 
 /// An indexed triangle mesh.
@@ -78,8 +80,10 @@ impl Mesh {
         (0..self.faces.len()).map(|f| self.face_area(f)).sum()
     }
 
-    /// How many faces use each undirected edge.
-    pub fn edge_uses(&self) -> HashMap<(u32, u32), u32> {
+    /// How many faces use each undirected edge (the plain way, for the
+    /// tests' references).
+    #[cfg(test)]
+    pub(crate) fn edge_uses(&self) -> HashMap<(u32, u32), u32> {
         let mut uses = HashMap::default();
         for f in &self.faces {
             for k in 0..3 {
@@ -97,7 +101,7 @@ impl Mesh {
     /// then a sort of each vertex's few edges: several times faster than
     /// sorting or hashing all edges of a large mesh; the same result as
     /// sorting the tuples (tested).
-    pub fn sorted_edges(&self) -> Vec<(u32, u32, u32)> {
+    pub(crate) fn sorted_edges(&self) -> Vec<(u32, u32, u32)> {
         sorted_edges_of(&self.faces)
     }
 
@@ -119,7 +123,16 @@ impl Mesh {
 
     /// True if no edge is used by more than two faces.
     pub fn is_edge_manifold(&self) -> bool {
-        self.edge_uses().values().all(|&n| n <= 2)
+        topology::edge_defects(self).0 == 0
+    }
+
+    /// Checks that the mesh is edge-manifold (no edge used by more than two
+    /// faces, [`MeshError::NonManifold`]) and consistently oriented (no two
+    /// faces run a shared edge the same way, [`MeshError::Misoriented`]):
+    /// what trimming and cleanup need of their input, and guarantee of
+    /// their output.
+    pub fn check_manifold(&self) -> Result<(), MeshError> {
+        topology::check_manifold(self)
     }
 
     /// The border: directed edges (as the faces run) used by one face only,

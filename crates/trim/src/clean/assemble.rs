@@ -1,0 +1,86 @@
+//! The patches put into the mesh (step 6 of the cleanup): each band's
+//! faces replaced by its patch, the patches that would break the manifold
+//! found, and the report's figures of the new faces.
+
+use super::*;
+use crate::mesh::topology::for_each_edge;
+
+/// The input with every patch applied, and for each output face the
+/// outcome whose patch made it (`None` for input faces).
+pub(super) fn assemble(mesh: &Mesh, outcomes: &[Outcome]) -> (Mesh, Vec<Option<usize>>) {
+    let n = mesh.vertices.len() as u32;
+    let mut removed = vec![false; mesh.faces.len()];
+    let mut vertices = mesh.vertices.clone();
+    let mut new_faces = Vec::new();
+    for (g, outcome) in outcomes.iter().enumerate() {
+        let Some(patch) = &outcome.patch else {
+            continue;
+        };
+        for &f in &patch.removed {
+            removed[f as usize] = true;
+        }
+        let base = vertices.len() as u32;
+        vertices.extend_from_slice(&patch.vertices);
+        for face in &patch.faces {
+            new_faces.push((g, face.map(|id| if id < n { id } else { base + id - n })));
+        }
+    }
+    let mut faces: Vec<[u32; 3]> = Vec::with_capacity(mesh.faces.len() + new_faces.len());
+    let mut origin = Vec::with_capacity(faces.capacity());
+    for (f, _) in mesh.faces.iter().zip(&removed).filter(|(_, &r)| !r) {
+        faces.push(*f);
+        origin.push(None);
+    }
+    for (g, f) in new_faces {
+        faces.push(f);
+        origin.push(Some(g));
+    }
+    (Mesh { vertices, faces }, origin)
+}
+
+/// The outcomes whose new faces use an edge more than twice or twice the
+/// same way.
+pub(super) fn patches_breaking_manifold(mesh: &Mesh, origin: &[Option<usize>]) -> BTreeSet<usize> {
+    let mut bad = BTreeSet::new();
+    for_each_edge(mesh, |faces, forward, backward| {
+        if forward > 1 || backward > 1 {
+            bad.extend(faces.iter().filter_map(|e| origin[e.2 as usize]));
+        }
+    });
+    bad
+}
+
+/// Counts what the applied patches did.
+pub(super) fn summarise(outcomes: &[Outcome], out: &Mesh, report: &mut CleanReport) {
+    let mut min_angle = f64::INFINITY;
+    for outcome in outcomes {
+        report.loops_left.extend(outcome.left.iter().cloned());
+        if let Some(patch) = &outcome.patch {
+            report.loops_smoothed += patch.loops.len();
+            report.faces_removed += patch.removed.len();
+            report.faces_added += patch.faces.len();
+            report.vertices_added += patch.vertices.len();
+        }
+    }
+    let new_faces = &out.faces[out.faces.len() - report.faces_added..];
+    for &face in new_faces {
+        min_angle = min_angle.min(smallest_angle(&out.vertices, face));
+    }
+    report.min_angle_new = if min_angle.is_finite() {
+        min_angle
+    } else {
+        0.0
+    };
+}
+
+/// Smallest angle of a triangle, in degrees.
+pub(super) fn smallest_angle(vertices: &[Point3], face: [u32; 3]) -> f64 {
+    let p = face.map(|i| vertices[i as usize]);
+    (0..3)
+        .map(|k| {
+            let (a, b) = (sub(p[(k + 1) % 3], p[k]), sub(p[(k + 2) % 3], p[k]));
+            let c = dot(a, b) / (norm2(a) * norm2(b)).sqrt();
+            c.clamp(-1.0, 1.0).acos().to_degrees()
+        })
+        .fold(f64::INFINITY, f64::min)
+}

@@ -1,0 +1,393 @@
+//! The band round a border loop (steps 3 and 4 of the cleanup): the faces
+//! within a few rings of the border, their projection along the band's
+//! mean normal, the smoothed loops in it, and the faces that go.
+
+use super::*;
+
+/// The faces within some rings of a group's border, projected.
+pub(super) struct Band {
+    pub(super) depth: u32,
+    /// Ring distance of each band vertex from the border, and the loop
+    /// (position in the group) it is nearest to.
+    pub(super) rings_from_border: HashMap<u32, (u32, usize)>,
+    /// Band faces, ascending.
+    pub(super) faces: Vec<u32>,
+}
+
+impl Band {
+    /// Faces with a vertex less than `depth` rings from the border of the
+    /// `group`'s loops.
+    pub(super) fn around(cx: &Context, group: &[usize], depth: u32) -> Band {
+        let mut distance: HashMap<u32, (u32, usize)> = HashMap::default();
+        for (k, &l) in group.iter().enumerate() {
+            for &v in &cx.borders[l] {
+                distance.entry(v).or_insert((0, k));
+            }
+        }
+        let mut frontier: Vec<u32> = distance.keys().copied().collect();
+        frontier.sort_unstable();
+        for d in 1..=depth {
+            let mut next = Vec::new();
+            for &v in &frontier {
+                let origin = distance[&v].1;
+                for &f in cx.topology.faces_of(v) {
+                    for w in cx.mesh.faces[f as usize] {
+                        distance.entry(w).or_insert_with(|| {
+                            next.push(w);
+                            (d, origin)
+                        });
+                    }
+                }
+            }
+            next.sort_unstable();
+            frontier = next;
+        }
+        let faces: BTreeSet<u32> = distance
+            .iter()
+            .filter(|&(_, &(d, _))| d < depth)
+            .flat_map(|(&v, _)| cx.topology.faces_of(v).iter().copied())
+            .collect();
+        Band {
+            depth,
+            rings_from_border: distance,
+            faces: faces.into_iter().collect(),
+        }
+    }
+
+    /// The patch replacing the group's loops, or why not: the smoothed
+    /// loops in the band's projection (steps 2 and 3), what goes (step 4)
+    /// and the gap filled (step 5).
+    pub(super) fn replace(&self, cx: &Context, group: &[usize]) -> Result<Patch, Retry> {
+        let mesh = cx.mesh;
+        let projection = Projection::of(cx, &self.faces);
+        let mut rings = projected_rings(cx, group, &projection);
+        let (grid, _) = untwist(&mut rings, GRID_CELL * cx.beta_median, MAX_UNTWIST)
+            .map_err(|tangle| untwist_failure(tangle, &rings))?;
+        let stay = self.staying_vertices(cx, group, &projection, &grid, &rings);
+        let removed = self.cut_faces(mesh, &projection, &grid, &stay);
+        let turned = self.turned_faces(mesh, &projection);
+        let removed = with_turned_neighbours(mesh, removed, &turned, |f| self.is_inner(mesh, f));
+        let gap = Gap {
+            border_edges: group_border_edges(cx, group),
+            folded: turned
+                .iter()
+                .flat_map(|&f| mesh.faces[f as usize])
+                .collect(),
+            projection,
+            rings,
+            stay,
+        };
+        self.fill_gap(cx, &gap, removed)
+    }
+
+    /// Whether each vertex of the band's faces stays: it lies on the
+    /// surface's side of the smoothed loops (inside an odd number of them
+    /// when one is an outer border, of positive area; an even number when
+    /// all are holes), farther than [`MARGIN`]·βᵢ from them (closer, it
+    /// would only make a sliver against the new border), and is not a
+    /// vertex of the group's old border.
+    pub(super) fn staying_vertices(
+        &self,
+        cx: &Context,
+        group: &[usize],
+        projection: &Projection,
+        grid: &SegmentGrid,
+        rings: &[Ring],
+    ) -> HashMap<u32, bool> {
+        let mesh = cx.mesh;
+        let has_outer = rings.iter().any(|r| r.area() > 0.0);
+        let old_border: BTreeSet<u32> = group
+            .iter()
+            .flat_map(|&l| cx.borders[l].iter().copied())
+            .collect();
+        let stays = |v: u32| {
+            let p = projection.vertex_to2(mesh, v);
+            !old_border.contains(&v)
+                && grid.parity(p) == has_outer
+                && !grid.near(p, MARGIN * cx.beta[v as usize])
+        };
+        self.faces
+            .iter()
+            .flat_map(|&f| mesh.faces[f as usize])
+            .map(|v| (v, stays(v)))
+            .collect()
+    }
+
+    /// The band's faces with a vertex that goes, or crossed by a smoothed
+    /// loop, ascending.
+    pub(super) fn cut_faces(
+        &self,
+        mesh: &Mesh,
+        projection: &Projection,
+        grid: &SegmentGrid,
+        stay: &HashMap<u32, bool>,
+    ) -> Vec<u32> {
+        let p2 = |v: u32| projection.vertex_to2(mesh, v);
+        let mut removed = Vec::new();
+        for &f in &self.faces {
+            let face = mesh.faces[f as usize];
+            let all_stay = face.iter().all(|v| stay[v]);
+            let crossed =
+                all_stay && (0..3).any(|k| grid.crosses(p2(face[k]), p2(face[(k + 1) % 3])));
+            if !all_stay || crossed {
+                removed.push(f);
+            }
+        }
+        removed
+    }
+
+    /// The band's faces that turn over in the projection (a range scan's
+    /// skirt across a depth jump at a silhouette, a fold). They go too
+    /// when they touch what goes and lie inside the band
+    /// ([`with_turned_neighbours`], [`Band::is_inner`]): the gap filling
+    /// replaces them by one layer. Kept faces beyond may turn over: the
+    /// new faces join them along the walls with opposite edge directions
+    /// all the same (the safety net of [`assemble_manifold`] checks it).
+    pub(super) fn turned_faces(&self, mesh: &Mesh, projection: &Projection) -> BTreeSet<u32> {
+        self.faces
+            .iter()
+            .copied()
+            .filter(|&f| {
+                let [a, b, c] = mesh.faces[f as usize].map(|v| projection.vertex_to2(mesh, v));
+                orient(a, b, c) <= 0.0
+            })
+            .collect()
+    }
+
+    /// Whether every vertex of face `f` lies more than two rings inside
+    /// the band's rim.
+    pub(super) fn is_inner(&self, mesh: &Mesh, f: u32) -> bool {
+        mesh.faces[f as usize]
+            .iter()
+            .all(|v| self.rings_from_border[v].0 + 2 < self.depth)
+    }
+
+    /// Step 5 for the faces `removed`. Where a fold beyond the turned
+    /// faces makes two walls cross in the projection, the faces round the
+    /// crossing go too, and the gap is triangulated again, a few times at
+    /// most ([`WALL_REPAIRS`]).
+    pub(super) fn fill_gap(
+        &self,
+        cx: &Context,
+        gap: &Gap,
+        mut removed: Vec<u32>,
+    ) -> Result<Patch, Retry> {
+        for _ in 0..=WALL_REPAIRS {
+            let at_rim = self.loops_reaching_rim(cx.mesh, &removed);
+            if !at_rim.is_empty() {
+                return Err(Retry::Grow(at_rim.into_iter().collect()));
+            }
+            match self.triangulate_gap(cx, gap, &removed) {
+                Ok(mut patch) => {
+                    patch.removed = removed;
+                    return Ok(patch);
+                }
+                Err(Blocked::Walls(vertices)) => {
+                    let before = removed.len();
+                    removed = self.with_faces_round(cx, removed, &vertices);
+                    if removed.len() == before {
+                        break;
+                    }
+                }
+                Err(Blocked::Other(retry)) => return Err(retry),
+            }
+        }
+        Err(leave(
+            "the mesh folds over the new border's plane beside it",
+            Vec::new(),
+        ))
+    }
+
+    /// The loops (positions in the group) whose cut reaches the band's
+    /// rim: a removed face has a vertex `depth` − 1 or more rings from the
+    /// border.
+    pub(super) fn loops_reaching_rim(&self, mesh: &Mesh, removed: &[u32]) -> BTreeSet<usize> {
+        removed
+            .iter()
+            .flat_map(|&f| mesh.faces[f as usize])
+            .map(|v| self.rings_from_border[&v])
+            .filter(|&(d, _)| d + 1 >= self.depth)
+            .map(|(_, origin)| origin)
+            .collect()
+    }
+
+    /// The gap left by the faces `removed`, triangulated: bounded by the
+    /// smoothed loops and the walls, with the kept vertices of the removed
+    /// faces (not those of the fold's second layer) inside.
+    pub(super) fn triangulate_gap(
+        &self,
+        cx: &Context,
+        gap: &Gap,
+        removed: &[u32],
+    ) -> Result<Patch, Blocked> {
+        let mesh = cx.mesh;
+        let walls = walls(mesh, &self.faces, removed, &gap.border_edges, &gap.stay);
+        let free: BTreeSet<u32> = removed
+            .iter()
+            .flat_map(|&f| mesh.faces[f as usize])
+            .filter(|v| gap.stay[v] && !gap.folded.contains(v))
+            .collect();
+        triangulate(
+            mesh,
+            &gap.projection,
+            &gap.rings,
+            &walls,
+            &free,
+            cx.beta_median,
+        )
+    }
+
+    /// `removed` and the band's faces round `vertices` (where two walls
+    /// cross), ascending.
+    pub(super) fn with_faces_round(
+        &self,
+        cx: &Context,
+        removed: Vec<u32>,
+        vertices: &[u32],
+    ) -> Vec<u32> {
+        let mut all: BTreeSet<u32> = removed.into_iter().collect();
+        all.extend(
+            vertices
+                .iter()
+                .flat_map(|&v| cx.topology.faces_of(v).iter().copied())
+                .filter(|&f| self.faces.binary_search(&f).is_ok()),
+        );
+        all.into_iter().collect()
+    }
+}
+
+/// The best-fit plane of a band, oriented with its faces.
+pub(super) struct Projection {
+    pub(super) origin: Point3,
+    pub(super) u: Point3,
+    pub(super) v: Point3,
+}
+
+impl Projection {
+    /// Fits the band's plane, oriented so the faces face its normal.
+    pub(super) fn of(cx: &Context, faces: &[u32]) -> Projection {
+        let mesh = cx.mesh;
+        let origin = mesh.vertices[mesh.faces[faces[0] as usize][0] as usize];
+        // The area-weighted mean face normal, not the best-fit plane: a
+        // range scan faces its scanner everywhere, so every face projects
+        // the right way up along the mean normal even where a band that
+        // curves round a silhouette has a best-fit plane at a steep angle.
+        let sum = faces.iter().fold([0.0; 3], |acc, &f| {
+            let n = face_normal(mesh, f);
+            [acc[0] + n[0], acc[1] + n[1], acc[2] + n[2]]
+        });
+        let length = norm2(sum).sqrt();
+        let normal = if length > 0.0 {
+            sum.map(|c| c / length)
+        } else {
+            let members: Vec<u32> = faces.iter().flat_map(|&f| mesh.faces[f as usize]).collect();
+            fit_plane(&mesh.vertices, &members).normal
+        };
+        // Any tangent axis: the coordinate axis least aligned with n.
+        let axis = (0..3)
+            .min_by(|&a, &b| normal[a].abs().total_cmp(&normal[b].abs()))
+            .unwrap_or(0);
+        let mut e = [0.0; 3];
+        e[axis] = 1.0;
+        let u = cross(normal, e);
+        let u = u.map(|c| c / norm2(u).sqrt());
+        Projection {
+            origin,
+            u,
+            v: cross(normal, u),
+        }
+    }
+
+    pub(super) fn to2(&self, p: Point3) -> [f64; 2] {
+        let d = sub(p, self.origin);
+        [dot(d, self.u), dot(d, self.v)]
+    }
+
+    /// The projection of the mesh's vertex `v`.
+    pub(super) fn vertex_to2(&self, mesh: &Mesh, v: u32) -> [f64; 2] {
+        self.to2(mesh.vertices[v as usize])
+    }
+}
+
+pub(super) fn face_normal(mesh: &Mesh, f: u32) -> Point3 {
+    let [a, b, c] = mesh.faces[f as usize].map(|i| mesh.vertices[i as usize]);
+    cross(sub(b, a), sub(c, a))
+}
+
+/// The group's smoothed loops in the band's projection, with the vertices
+/// that coincide there merged.
+pub(super) fn projected_rings(cx: &Context, group: &[usize], projection: &Projection) -> Vec<Ring> {
+    group
+        .iter()
+        .filter_map(|&l| cx.rings[l].as_ref())
+        .map(|r| {
+            let mut ring = r.clone();
+            ring.p2 = ring.p3.iter().map(|&p| projection.to2(p)).collect();
+            ring.merge_coincident();
+            ring
+        })
+        .collect()
+}
+
+/// The directed edges of the borders of the group's loops.
+pub(super) fn group_border_edges(cx: &Context, group: &[usize]) -> BTreeSet<(u32, u32)> {
+    group
+        .iter()
+        .flat_map(|&l| {
+            let b = &cx.borders[l];
+            (0..b.len()).map(move |i| (b[i], b[(i + 1) % b.len()]))
+        })
+        .collect()
+}
+
+/// `removed` and every turned face connected to it through turned faces
+/// (sharing a vertex), ascending.
+pub(super) fn with_turned_neighbours(
+    mesh: &Mesh,
+    removed: Vec<u32>,
+    turned: &BTreeSet<u32>,
+    inner: impl Fn(u32) -> bool,
+) -> Vec<u32> {
+    let mut by_vertex: HashMap<u32, Vec<u32>> = HashMap::default();
+    for &f in turned {
+        for v in mesh.faces[f as usize] {
+            by_vertex.entry(v).or_default().push(f);
+        }
+    }
+    let mut all: BTreeSet<u32> = removed.iter().copied().collect();
+    let mut stack = removed;
+    while let Some(f) = stack.pop() {
+        for v in mesh.faces[f as usize] {
+            for &g in by_vertex.get(&v).map_or(&[][..], Vec::as_slice) {
+                if inner(g) && all.insert(g) {
+                    stack.push(g);
+                }
+            }
+        }
+    }
+    all.into_iter().collect()
+}
+
+/// The loop to leave when the smoothed loops cross: the one that crosses
+/// itself, or the smaller of two that cross each other.
+pub(super) fn untwist_failure(tangle: Tangle, rings: &[Ring]) -> Retry {
+    match tangle {
+        Tangle::SelfCrossing {
+            index,
+            vertices,
+            dropped,
+        } => leave(
+            format!(
+                "its smoothed loop crosses itself in the band's projection (untwisting it would drop {dropped} of its {vertices} vertices)"
+            ),
+            vec![index],
+        ),
+        Tangle::Crossing { a, b } => {
+            let smaller = if rings[a].len() <= rings[b].len() { a } else { b };
+            leave(
+                "its smoothed loop crosses the smoothed loop of another border",
+                vec![smaller],
+            )
+        }
+    }
+}

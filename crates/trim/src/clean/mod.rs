@@ -1,0 +1,539 @@
+//! Border cleanup of triangulated scans — `meshtrim clean` (meshtrim's
+//! extension of the paper to meshes whose own vertices are the cloud).
+//!
+//! Scanner software triangulates the raw samples, so a scan's border runs
+//! through the outermost samples and zig-zags between them. The paper's
+//! edge reconstruction (section 3) gives the smooth edge those samples
+//! stand for; cleaning replaces the jagged border by it:
+//!
+//! 1. **Border loops.** The mesh's own border (edges used by one face),
+//!    chained in face order, gives each boundary already ordered: the
+//!    mesh's connectivity replaces BPD's clustering and the travelling-
+//!    salesman tour, which can only guess the order the mesh knows. Loops
+//!    of fewer than [`MIN_LOOP_POINTS`] vertices (a missing triangle) are
+//!    too small to smooth and stay as they are.
+//! 2. **Smoothed loops.** Each loop gets its corners (section 3.1), its
+//!    FFT-smoothed edges (section 3.3, cut-off following the local β of the
+//!    vertices) and, unless switched off, the outward offset to the
+//!    physical edge ([`crate::edges::offset`]): the smoothed loop passes
+//!    outside the jagged border at its notches and inside it at its spikes.
+//!    Vertices closer than [`MIN_GAP`]·β to the previous one are merged.
+//! 3. **The band.** Around each loop, the faces within a few rings of its
+//!    border (starting at [`FIRST_DEPTH`] rings, grown to [`MAX_DEPTH`]
+//!    while the cut reaches the band's rim) are projected along their
+//!    area-weighted mean normal (a range scan faces its scanner
+//!    everywhere, so its faces stay the right way up even where the band's
+//!    best-fit plane is steep). Loops whose bands share a face are handled
+//!    together.
+//! 4. **What goes.** Within the band, a vertex stays when it lies on the
+//!    surface's side of the smoothed loops and farther than [`MARGIN`]·βᵢ
+//!    from them (closer, it would only make a sliver against the new
+//!    border), and is not a vertex of the old border. Faces with a vertex
+//!    that goes, or crossed by a smoothed loop, are removed, and with them
+//!    the faces that turn over in the projection and touch them (a
+//!    skirt across a depth jump at a silhouette), inside the band.
+//! 5. **The gap is filled.** The removed region and the gap between the
+//!    old border and the smoothed loops are triangulated again, in the
+//!    projection, by a constrained Delaunay triangulation (spade, exact
+//!    predicates) of the smoothed loops' vertices, the kept vertices of the
+//!    removed faces (not those of turned faces), and, as constraints, the
+//!    smoothed loops and the *walls*: the edges where removed faces met
+//!    kept ones (and the borders of small loops the band takes in). The
+//!    faces between these curves — by a parity flood fill across the
+//!    constraints — are the new ones. Where walls cross in the projection
+//!    (a fold beside the band), the faces round the crossing go too and
+//!    the gap is triangulated again, at most [`WALL_REPAIRS`] times. Where
+//!    the gap is wide, Delaunay refinement adds points lifted onto the
+//!    unrefined triangles ([`REFINE_ANGLE`]); otherwise every vertex is a
+//!    point of the surface already (a mesh vertex or a smoothed loop
+//!    vertex), so the new faces follow the surface without any lifting.
+//! 6. Unused vertices are removed. Vertices outside the bands keep their
+//!    exact coordinates and the faces there are untouched.
+//!
+//! A loop whose band cannot be replaced safely (its smoothed loop crosses
+//! itself by more than [`MAX_UNTWIST`] or crosses another loop or the kept
+//! mesh, its walls keep crossing, its cut runs deeper than [`MAX_DEPTH`]
+//! rings) is left unchanged and reported, and the other loops of its band
+//! are tried again without it. A patch whose faces would meet others at a
+//! non-manifold or same-direction edge is dropped the same way, so the
+//! output is never a broken mesh.
+
+mod assemble;
+mod band;
+mod gap;
+
+use assemble::*;
+use band::*;
+use gap::*;
+
+use std::borrow::Cow;
+use std::collections::BTreeSet;
+
+use crate::hash::{HashMap, HashSet};
+
+use rayon::prelude::*;
+use spade::handles::FixedVertexHandle;
+use spade::{
+    AngleLimit, Point2 as SpadePoint, PositionInTriangulation, RefinementParameters, Triangulation,
+};
+
+use crate::edges::cluster::MIN_LOOP_POINTS;
+use crate::edges::loop_from_tour;
+use crate::error::MeshError;
+use crate::frame::fit_plane;
+use crate::geom::{cross, dist2, dot, norm2, sub, Point3};
+use crate::geom::{median, orient};
+use crate::mesh::topology::{check_manifold, Topology};
+use crate::mesh::{lowest_first, Mesh};
+use crate::planar::{
+    inside_faces, obstacle, untwist, Cdt, Node, Ring, SegmentGrid, Tangle, STEINER,
+};
+use crate::spatial::neighbours::NeighbourIndex;
+
+/// The segment grid's cells are no smaller than this many β.
+const GRID_CELL: f64 = 0.1;
+/// Vertices closer than this many β to a smoothed loop are replaced.
+const MARGIN: f64 = 0.5;
+/// Largest share of a smoothed loop's vertices that untwisting it may drop
+/// (where the low-pass filter pulls the two sides of a deep, narrow notch
+/// across each other, the notch is cut off).
+const MAX_UNTWIST: f64 = 0.15;
+/// Consecutive smoothed loop vertices closer than this many β are merged:
+/// where a zig-zag border is smoothed, its vertices bunch up, and a short
+/// border segment against interior vertices a spacing away makes a
+/// sliver.
+const MIN_GAP: f64 = 0.4;
+/// Refinement of the gap: new faces' smallest angle aimed at (degrees) …
+const REFINE_ANGLE: f64 = 20.0;
+/// … leaving faces below this many β² alone.
+const REFINE_MIN_AREA: f64 = 0.05;
+/// Times the faces round crossing walls are removed before a band gives up.
+const WALL_REPAIRS: usize = 8;
+/// Rings of faces around a border the band starts with …
+const FIRST_DEPTH: u32 = 3;
+/// … and the most it grows to.
+const MAX_DEPTH: u32 = 30;
+
+/// Options of the cleanup.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CleanOptions {
+    /// Move the smoothed border out to the estimated physical edge (off
+    /// gives the paper's edges, through the border vertices).
+    pub offset: bool,
+}
+
+impl Default for CleanOptions {
+    fn default() -> Self {
+        Self { offset: true }
+    }
+}
+
+/// Loops left as they were, and why.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LeftLoops {
+    /// Indices of the loops (in the input's border order).
+    pub loops: Vec<usize>,
+    /// Why they could not be replaced.
+    pub reason: String,
+}
+
+/// What the cleanup did.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct CleanReport {
+    /// Border loops of the input.
+    pub loops_in: usize,
+    /// Loops replaced by their smoothed edge.
+    pub loops_smoothed: usize,
+    /// Loops too small to smooth (kept as they are).
+    pub loops_too_small: usize,
+    /// Loops that could not be replaced, with the reason.
+    pub loops_left: Vec<LeftLoops>,
+    /// Input faces.
+    pub faces_in: usize,
+    /// Input faces that named a vertex twice, dropped before anything else
+    /// (see `without_empty_faces`).
+    pub slivers_dropped: usize,
+    /// Input faces that repeated an earlier face with the same corners in
+    /// the same turn, dropped before anything else (see
+    /// `without_empty_faces`).
+    pub repeated_faces_dropped: usize,
+    /// Input faces removed (in the bands).
+    pub faces_removed: usize,
+    /// New faces (the bands triangulated again).
+    pub faces_added: usize,
+    /// Output faces.
+    pub faces_out: usize,
+    /// New vertices (on the smoothed loops).
+    pub vertices_added: usize,
+    /// Area of the input.
+    pub area_in: f64,
+    /// Area of the output.
+    pub area_out: f64,
+    /// Smallest angle of the new faces, in degrees; 0 when no face was
+    /// added (`faces_added` is 0).
+    pub min_angle_new: f64,
+}
+
+/// Replaces the jagged border of `mesh` by its smoothed boundary (see the
+/// module doc). `beta` is the local resolution of each vertex (from BPD on
+/// the vertices).
+pub fn clean_mesh(
+    mesh: &Mesh,
+    beta: &[f64],
+    options: &CleanOptions,
+) -> Result<(Mesh, CleanReport), MeshError> {
+    mesh.validate()?;
+    let faces_in = mesh.faces.len();
+    let (kept, dropped) = without_empty_faces(mesh);
+    let mesh: &Mesh = &kept;
+    check_cleanable(mesh, beta)?;
+    let borders = mesh.boundary_loops();
+    let rings = smoothed_loops(mesh, beta, &borders, options);
+    let report = CleanReport {
+        loops_in: borders.len(),
+        loops_too_small: rings.iter().filter(|r| r.is_none()).count(),
+        faces_in,
+        slivers_dropped: dropped.slivers,
+        repeated_faces_dropped: dropped.repeats,
+        area_in: mesh.area(),
+        ..Default::default()
+    };
+    let mut outcomes = replace_bands(mesh, beta, &borders, &rings);
+    let out = assemble_manifold(mesh, &mut outcomes);
+    finish(out, &outcomes, report)
+}
+
+/// What the cleanup needs of the mesh left once its empty faces are dropped:
+/// faces, one β per vertex, every edge used at most twice and never twice
+/// the same way.
+fn check_cleanable(mesh: &Mesh, beta: &[f64]) -> Result<(), MeshError> {
+    if mesh.faces.is_empty() {
+        return Err(MeshError::NoFaces);
+    }
+    if beta.len() != mesh.vertices.len() {
+        return Err(MeshError::ResolutionLength {
+            values: beta.len(),
+            vertices: mesh.vertices.len(),
+        });
+    }
+    check_manifold(mesh)
+}
+
+/// Step 2: each border loop smoothed (corners, FFT edges and, with
+/// `options.offset`, the outward offset) and evened out, in parallel;
+/// None for loops of fewer than [`MIN_LOOP_POINTS`] vertices, too small
+/// to smooth.
+fn smoothed_loops(
+    mesh: &Mesh,
+    beta: &[f64],
+    borders: &[Vec<u32>],
+    options: &CleanOptions,
+) -> Vec<Option<Ring>> {
+    let index = options.offset.then(|| NeighbourIndex::new(&mesh.vertices));
+    borders
+        .par_iter()
+        .map(|border| {
+            (border.len() >= MIN_LOOP_POINTS).then(|| {
+                let lp = loop_from_tour(&mesh.vertices, beta, border.clone(), index.as_ref());
+                even_out(Ring::from_loop(&lp, beta))
+            })
+        })
+        .collect()
+}
+
+/// Steps 3 to 5 for every smoothed loop: its band, what goes and the new
+/// faces, one outcome per group of loops whose bands overlap.
+fn replace_bands(
+    mesh: &Mesh,
+    beta: &[f64],
+    borders: &[Vec<u32>],
+    rings: &[Option<Ring>],
+) -> Vec<Outcome> {
+    let topology = Topology::new(mesh);
+    let context = Context {
+        mesh,
+        beta,
+        borders,
+        rings,
+        topology: &topology,
+        beta_median: median(beta),
+    };
+    replace_all(&context)
+}
+
+/// The input with every patch applied. A safety net: a patch whose faces
+/// would make an edge non-manifold (not seen on the test data) is
+/// dropped, its loops left, and the rest is assembled again.
+fn assemble_manifold(mesh: &Mesh, outcomes: &mut [Outcome]) -> Mesh {
+    loop {
+        let (out, origin) = assemble(mesh, outcomes);
+        let bad = patches_breaking_manifold(&out, &origin);
+        if bad.is_empty() {
+            return out;
+        }
+        for g in bad {
+            if let Some(patch) = outcomes[g].patch.take() {
+                outcomes[g].left.push(LeftLoops {
+                    loops: patch.loops,
+                    reason: "its new faces would meet others at a non-manifold edge".into(),
+                });
+            }
+        }
+    }
+}
+
+/// Step 6 and the output's part of the report: what the patches did,
+/// unused vertices removed, the result checked, its faces and area.
+fn finish(
+    mut out: Mesh,
+    outcomes: &[Outcome],
+    mut report: CleanReport,
+) -> Result<(Mesh, CleanReport), MeshError> {
+    summarise(outcomes, &out, &mut report);
+    out.remove_unused_vertices();
+    check_manifold(&out)?;
+    report.faces_out = out.faces.len();
+    report.area_out = out.area();
+    Ok((out, report))
+}
+
+/// Everything the band replacement reads.
+struct Context<'a> {
+    mesh: &'a Mesh,
+    beta: &'a [f64],
+    borders: &'a [Vec<u32>],
+    rings: &'a [Option<Ring>],
+    topology: &'a Topology,
+    beta_median: f64,
+}
+
+/// The new faces of one band.
+#[derive(Debug, Default)]
+struct Patch {
+    /// Loops it replaces.
+    loops: Vec<usize>,
+    /// Input faces it removes.
+    removed: Vec<u32>,
+    /// New vertices (smoothed loop vertices).
+    vertices: Vec<Point3>,
+    /// New faces: ids below the mesh's vertex count are input vertices,
+    /// the others `vertex count + index into vertices`.
+    faces: Vec<[u32; 3]>,
+}
+
+/// One group's outcome: the band of its replaced loops (to detect bands
+/// that overlap), their patch, and the loops that stay, with why.
+struct Outcome {
+    band: Vec<u32>,
+    patch: Option<Patch>,
+    left: Vec<LeftLoops>,
+}
+
+/// Replaces every smoothable loop, merging loops whose bands overlap until
+/// no two bands share a face.
+fn replace_all(cx: &Context) -> Vec<Outcome> {
+    let mut groups: Vec<Vec<usize>> = (0..cx.rings.len())
+        .filter(|&l| cx.rings[l].is_some())
+        .map(|l| vec![l])
+        .collect();
+    let mut outcomes: Vec<Outcome> = groups.par_iter().map(|g| replace_group(cx, g)).collect();
+    // Only the merged group is replaced again: the others do not change.
+    while let Some((a, b)) = first_overlap(&outcomes) {
+        let taken = groups.remove(b);
+        outcomes.remove(b);
+        groups[a].extend(taken);
+        groups[a].sort_unstable();
+        outcomes[a] = replace_group(cx, &groups[a]);
+    }
+    outcomes
+}
+
+/// Two outcomes whose bands share a face (indices, a < b).
+fn first_overlap(outcomes: &[Outcome]) -> Option<(usize, usize)> {
+    let mut owner: HashMap<u32, usize> = HashMap::default();
+    for (g, outcome) in outcomes.iter().enumerate() {
+        for &f in &outcome.band {
+            if let Some(&other) = owner.get(&f) {
+                return Some((other, g));
+            }
+            owner.insert(f, g);
+        }
+    }
+    None
+}
+
+/// Replaces one group of loops, growing the band while the cut reaches
+/// its rim. A loop that cannot be replaced (its band folds, its smoothed
+/// loop crosses itself or the kept mesh) is left as it is and the others
+/// are tried again without it, so one bad border does not spoil its
+/// neighbours.
+fn replace_group(cx: &Context, group: &[usize]) -> Outcome {
+    let mut active = group.to_vec();
+    let mut left = Vec::new();
+    'attempt: while !active.is_empty() {
+        let mut depth = FIRST_DEPTH;
+        loop {
+            let band = Band::around(cx, &active, depth);
+            let failure = match band.replace(cx, &active) {
+                Ok(mut patch) => {
+                    patch.loops = active;
+                    return Outcome {
+                        band: band.faces,
+                        patch: Some(patch),
+                        left,
+                    };
+                }
+                Err(Retry::Grow(_)) if depth < MAX_DEPTH => {
+                    depth = (depth * 3 / 2).min(MAX_DEPTH);
+                    continue;
+                }
+                Err(Retry::Grow(culprits)) => Failure {
+                    reason: format!(
+                        "the smoothed border runs more than {MAX_DEPTH} rings of faces from the mesh border"
+                    ),
+                    culprits,
+                },
+                Err(Retry::Leave(failure)) => failure,
+            };
+            let mut culprits: Vec<usize> = failure
+                .culprits
+                .iter()
+                .filter_map(|&k| active.get(k).copied())
+                .collect();
+            culprits.sort_unstable();
+            culprits.dedup();
+            if culprits.is_empty() {
+                culprits = active.clone();
+            }
+            active.retain(|l| !culprits.contains(l));
+            left.push(LeftLoops {
+                loops: culprits,
+                reason: failure.reason,
+            });
+            continue 'attempt;
+        }
+    }
+    Outcome {
+        band: Vec::new(),
+        patch: None,
+        left,
+    }
+}
+
+/// Why the gap could not be triangulated: walls crossing (with the mesh
+/// vertices involved), or anything else.
+enum Blocked {
+    Walls(Vec<u32>),
+    Other(Retry),
+}
+
+/// Why a band could not be replaced as it is.
+enum Retry {
+    /// The cut reaches the band's rim: take more rings. Holds the loops
+    /// (positions in the group) whose cut reaches it.
+    Grow(Vec<usize>),
+    /// Some loops must stay.
+    Leave(Failure),
+}
+
+/// Why some loops stay: `culprits` are positions in the group (empty when
+/// the whole group is concerned).
+struct Failure {
+    reason: String,
+    culprits: Vec<usize>,
+}
+
+fn leave(reason: impl Into<String>, culprits: Vec<usize>) -> Retry {
+    Retry::Leave(Failure {
+        reason: reason.into(),
+        culprits,
+    })
+}
+
+/// Faces dropped before cleaning, by kind.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+struct DroppedFaces {
+    /// Faces that named a vertex twice.
+    slivers: usize,
+    /// Faces that repeated an earlier one, corners and turn alike.
+    repeats: usize,
+}
+
+/// `mesh` without the faces that add no surface, and how many there were.
+///
+/// - A face that names a vertex twice (a binary STL's sliver whose two
+///   corners coincide becomes one once its vertices are merged) has no
+///   area and no border of its own: the faces on either side of it already
+///   share its one real edge. Kept, that edge would count twice and read
+///   as non-manifold.
+/// - A face that repeats an earlier one with the same corners in the same
+///   turn (a triangle written twice, as exporters that concatenate patches
+///   do) covers the same surface again. Kept, each of its edges would
+///   count three times and read as non-manifold. The first copy stays.
+///
+/// Both are dropped, as MeshLab's "Remove Zero Area Faces" and "Remove
+/// Duplicate Faces" would, and counted in the report. Faces of three
+/// distinct but collinear vertices stay (they hold the surface together),
+/// and so does a face that repeats another's corners in the opposite turn:
+/// which of the two agrees with its neighbours is not known here, so the
+/// mesh stays as it is and its edges are reported as non-manifold.
+fn without_empty_faces(mesh: &Mesh) -> (Cow<'_, Mesh>, DroppedFaces) {
+    let distinct = |f: &[u32; 3]| f[0] != f[1] && f[1] != f[2] && f[2] != f[0];
+    let mut seen = HashSet::with_capacity_and_hasher(mesh.faces.len(), Default::default());
+    let mut dropped = DroppedFaces::default();
+    let keep: Vec<bool> = mesh
+        .faces
+        .iter()
+        .map(|f| {
+            if !distinct(f) {
+                dropped.slivers += 1;
+                false
+            } else if !seen.insert(lowest_first(*f)) {
+                dropped.repeats += 1;
+                false
+            } else {
+                true
+            }
+        })
+        .collect();
+    if dropped == DroppedFaces::default() {
+        return (Cow::Borrowed(mesh), dropped);
+    }
+    let mut kept = mesh.clone();
+    kept.retain_faces(&keep);
+    (Cow::Owned(kept), dropped)
+}
+
+/// Drops each smoothed loop vertex closer than [`MIN_GAP`]·β to the last
+/// one kept (and, at the end, to the first), so that the new border's
+/// segments are not much shorter than the mesh's edges.
+fn even_out(mut ring: Ring) -> Ring {
+    let m = ring.p3.len();
+    if m < 2 * MIN_LOOP_POINTS {
+        return ring;
+    }
+    let mut keep = vec![true; m];
+    let mut last = 0;
+    for (j, kept) in keep.iter_mut().enumerate().skip(1) {
+        let gap = MIN_GAP * ring.beta[j];
+        let close = dist2(ring.p3[j], ring.p3[last]).sqrt() < gap;
+        let closing = dist2(ring.p3[j], ring.p3[0]).sqrt() < gap;
+        if close || closing {
+            *kept = false;
+        } else {
+            last = j;
+        }
+    }
+    if keep.iter().filter(|&&k| k).count() >= MIN_LOOP_POINTS {
+        let mut k = keep.iter();
+        ring.p3.retain(|_| *k.next().unwrap_or(&true));
+        let mut k = keep.iter();
+        ring.reference.retain(|_| *k.next().unwrap_or(&true));
+        let mut k = keep.iter();
+        ring.beta.retain(|_| *k.next().unwrap_or(&true));
+    }
+    ring
+}
+
+#[cfg(test)]
+mod tests;

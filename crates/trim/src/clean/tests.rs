@@ -1,0 +1,298 @@
+//! Tests of the cleanup: random meshes against plain references, and
+//! jagged annuli whose true circles are known.
+
+use super::*;
+use crate::mesh::topology::edge_defects;
+use rand::{RngExt, SeedableRng};
+
+/// [`edge_defects`] by hashing every edge: the plain way, kept as the
+/// reference.
+fn edge_defects_reference(mesh: &Mesh) -> (usize, usize) {
+    let mut directed: HashMap<(u32, u32), u32> = HashMap::default();
+    let mut undirected: HashMap<(u32, u32), u32> = HashMap::default();
+    for f in &mesh.faces {
+        for k in 0..3 {
+            let (a, b) = (f[k], f[(k + 1) % 3]);
+            *directed.entry((a, b)).or_insert(0) += 1;
+            *undirected.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+        }
+    }
+    (
+        undirected.values().filter(|&&c| c > 2).count(),
+        directed.values().filter(|&&c| c > 1).count(),
+    )
+}
+
+/// [`patches_breaking_manifold`] by hashing every directed edge: the
+/// plain way, kept as the reference.
+fn patches_breaking_manifold_reference(mesh: &Mesh, origin: &[Option<usize>]) -> BTreeSet<usize> {
+    let mut directed: HashMap<(u32, u32), Vec<usize>> = HashMap::default();
+    for (i, f) in mesh.faces.iter().enumerate() {
+        for k in 0..3 {
+            directed.entry((f[k], f[(k + 1) % 3])).or_default().push(i);
+        }
+    }
+    let mut bad = BTreeSet::new();
+    for (&(a, b), faces) in &directed {
+        let reverse = directed.get(&(b, a)).map_or(0, Vec::len);
+        if faces.len() > 1 || reverse > 1 {
+            bad.extend(faces.iter().filter_map(|&i| origin[i]));
+        }
+    }
+    bad
+}
+
+/// The sorted-edge counts and the patches they blame agree with the
+/// hashed ones on random faces over few vertices: repeated, reversed
+/// and fanned faces, and faces naming a vertex twice or three times.
+#[test]
+fn edge_defects_match_the_reference() {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(20);
+    for case in 0..2000 {
+        let vertices = rng.random_range(3..9u32);
+        let faces = (0..rng.random_range(1..25))
+            .map(|_| [0; 3].map(|_| rng.random_range(0..vertices)))
+            .collect();
+        let mesh = Mesh {
+            vertices: vec![[0.0; 3]; vertices as usize],
+            faces,
+        };
+        assert_eq!(
+            edge_defects(&mesh),
+            edge_defects_reference(&mesh),
+            "case {case}: {mesh:?}"
+        );
+        let origin: Vec<Option<usize>> = (0..mesh.faces.len())
+            .map(|_| rng.random_bool(0.7).then(|| rng.random_range(0..4)))
+            .collect();
+        assert_eq!(
+            patches_breaking_manifold(&mesh, &origin),
+            patches_breaking_manifold_reference(&mesh, &origin),
+            "case {case}: {mesh:?}"
+        );
+    }
+}
+use crate::bpd::{detect_boundary, BpdOptions};
+use spade::{DelaunayTriangulation, Point2 as SpadePoint};
+use testkit::SplitMix64;
+
+/// A jittered grid of pitch 1 over a disc of radius `r` with a hole of
+/// radius `hole` at the centre, triangulated by Delaunay, keeping the
+/// triangles whose centroid lies in the annulus: a jagged scan border.
+fn jagged_annulus(r: f64, hole: f64, seed: u64) -> Mesh {
+    let mut rng = SplitMix64::new(seed);
+    let mut points = Vec::new();
+    let m = r.ceil() as i64 + 1;
+    for j in -m..=m {
+        for i in -m..=m {
+            let p = [
+                i as f64 + rng.range(-0.3, 0.3),
+                j as f64 + rng.range(-0.3, 0.3),
+            ];
+            let d = (p[0] * p[0] + p[1] * p[1]).sqrt();
+            if d <= r && d >= hole {
+                points.push(p);
+            }
+        }
+    }
+    let mut dt: DelaunayTriangulation<SpadePoint<f64>> = DelaunayTriangulation::new();
+    for p in &points {
+        dt.insert(SpadePoint::new(p[0], p[1])).unwrap();
+    }
+    let vertices: Vec<Point3> = dt
+        .vertices()
+        .map(|v| [v.position().x, v.position().y, 0.1 * v.position().x])
+        .collect();
+    let faces = dt
+        .inner_faces()
+        .map(|f| f.vertices().map(|v| v.fix().index() as u32))
+        .filter(|f| {
+            let c = f.iter().fold([0.0, 0.0], |c, &v| {
+                [
+                    c[0] + vertices[v as usize][0] / 3.0,
+                    c[1] + vertices[v as usize][1] / 3.0,
+                ]
+            });
+            let d = (c[0] * c[0] + c[1] * c[1]).sqrt();
+            d < r && d > hole
+        })
+        .collect();
+    let mut mesh = Mesh { vertices, faces };
+    mesh.remove_unused_vertices();
+    mesh
+}
+
+/// Mean and largest distance of the border vertices to the true
+/// circles (radii `r` and `hole`, in the x-y projection; the surface
+/// z = 0.1·x stretches x by under 0.5 %).
+fn border_error(mesh: &Mesh, r: f64, hole: f64) -> (f64, f64) {
+    let loops = mesh.boundary_loops();
+    let d: Vec<f64> = loops
+        .iter()
+        .flatten()
+        .map(|&v| {
+            let p = mesh.vertices[v as usize];
+            let rho = (p[0] * p[0] + p[1] * p[1]).sqrt();
+            (rho - r).abs().min((rho - hole).abs())
+        })
+        .collect();
+    let mean = d.iter().sum::<f64>() / d.len() as f64;
+    (mean, d.iter().copied().fold(0.0, f64::max))
+}
+
+fn clean(mesh: &Mesh) -> (Mesh, CleanReport) {
+    let detection = detect_boundary(&mesh.vertices, &BpdOptions::default()).unwrap();
+    clean_mesh(mesh, &detection.beta, &CleanOptions::default()).unwrap()
+}
+
+#[test]
+fn a_jagged_annulus_gets_its_circles_back() {
+    let mesh = jagged_annulus(20.0, 6.0, 7);
+    let (before_mean, _) = border_error(&mesh, 20.0, 6.0);
+    let (out, report) = clean(&mesh);
+    let (after_mean, after_max) = border_error(&out, 20.0, 6.0);
+    assert_eq!(report.loops_in, 2, "{report:?}");
+    assert_eq!(report.loops_smoothed, 2, "{report:?}");
+    assert_eq!(out.boundary_loops().len(), 2);
+    // Measured: 0.20 pitch before, 0.15 after (the jagged border's
+    // vertices are on the true circle's side of the samples; its
+    // straight edges cut the corners, which vertices alone do not see).
+    assert!(
+        after_mean < 0.8 * before_mean,
+        "before {before_mean}, after {after_mean}"
+    );
+    assert!(after_mean < 0.2, "after {after_mean}");
+    let truth = std::f64::consts::PI * (20.0f64.powi(2) - 6.0f64.powi(2));
+    let error = |a: f64| (a - truth).abs() / truth;
+    assert!(
+        error(report.area_out) < 0.5 * error(report.area_in),
+        "{report:?}"
+    );
+    assert!(after_max < 1.0, "{after_max}");
+    assert!(report.min_angle_new > 5.0, "{report:?}");
+    check_manifold(&out).unwrap();
+}
+
+/// A closed surface has no border: it comes back as it was.
+#[test]
+fn a_closed_mesh_is_returned_unchanged() {
+    let vertices = vec![
+        [1.0, 0.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [0.0, -1.0, 0.0],
+        [0.0, 0.0, 1.0],
+        [0.0, 0.0, -1.0],
+    ];
+    let faces = vec![
+        [0, 2, 4],
+        [2, 1, 4],
+        [1, 3, 4],
+        [3, 0, 4],
+        [2, 0, 5],
+        [1, 2, 5],
+        [3, 1, 5],
+        [0, 3, 5],
+    ];
+    let mesh = Mesh { vertices, faces };
+    let (out, report) = clean_mesh(&mesh, &[1.0; 6], &CleanOptions::default()).unwrap();
+    assert_eq!(out, mesh);
+    assert_eq!(report.loops_in, 0);
+    assert_eq!(report.faces_out, 8);
+}
+
+/// Misoriented and non-manifold meshes, and resolutions that do not
+/// match the vertices, are clear errors.
+#[test]
+fn bad_topology_is_an_error() {
+    let mesh = jagged_annulus(8.0, 3.0, 3);
+    assert!(matches!(
+        clean_mesh(&mesh, &[1.0; 3], &CleanOptions::default()),
+        Err(MeshError::ResolutionLength { values: 3, .. })
+    ));
+    let mut mesh = jagged_annulus(8.0, 3.0, 3);
+    let beta = vec![1.0; mesh.vertices.len()];
+    mesh.faces[0].swap(1, 2);
+    assert!(matches!(
+        clean_mesh(&mesh, &beta, &CleanOptions::default()),
+        Err(MeshError::Misoriented { .. })
+    ));
+    let mut mesh = jagged_annulus(8.0, 3.0, 3);
+    let f = mesh.faces[0];
+    mesh.vertices.push([0.0, 0.0, 5.0]);
+    let apex = mesh.vertices.len() as u32 - 1;
+    mesh.faces.push([f[0], f[1], apex]);
+    assert!(matches!(
+        clean_mesh(
+            &mesh,
+            &vec![1.0; mesh.vertices.len()],
+            &CleanOptions::default()
+        ),
+        Err(MeshError::NonManifold { .. })
+    ));
+}
+
+/// A jagged annulus, its β, the default options and its cleaned mesh:
+/// what the tests of faces to drop compare against.
+fn annulus_cleaned() -> (Mesh, Vec<f64>, CleanOptions, Mesh) {
+    let mesh = jagged_annulus(8.0, 3.0, 3);
+    let beta = vec![1.0; mesh.vertices.len()];
+    let options = CleanOptions::default();
+    let (cleaned, _) = clean_mesh(&mesh, &beta, &options).unwrap();
+    (mesh, beta, options, cleaned)
+}
+
+/// Faces with two equal corners (a binary STL's sliver, merged) are
+/// dropped and counted, neither reported as non-manifold edges nor an
+/// error of their own that stops the cleanup. The rest of the mesh is
+/// cleaned exactly as it would be without them.
+#[test]
+fn faces_naming_a_vertex_twice_are_dropped() {
+    let (mesh, beta, options, want) = annulus_cleaned();
+    let mut with_slivers = mesh.clone();
+    let [a, b, _] = mesh.faces[5];
+    let [c, d, _] = mesh.faces[9];
+    with_slivers.faces.insert(3, [a, b, a]);
+    with_slivers.faces.push([c, d, d]);
+    with_slivers.faces.push([c, c, c]);
+    let (got, report) = clean_mesh(&with_slivers, &beta, &options).unwrap();
+    assert_eq!(got, want);
+    assert_eq!(report.slivers_dropped, 3);
+    assert_eq!(report.faces_in, mesh.faces.len() + 3);
+}
+
+/// A face written twice with the same corners in the same turn is
+/// dropped and counted (not read as 3 non-manifold edges); one in the
+/// opposite turn stays, and its edges are still reported.
+#[test]
+fn repeated_faces_are_dropped_when_they_turn_the_same_way() {
+    let (mesh, beta, options, want) = annulus_cleaned();
+    let mut repeated = mesh.clone();
+    let [a, b, c] = mesh.faces[5];
+    repeated.faces.push([b, c, a]);
+    repeated.faces.push(mesh.faces[9]);
+    repeated.faces.push([c, a, b]);
+    let (got, report) = clean_mesh(&repeated, &beta, &options).unwrap();
+    assert_eq!(got, want);
+    assert_eq!(report.repeated_faces_dropped, 3);
+    assert_eq!(report.slivers_dropped, 0);
+    let mut reversed = mesh.clone();
+    reversed.faces.push([a, c, b]);
+    assert!(matches!(
+        clean_mesh(&reversed, &beta, &options),
+        Err(MeshError::NonManifold { .. })
+    ));
+}
+
+/// A mesh of slivers alone has no faces to clean.
+#[test]
+fn a_mesh_of_slivers_alone_has_no_faces() {
+    let mesh = Mesh {
+        vertices: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        faces: vec![[0, 1, 1], [2, 2, 0]],
+    };
+    assert_eq!(
+        clean_mesh(&mesh, &[1.0; 3], &CleanOptions::default()).unwrap_err(),
+        MeshError::NoFaces
+    );
+}
