@@ -58,6 +58,7 @@ pub(crate) fn detect_read_cloud(
     } else {
         trim::detect_boundary(&cloud.points, options)
     }
+    .map_err(in_cli_words)
     .with_context(|| path.display().to_string())?;
     Ok(Detected {
         cloud,
@@ -96,4 +97,61 @@ fn detect_with_progress(points: &[Point3], options: &BpdOptions) -> Result<Detec
     let result = trim::detect_boundary_with_progress(points, options, &progress);
     bar.finish_and_clear();
     result
+}
+
+/// A library error in the command line's words. The library advises in
+/// terms of its parameters and functions: lower k, trim a Poisson mesh
+/// instead; here they are the flag `--k` and the command
+/// `meshtrim MESH CLOUD OUT`.
+pub(crate) fn in_cli_words(error: impl std::error::Error) -> anyhow::Error {
+    let message = error
+        .to_string()
+        .replace("lower k or", "lower --k or")
+        .replace(
+            "trim that mesh instead",
+            "use `meshtrim MESH CLOUD OUT` instead",
+        );
+    anyhow::Error::msg(message)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use trim::DelaunayError;
+
+    /// Every library message that advises a parameter or another stage
+    /// gets the flag or the command that sets it.
+    #[test]
+    fn advice_names_the_flag_and_the_command() {
+        let few = CloudError::TooFewPoints {
+            distinct: 5,
+            total: 6,
+            k: 30,
+        };
+        assert!(in_cli_words(few)
+            .to_string()
+            .ends_with("; lower --k or use a denser cloud"));
+        let folds = [
+            DelaunayError::NotAHeightField {
+                percent: 2.0,
+                what: "triangles",
+                limit: 1.0,
+            },
+            DelaunayError::LoopNotSimple {
+                index: 0,
+                vertices: 10,
+                dropped: 4,
+            },
+            DelaunayError::LoopsCross { a: 0, b: 1 },
+        ];
+        for error in folds {
+            let words = in_cli_words(error).to_string();
+            assert!(
+                words.ends_with(
+                    "mesh it with screened Poisson and use `meshtrim MESH CLOUD OUT` instead"
+                ),
+                "{words}"
+            );
+        }
+    }
 }

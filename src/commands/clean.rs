@@ -15,7 +15,7 @@ use trim::{clean_mesh, CleanOptions, CleanReport};
 use crate::commands::args::StageArgs;
 use crate::io::mesh_out::write_mesh;
 use crate::io::read_mesh_with_faces;
-use crate::stages::{millis, Stages};
+use crate::stages::{in_cli_words, millis, Stages};
 
 /// Arguments of `meshtrim clean`.
 #[derive(Debug, Clone, clap::Args)]
@@ -140,6 +140,7 @@ fn clean(input: &Path, output: &Path, stages: &Stages) -> Result<Report> {
     // Only β is needed: the mesh knows its border (BPD's labels would be
     // thrown away), and β alone takes about half the time.
     let beta = trim::local_resolution(&mesh.vertices, &stages.detection)
+        .map_err(in_cli_words)
         .with_context(|| format!("{}: the mesh's vertices", input.display()))?;
     let resolution_time = started.elapsed();
     let started = Instant::now();
@@ -181,7 +182,7 @@ impl Report {
                 .iter()
                 .map(|l| LeftLoops {
                     loops: l.loops.clone(),
-                    reason: l.reason.clone(),
+                    reason: l.reason.to_string(),
                 })
                 .collect(),
             faces_in: r.faces_in,

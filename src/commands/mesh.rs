@@ -11,7 +11,7 @@ use trim::{delaunay_mesh_with_report, reconstruct_edges, DelaunayReport};
 
 use crate::commands::args::StageArgs;
 use crate::io::mesh_out::write_mesh;
-use crate::stages::{millis, read_and_detect, Detected};
+use crate::stages::{in_cli_words, millis, read_and_detect, Detected};
 
 /// Arguments of `meshtrim mesh`.
 #[derive(Debug, Clone, clap::Args)]
@@ -87,6 +87,7 @@ pub fn run(args: &Args) -> Result<()> {
     let edges_time = started.elapsed();
     let started = Instant::now();
     let (mesh, made) = delaunay_mesh_with_report(&cloud.points, &detection, &edges)
+        .map_err(in_cli_words)
         .with_context(|| args.cloud.display().to_string())?;
     let mesh_time = started.elapsed();
     let started = Instant::now();

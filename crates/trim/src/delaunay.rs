@@ -11,7 +11,7 @@
 //!    stands on edge or folds over its plane, local normals turn
 //!    perpendicular to n; if more than [`STEEP_SHARE`] of the points have
 //!    |nᵢ·n| < [`STEEP_COS`], the cloud is rejected with
-//!    [`MeshError::NotAHeightField`].
+//!    [`DelaunayError::NotAHeightField`].
 //! 3. **Loops made valid.** Each smoothed loop becomes one closed polyline
 //!    (each open edge without its last point, the next edge's corner), with
 //!    its smoothed 3D positions. In the projection, consecutive vertices
@@ -20,8 +20,8 @@
 //!    by dropping the vertices of the shorter side of the crossing (a
 //!    twist, or a spike that turns straight back), as long as that takes at
 //!    most [`MAX_REPAIR`] of its vertices (and at least 4 may always go);
-//!    otherwise [`MeshError::LoopNotSimple`]. Two loops that cross or touch
-//!    give [`MeshError::LoopsCross`]. spade's exact predicates check every
+//!    otherwise [`DelaunayError::LoopNotSimple`]. Two loops that cross or touch
+//!    give [`DelaunayError::LoopsCross`]. spade's exact predicates check every
 //!    constraint again before it is added (spade panics on crossing
 //!    constraints): what the floating-point repair missed is an error,
 //!    never a panic.
@@ -54,7 +54,7 @@
 //!    joining the overlapping sheets, steep to the surface: a triangle is a
 //!    misfit when the mean |n_t·nᵥ| over its vertices' local normals is
 //!    below [`MISFIT_COS`]; more than [`MISFIT_SHARE`] of misfits gives
-//!    [`MeshError::NotAHeightField`].
+//!    [`DelaunayError::NotAHeightField`].
 //!
 //! Degenerate faces: a projected Delaunay triangle has a positive area and
 //! its lift is never smaller, so no face has zero area. Slivers are
@@ -71,7 +71,7 @@ use spade::{PositionInTriangulation, Triangulation};
 
 use crate::bpd::Detection;
 use crate::edges::Edges;
-use crate::error::MeshError;
+use crate::error::{DelaunayError, MeshError};
 use crate::frame::{fit_plane, Frame};
 use crate::geom::{cross, dot, norm2, sub, Point3};
 use crate::mesh::{lowest_first, Mesh};
@@ -145,7 +145,7 @@ pub fn delaunay_mesh(
     cloud: &[Point3],
     detection: &Detection,
     edges: &Edges,
-) -> Result<Mesh, MeshError> {
+) -> Result<Mesh, DelaunayError> {
     delaunay_mesh_with_report(cloud, detection, edges).map(|(mesh, _)| mesh)
 }
 
@@ -155,7 +155,7 @@ pub fn delaunay_mesh_with_report(
     cloud: &[Point3],
     detection: &Detection,
     edges: &Edges,
-) -> Result<(Mesh, DelaunayReport), MeshError> {
+) -> Result<(Mesh, DelaunayReport), DelaunayError> {
     check_input(cloud, detection)?;
     let n = cloud.len();
     let beta = &detection.beta;
@@ -169,7 +169,7 @@ pub fn delaunay_mesh_with_report(
     let normals = local_normals(cloud, plane.frame.normal);
     check_steep_normals(&normals, plane.frame.normal, &mut report)?;
     if edges.loops.is_empty() {
-        return Err(MeshError::NoFaces);
+        return Err(MeshError::NoFaces.into());
     }
     let (rings, grid) = valid_rings(edges, beta, beta_median, &plane, &mut report)?;
     let nodes = points_inside(cloud, beta, &plane, &grid, &mut report);
@@ -184,13 +184,13 @@ pub fn delaunay_mesh_with_report(
 /// coordinates, coordinates beyond spade's range (checked before spade,
 /// which panics or refuses points there), fewer than 3 points, or a β
 /// count other than one per point.
-fn check_input(cloud: &[Point3], detection: &Detection) -> Result<(), MeshError> {
+fn check_input(cloud: &[Point3], detection: &Detection) -> Result<(), DelaunayError> {
     if let Some(index) = cloud.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
-        return Err(MeshError::NonFinite { index });
+        return Err(MeshError::NonFinite { index }.into());
     }
     crate::mesh::check_vertex_range(cloud)?;
     if cloud.len() < 3 || detection.beta.len() != cloud.len() {
-        return Err(MeshError::NoFaces);
+        return Err(MeshError::NoFaces.into());
     }
     Ok(())
 }
@@ -273,13 +273,13 @@ fn oriented_normal(cloud: &[Point3], members: &[u32], plane_normal: Point3) -> P
 /// Step 2, **height-field check on the points**: where the surface stands
 /// on edge or folds over its plane, local normals turn perpendicular to
 /// the plane normal; more than [`STEEP_SHARE`] of them below
-/// [`STEEP_COS`] is [`MeshError::NotAHeightField`]. Fills
+/// [`STEEP_COS`] is [`DelaunayError::NotAHeightField`]. Fills
 /// `steep_normals_percent`.
 fn check_steep_normals(
     normals: &[Point3],
     plane_normal: Point3,
     report: &mut DelaunayReport,
-) -> Result<(), MeshError> {
+) -> Result<(), DelaunayError> {
     let n = normals.len();
     let steep = normals
         .iter()
@@ -287,7 +287,7 @@ fn check_steep_normals(
         .count();
     report.steep_normals_percent = 100.0 * steep as f64 / n as f64;
     if steep as f64 > STEEP_SHARE * n as f64 {
-        return Err(MeshError::NotAHeightField {
+        return Err(DelaunayError::NotAHeightField {
             percent: report.steep_normals_percent,
             what: "local normals",
             limit: 100.0 * STEEP_SHARE,
@@ -306,7 +306,7 @@ fn valid_rings(
     beta_median: f64,
     plane: &Projection,
     report: &mut DelaunayReport,
-) -> Result<(Vec<Ring>, SegmentGrid), MeshError> {
+) -> Result<(Vec<Ring>, SegmentGrid), DelaunayError> {
     let mut rings: Vec<Ring> = edges
         .loops
         .iter()
@@ -322,12 +322,12 @@ fn valid_rings(
                 index,
                 vertices,
                 dropped,
-            } => MeshError::LoopNotSimple {
+            } => DelaunayError::LoopNotSimple {
                 index,
                 vertices,
                 dropped,
             },
-            Tangle::Crossing { a, b } => MeshError::LoopsCross { a, b },
+            Tangle::Crossing { a, b } => DelaunayError::LoopsCross { a, b },
         })?;
     report.loop_vertices_dropped += dropped;
     Ok((rings, grid))
@@ -408,12 +408,12 @@ impl LoopCdt {
         rings: &[Ring],
         n: usize,
         report: &mut DelaunayReport,
-    ) -> Result<Self, MeshError> {
+    ) -> Result<Self, DelaunayError> {
         let inserted = nodes.len();
         let cdt: Cdt = if nodes.is_empty() {
             Cdt::new()
         } else {
-            Cdt::bulk_load(nodes).map_err(|_| MeshError::NoFaces)?
+            Cdt::bulk_load(nodes).map_err(|_| DelaunayError::Input(MeshError::NoFaces))?
         };
         report.points_merged = inserted - cdt.num_vertices();
         let mut t = LoopCdt {
@@ -438,7 +438,7 @@ impl LoopCdt {
         &mut self,
         l: usize,
         ring: &Ring,
-    ) -> Result<Vec<FixedVertexHandle>, MeshError> {
+    ) -> Result<Vec<FixedVertexHandle>, DelaunayError> {
         let mut handles = Vec::with_capacity(ring.p2.len());
         for j in 0..ring.p2.len() {
             let id = (self.n + self.loop_p3.len()) as u32;
@@ -459,7 +459,7 @@ impl LoopCdt {
             let h = self
                 .cdt
                 .insert(Node::new(ring.p2[j], id))
-                .map_err(|_| MeshError::NonFinite { index: 0 })?;
+                .map_err(|_| DelaunayError::Input(MeshError::NonFinite { index: 0 }))?;
             self.loop_p3.push(ring.p3[j]);
             self.loop_ref.push(ring.reference[j]);
             self.loop_of.push(l as u32);
@@ -476,7 +476,7 @@ impl LoopCdt {
         l: usize,
         vertices: usize,
         handles: &[FixedVertexHandle],
-    ) -> Result<(), MeshError> {
+    ) -> Result<(), DelaunayError> {
         let m = handles.len();
         for j in 0..m {
             let (a, b) = (handles[j], handles[(j + 1) % m]);
@@ -489,7 +489,7 @@ impl LoopCdt {
     }
 
     /// The error for ring `l` meeting the vertex `other` ([`crossing`]).
-    fn crossing(&self, l: usize, vertices: usize, other: u32) -> MeshError {
+    fn crossing(&self, l: usize, vertices: usize, other: u32) -> DelaunayError {
         crossing(l, vertices, other, self.n, &self.loop_of)
     }
 
@@ -506,7 +506,7 @@ impl LoopCdt {
         &self,
         cloud: &[Point3],
         report: &mut DelaunayReport,
-    ) -> Result<(Mesh, Vec<u32>), MeshError> {
+    ) -> Result<(Mesh, Vec<u32>), DelaunayError> {
         // Jittered and real float clouds have no co-circular quad: the
         // flip pass, which indexes every edge and needs every position, is
         // skipped without changing its result (it flips only where a quad
@@ -684,7 +684,7 @@ fn sort_faces(faces: &mut [[u32; 3]]) {
 /// counter-clockwise triangle can never be flipped relative to the plane
 /// normal, so folds show instead as triangles joining the overlapping
 /// sheets, steep to the surface. More than [`MISFIT_SHARE`] of misfits
-/// ([`is_misfit`]) is [`MeshError::NotAHeightField`]. Fills
+/// ([`is_misfit`]) is [`DelaunayError::NotAHeightField`]. Fills
 /// `degenerate_faces` (below [`DEGENERATE`]·β², counted, not removed) and
 /// `misfit_triangles_percent`.
 fn check_triangles(
@@ -693,7 +693,7 @@ fn check_triangles(
     normals: &[Point3],
     beta_median: f64,
     report: &mut DelaunayReport,
-) -> Result<(), MeshError> {
+) -> Result<(), DelaunayError> {
     let mut misfits = 0;
     for face in &mesh.faces {
         let [a, b, c] = face.map(|v| mesh.vertices[v as usize]);
@@ -710,7 +710,7 @@ fn check_triangles(
     }
     report.misfit_triangles_percent = 100.0 * misfits as f64 / mesh.faces.len() as f64;
     if misfits as f64 > MISFIT_SHARE * mesh.faces.len() as f64 {
-        return Err(MeshError::NotAHeightField {
+        return Err(DelaunayError::NotAHeightField {
             percent: report.misfit_triangles_percent,
             what: "triangles",
             limit: 100.0 * MISFIT_SHARE,
@@ -735,19 +735,19 @@ fn is_misfit(nt: Point3, len: f64, vertex_normals: [Point3; 3]) -> bool {
 }
 
 /// The error for loop `l` meeting the vertex `other` (a vertex id).
-fn crossing(l: usize, vertices: usize, other: u32, n: usize, loop_of: &[u32]) -> MeshError {
+fn crossing(l: usize, vertices: usize, other: u32, n: usize, loop_of: &[u32]) -> DelaunayError {
     let b = (other as usize)
         .checked_sub(n)
         .and_then(|j| loop_of.get(j))
         .map_or(l, |&b| b as usize);
     if b == l {
-        MeshError::LoopNotSimple {
+        DelaunayError::LoopNotSimple {
             index: l,
             vertices,
             dropped: 0,
         }
     } else {
-        MeshError::LoopsCross {
+        DelaunayError::LoopsCross {
             a: b.min(l),
             b: b.max(l),
         }

@@ -1,7 +1,10 @@
-//! Error types of the algorithm library.
+//! Error types of the algorithm library: the input cloud's and mesh's, and
+//! one per stage that can fail (trimming, the Delaunay path, cleanup;
+//! detection's is the cloud's, and edge reconstruction cannot fail).
 //!
 //! Every variant says what was wrong with the input and, where it applies,
-//! which element. Internal invariants are `debug_assert!`s, never errors.
+//! which element, in the library's terms (its parameters, not a command
+//! line's flags). Internal invariants are `debug_assert!`s, never errors.
 
 use thiserror::Error;
 
@@ -53,7 +56,7 @@ pub enum CloudError {
         why: &'static str,
     },
     /// Fewer distinct points than one neighbourhood holds.
-    #[error("the cloud has {distinct} distinct points ({total} in all), fewer than the neighbourhood size k = {k}; lower --k or use a denser cloud")]
+    #[error("the cloud has {distinct} distinct points ({total} in all), fewer than the neighbourhood size k = {k}; lower k or use a denser cloud")]
     TooFewPoints {
         /// Points after merging exact duplicates.
         distinct: usize,
@@ -116,39 +119,6 @@ pub enum MeshError {
     /// The mesh has no faces.
     #[error("the mesh has no faces")]
     NoFaces,
-    /// Nothing of the mesh lies where the cloud is.
-    #[error("no part of the mesh is supported by the cloud: is the cloud the one the mesh was reconstructed from, in the same units and pose?")]
-    Unsupported,
-    /// The cloud is not a height field over its best-fit plane: the
-    /// Delaunay path, which triangulates in that projection, cannot mesh it.
-    #[error("the surface folds over its best-fit plane ({percent:.1}% of the {what} stand on edge or face away from it, at most {limit}% allowed), so a mesh built in that projection would be broken; mesh it with screened Poisson and use `meshtrim MESH CLOUD OUT` instead")]
-    NotAHeightField {
-        /// Share of the offending elements, in percent.
-        percent: f64,
-        /// What was counted: "local normals" or "triangles".
-        what: &'static str,
-        /// Largest accepted share, in percent.
-        limit: f64,
-    },
-    /// A smoothed loop crosses itself in the projection onto the cloud's
-    /// best-fit plane, and removing the twisted stretch would take too much.
-    #[error("smoothed loop {index} crosses itself in the projection onto the best-fit plane (repairing it would drop {dropped} of its {vertices} vertices); the surface may fold over its plane there: mesh it with screened Poisson and use `meshtrim MESH CLOUD OUT` instead")]
-    LoopNotSimple {
-        /// Index of the loop in the edges.
-        index: usize,
-        /// Its vertices.
-        vertices: usize,
-        /// Vertices a repair would have dropped.
-        dropped: usize,
-    },
-    /// The local resolutions given do not match the vertices.
-    #[error("{values} local resolutions given for {vertices} vertices")]
-    ResolutionLength {
-        /// Values given.
-        values: usize,
-        /// Vertices of the mesh.
-        vertices: usize,
-    },
     /// Some edges are shared by more than two faces.
     #[error("{edges} edges are shared by more than two faces; the mesh must be edge-manifold (repair it first, e.g. MeshLab's \"Repair non Manifold Edges\")")]
     NonManifold {
@@ -161,13 +131,72 @@ pub enum MeshError {
         /// How many such edges.
         edges: usize,
     },
+}
+
+/// Why trimming failed.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum TrimError {
+    /// The mesh is not one trimming can cut.
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
+    /// Nothing of the mesh lies where the cloud is.
+    #[error("no part of the mesh is supported by the cloud: is the cloud the one the mesh was reconstructed from, in the same units and pose?")]
+    Unsupported,
+}
+
+/// Why the Delaunay path could not mesh a cloud. All but [`Self::Input`]
+/// say the cloud is no height field over its best-fit plane, where screened
+/// Poisson and [`trim_mesh`](crate::trim_mesh) still work.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum DelaunayError {
+    /// The cloud's coordinates, or too few points to triangulate.
+    #[error(transparent)]
+    Input(#[from] MeshError),
+    /// The cloud is not a height field over its best-fit plane: the
+    /// Delaunay path, which triangulates in that projection, cannot mesh it.
+    #[error("the surface folds over its best-fit plane ({percent:.1}% of the {what} stand on edge or face away from it, at most {limit}% allowed), so a mesh built in that projection would be broken; mesh it with screened Poisson and trim that mesh instead")]
+    NotAHeightField {
+        /// Share of the offending elements, in percent.
+        percent: f64,
+        /// What was counted: "local normals" or "triangles".
+        what: &'static str,
+        /// Largest accepted share, in percent.
+        limit: f64,
+    },
+    /// A smoothed loop crosses itself in the projection onto the cloud's
+    /// best-fit plane, and removing the twisted stretch would take too much.
+    #[error("smoothed loop {index} crosses itself in the projection onto the best-fit plane (repairing it would drop {dropped} of its {vertices} vertices); the surface may fold over its plane there: mesh it with screened Poisson and trim that mesh instead")]
+    LoopNotSimple {
+        /// Index of the loop in the edges.
+        index: usize,
+        /// Its vertices.
+        vertices: usize,
+        /// Vertices a repair would have dropped.
+        dropped: usize,
+    },
     /// Two smoothed loops cross or touch in the projection onto the cloud's
     /// best-fit plane.
-    #[error("smoothed loops {a} and {b} cross or touch in the projection onto the best-fit plane; the surface may fold over its plane there: mesh it with screened Poisson and use `meshtrim MESH CLOUD OUT` instead")]
+    #[error("smoothed loops {a} and {b} cross or touch in the projection onto the best-fit plane; the surface may fold over its plane there: mesh it with screened Poisson and trim that mesh instead")]
     LoopsCross {
         /// Index of one loop in the edges.
         a: usize,
         /// Index of the other.
         b: usize,
+    },
+}
+
+/// Why cleanup failed.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum CleanError {
+    /// The mesh is not one cleanup can work on.
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
+    /// The local resolutions given do not match the vertices.
+    #[error("{values} local resolutions given for {vertices} vertices")]
+    ResolutionLength {
+        /// Values given.
+        values: usize,
+        /// Vertices of the mesh.
+        vertices: usize,
     },
 }

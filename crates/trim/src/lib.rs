@@ -74,11 +74,11 @@ pub use bpd::{
 };
 #[doc(hidden)]
 pub use bpd::{detect_boundary_reference, Decision};
-pub use clean::{clean_mesh, CleanOptions, CleanReport, LeftLoops};
+pub use clean::{clean_mesh, CleanOptions, CleanReport, LeftLoops, LeftReason};
 pub use cloud::Point3;
 pub use delaunay::{delaunay_mesh, delaunay_mesh_with_report, DelaunayReport};
 pub use edges::{reconstruct_edges, Edge, EdgeOptions, Edges, Loop};
-pub use error::{CloudError, MeshError};
+pub use error::{CleanError, CloudError, DelaunayError, MeshError, TrimError};
 pub use frame::{fit_plane, Frame};
 pub use mesh::{check_vertex_range, Mesh};
 pub use spatial::neighbours::NeighbourIndex;

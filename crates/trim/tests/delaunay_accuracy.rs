@@ -10,10 +10,10 @@ use testkit::{
 };
 use trim::{
     delaunay_mesh, delaunay_mesh_with_report, detect_boundary, reconstruct_edges, BpdOptions,
-    DelaunayReport, EdgeOptions, Mesh, MeshError, Point3,
+    DelaunayError, DelaunayReport, EdgeOptions, Mesh, Point3,
 };
 
-fn meshed(points: &[Point3]) -> Result<(Mesh, DelaunayReport), MeshError> {
+fn meshed(points: &[Point3]) -> Result<(Mesh, DelaunayReport), DelaunayError> {
     let detection = detect_boundary(points, &BpdOptions::default()).unwrap();
     let edges = reconstruct_edges(points, &detection, &EdgeOptions::default());
     delaunay_mesh_with_report(points, &detection, &edges)
@@ -221,7 +221,7 @@ fn a_folded_surface_is_not_a_height_field() {
     let result = delaunay_mesh(&points, &detection, &edges);
     eprintln!("folded cylinder: {result:?}");
     match result {
-        Err(e @ MeshError::NotAHeightField { .. }) => {
+        Err(e @ DelaunayError::NotAHeightField { .. }) => {
             let message = e.to_string();
             assert!(message.contains("screened Poisson"), "{message}");
         }

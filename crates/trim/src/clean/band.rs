@@ -192,10 +192,7 @@ impl Band {
                 Err(Blocked::Other(retry)) => return Err(retry),
             }
         }
-        Err(leave(
-            "the mesh folds over the new border's plane beside it",
-            Vec::new(),
-        ))
+        Err(leave(LeftReason::Folds, Vec::new()))
     }
 
     /// The loops (positions in the group) whose cut reaches the band's
@@ -376,18 +373,14 @@ pub(super) fn untwist_failure(tangle: Tangle, rings: &[Ring]) -> Retry {
             index,
             vertices,
             dropped,
-        } => leave(
-            format!(
-                "its smoothed loop crosses itself in the band's projection (untwisting it would drop {dropped} of its {vertices} vertices)"
-            ),
-            vec![index],
-        ),
+        } => leave(LeftReason::CrossesItself { dropped, vertices }, vec![index]),
         Tangle::Crossing { a, b } => {
-            let smaller = if rings[a].len() <= rings[b].len() { a } else { b };
-            leave(
-                "its smoothed loop crosses the smoothed loop of another border",
-                vec![smaller],
-            )
+            let smaller = if rings[a].len() <= rings[b].len() {
+                a
+            } else {
+                b
+            };
+            leave(LeftReason::CrossesAnotherLoop, vec![smaller])
         }
     }
 }

@@ -192,9 +192,7 @@ impl GapTriangulation {
     ) -> Result<(), Blocked> {
         if let Some(other) = obstacle(&self.cdt, a, b) {
             return Err(match ring {
-                Some(k) => {
-                    Blocked::Other(leave("the smoothed border crosses the kept mesh", vec![k]))
-                }
+                Some(k) => Blocked::Other(leave(LeftReason::CrossesKeptMesh, vec![k])),
                 None => Blocked::Walls(vec![
                     self.cdt.vertex(a).data().id,
                     self.cdt.vertex(b).data().id,
@@ -229,10 +227,7 @@ impl GapTriangulation {
 /// Two vertices coincide in the projection: the loop `ring` is left, or,
 /// without one, the whole group.
 pub(super) fn coincide(ring: Option<usize>) -> Retry {
-    leave(
-        "two vertices coincide in the projection of the band",
-        ring.into_iter().collect(),
-    )
+    leave(LeftReason::VerticesCoincide, ring.into_iter().collect())
 }
 
 /// Where the gap is wide and holds no mesh vertex (a deep notch the

@@ -79,7 +79,7 @@ use spade::{
 
 use crate::edges::cluster::MIN_LOOP_POINTS;
 use crate::edges::loop_from_tour;
-use crate::error::MeshError;
+use crate::error::{CleanError, MeshError};
 use crate::frame::fit_plane;
 use crate::geom::{cross, dist2, dot, norm2, sub, Point3};
 use crate::geom::{median, orient};
@@ -134,7 +134,64 @@ pub struct LeftLoops {
     /// Indices of the loops (in the input's border order).
     pub loops: Vec<usize>,
     /// Why they could not be replaced.
-    pub reason: String,
+    pub reason: LeftReason,
+}
+
+/// Why border loops were left unchanged. Each says what in the mesh stands
+/// in the way, so that a user can act on it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LeftReason {
+    /// The faces beside the new border fold over its projection plane
+    /// (walls kept crossing after the faces round them were removed).
+    Folds,
+    /// The loop's smoothed loop crosses itself in the band's projection,
+    /// and untwisting it would drop too many of its vertices.
+    CrossesItself {
+        /// Vertices untwisting would drop.
+        dropped: usize,
+        /// Vertices of the smoothed loop.
+        vertices: usize,
+    },
+    /// The loop's smoothed loop crosses that of another border.
+    CrossesAnotherLoop,
+    /// The smoothed border crosses the part of the mesh that stays.
+    CrossesKeptMesh,
+    /// Two vertices coincide in the band's projection.
+    VerticesCoincide,
+    /// The smoothed border lies farther from the mesh border than the
+    /// band may grow (rings of faces).
+    TooFarFromBorder {
+        /// The largest band, in rings of faces.
+        rings: u32,
+    },
+    /// The new faces would meet others at a non-manifold edge.
+    NonManifold,
+}
+
+impl std::fmt::Display for LeftReason {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Folds => write!(f, "the mesh folds over the new border's plane beside it"),
+            Self::CrossesItself { dropped, vertices } => write!(
+                f,
+                "its smoothed loop crosses itself in the band's projection (untwisting it would drop {dropped} of its {vertices} vertices)"
+            ),
+            Self::CrossesAnotherLoop => {
+                write!(f, "its smoothed loop crosses the smoothed loop of another border")
+            }
+            Self::CrossesKeptMesh => write!(f, "the smoothed border crosses the kept mesh"),
+            Self::VerticesCoincide => {
+                write!(f, "two vertices coincide in the projection of the band")
+            }
+            Self::TooFarFromBorder { rings } => write!(
+                f,
+                "the smoothed border runs more than {rings} rings of faces from the mesh border"
+            ),
+            Self::NonManifold => {
+                write!(f, "its new faces would meet others at a non-manifold edge")
+            }
+        }
+    }
 }
 
 /// What the cleanup did.
@@ -181,7 +238,7 @@ pub fn clean_mesh(
     mesh: &Mesh,
     beta: &[f64],
     options: &CleanOptions,
-) -> Result<(Mesh, CleanReport), MeshError> {
+) -> Result<(Mesh, CleanReport), CleanError> {
     mesh.validate()?;
     let faces_in = mesh.faces.len();
     let (kept, dropped) = without_empty_faces(mesh);
@@ -206,17 +263,17 @@ pub fn clean_mesh(
 /// What the cleanup needs of the mesh left once its empty faces are dropped:
 /// faces, one β per vertex, every edge used at most twice and never twice
 /// the same way.
-fn check_cleanable(mesh: &Mesh, beta: &[f64]) -> Result<(), MeshError> {
+fn check_cleanable(mesh: &Mesh, beta: &[f64]) -> Result<(), CleanError> {
     if mesh.faces.is_empty() {
-        return Err(MeshError::NoFaces);
+        return Err(MeshError::NoFaces.into());
     }
     if beta.len() != mesh.vertices.len() {
-        return Err(MeshError::ResolutionLength {
+        return Err(CleanError::ResolutionLength {
             values: beta.len(),
             vertices: mesh.vertices.len(),
         });
     }
-    check_manifold(mesh)
+    Ok(check_manifold(mesh)?)
 }
 
 /// Step 2: each border loop smoothed (corners, FFT edges and, with
@@ -275,7 +332,7 @@ fn assemble_manifold(mesh: &Mesh, outcomes: &mut [Outcome]) -> Mesh {
             if let Some(patch) = outcomes[g].patch.take() {
                 outcomes[g].left.push(LeftLoops {
                     loops: patch.loops,
-                    reason: "its new faces would meet others at a non-manifold edge".into(),
+                    reason: LeftReason::NonManifold,
                 });
             }
         }
@@ -288,7 +345,7 @@ fn finish(
     mut out: Mesh,
     outcomes: &[Outcome],
     mut report: CleanReport,
-) -> Result<(Mesh, CleanReport), MeshError> {
+) -> Result<(Mesh, CleanReport), CleanError> {
     summarise(outcomes, &out, &mut report);
     out.remove_unused_vertices();
     check_manifold(&out)?;
@@ -388,9 +445,7 @@ fn replace_group(cx: &Context, group: &[usize]) -> Outcome {
                     continue;
                 }
                 Err(Retry::Grow(culprits)) => Failure {
-                    reason: format!(
-                        "the smoothed border runs more than {MAX_DEPTH} rings of faces from the mesh border"
-                    ),
+                    reason: LeftReason::TooFarFromBorder { rings: MAX_DEPTH },
                     culprits,
                 },
                 Err(Retry::Leave(failure)) => failure,
@@ -439,15 +494,12 @@ enum Retry {
 /// Why some loops stay: `culprits` are positions in the group (empty when
 /// the whole group is concerned).
 struct Failure {
-    reason: String,
+    reason: LeftReason,
     culprits: Vec<usize>,
 }
 
-fn leave(reason: impl Into<String>, culprits: Vec<usize>) -> Retry {
-    Retry::Leave(Failure {
-        reason: reason.into(),
-        culprits,
-    })
+fn leave(reason: LeftReason, culprits: Vec<usize>) -> Retry {
+    Retry::Leave(Failure { reason, culprits })
 }
 
 /// Faces dropped before cleaning, by kind.

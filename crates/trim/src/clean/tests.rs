@@ -208,14 +208,14 @@ fn bad_topology_is_an_error() {
     let mesh = jagged_annulus(8.0, 3.0, 3);
     assert!(matches!(
         clean_mesh(&mesh, &[1.0; 3], &CleanOptions::default()),
-        Err(MeshError::ResolutionLength { values: 3, .. })
+        Err(CleanError::ResolutionLength { values: 3, .. })
     ));
     let mut mesh = jagged_annulus(8.0, 3.0, 3);
     let beta = vec![1.0; mesh.vertices.len()];
     mesh.faces[0].swap(1, 2);
     assert!(matches!(
         clean_mesh(&mesh, &beta, &CleanOptions::default()),
-        Err(MeshError::Misoriented { .. })
+        Err(CleanError::Mesh(MeshError::Misoriented { .. }))
     ));
     let mut mesh = jagged_annulus(8.0, 3.0, 3);
     let f = mesh.faces[0];
@@ -228,7 +228,7 @@ fn bad_topology_is_an_error() {
             &vec![1.0; mesh.vertices.len()],
             &CleanOptions::default()
         ),
-        Err(MeshError::NonManifold { .. })
+        Err(CleanError::Mesh(MeshError::NonManifold { .. }))
     ));
 }
 
@@ -280,7 +280,7 @@ fn repeated_faces_are_dropped_when_they_turn_the_same_way() {
     reversed.faces.push([a, c, b]);
     assert!(matches!(
         clean_mesh(&reversed, &beta, &options),
-        Err(MeshError::NonManifold { .. })
+        Err(CleanError::Mesh(MeshError::NonManifold { .. }))
     ));
 }
 
@@ -293,6 +293,6 @@ fn a_mesh_of_slivers_alone_has_no_faces() {
     };
     assert_eq!(
         clean_mesh(&mesh, &[1.0; 3], &CleanOptions::default()).unwrap_err(),
-        MeshError::NoFaces
+        CleanError::Mesh(MeshError::NoFaces)
     );
 }

@@ -73,7 +73,7 @@ use rayon::prelude::*;
 use crate::bpd::Detection;
 use crate::edges::offset::{edge_sides, outward};
 use crate::edges::Edges;
-use crate::error::MeshError;
+use crate::error::TrimError;
 use crate::geom::UnionFind;
 use crate::geom::{dist2, dot, norm2, sub, Point3};
 use crate::mesh::{sorted_edges_of, Mesh};
@@ -165,7 +165,7 @@ pub fn trim_mesh(
     detection: &Detection,
     edges: &Edges,
     options: &TrimOptions,
-) -> Result<(Mesh, TrimReport), MeshError> {
+) -> Result<(Mesh, TrimReport), TrimError> {
     mesh.validate()?;
     let walls = Walls::new(cloud, detection, edges);
     let to_walls: Vec<(f64, f64)> = mesh

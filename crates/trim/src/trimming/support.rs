@@ -23,9 +23,9 @@ pub(super) fn supported_faces(
     cloud: &[Point3],
     beta: &[f64],
     support: f64,
-) -> Result<Support, MeshError> {
+) -> Result<Support, TrimError> {
     if cut.faces.is_empty() {
-        return Err(MeshError::Unsupported);
+        return Err(TrimError::Unsupported);
     }
     let piece = face_pieces(&cut.faces, beyond);
     let pieces = piece.iter().map(|&p| p as usize + 1).max().unwrap_or(0);
@@ -58,7 +58,7 @@ pub(super) fn supported_faces(
         })
         .collect();
     if !keep.iter().any(|&k| k) {
-        return Err(MeshError::Unsupported);
+        return Err(TrimError::Unsupported);
     }
     let mut piece_beyond = vec![false; pieces];
     for (&p, &b) in piece.iter().zip(beyond) {
