@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use serde::Serialize;
-use trim::{delaunay_mesh_with_report, reconstruct_edges, DelaunayReport};
+use trim::{delaunay_mesh_with_report, reconstruct_edges, DelaunayOptions, DelaunayReport};
 
 use crate::commands::args::StageArgs;
 use crate::io::mesh_out::write_mesh;
@@ -86,9 +86,14 @@ pub fn run(args: &Args) -> Result<()> {
     let edges = reconstruct_edges(&cloud.points, &detection, &stages.edges);
     let edges_time = started.elapsed();
     let started = Instant::now();
-    let (mesh, made) = delaunay_mesh_with_report(&cloud.points, &detection, &edges)
-        .map_err(in_cli_words)
-        .with_context(|| args.cloud.display().to_string())?;
+    let (mesh, made) = delaunay_mesh_with_report(
+        &cloud.points,
+        &detection,
+        &edges,
+        &DelaunayOptions::default(),
+    )
+    .map_err(in_cli_words)
+    .with_context(|| args.cloud.display().to_string())?;
     let mesh_time = started.elapsed();
     let started = Instant::now();
     write_mesh(&args.output, &mesh.vertices, &mesh.faces)?;

@@ -575,7 +575,7 @@ pub struct Jumps {
 /// Steps of a closed `tour` (indices into `points`) that jump across the
 /// surface: consecutive points farther apart than 3 β (the larger local
 /// resolution of the two) and not joined by one of `links` (BPD's
-/// [`crate::Detection::links`], sorted pairs, smaller index first).
+/// [`trim::Detection::links`], sorted pairs, smaller index first).
 pub fn tour_jumps(points: &[Point3], beta: &[f64], links: &[[u32; 2]], tour: &[u32]) -> Jumps {
     let n = tour.len();
     let mut jumps = Jumps::default();

@@ -1,5 +1,7 @@
 //! The Delaunay path: a mesh built from the cloud itself, bounded by the
-//! smoothed loops.
+//! smoothed loops. The paper's introduction names Delaunay triangulation
+//! as one of the two kinds of mesh its edges are for and leaves the method
+//! open; this one is meshtrim's.
 //!
 //! 1. **Projection.** The whole cloud is projected onto its best-fit plane
 //!    (PCA of all points, [`fit_plane`]), in the frame's (u, v) axes
@@ -7,10 +9,10 @@
 //!    from the origin. Since u × v = n, counter-clockwise in (u, v) is
 //!    counter-clockwise seen from the side the plane normal n points to.
 //! 2. **Height-field check, on the points.** Each point's local normal is
-//!    fitted to its [`NORMAL_K`] nearest neighbours. Where the surface
+//!    fitted to its 30 nearest neighbours. Where the surface
 //!    stands on edge or folds over its plane, local normals turn
-//!    perpendicular to n; if more than [`STEEP_SHARE`] of the points have
-//!    |nᵢ·n| < [`STEEP_COS`], the cloud is rejected with
+//!    perpendicular to n; if more than [`DelaunayOptions::max_steep_share`] of the points have
+//!    |nᵢ·n| < 0.1, the cloud is rejected with
 //!    [`DelaunayError::NotAHeightField`].
 //! 3. **Loops made valid.** Each smoothed loop becomes one closed polyline
 //!    (each open edge without its last point, the next edge's corner), with
@@ -19,7 +21,7 @@
 //!    must not touch one another: a loop that crosses itself is repaired
 //!    by dropping the vertices of the shorter side of the crossing (a
 //!    twist, or a spike that turns straight back), as long as that takes at
-//!    most [`MAX_REPAIR`] of its vertices (and at least 4 may always go);
+//!    most [`DelaunayOptions::max_repair`] of its vertices (and at least 4 may always go);
 //!    otherwise [`DelaunayError::LoopNotSimple`]. Two loops that cross or touch
 //!    give [`DelaunayError::LoopsCross`]. spade's exact predicates check every
 //!    constraint again before it is added (spade panics on crossing
@@ -27,7 +29,7 @@
 //!    never a panic.
 //! 4. **Which points go in.** A cloud point is inserted when it lies inside
 //!    the loops by parity (inside the outer border, outside the holes; with
-//!    several outer loops, each patch) and farther than [`EXCLUDE`]·βᵢ from
+//!    several outer loops, each patch) and farther than [`DelaunayOptions::exclude`]·βᵢ from
 //!    every loop. Points closer to a loop are left out: the loop vertices
 //!    stand for the border there, and a point next to a constraint would
 //!    only make a sliver (or, on it, split the constraint and change the
@@ -53,14 +55,14 @@
 //!    along n is its projected area), so folds show instead as triangles
 //!    joining the overlapping sheets, steep to the surface: a triangle is a
 //!    misfit when the mean |n_t·nᵥ| over its vertices' local normals is
-//!    below [`MISFIT_COS`]; more than [`MISFIT_SHARE`] of misfits gives
+//!    below 0.5; more than [`DelaunayOptions::max_misfit_share`] of misfits gives
 //!    [`DelaunayError::NotAHeightField`].
 //!
 //! Degenerate faces: a projected Delaunay triangle has a positive area and
 //! its lift is never smaller, so no face has zero area. Slivers are
 //! prevented (points near loops left out, coincident loop vertices merged)
 //! rather than removed, since removing a face would open a hole; faces
-//! below [`DEGENERATE`]·β² (β the median resolution) are counted in the
+//! below 10⁻¹²·β² (β the median resolution) are counted in the
 //! report, not removed.
 
 use crate::hash::{HashMap, HashSet};
@@ -90,18 +92,40 @@ const NORMAL_K: usize = 30;
 const NORMAL_RUN: usize = 32;
 /// A local normal with |nᵢ·n| below this stands on edge over the plane.
 const STEEP_COS: f64 = 0.1;
-/// Largest accepted share of such points.
-const STEEP_SHARE: f64 = 0.01;
 /// A triangle whose normal makes a mean |n_t·nᵥ| below this with its
 /// vertices' local normals does not follow the surface.
 const MISFIT_COS: f64 = 0.5;
-/// Largest accepted share of such triangles.
-const MISFIT_SHARE: f64 = 0.01;
-/// Cloud points closer to a loop than this many local resolutions β are
-/// left out.
-const EXCLUDE: f64 = 0.1;
-/// Largest share of a loop's vertices that untwisting it may drop.
-const MAX_REPAIR: f64 = 0.05;
+
+/// Options of the Delaunay path. Shares are fractions (0.01 is 1 %);
+/// distances are multiples of the local resolution β, so none depends on
+/// the cloud's units.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DelaunayOptions {
+    /// Largest share of the points whose local normal stands on edge over
+    /// the best-fit plane (|nᵢ·n| < 0.1) before the cloud is no height
+    /// field (step 2). Default 0.01.
+    pub max_steep_share: f64,
+    /// Largest share of the kept triangles that may not follow the surface
+    /// (step 7). Default 0.01.
+    pub max_misfit_share: f64,
+    /// Cloud points closer to a loop than this many β are left out: the
+    /// loop stands for the border there (step 4). Default 0.1.
+    pub exclude: f64,
+    /// Largest share of a loop's vertices that untwisting it may drop
+    /// (step 3); at least 4 may always go. Default 0.05.
+    pub max_repair: f64,
+}
+
+impl Default for DelaunayOptions {
+    fn default() -> Self {
+        Self {
+            max_steep_share: 0.01,
+            max_misfit_share: 0.01,
+            exclude: 0.1,
+            max_repair: 0.05,
+        }
+    }
+}
 /// Faces smaller than this many β² are counted as degenerate.
 const DEGENERATE: f64 = 1e-12;
 
@@ -114,7 +138,7 @@ pub struct DelaunayReport {
     pub points_used: usize,
     /// Cloud points outside the loops (beyond the border or in holes).
     pub points_outside: usize,
-    /// Cloud points left out for lying within [`EXCLUDE`]·β of a loop.
+    /// Cloud points left out for lying within [`DelaunayOptions::exclude`]·β of a loop.
     pub points_near_loop: usize,
     /// Cloud points merged with another that projects to the same spot.
     pub points_merged: usize,
@@ -122,14 +146,14 @@ pub struct DelaunayReport {
     pub loop_vertices_merged: usize,
     /// Loop vertices dropped to untwist self-crossing loops.
     pub loop_vertices_dropped: usize,
-    /// Share of local normals standing on edge (|nᵢ·n| < [`STEEP_COS`]), %.
+    /// Share of local normals standing on edge (|nᵢ·n| < 0.1), %.
     pub steep_normals_percent: f64,
     /// Share of kept triangles not following the surface, %.
     pub misfit_triangles_percent: f64,
-    /// Faces below [`DEGENERATE`]·β² (kept, counted).
+    /// Faces below 10⁻¹²·β² (kept, counted).
     pub degenerate_faces: usize,
-    /// Diagonals of co-circular quads flipped to their canonical side
-    /// ([`canonical_diagonals`]).
+    /// Diagonals of co-circular quads flipped to their canonical side (the
+    /// one through the quad's lowest id).
     pub diagonals_flipped: usize,
     /// For each smoothed loop, its vertices in the output, in loop order.
     pub loops: Vec<Vec<u32>>,
@@ -145,8 +169,9 @@ pub fn delaunay_mesh(
     cloud: &[Point3],
     detection: &Detection,
     edges: &Edges,
+    options: &DelaunayOptions,
 ) -> Result<Mesh, DelaunayError> {
-    delaunay_mesh_with_report(cloud, detection, edges).map(|(mesh, _)| mesh)
+    delaunay_mesh_with_report(cloud, detection, edges, options).map(|(mesh, _)| mesh)
 }
 
 /// [`delaunay_mesh`], with what it did. The steps are those of the module
@@ -155,6 +180,7 @@ pub fn delaunay_mesh_with_report(
     cloud: &[Point3],
     detection: &Detection,
     edges: &Edges,
+    options: &DelaunayOptions,
 ) -> Result<(Mesh, DelaunayReport), DelaunayError> {
     check_input(cloud, detection)?;
     let n = cloud.len();
@@ -167,15 +193,22 @@ pub fn delaunay_mesh_with_report(
     let plane = Projection::fit(cloud);
     report.plane_normal = plane.frame.normal;
     let normals = local_normals(cloud, plane.frame.normal);
-    check_steep_normals(&normals, plane.frame.normal, &mut report)?;
+    check_steep_normals(&normals, plane.frame.normal, options, &mut report)?;
     if edges.loops.is_empty() {
         return Err(MeshError::NoFaces.into());
     }
-    let (rings, grid) = valid_rings(edges, beta, beta_median, &plane, &mut report)?;
-    let nodes = points_inside(cloud, beta, &plane, &grid, &mut report);
+    let (rings, grid) = valid_rings(edges, beta, beta_median, &plane, options, &mut report)?;
+    let nodes = points_inside(cloud, beta, &plane, &grid, options.exclude, &mut report);
     let triangulation = LoopCdt::build(nodes, &rings, n, &mut report)?;
     let (mesh, reference) = triangulation.lift(cloud, &mut report)?;
-    check_triangles(&mesh, &reference, &normals, beta_median, &mut report)?;
+    check_triangles(
+        &mesh,
+        &reference,
+        &normals,
+        beta_median,
+        options,
+        &mut report,
+    )?;
     report.area = mesh.area();
     Ok((mesh, report))
 }
@@ -221,11 +254,11 @@ impl Projection {
 }
 
 /// Step 2, **local normals**: each point's normal fitted to its
-/// [`NORMAL_K`] nearest neighbours, oriented to the side `plane_normal`
+/// 30 nearest neighbours, oriented to the side `plane_normal`
 /// points to.
 ///
 /// The search runs over the points in Morton order, as BPD's does (about
-/// twice as fast as kiddo's tree at 1M points), with ties cut by input
+/// twice as fast as a k-d tree at 1M points), with ties cut by input
 /// index: the same neighbours in the same order as [`NeighbourIndex::new`]
 /// gives, so the same normals.
 fn local_normals(cloud: &[Point3], plane_normal: Point3) -> Vec<Point3> {
@@ -272,12 +305,13 @@ fn oriented_normal(cloud: &[Point3], members: &[u32], plane_normal: Point3) -> P
 
 /// Step 2, **height-field check on the points**: where the surface stands
 /// on edge or folds over its plane, local normals turn perpendicular to
-/// the plane normal; more than [`STEEP_SHARE`] of them below
-/// [`STEEP_COS`] is [`DelaunayError::NotAHeightField`]. Fills
+/// the plane normal; more than [`DelaunayOptions::max_steep_share`] of them below
+/// 0.1 is [`DelaunayError::NotAHeightField`]. Fills
 /// `steep_normals_percent`.
 fn check_steep_normals(
     normals: &[Point3],
     plane_normal: Point3,
+    options: &DelaunayOptions,
     report: &mut DelaunayReport,
 ) -> Result<(), DelaunayError> {
     let n = normals.len();
@@ -286,11 +320,11 @@ fn check_steep_normals(
         .filter(|m| dot(**m, plane_normal) < STEEP_COS)
         .count();
     report.steep_normals_percent = 100.0 * steep as f64 / n as f64;
-    if steep as f64 > STEEP_SHARE * n as f64 {
+    if steep as f64 > options.max_steep_share * n as f64 {
         return Err(DelaunayError::NotAHeightField {
             percent: report.steep_normals_percent,
             what: "local normals",
-            limit: 100.0 * STEEP_SHARE,
+            limit: 100.0 * options.max_steep_share,
         });
     }
     Ok(())
@@ -305,6 +339,7 @@ fn valid_rings(
     beta: &[f64],
     beta_median: f64,
     plane: &Projection,
+    options: &DelaunayOptions,
     report: &mut DelaunayReport,
 ) -> Result<(Vec<Ring>, SegmentGrid), DelaunayError> {
     let mut rings: Vec<Ring> = edges
@@ -316,19 +351,23 @@ fn valid_rings(
         ring.p2 = ring.p3.iter().map(|&p| plane.to2(p)).collect();
         report.loop_vertices_merged += ring.merge_coincident();
     }
-    let (grid, dropped) =
-        untwist(&mut rings, EXCLUDE * beta_median, MAX_REPAIR).map_err(|tangle| match tangle {
-            Tangle::SelfCrossing {
-                index,
-                vertices,
-                dropped,
-            } => DelaunayError::LoopNotSimple {
-                index,
-                vertices,
-                dropped,
-            },
-            Tangle::Crossing { a, b } => DelaunayError::LoopsCross { a, b },
-        })?;
+    let (grid, dropped) = untwist(
+        &mut rings,
+        options.exclude * beta_median,
+        options.max_repair,
+    )
+    .map_err(|tangle| match tangle {
+        Tangle::SelfCrossing {
+            index,
+            vertices,
+            dropped,
+        } => DelaunayError::LoopNotSimple {
+            index,
+            vertices,
+            dropped,
+        },
+        Tangle::Crossing { a, b } => DelaunayError::LoopsCross { a, b },
+    })?;
     report.loop_vertices_dropped += dropped;
     Ok((rings, grid))
 }
@@ -338,7 +377,7 @@ fn valid_rings(
 enum PointClass {
     /// Inside the loops by parity and away from them: inserted.
     Inside,
-    /// Within [`EXCLUDE`]·β of a loop: left out, the loop stands for the
+    /// Within [`DelaunayOptions::exclude`]·β of a loop: left out, the loop stands for the
     /// border there.
     NearLoop,
     /// Beyond the outer border or in a hole.
@@ -346,7 +385,7 @@ enum PointClass {
 }
 
 /// Step 4, **which points go in**: the cloud points inside the loops by
-/// parity and farther than [`EXCLUDE`]·βᵢ from every loop, as
+/// parity and farther than [`DelaunayOptions::exclude`]·βᵢ from every loop, as
 /// triangulation nodes in cloud order. Points next to a loop would only
 /// make slivers, or on it split the constraint and change the border's
 /// vertex sequence. Fills `points_near_loop` and `points_outside`.
@@ -355,13 +394,14 @@ fn points_inside(
     beta: &[f64],
     plane: &Projection,
     grid: &SegmentGrid,
+    exclude: f64,
     report: &mut DelaunayReport,
 ) -> Vec<Node> {
     let class: Vec<PointClass> = (0..cloud.len())
         .into_par_iter()
         .map(|i| {
             let p = plane.to2(cloud[i]);
-            if grid.near(p, EXCLUDE * beta[i]) {
+            if grid.near(p, exclude * beta[i]) {
                 PointClass::NearLoop
             } else if grid.parity(p) {
                 PointClass::Inside
@@ -683,15 +723,16 @@ fn sort_faces(faces: &mut [[u32; 3]]) {
 /// Step 7, **height-field check on the triangles**: a lifted
 /// counter-clockwise triangle can never be flipped relative to the plane
 /// normal, so folds show instead as triangles joining the overlapping
-/// sheets, steep to the surface. More than [`MISFIT_SHARE`] of misfits
+/// sheets, steep to the surface. More than [`DelaunayOptions::max_misfit_share`] of misfits
 /// ([`is_misfit`]) is [`DelaunayError::NotAHeightField`]. Fills
-/// `degenerate_faces` (below [`DEGENERATE`]·β², counted, not removed) and
+/// `degenerate_faces` (below 10⁻¹²·β², counted, not removed) and
 /// `misfit_triangles_percent`.
 fn check_triangles(
     mesh: &Mesh,
     reference: &[u32],
     normals: &[Point3],
     beta_median: f64,
+    options: &DelaunayOptions,
     report: &mut DelaunayReport,
 ) -> Result<(), DelaunayError> {
     let mut misfits = 0;
@@ -709,11 +750,11 @@ fn check_triangles(
         }
     }
     report.misfit_triangles_percent = 100.0 * misfits as f64 / mesh.faces.len() as f64;
-    if misfits as f64 > MISFIT_SHARE * mesh.faces.len() as f64 {
+    if misfits as f64 > options.max_misfit_share * mesh.faces.len() as f64 {
         return Err(DelaunayError::NotAHeightField {
             percent: report.misfit_triangles_percent,
             what: "triangles",
-            limit: 100.0 * MISFIT_SHARE,
+            limit: 100.0 * options.max_misfit_share,
         });
     }
     Ok(())
@@ -721,7 +762,7 @@ fn check_triangles(
 
 /// Does a triangle with normal `nt` (unnormalised, of length `len`) not
 /// follow the surface: a mean |n_t·nᵥ| over its vertices' local normals
-/// below [`MISFIT_COS`]? A zero-area triangle counts as one.
+/// below 0.5? A zero-area triangle counts as one.
 fn is_misfit(nt: Point3, len: f64, vertex_normals: [Point3; 3]) -> bool {
     if len == 0.0 {
         return true;

@@ -20,7 +20,7 @@ pub type Point2 = [f64; 2];
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Frame {
     /// First tangent axis: the direction of largest spread from
-    /// [`fit_plane`], one fixed by the normal alone from [`fit_plane_normal`].
+    /// [`fit_plane`], or one fixed by the normal alone.
     pub u: Point3,
     /// Second tangent axis.
     pub v: Point3,
@@ -59,7 +59,7 @@ pub fn fit_plane_normal(points: &[Point3], members: &[u32]) -> Frame {
 }
 
 impl Frame {
-    /// The frame of [`fit_plane_normal`] for the unit `normal`: in-plane
+    /// The frame of the unit `normal` alone: in-plane
     /// axes that follow from the normal's components alone, so a caller
     /// that keeps only the normal gets the same frame, bit for bit.
     pub fn of_normal(normal: Point3) -> Self {

@@ -69,14 +69,16 @@ mod spatial;
 
 mod trimming;
 
-pub use bpd::{
-    detect_boundary, detect_boundary_with_progress, local_resolution, BpdOptions, Detection, View,
-};
+/// The plain detector the fast one is tested against (same labels).
 #[doc(hidden)]
-pub use bpd::{detect_boundary_reference, Decision};
+pub use bpd::detect_boundary_reference;
+pub use bpd::{
+    detect_boundary, detect_boundary_with_progress, local_resolution, BpdOptions, Decision,
+    Detection, View,
+};
 pub use clean::{clean_mesh, CleanOptions, CleanReport, LeftLoops, LeftReason};
 pub use cloud::Point3;
-pub use delaunay::{delaunay_mesh, delaunay_mesh_with_report, DelaunayReport};
+pub use delaunay::{delaunay_mesh, delaunay_mesh_with_report, DelaunayOptions, DelaunayReport};
 pub use edges::{reconstruct_edges, Edge, EdgeOptions, Edges, Loop};
 pub use error::{CleanError, CloudError, DelaunayError, MeshError, TrimError};
 pub use frame::{fit_plane, Frame};

@@ -10,13 +10,13 @@ use testkit::{
 };
 use trim::{
     delaunay_mesh, delaunay_mesh_with_report, detect_boundary, reconstruct_edges, BpdOptions,
-    DelaunayError, DelaunayReport, EdgeOptions, Mesh, Point3,
+    DelaunayError, DelaunayOptions, DelaunayReport, EdgeOptions, Mesh, Point3,
 };
 
 fn meshed(points: &[Point3]) -> Result<(Mesh, DelaunayReport), DelaunayError> {
     let detection = detect_boundary(points, &BpdOptions::default()).unwrap();
     let edges = reconstruct_edges(points, &detection, &EdgeOptions::default());
-    delaunay_mesh_with_report(points, &detection, &edges)
+    delaunay_mesh_with_report(points, &detection, &edges, &DelaunayOptions::default())
 }
 
 /// Area of the true surface: the midpoint rule over a fine grid of the
@@ -218,7 +218,7 @@ fn a_folded_surface_is_not_a_height_field() {
     }
     let detection = detect_boundary(&points, &BpdOptions::default()).unwrap();
     let edges = reconstruct_edges(&points, &detection, &EdgeOptions::default());
-    let result = delaunay_mesh(&points, &detection, &edges);
+    let result = delaunay_mesh(&points, &detection, &edges, &DelaunayOptions::default());
     eprintln!("folded cylinder: {result:?}");
     match result {
         Err(e @ DelaunayError::NotAHeightField { .. }) => {

@@ -23,7 +23,7 @@ use testkit::{
 };
 use trim::{
     clean_mesh, delaunay_mesh, detect_boundary, detect_boundary_reference, reconstruct_edges,
-    trim_mesh, BpdOptions, CleanOptions, EdgeOptions, Mesh, Point3, TrimOptions,
+    trim_mesh, BpdOptions, CleanOptions, DelaunayOptions, EdgeOptions, Mesh, Point3, TrimOptions,
 };
 
 /// A jittered patch of about `20 × 14 / h²` points on a gently curved
@@ -357,7 +357,7 @@ proptest! {
         let job = |cloud: &[Point3]| {
             let detection = detect_boundary(cloud, &BpdOptions::default()).unwrap();
             let edges = reconstruct_edges(cloud, &detection, &EdgeOptions::default());
-            delaunay_mesh(cloud, &detection, &edges).unwrap()
+            delaunay_mesh(cloud, &detection, &edges, &DelaunayOptions::default()).unwrap()
         };
         let (out, out2) = (job(&cloud), job(&moved(&cloud, shift)));
         prop_assert!(!out.faces.is_empty());
@@ -399,7 +399,7 @@ proptest! {
         let job = |cloud: &[Point3]| {
             let detection = detect_boundary(cloud, &BpdOptions::default()).unwrap();
             let edges = reconstruct_edges(cloud, &detection, &EdgeOptions::default());
-            delaunay_mesh(cloud, &detection, &edges).unwrap()
+            delaunay_mesh(cloud, &detection, &edges, &DelaunayOptions::default()).unwrap()
         };
         let (out, out2) = (job(&cloud), job(&shuffled));
         // The same triangles over the same positions, whatever the numbering.

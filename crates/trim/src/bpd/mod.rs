@@ -2,7 +2,7 @@
 //!
 //! For every point P_i of an unorganised surface cloud, with no user
 //! threshold:
-//! 1. its k nearest neighbours, P_i included ([`crate::neighbours`]);
+//! 1. its k nearest neighbours, P_i included ([`crate::spatial::neighbours`]);
 //! 2. their best-fit plane and 2D projection ([`crate::frame`]), mapped by the
 //!    sampling tensor when `anisotropy` is on ([`crate::anisotropy`]);
 //! 3. the local resolution β_i = μ_i + 2σ_i ([`crate::resolution`]);
@@ -40,7 +40,7 @@ pub struct BpdOptions {
     /// so 29 neighbours). Must be at least [`BpdOptions::MIN_K`].
     pub k: usize,
     /// Map each projected neighbourhood by its sampling tensor before the
-    /// tests (meshtrim's extension for line scans; see [`crate::anisotropy`]).
+    /// tests (meshtrim's extension for line scans; docs/bpd.md).
     /// Off gives the paper's isotropic behaviour.
     pub anisotropy: bool,
     /// Where a range scanner saw the cloud from, when known: each
@@ -75,8 +75,7 @@ impl Default for BpdOptions {
 /// paper's projection along the normal turns part of each such move into a
 /// shift within the plane, and the terraces of a quantised depth open gaps
 /// of a spacing or more between their rows: interior points turn boundary
-/// all over the scan. Projected along the ray (see
-/// [`crate::frame::ray_shear`]), a point moved along its ray lands where
+/// all over the scan. Projected along the ray, a point moved along its ray lands where
 /// it would have without the move.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum View {
@@ -141,8 +140,7 @@ pub struct Detection {
     pub duplicates: usize,
     /// Pairs of boundary points (input indices, smaller first, sorted)
     /// joined by an empty circle of radius ≥ β: neighbours along the
-    /// boundary, the edges of the α-shape with α = β (see
-    /// [`circle::boundary_links`]). A duplicate point is represented by
+    /// boundary, the edges of the α-shape with α = β. A duplicate point is represented by
     /// its first copy. Edge reconstruction clusters and orders with them.
     pub links: Vec<[u32; 2]>,
 }

@@ -149,7 +149,7 @@ impl Band {
             .copied()
             .filter(|&f| {
                 let [a, b, c] = mesh.faces[f as usize].map(|v| projection.vertex_to2(mesh, v));
-                orient(a, b, c) <= 0.0
+                orientation(a, b, c) <= 0.0
             })
             .collect()
     }

@@ -215,7 +215,7 @@ impl GapTriangulation {
                 let q = v.position();
                 [q.x, q.y]
             });
-            if orient(p[0], p[1], p[2]) < 0.0 {
+            if orientation(p[0], p[1], p[2]) < 0.0 {
                 ids.swap(1, 2);
             }
             self.patch.faces.push(ids);

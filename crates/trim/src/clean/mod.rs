@@ -82,7 +82,7 @@ use crate::edges::loop_from_tour;
 use crate::error::{CleanError, MeshError};
 use crate::frame::fit_plane;
 use crate::geom::{cross, dist2, dot, norm2, sub, Point3};
-use crate::geom::{median, orient};
+use crate::geom::{median, orient, orientation};
 use crate::mesh::topology::{check_manifold, Topology};
 use crate::mesh::{lowest_first, Mesh};
 use crate::planar::{

@@ -82,8 +82,7 @@ pub struct Edges {
     /// The loops, in a deterministic order (by smallest point index).
     pub loops: Vec<Loop>,
     /// Groups of boundary points too small or too thin to close a loop,
-    /// and pieces of jumping tours that closed no loop of their own (see
-    /// [`split`]).
+    /// and pieces of jumping tours that closed no loop of their own.
     pub dropped_clusters: usize,
     /// Boundary points removed as spurs, strays or isolated points, or
     /// left on no loop when a jumping tour was split.

@@ -15,11 +15,11 @@
 //! Everything is sequential and tie-broken by index: the same cluster gives
 //! the same tour.
 
-use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use std::num::NonZeroUsize;
 
 use crate::geom::UnionFind;
 use crate::geom::{dist2, Point3};
+use crate::spatial::PointTree;
 
 /// Clusters up to this size get the exact shortest tour.
 pub const EXACT_MAX: usize = 8;
@@ -114,23 +114,15 @@ fn next_permutation(v: &mut [u32]) -> bool {
 /// For each point, its linked points and nearest cluster members, without
 /// repeats, nearest first.
 fn candidate_lists(pts: &[Point3], links: &[[u32; 2]]) -> Vec<Vec<u32>> {
-    let tree: ImmutableKdTree<f64, 3> =
-        ImmutableKdTree::new_from_slice(pts).expect("cluster fits in u32");
+    let tree = PointTree::new(pts).expect("a cluster fits in the tree's index");
     let want = NonZeroUsize::new((CANDIDATES + 1).min(pts.len())).expect("non-empty");
     let mut lists: Vec<Vec<u32>> = pts
         .iter()
         .enumerate()
         .map(|(i, p)| {
-            let mut found = tree
-                .query(p)
-                .nearest_n::<SquaredEuclidean<f64>>(want)
-                .execute();
-            found.sort_unstable_by(|a, b| {
-                a.distance.total_cmp(&b.distance).then(a.item.cmp(&b.item))
-            });
-            found
-                .iter()
-                .map(|n| n.item)
+            tree.nearest_n(p, want)
+                .into_iter()
+                .map(|(_, j)| j)
                 .filter(|&j| j as usize != i)
                 .collect()
         })
@@ -177,12 +169,14 @@ fn greedy_tour(pts: &[Point3], candidates: &[Vec<u32>], links: &[[u32; 2]]) -> V
         degree[b as usize] += 1;
     };
     for &(_, a, b) in &edges {
-        if degree[a as usize] < 2 && degree[b as usize] < 2 {
-            if sets.find(a) != sets.find(b) && added + 1 < n {
-                sets.union(a, b);
-                add(a, b, &mut adjacency, &mut degree);
-                added += 1;
-            }
+        if degree[a as usize] < 2
+            && degree[b as usize] < 2
+            && sets.find(a) != sets.find(b)
+            && added + 1 < n
+        {
+            sets.union(a, b);
+            add(a, b, &mut adjacency, &mut degree);
+            added += 1;
         }
     }
     // Join the fragments: repeatedly link the closest pair of free ends

@@ -1,11 +1,12 @@
-//! Geometry shared by every stage: vector arithmetic on points, planar
-//! predicates, medians and union-find.
+//! Geometry shared by every stage (infrastructure; no section of the
+//! paper): vector arithmetic on points, planar predicates, medians and
+//! union-find.
 
 mod predicates;
 mod union_find;
 mod vec3;
 
-pub(crate) use predicates::{orient, segments_meet};
+pub(crate) use predicates::{orient, orientation, segments_meet};
 pub(crate) use union_find::UnionFind;
 pub use vec3::Point3;
 pub(crate) use vec3::{cross, dist2, dot, norm2, sub};

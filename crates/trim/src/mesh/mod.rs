@@ -1,5 +1,6 @@
-//! Triangle meshes: validation, area, boundary loops and manifoldness, the
-//! checks the trimming stage and its tests need.
+//! Triangle meshes: validation, area, boundary loops and manifoldness —
+//! what trimming, the Delaunay path and cleanup take and give. The paper
+//! works on clouds; this is infrastructure of meshtrim's mesh stages.
 
 use crate::hash::HashMap;
 
@@ -20,8 +21,8 @@ pub struct Mesh {
     pub faces: Vec<[u32; 3]>,
 }
 
-/// Refuses finite vertices outside the supported coordinate range
-/// ([`crate::cloud::check_range`]): beyond it spade panics or fails and
+/// Refuses finite vertices outside the supported coordinate range (the
+/// largest |coordinate| between 10⁻³⁰ and 10⁵⁰): beyond it spade panics or fails and
 /// the geometry's squares overflow or underflow.
 pub fn check_vertex_range(vertices: &[Point3]) -> Result<(), MeshError> {
     match out_of_range(vertices) {

@@ -14,7 +14,7 @@
 
 use crate::hash::{HashMap, HashSet};
 
-use crate::geom::orient;
+use crate::geom::orientation;
 
 /// Quads whose in-circle determinant is below this, relative to the
 /// fourth power of their size, count as co-circular. Far above the rounding
@@ -113,7 +113,10 @@ pub(crate) fn cocircular(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> 
 /// Is the quad p, q, r, s (in this order) strictly convex and
 /// counter-clockwise?
 fn convex(p: [f64; 2], q: [f64; 2], r: [f64; 2], s: [f64; 2]) -> bool {
-    orient(p, q, r) > 0.0 && orient(q, r, s) > 0.0 && orient(r, s, p) > 0.0 && orient(s, p, q) > 0.0
+    orientation(p, q, r) > 0.0
+        && orientation(q, r, s) > 0.0
+        && orientation(r, s, p) > 0.0
+        && orientation(s, p, q) > 0.0
 }
 
 #[cfg(test)]
@@ -164,7 +167,7 @@ mod tests {
         // Every face stays counter-clockwise.
         for f in &a {
             let [x, y, z] = f.map(|v| positions[&v]);
-            assert!(orient(x, y, z) > 0.0, "{f:?} is not counter-clockwise");
+            assert!(orientation(x, y, z) > 0.0, "{f:?} is not counter-clockwise");
         }
     }
 

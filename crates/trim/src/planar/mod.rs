@@ -1,4 +1,5 @@
-//! The planar toolkit shared by the Delaunay path and clean: a constrained
+//! The planar toolkit shared by the Delaunay path and cleanup
+//! (infrastructure; no section of the paper): a constrained
 //! Delaunay triangulation (spade, exact predicates) whose vertices carry
 //! ids, smoothed loops as closed polylines in a projection, their repair
 //! where they cross themselves, and a segment grid for parity, proximity

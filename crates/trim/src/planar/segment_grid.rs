@@ -1,7 +1,7 @@
 //! The loops' segments in a uniform grid.
 
 use super::ring::{dist2d, Ring};
-use crate::geom::{orient, segments_meet};
+use crate::geom::{orientation, segments_meet};
 
 /// The loops' segments in a uniform grid, for parity, proximity and
 /// crossing queries in 2D.
@@ -191,7 +191,7 @@ impl SegmentGrid {
                         // Adjacent: a spike turns straight back.
                         let (p, q, r) = (first.0, first.1, second.1);
                         let back = (q[0] - p[0]) * (r[0] - q[0]) + (q[1] - p[1]) * (r[1] - q[1]);
-                        if m > 3 && orient(p, q, r) == 0.0 && back < 0.0 {
+                        if m > 3 && orientation(p, q, r) == 0.0 && back < 0.0 {
                             return Some((s, t));
                         }
                         continue;

@@ -6,7 +6,7 @@
 //! has no bucket that can overflow when many points share one coordinate
 //! value, as quantised scanner data does and kiddo's mutable tree fails
 //! on), and the points' own Morton order ([`NeighbourIndex::in_morton_order`],
-//! [`crate::morton`]), which BPD sorts its points into anyway and which
+//! [`crate::spatial::morton`]), which BPD sorts its points into anyway and which
 //! needs nothing built. The neighbourhood of a point includes the point
 //! itself, first.
 //! Ties in distance are broken by index so the result never depends on the
@@ -31,7 +31,7 @@ pub struct NeighbourIndex<'a> {
 enum Search<'a> {
     /// kiddo's immutable k-d tree, for points in any order.
     Tree(ImmutableKdTree<f64, 3>),
-    /// The points' own Morton order ([`crate::morton`]): nothing to build.
+    /// The points' own Morton order ([`crate::spatial::morton`]): nothing to build.
     Morton(MortonCells<'a>),
 }
 
@@ -54,9 +54,9 @@ impl<'a> NeighbourIndex<'a> {
     }
 
     /// The index of points sorted by Morton key (`cells`, see
-    /// [`crate::morton`]): the same answers as [`Self::new`]'s, found
+    /// [`crate::spatial::morton`]): the same answers as [`Self::new`]'s, found
     /// through the sorted keys instead of a tree.
-    pub fn in_morton_order(points: &'a [Point3], cells: MortonCells<'a>) -> Self {
+    pub(crate) fn in_morton_order(points: &'a [Point3], cells: MortonCells<'a>) -> Self {
         Self {
             points,
             search: Search::Morton(cells),
@@ -66,7 +66,7 @@ impl<'a> NeighbourIndex<'a> {
 
     /// Breaks distance ties by `ranks[i]` instead of the index i (e.g. the
     /// points' input order when `points` was reordered).
-    pub fn with_ranks(mut self, ranks: &'a [u32]) -> Self {
+    pub(crate) fn with_ranks(mut self, ranks: &'a [u32]) -> Self {
         self.ranks = Some(ranks);
         self
     }
@@ -201,7 +201,13 @@ impl NeighbourIndex<'_> {
     /// checked: c's k nearest must lie within G; if not, c gets its own
     /// k-NN query. A point for which the gathered set cannot prove its
     /// answer gets its own k-NN query too.
-    pub fn nearest_of_run(&self, run: Range<usize>, k: usize, out: &mut [u32], s: &mut RunScratch) {
+    pub(crate) fn nearest_of_run(
+        &self,
+        run: Range<usize>,
+        k: usize,
+        out: &mut [u32],
+        s: &mut RunScratch,
+    ) {
         let k = k.min(self.points.len());
         debug_assert_eq!(out.len(), run.len() * k);
         if k == 0 || run.is_empty() {
@@ -611,7 +617,7 @@ mod tests {
         assert_runs_match(&index, 32, |p| nearest_brute_force(&pts, p, 30));
     }
 
-    /// The index over points in Morton order ([`crate::morton`]) gives the
+    /// The index over points in Morton order ([`crate::spatial::morton`]) gives the
     /// brute force's answers on the original points, ties cut by input
     /// index: by runs (gathers, and the fallbacks given a radius) and by
     /// single queries (which find their own radius).

@@ -17,7 +17,7 @@ pub(super) struct Walls {
     /// The loop each point belongs to.
     pub(super) loop_of: Vec<u32>,
     pub(super) loops: usize,
-    pub(super) tree: Option<ImmutableKdTree<f64, 3>>,
+    pub(super) tree: Option<PointTree>,
 }
 
 impl Walls {
@@ -82,19 +82,14 @@ impl Walls {
             }
         }
         if !w.points.is_empty() {
-            w.tree = ImmutableKdTree::new_from_slice(&w.points).ok();
+            w.tree = PointTree::new(&w.points);
         }
         w
     }
 
     pub(super) fn nearest_point(&self, v: Point3) -> Option<usize> {
         let tree = self.tree.as_ref()?;
-        Some(
-            tree.query(&v)
-                .nearest_one::<SquaredEuclidean<f64>>()
-                .execute()
-                .item as usize,
-        )
+        Some(tree.nearest(&v).0)
     }
 
     /// f(v): signed distance from v to the nearest wall (negative inside),
@@ -192,7 +187,7 @@ pub(super) struct Reach<'a> {
     pub(super) beta: &'a [f64],
     /// β's that end the kept surface.
     pub(super) reach: f64,
-    pub(super) tree: Option<ImmutableKdTree<f64, 3>>,
+    pub(super) tree: Option<PointTree>,
 }
 
 impl<'a> Reach<'a> {
@@ -200,7 +195,7 @@ impl<'a> Reach<'a> {
         Reach {
             beta,
             reach,
-            tree: ImmutableKdTree::new_from_slice(cloud).ok(),
+            tree: PointTree::new(cloud),
         }
     }
 
@@ -208,17 +203,14 @@ impl<'a> Reach<'a> {
     /// point and β that point's local resolution; and β, which snaps g.
     /// g > 0 where v is out of the cloud's reach.
     pub(super) fn excess(&self, v: Point3) -> (f64, f64) {
-        // kiddo refuses only more points than its item index holds (2⁶⁴):
+        // The tree refuses only more points than its item index holds:
         // then, as without walls, nothing is cut.
         let Some(tree) = &self.tree else {
             return (-1.0, 0.0);
         };
-        let nearest = tree
-            .query(&v)
-            .nearest_one::<SquaredEuclidean<f64>>()
-            .execute();
-        let beta = self.beta[nearest.item as usize];
-        (nearest.distance.sqrt() - self.reach * beta, beta)
+        let (nearest, distance2) = tree.nearest(&v);
+        let beta = self.beta[nearest];
+        (distance2.sqrt() - self.reach * beta, beta)
     }
 }
 

@@ -1,5 +1,8 @@
 //! Trimming a reconstructed mesh along the cloud's smoothed boundary —
-//! meshtrim's third stage (the paper's aim: meshes fit for CAM toolpaths).
+//! meshtrim's third stage, the use the paper builds its edges for (its
+//! introduction and section 4: "the reconstructed boundary edges can be
+//! used to trim the Poisson mesh"; how is "out of the scope of this
+//! paper", so the method here is meshtrim's).
 //!
 //! A screened-Poisson mesh wraps an open scan in a closed envelope that
 //! bulges past the borders and caps the holes; a Delaunay mesh has jagged
@@ -67,7 +70,7 @@ use support::*;
 
 use crate::hash::HashMap;
 
-use kiddo::{ImmutableKdTree, SquaredEuclidean};
+use crate::spatial::PointTree;
 use rayon::prelude::*;
 
 use crate::bpd::Detection;

@@ -22,7 +22,7 @@ fn polygon_walls(n: usize, r: f64) -> Walls {
         })
         .collect();
     Walls {
-        tree: ImmutableKdTree::new_from_slice(&points).ok(),
+        tree: PointTree::new(&points),
         points,
         out,
         next: (0..n).map(|k| ((k + 1) % n) as u32).collect(),
@@ -98,7 +98,7 @@ fn random_grid_mesh(seed: u64, side: u32) -> Mesh {
     Mesh { vertices, faces }
 }
 
-/// The reach's field by kiddo's tree equals the plain one: the nearest
+/// The reach's field by the k-d tree equals the plain one: the nearest
 /// point by scanning them all, its β, g = d − 2β.
 #[test]
 fn the_reach_matches_a_scan_of_every_point() {
