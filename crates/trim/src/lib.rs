@@ -85,3 +85,12 @@ pub use frame::{fit_plane, Frame};
 pub use mesh::{check_vertex_range, Mesh};
 pub use spatial::neighbours::NeighbourIndex;
 pub use trimming::{trim_mesh, LoopFit, TrimOptions, TrimReport};
+
+/// Steps of detection the test kit's research examples look into (which
+/// mechanism flips a label under noise). Not part of the API: they may
+/// change with the algorithm.
+#[doc(hidden)]
+pub mod internals {
+    pub use crate::anisotropy::own_sampling_vectors;
+    pub use crate::frame::project;
+}
