@@ -24,9 +24,10 @@
 
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 
-use crate::evaluate::BoundaryIndex;
+use crate::synthetic::BoundaryIndex;
 use crate::synthetic::SyntheticCloud;
 use crate::vec3::{dist2, dot, norm2, sub};
+use trim::internals::step_is_supported;
 use trim::Point3;
 
 /// Turning angle above which a vertex of a true boundary is a corner
@@ -573,8 +574,9 @@ pub struct Jumps {
 }
 
 /// Steps of a closed `tour` (indices into `points`) that jump across the
-/// surface: consecutive points farther apart than 3 β (the larger local
-/// resolution of the two) and not joined by one of `links` (BPD's
+/// surface, by the rule edge reconstruction cuts tours with: consecutive
+/// points farther apart than 3 β (the larger local resolution of the two)
+/// and not joined by one of `links` (BPD's
 /// [`trim::Detection::links`], sorted pairs, smaller index first).
 pub fn tour_jumps(points: &[Point3], beta: &[f64], links: &[[u32; 2]], tour: &[u32]) -> Jumps {
     let n = tour.len();
@@ -584,9 +586,9 @@ pub fn tour_jumps(points: &[Point3], beta: &[f64], links: &[[u32; 2]], tour: &[u
     }
     for k in 0..n {
         let (a, b) = (tour[k], tour[(k + 1) % n]);
-        let d = dist2(points[a as usize], points[b as usize]).sqrt();
-        let scale = beta[a as usize].max(beta[b as usize]);
-        if d > 3.0 * scale && links.binary_search(&[a.min(b), a.max(b)]).is_err() {
+        if !step_is_supported(points, beta, links, a, b) {
+            let d = dist2(points[a as usize], points[b as usize]).sqrt();
+            let scale = beta[a as usize].max(beta[b as usize]);
             jumps.count += 1;
             jumps.longest_in_beta = jumps.longest_in_beta.max(d / scale);
         }

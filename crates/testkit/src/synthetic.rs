@@ -42,7 +42,7 @@
 //! between consecutive samples (h_min the smallest pitch of the cloud).
 //! [`SyntheticCloud::boundary_3d`] maps them onto the surface;
 //! distances to the boundary are measured in 3D by
-//! [`crate::evaluate::BoundaryIndex`]. [`SyntheticCloud::distance_to_boundary_uv`]
+//! [`crate::synthetic::BoundaryIndex`]. [`SyntheticCloud::distance_to_boundary_uv`]
 //! is the exact distance in the parameter domain (equal to the surface
 //! distance on the plane and the cylinder, an approximation elsewhere).
 //!
@@ -63,6 +63,9 @@ use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use crate::vec3::dist2;
 
 pub mod jagged;
+mod truth;
+
+pub use truth::BoundaryIndex;
 
 /// A position in the parameter domain.
 pub type Uv = [f64; 2];

@@ -36,7 +36,7 @@ use crate::spatial::neighbours::tie_key;
 pub type Map2 = [[f64; 2]; 2];
 
 /// The identity map.
-pub const IDENTITY: Map2 = [[1.0, 0.0], [0.0, 1.0]];
+pub(crate) const IDENTITY: Map2 = [[1.0, 0.0], [0.0, 1.0]];
 
 /// Applies `m` to `p`.
 #[inline]

@@ -37,14 +37,14 @@ impl Sites {
 /// products' norms, circle tests: overflow near 1e77), and spade refuses
 /// plane coordinates beyond 2^201 ≈ 3.2e60; 1e50 stays ten orders of
 /// magnitude below the first of these, with the cloud anywhere in that box.
-pub const MAX_COORDINATE: f64 = 1e50;
+pub(crate) const MAX_COORDINATE: f64 = 1e50;
 
 /// The smallest largest |coordinate| meshtrim accepts (except 0: points all
 /// at the origin are one point). Spade flushes plane coordinates below
 /// 2^-142 ≈ 1.8e-43 to zero, and products of two squared distances
 /// underflow near 1e-77; from 1e-30 up the flush moves a point by less than
 /// 1e-12 of the cloud's size, below the rounding of the plane fit.
-pub const MIN_LARGEST_COORDINATE: f64 = 1e-30;
+pub(crate) const MIN_LARGEST_COORDINATE: f64 = 1e-30;
 
 /// Fewest points per piece of a parallel pass over a cloud: a pass over
 /// fewer runs on the calling thread alone. Such passes (bounds, checks,

@@ -359,7 +359,7 @@ pub fn project(points: &[Point3], members: &[u32], frame: &Frame, out: &mut Vec<
 /// ray multiplies every height above the fitted plane (curvature, noise
 /// across the ray) by tan θ (2.7 at 70°, 11 at 85°) into the plane, and
 /// at 90° it has no answer; scanners measure little there anyway.
-pub const MAX_INCIDENCE_DEGREES: f64 = 70.0;
+pub(crate) const MAX_INCIDENCE_DEGREES: f64 = 70.0;
 
 /// The shear that projects a neighbourhood onto its plane along `ray`
 /// (a scanner's line of sight, either sense) instead of along the normal.

@@ -86,11 +86,13 @@ pub use mesh::{check_vertex_range, Mesh};
 pub use spatial::neighbours::NeighbourIndex;
 pub use trimming::{trim_mesh, LoopFit, TrimOptions, TrimReport};
 
-/// Steps of detection the test kit's research examples look into (which
-/// mechanism flips a label under noise). Not part of the API: they may
-/// change with the algorithm.
+/// Steps of detection and edge reconstruction the test kit looks into
+/// (which mechanism flips a label under noise; which steps of a tour jump
+/// across the surface, by the rule that cuts tours). Not part of the API:
+/// they change with the algorithm.
 #[doc(hidden)]
 pub mod internals {
     pub use crate::anisotropy::own_sampling_vectors;
+    pub use crate::edges::split::supported as step_is_supported;
     pub use crate::frame::project;
 }

@@ -408,7 +408,7 @@ fn flips_beyond_the_first_rows(
     options: &BpdOptions,
     deep: Deep,
 ) -> Vec<String> {
-    let index = testkit::evaluate::BoundaryIndex::new(cloud);
+    let index = testkit::synthetic::BoundaryIndex::new(cloud);
     let clean = detect_boundary(&cloud.points, options).unwrap().boundary;
     let boundary_count = clean.iter().filter(|&&b| b).count();
     let mut failures = Vec::new();

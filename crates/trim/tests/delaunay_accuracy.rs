@@ -5,7 +5,7 @@
 use std::collections::HashSet;
 
 use testkit::{
-    evaluate::BoundaryIndex,
+    synthetic::BoundaryIndex,
     synthetic::{self, SyntheticCloud},
 };
 use trim::{

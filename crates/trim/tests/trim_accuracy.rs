@@ -3,7 +3,7 @@
 //! the smoothed boundary. Run with `--nocapture` for the numbers.
 
 use testkit::{
-    evaluate::BoundaryIndex,
+    synthetic::BoundaryIndex,
     synthetic::{self, SyntheticCloud},
 };
 use trim::{

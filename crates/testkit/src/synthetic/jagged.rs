@@ -44,7 +44,7 @@ use std::collections::HashMap;
 use spade::{DelaunayTriangulation, HasPosition, Point2, Triangulation};
 
 use super::{jittered, notched_plate_region, Region, SpacingField, Surface, SyntheticCloud, P3};
-use crate::evaluate::BoundaryIndex;
+use crate::synthetic::BoundaryIndex;
 use crate::vec3::{cross, dot, sub};
 use trim::Mesh;
 

@@ -81,7 +81,7 @@ pub fn cluster_boundary(boundary: &[bool], links: &[[u32; 2]]) -> Clusters {
 
 /// The smallest loop kept: the paper's smallest hole, of radius just
 /// above β, is found by four points.
-pub const MIN_LOOP_POINTS: usize = 4;
+pub(crate) const MIN_LOOP_POINTS: usize = 4;
 
 /// Drops clusters of fewer than [`MIN_LOOP_POINTS`] points (three points
 /// around an empty circle of radius β: a gap of the sampling itself at the

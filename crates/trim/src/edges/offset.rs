@@ -26,7 +26,7 @@ use crate::geom::{cross, dot, norm2, sub, Point3};
 use crate::spatial::neighbours::NeighbourIndex;
 
 /// Loop points on each side averaged into each estimate.
-pub const WINDOW: usize = 5;
+pub(crate) const WINDOW: usize = 5;
 
 /// Neighbourhood size for the area per sample (as in BPD).
 const K: usize = 30;

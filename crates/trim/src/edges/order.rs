@@ -22,7 +22,7 @@ use crate::geom::{dist2, Point3};
 use crate::spatial::PointTree;
 
 /// Clusters up to this size get the exact shortest tour.
-pub const EXACT_MAX: usize = 8;
+pub(crate) const EXACT_MAX: usize = 8;
 
 /// Nearest cluster members considered for each point's moves.
 const CANDIDATES: usize = 8;

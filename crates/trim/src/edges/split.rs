@@ -32,7 +32,7 @@ use super::cluster::MIN_LOOP_POINTS;
 use super::order::canonical;
 
 /// Factor of β above which a step no link supports is a jump.
-pub const JUMP_BETAS: f64 = 3.0;
+const JUMP_BETAS: f64 = 3.0;
 
 /// Is the step between `a` and `b` supported: at most 3β long (the larger
 /// β of the two), or a link? `links` are sorted pairs, smaller index first.

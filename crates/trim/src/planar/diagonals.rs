@@ -20,7 +20,7 @@ use crate::geom::orientation;
 /// fourth power of their size, count as co-circular. Far above the rounding
 /// of coordinates 10⁵ spacings from the origin (about 10⁻¹⁰ relative),
 /// far below the jitter of real samplings.
-pub const COCIRCULAR: f64 = 1e-9;
+pub(crate) const COCIRCULAR: f64 = 1e-9;
 
 /// Flips the diagonals of co-circular quads of `faces` (counter-clockwise
 /// triangles over `positions`, indexed by vertex id) towards the quad's
