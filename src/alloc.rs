@@ -21,7 +21,7 @@
 /// nothing. No unit test: the thresholds are process-wide, and glibc's
 /// own threshold moves with what the process has freed before, so a test
 /// in the test binary cannot tell the settings' effect from the default's;
-/// `bench/bpd.sh` and the page-fault counts in `docs/results.md` measure it.
+/// `bench/bpd.sh` and the page-fault counts in `docs/bpd.md` ("Speed") measure it.
 pub fn keep_freed_memory() {
     #[cfg(all(target_os = "linux", target_env = "gnu"))]
     // SAFETY: `mallopt` only sets glibc's allocation thresholds; it takes

@@ -74,6 +74,27 @@ impl Loop {
             .map(|&c| points[self.boundary_points[c] as usize])
             .collect()
     }
+
+    /// The loop as one closed polyline: each open edge without its last
+    /// point, which is the next edge's first (the corner), so that every
+    /// corner appears once, with both of its segments. Each vertex comes
+    /// with the position in `boundary_points` of the point it was smoothed
+    /// from.
+    pub(crate) fn closed_polyline(&self) -> Vec<(Point3, usize)> {
+        let n = self.boundary_points.len().max(1);
+        let mut polyline = Vec::new();
+        for (k, edge) in self.edges.iter().enumerate() {
+            let from = self.corners.get(k).copied().unwrap_or(0);
+            let take = if edge.closed {
+                edge.points.len()
+            } else {
+                edge.points.len().saturating_sub(1)
+            };
+            let positions = (from..).map(|j| j % n);
+            polyline.extend(edge.points.iter().copied().take(take).zip(positions));
+        }
+        polyline
+    }
 }
 
 /// Result of edge reconstruction.

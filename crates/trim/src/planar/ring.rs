@@ -35,26 +35,17 @@ pub(crate) struct Ring {
 
 impl Ring {
     pub(crate) fn from_loop(lp: &Loop, beta: &[f64]) -> Self {
-        let n = lp.boundary_points.len().max(1);
         let mut ring = Ring {
             p3: Vec::new(),
             p2: Vec::new(),
             reference: Vec::new(),
             beta: Vec::new(),
         };
-        for (k, edge) in lp.edges.iter().enumerate() {
-            let from = lp.corners.get(k).copied().unwrap_or(0);
-            let take = if edge.closed {
-                edge.points.len()
-            } else {
-                edge.points.len().saturating_sub(1)
-            };
-            for (j, &p) in edge.points.iter().take(take).enumerate() {
-                let r = lp.boundary_points.get((from + j) % n).copied().unwrap_or(0);
-                ring.p3.push(p);
-                ring.reference.push(r);
-                ring.beta.push(beta.get(r as usize).copied().unwrap_or(0.0));
-            }
+        for (p, position) in lp.closed_polyline() {
+            let r = lp.boundary_points.get(position).copied().unwrap_or(0);
+            ring.p3.push(p);
+            ring.reference.push(r);
+            ring.beta.push(beta.get(r as usize).copied().unwrap_or(0.0));
         }
         ring
     }

@@ -85,7 +85,7 @@ pub fn spatial_order(points: &[Point3], grid: &MortonGrid) -> (Vec<u32>, Vec<u64
         .collect();
     // A radix sort where it is the faster: 12k points 185 µs against
     // 370 µs for rayon's (in the benchmark, two threads); from about 100k
-    // points rayon's parallel sort wins (sort benchmark in docs/results.md).
+    // points rayon's parallel sort wins (sort benchmark in docs/bpd.md, "Speed").
     if keyed.len() < RADIX_SORT_BELOW {
         keyed.voracious_sort();
     } else {

@@ -48,22 +48,10 @@ impl Walls {
                 }
                 _ => &lp.sides,
             };
-            let n = lp.boundary_points.len();
-            // The loop as one closed polyline: each open edge without its
-            // last point, which is the next edge's first (the corner), so
-            // that a corner has both of its segments.
             let mut positions = Vec::new();
-            for (k, edge) in lp.edges.iter().enumerate() {
-                let from = lp.corners.get(k).copied().unwrap_or(0);
-                let take = if edge.closed {
-                    edge.points.len()
-                } else {
-                    edge.points.len() - 1
-                };
-                for (j, &p) in edge.points.iter().take(take).enumerate() {
-                    positions.push((from + j) % n);
-                    w.points.push(p);
-                }
+            for (p, position) in lp.closed_polyline() {
+                positions.push(position);
+                w.points.push(p);
             }
             let start = w.points.len() - positions.len();
             let m = positions.len();
