@@ -77,6 +77,11 @@ pub struct Report {
     /// Input faces that repeated an earlier one (same corners, same turn),
     /// dropped.
     pub repeated_faces_dropped: usize,
+    /// Zero-area faces of the output repaired (inside the mesh, away
+    /// from the border bands).
+    pub zero_area_faces_repaired: usize,
+    /// Zero-area faces left where no repair keeps the mesh manifold.
+    pub zero_area_faces_left: usize,
     /// Input faces removed in the border bands.
     pub faces_removed: usize,
     /// New faces.
@@ -188,6 +193,8 @@ impl Report {
             faces_in: r.faces_in,
             slivers_dropped: r.slivers_dropped,
             repeated_faces_dropped: r.repeated_faces_dropped,
+            zero_area_faces_repaired: r.repaired.repaired(),
+            zero_area_faces_left: r.repaired.left,
             faces_removed: r.faces_removed,
             faces_added: r.faces_added,
             faces_out: r.faces_out,
@@ -249,6 +256,18 @@ impl crate::report::Table for Report {
             ("write time", format!("{:.1} ms", self.write_ms)),
             ("output", self.output.clone()),
         ];
+        if self.zero_area_faces_repaired + self.zero_area_faces_left > 0 {
+            rows.insert(
+                3,
+                (
+                    "zero-area faces",
+                    format!(
+                        "{} repaired, {} left",
+                        self.zero_area_faces_repaired, self.zero_area_faces_left
+                    ),
+                ),
+            );
+        }
         if self.repeated_faces_dropped > 0 {
             rows.insert(
                 3,

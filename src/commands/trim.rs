@@ -105,6 +105,11 @@ pub struct Report {
     /// Parts of faces dropped because no cloud point lies within reach
     /// (2 local resolutions): envelope that no wall cut off.
     pub faces_out_of_reach: usize,
+    /// Zero-area or repeated faces of the output repaired (screened
+    /// Poisson leaves a few tiny triangles).
+    pub faces_repaired: usize,
+    /// Zero-area faces left where no repair keeps the mesh manifold.
+    pub zero_area_faces_left: usize,
     /// Area of the input mesh.
     pub area_in: f64,
     /// Area of the output mesh.
@@ -256,6 +261,8 @@ impl Report {
             pieces_restored: r.pieces_restored,
             vertices_snapped: r.vertices_snapped,
             faces_out_of_reach: r.faces_out_of_reach,
+            faces_repaired: r.repaired.repaired(),
+            zero_area_faces_left: r.repaired.left,
             area_in: r.area_in,
             area_out: r.area_out,
             border_to_edge: r.loops.iter().map(fit).collect(),
@@ -294,6 +301,7 @@ impl crate::report::Table for Report {
             ("pieces dropped", self.pieces_dropped.to_string()),
             ("pieces restored", self.pieces_restored.to_string()),
             ("faces out of reach", self.faces_out_of_reach.to_string()),
+            ("faces repaired", self.faces_repaired.to_string()),
             (
                 "area in / out",
                 format!("{:.6} / {:.6}", self.area_in, self.area_out),

@@ -83,6 +83,7 @@ use crate::error::{CleanError, MeshError};
 use crate::frame::fit_plane;
 use crate::geom::{cross, dist2, dot, norm2, sub, Point3};
 use crate::geom::{median, orient, orientation};
+use crate::mesh::repair::{repair_degenerate_faces, FaceRepair};
 use crate::mesh::topology::{check_manifold, Topology};
 use crate::mesh::{lowest_first, Mesh};
 use crate::planar::{
@@ -229,6 +230,9 @@ pub struct CleanReport {
     /// Smallest angle of the new faces, in degrees; 0 when no face was
     /// added (`faces_added` is 0).
     pub min_angle_new: f64,
+    /// Zero-area faces of the output repaired (those the input had
+    /// inside, away from the border); none is written.
+    pub repaired: FaceRepair,
 }
 
 /// Replaces the jagged border of `mesh` by its smoothed boundary (see the
@@ -347,6 +351,7 @@ fn finish(
     mut report: CleanReport,
 ) -> Result<(Mesh, CleanReport), CleanError> {
     summarise(outcomes, &out, &mut report);
+    report.repaired = repair_degenerate_faces(&mut out);
     out.remove_unused_vertices();
     check_manifold(&out)?;
     report.faces_out = out.faces.len();

@@ -8,6 +8,7 @@ use crate::cloud::out_of_range;
 use crate::cloud::{MAX_COORDINATE, MIN_LARGEST_COORDINATE};
 use crate::error::MeshError;
 
+pub(crate) mod repair;
 pub(crate) mod topology;
 use crate::geom::{cross, norm2, sub, Point3};
 
@@ -273,7 +274,7 @@ pub fn sorted_edges_of(faces: &[[u32; 3]]) -> Vec<(u32, u32, u32)> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// An n × n grid of unit squares, two triangles each, counter-clockwise.

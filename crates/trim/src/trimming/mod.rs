@@ -70,6 +70,7 @@ use support::*;
 
 use crate::hash::HashMap;
 
+use crate::mesh::repair::{repair_degenerate_faces, FaceRepair};
 use crate::spatial::PointTree;
 use rayon::prelude::*;
 
@@ -147,6 +148,9 @@ pub struct TrimReport {
     /// border (its vertices) to the loop, and how many border vertices
     /// were measured.
     pub loops: Vec<LoopFit>,
+    /// Zero-area and repeated faces of the output repaired (screened
+    /// Poisson leaves a few tiny triangles); none is written.
+    pub repaired: FaceRepair,
 }
 
 /// How closely the output border follows one smoothed loop.
@@ -202,6 +206,7 @@ pub fn trim_mesh(
     }
     let mut kept = cut;
     kept.retain_faces(&keep);
+    let repaired = repair_degenerate_faces(&mut kept);
     kept.remove_unused_vertices();
     let report = TrimReport {
         faces_in: mesh.faces.len(),
@@ -215,6 +220,7 @@ pub fn trim_mesh(
         area_in: mesh.area(),
         area_out: kept.area(),
         loops: walls.border_fit(&kept),
+        repaired,
     };
     Ok((kept, report))
 }

@@ -1,0 +1,539 @@
+//! Zero-area and repeated faces taken out of a mesh, the manifold and the
+//! orientation kept (infrastructure of meshtrim's mesh stages; no section
+//! of the paper).
+//!
+//! A face whose area is below 10⁻¹² of the squared bounding-box diagonal
+//! gives a CAM system a NaN normal. Screened Poisson leaves a few such
+//! faces (tiny triangles where its marching cubes cut a cell at a corner),
+//! and a mesh's faces may repeat. Each one is repaired by the smallest
+//! change that removes it:
+//!
+//! - **Tiny or needle faces** (the shortest edge below 1 % of the mesh's
+//!   median edge): the shortest edge is collapsed, its second vertex
+//!   merged into the first (a border vertex is kept where one is), which
+//!   removes the face and its neighbour across that edge. The collapse is
+//!   made only where it keeps the mesh manifold: the two vertices' common
+//!   neighbours are exactly the faces' opposite vertices (the link
+//!   condition), and two border vertices merge only along a border edge.
+//! - **Caps** (a vertex on the longest edge, the other edges long): the
+//!   longest edge is flipped with the neighbour across it, which splits
+//!   that neighbour at the vertex; on the border the cap is dropped.
+//! - **Faces that name a vertex twice** are dropped; a face repeated with
+//!   the same vertices keeps its first copy, a pair wound opposite ways
+//!   (a pocket of no volume) goes.
+//!
+//! A face whose repair would break the manifold stays, and is counted as
+//! left. Faces that are not degenerate are never touched, apart from the
+//! one vertex a collapse renames.
+
+use super::Mesh;
+use crate::geom::{cross, dist2, norm2, sub, Point3};
+use crate::hash::HashMap;
+
+/// Area below which a face is degenerate, relative to the squared
+/// bounding-box diagonal.
+const MIN_RELATIVE_AREA: f64 = 1e-12;
+/// A face whose shortest edge is below this share of the median edge is
+/// collapsed along it.
+const SHORT_EDGE: f64 = 0.01;
+/// Repair passes at most (each repairs every degenerate face whose
+/// vertices the pass has not touched yet).
+const PASSES: usize = 8;
+
+/// What the repair did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct FaceRepair {
+    /// Zero-area faces removed by collapsing their shortest edge.
+    pub collapsed: usize,
+    /// Zero-area faces removed by flipping their longest edge (or dropped
+    /// on the border).
+    pub flipped: usize,
+    /// Faces dropped for naming a vertex twice or repeating another face.
+    pub dropped: usize,
+    /// Zero-area faces left, where no repair keeps the mesh manifold.
+    pub left: usize,
+}
+
+impl FaceRepair {
+    /// Faces repaired in all.
+    pub fn repaired(&self) -> usize {
+        self.collapsed + self.flipped + self.dropped
+    }
+}
+
+/// Repairs the zero-area and repeated faces of `mesh` in place (see the
+/// module doc); unused vertices are left for the caller to remove.
+pub(crate) fn repair_degenerate_faces(mesh: &mut Mesh) -> FaceRepair {
+    let mut repair = FaceRepair::default();
+    repair.dropped += drop_repeated_faces(mesh);
+    let min_area = MIN_RELATIVE_AREA * diagonal2(mesh);
+    let short = SHORT_EDGE * median_edge(mesh);
+    for _ in 0..PASSES {
+        let degenerate: Vec<usize> = (0..mesh.faces.len())
+            .filter(|&f| mesh.face_area(f) < min_area)
+            .collect();
+        if degenerate.is_empty() {
+            break;
+        }
+        let mut pass = Pass::new(mesh);
+        for f in degenerate {
+            pass.repair(f, short, &mut repair);
+        }
+        mesh.faces = pass.into_faces();
+        repair.dropped += drop_repeated_faces(mesh);
+    }
+    repair.left = (0..mesh.faces.len())
+        .filter(|&f| mesh.face_area(f) < min_area)
+        .count();
+    repair
+}
+
+/// Drops faces that name a vertex twice, later copies of a face, and
+/// pairs of one face wound both ways; returns how many went.
+fn drop_repeated_faces(mesh: &mut Mesh) -> usize {
+    let mut first: HashMap<[u32; 3], (usize, [u32; 3])> = HashMap::default();
+    let mut keep = vec![true; mesh.faces.len()];
+    for (i, &f) in mesh.faces.iter().enumerate() {
+        if f[0] == f[1] || f[1] == f[2] || f[0] == f[2] {
+            keep[i] = false;
+            continue;
+        }
+        let mut key = f;
+        key.sort_unstable();
+        match first.get(&key) {
+            None => {
+                first.insert(key, (i, f));
+            }
+            Some(&(j, g)) => {
+                keep[i] = false;
+                if super::lowest_first(g) != super::lowest_first(f) {
+                    keep[j] = false;
+                }
+            }
+        }
+    }
+    let dropped = keep.iter().filter(|&&k| !k).count();
+    if dropped > 0 {
+        mesh.retain_faces(&keep);
+    }
+    dropped
+}
+
+/// One pass of repairs: faces are edited in a copy; a face whose vertices
+/// an earlier repair of the pass touched waits for the next pass, so each
+/// repair sees the faces round it as they are.
+struct Pass<'a> {
+    points: &'a [Point3],
+    faces: Vec<Option<[u32; 3]>>,
+    /// The live faces round each vertex.
+    around: Vec<Vec<u32>>,
+    touched: Vec<bool>,
+}
+
+impl<'a> Pass<'a> {
+    fn new(mesh: &'a Mesh) -> Self {
+        let mut around = vec![Vec::new(); mesh.vertices.len()];
+        for (i, f) in mesh.faces.iter().enumerate() {
+            for &v in f {
+                around[v as usize].push(i as u32);
+            }
+        }
+        Pass {
+            points: &mesh.vertices,
+            faces: mesh.faces.iter().copied().map(Some).collect(),
+            around,
+            touched: vec![false; mesh.vertices.len()],
+        }
+    }
+
+    fn into_faces(self) -> Vec<[u32; 3]> {
+        self.faces.into_iter().flatten().collect()
+    }
+
+    /// Repairs face `f` if it is still there and untouched.
+    fn repair(&mut self, f: usize, short: f64, repair: &mut FaceRepair) {
+        let Some(face) = self.faces[f] else { return };
+        if face.iter().any(|&v| self.touched[v as usize]) {
+            return;
+        }
+        let length = |k: usize| {
+            dist2(
+                self.points[face[k] as usize],
+                self.points[face[(k + 1) % 3] as usize],
+            )
+        };
+        let shortest = (0..3)
+            .min_by(|&i, &j| length(i).total_cmp(&length(j)))
+            .unwrap_or(0);
+        let longest = (0..3)
+            .max_by(|&i, &j| length(i).total_cmp(&length(j)))
+            .unwrap_or(0);
+        if length(shortest).sqrt() < short {
+            let (u, v) = (face[shortest], face[(shortest + 1) % 3]);
+            if self.collapse(u, v) {
+                repair.collapsed += 1;
+            }
+        } else if self.flip(f, longest) {
+            repair.flipped += 1;
+        }
+    }
+
+    /// The live faces holding both `u` and `v`.
+    fn faces_on_edge(&self, u: u32, v: u32) -> Vec<u32> {
+        self.around[u as usize]
+            .iter()
+            .copied()
+            .filter(|&g| self.faces[g as usize].is_some_and(|f| f.contains(&v)))
+            .collect()
+    }
+
+    /// The vertices sharing a face with `x`, ascending, without repeats.
+    fn neighbours(&self, x: u32) -> Vec<u32> {
+        let mut out: Vec<u32> = self.around[x as usize]
+            .iter()
+            .filter_map(|&g| self.faces[g as usize])
+            .flatten()
+            .filter(|&y| y != x)
+            .collect();
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
+    /// Is `x` on the border (an edge of one face), or at a non-manifold
+    /// edge (`None`)?
+    fn on_border(&self, x: u32) -> Option<bool> {
+        let mut border = false;
+        for y in self.neighbours(x) {
+            match self.faces_on_edge(x, y).len() {
+                1 => border = true,
+                2 => {}
+                _ => return None,
+            }
+        }
+        Some(border)
+    }
+
+    /// Collapses edge (u, v) if that keeps the mesh manifold and turns no
+    /// face over.
+    fn collapse(&mut self, u: u32, v: u32) -> bool {
+        let (Some(border_u), Some(border_v)) = (self.on_border(u), self.on_border(v)) else {
+            return false;
+        };
+        let shared = self.faces_on_edge(u, v);
+        if border_u && border_v && shared.len() != 1 {
+            return false;
+        }
+        // The border vertex stays where one is; otherwise the lower index.
+        let (keep, gone) = match (border_u, border_v) {
+            (false, true) => (v, u),
+            (true, false) => (u, v),
+            _ => (u.min(v), u.max(v)),
+        };
+        let mut opposite: Vec<u32> = shared
+            .iter()
+            .filter_map(|&g| self.faces[g as usize])
+            .flatten()
+            .filter(|&w| w != u && w != v)
+            .collect();
+        opposite.sort_unstable();
+        let common: Vec<u32> = {
+            let of_keep = self.neighbours(keep);
+            self.neighbours(gone)
+                .into_iter()
+                .filter(|w| of_keep.binary_search(w).is_ok())
+                .collect()
+        };
+        if common != opposite || self.turns_over(keep, gone) {
+            return false;
+        }
+        for g in std::mem::take(&mut self.around[gone as usize]) {
+            let Some(face) = self.faces[g as usize] else {
+                continue;
+            };
+            if face.contains(&keep) {
+                self.remove_face(g);
+            } else {
+                self.faces[g as usize] = Some(face.map(|w| if w == gone { keep } else { w }));
+                self.around[keep as usize].push(g);
+            }
+        }
+        self.touch_round(keep);
+        self.touched[gone as usize] = true;
+        true
+    }
+
+    /// Would moving `gone` onto `keep` turn a face round `gone` over?
+    fn turns_over(&self, keep: u32, gone: u32) -> bool {
+        self.around[gone as usize].iter().any(|&g| {
+            let Some(face) = self.faces[g as usize] else {
+                return false;
+            };
+            if face.contains(&keep) {
+                return false;
+            }
+            let before = normal(face.map(|w| self.points[w as usize]));
+            let after =
+                normal(face.map(|w| self.points[if w == gone { keep } else { w } as usize]));
+            crate::geom::dot(before, after) < 0.0
+        })
+    }
+
+    /// Flips the edge of face `f` that starts at its corner `k` (its
+    /// longest) with the face across it, which the opposite vertex splits;
+    /// on the border, drops `f`.
+    fn flip(&mut self, f: usize, k: usize) -> bool {
+        let Some(face) = self.faces[f] else {
+            return false;
+        };
+        let (a, b, c) = (face[k], face[(k + 1) % 3], face[(k + 2) % 3]);
+        let across: Vec<u32> = self
+            .faces_on_edge(a, b)
+            .into_iter()
+            .filter(|&g| g as usize != f)
+            .collect();
+        match across.as_slice() {
+            [] => {
+                // Dropping the cap puts `c` on the border: only if it is
+                // not on it already, or it would pinch the surface there.
+                if self.on_border(c) != Some(false) {
+                    return false;
+                }
+                self.remove_face(f as u32);
+                for w in [a, b, c] {
+                    self.touched[w as usize] = true;
+                }
+                true
+            }
+            &[g] => {
+                let Some(other) = self.faces[g as usize] else {
+                    return false;
+                };
+                let Some(j) = (0..3).find(|&j| other[j] == b && other[(j + 1) % 3] == a) else {
+                    return false;
+                };
+                let d = other[(j + 2) % 3];
+                if d == c || self.neighbours(c).binary_search(&d).is_ok() {
+                    return false;
+                }
+                self.faces[f] = Some([b, c, d]);
+                self.faces[g as usize] = Some([c, a, d]);
+                self.around[a as usize].retain(|&x| x as usize != f);
+                self.around[d as usize].push(f as u32);
+                self.around[b as usize].retain(|&x| x != g);
+                self.around[c as usize].push(g);
+                for w in [a, b, c, d] {
+                    self.touched[w as usize] = true;
+                }
+                true
+            }
+            _ => false,
+        }
+    }
+
+    fn remove_face(&mut self, g: u32) {
+        if let Some(face) = self.faces[g as usize].take() {
+            for w in face {
+                self.around[w as usize].retain(|&x| x != g);
+            }
+        }
+    }
+
+    /// Marks `x` and every vertex of the faces round it.
+    fn touch_round(&mut self, x: u32) {
+        self.touched[x as usize] = true;
+        for &g in &self.around[x as usize] {
+            if let Some(face) = self.faces[g as usize] {
+                for w in face {
+                    self.touched[w as usize] = true;
+                }
+            }
+        }
+    }
+}
+
+/// A face's (unnormalised) normal.
+fn normal(p: [Point3; 3]) -> Point3 {
+    cross(sub(p[1], p[0]), sub(p[2], p[0]))
+}
+
+/// The squared diagonal of the bounding box of the faces' vertices.
+fn diagonal2(mesh: &Mesh) -> f64 {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for f in &mesh.faces {
+        for &v in f {
+            let p = mesh.vertices[v as usize];
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+    }
+    if lo[0] > hi[0] {
+        return 0.0;
+    }
+    norm2(sub(hi, lo))
+}
+
+/// The median length of the faces' edges.
+fn median_edge(mesh: &Mesh) -> f64 {
+    let lengths: Vec<f64> = mesh
+        .faces
+        .iter()
+        .flat_map(|f| (0..3).map(move |k| (f[k], f[(k + 1) % 3])))
+        .map(|(u, v)| dist2(mesh.vertices[u as usize], mesh.vertices[v as usize]).sqrt())
+        .collect();
+    if lengths.is_empty() {
+        return 0.0;
+    }
+    crate::geom::median(&lengths)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::tests::grid;
+
+    fn zero_area_faces(mesh: &Mesh) -> usize {
+        let min_area = MIN_RELATIVE_AREA * diagonal2(mesh);
+        (0..mesh.faces.len())
+            .filter(|&f| mesh.face_area(f) < min_area)
+            .count()
+    }
+
+    /// A vertex moved next to its neighbour makes the two faces on their
+    /// edge needles; collapsing the edge removes both, keeps the grid's
+    /// area, its single border and its orientation.
+    #[test]
+    fn needles_are_collapsed() {
+        for (i, j) in [(2, 2), (0, 2), (3, 0)] {
+            let mut mesh = grid(5);
+            let v = (j * 6 + i) as usize;
+            let p = mesh.vertices[v];
+            mesh.vertices[v] = [p[0] + 1.0 - 1e-13, p[1], 0.0];
+            let area = mesh.area();
+            assert!(zero_area_faces(&mesh) > 0);
+            let repair = repair_degenerate_faces(&mut mesh);
+            assert!(repair.collapsed > 0 && repair.left == 0, "{repair:?}");
+            assert_eq!(zero_area_faces(&mesh), 0);
+            mesh.check_manifold().unwrap();
+            assert_eq!(mesh.boundary_loops().len(), 1);
+            assert!((mesh.area() - area).abs() < 1e-6);
+        }
+    }
+
+    /// A cap (a vertex on the opposite edge) is flipped with the face
+    /// across that edge, which the vertex then splits.
+    #[test]
+    fn caps_are_flipped() {
+        let (a, b, c, d, e) = (0, 1, 2, 3, 4);
+        let mut mesh = Mesh {
+            vertices: vec![
+                [0.0, 0.0, 0.0],
+                [2.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [1.0, 1.0, 0.0],
+                [1.0, -1.0, 0.0],
+            ],
+            faces: vec![[a, b, c], [b, a, e], [c, b, d], [a, c, d]],
+        };
+        mesh.check_manifold().unwrap();
+        let repair = repair_degenerate_faces(&mut mesh);
+        assert_eq!(repair.flipped, 1, "{repair:?}");
+        assert_eq!(zero_area_faces(&mesh), 0);
+        assert_eq!(mesh.faces.len(), 4);
+        mesh.check_manifold().unwrap();
+        assert!((mesh.area() - 2.0).abs() < 1e-12);
+    }
+
+    /// On the border a cap is dropped: the border then runs through its
+    /// middle vertex.
+    #[test]
+    fn border_caps_are_dropped() {
+        let mut mesh = Mesh {
+            vertices: vec![
+                [0.0, 0.0, 0.0],
+                [2.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [1.0, 1.0, 0.0],
+            ],
+            faces: vec![[0, 1, 2], [2, 1, 3], [0, 2, 3]],
+        };
+        let repair = repair_degenerate_faces(&mut mesh);
+        assert_eq!(repair.flipped, 1, "{repair:?}");
+        assert_eq!(mesh.faces, vec![[2, 1, 3], [0, 2, 3]]);
+    }
+
+    /// Faces naming a vertex twice go; a repeated face keeps its first
+    /// copy; a face and its reverse both go.
+    #[test]
+    fn repeated_faces_are_dropped() {
+        let mut mesh = grid(2);
+        let first = mesh.faces[0];
+        mesh.faces.push(first);
+        mesh.faces.push([first[1], first[2], first[0]]);
+        mesh.faces.push([4, 4, 5]);
+        let repair = repair_degenerate_faces(&mut mesh);
+        assert_eq!(repair.dropped, 3, "{repair:?}");
+        assert_eq!(mesh.faces, grid(2).faces);
+        let mut pocket = grid(2);
+        let f = pocket.faces[3];
+        pocket.faces.push([f[0], f[2], f[1]]);
+        assert_eq!(repair_degenerate_faces(&mut pocket).dropped, 2);
+        assert_eq!(pocket.faces.len(), grid(2).faces.len() - 1);
+    }
+
+    /// Random interior vertices of a jittered grid moved onto a
+    /// neighbour: every zero-area face goes, and the mesh stays manifold
+    /// and oriented. Needles between two border vertices across a corner
+    /// would pinch the border if collapsed: they are left, counted, and
+    /// the mesh stays manifold (the last assertion of each case).
+    #[test]
+    fn random_needles_are_all_repaired() {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let mut interior_cases = 0;
+        for case in 0..200 {
+            let n = 8;
+            let mut mesh = grid(n);
+            for p in mesh.vertices.iter_mut() {
+                p[0] += rng.random_range(-0.2..0.2);
+                p[1] += rng.random_range(-0.2..0.2);
+            }
+            let interior = |v: u32| {
+                let (i, j) = (v % (n + 1), v / (n + 1));
+                i > 0 && i < n && j > 0 && j < n
+            };
+            let moves = rng.random_range(1..4);
+            let mut moved = 0;
+            let mut all_interior = true;
+            while moved < moves {
+                let f = mesh.faces[rng.random_range(0..mesh.faces.len())];
+                let (u, v) = (f[0], f[1]);
+                all_interior &= interior(u) && interior(v);
+                let q = mesh.vertices[u as usize];
+                mesh.vertices[v as usize] = [q[0] + 1e-13, q[1], q[2]];
+                moved += 1;
+            }
+            let before = zero_area_faces(&mesh);
+            let repair = repair_degenerate_faces(&mut mesh);
+            assert_eq!(
+                zero_area_faces(&mesh),
+                repair.left,
+                "case {case}: {repair:?}"
+            );
+            if all_interior {
+                interior_cases += 1;
+                assert_eq!(repair.left, 0, "case {case}: {repair:?}");
+                assert!(
+                    repair.collapsed > 0 || before == 0,
+                    "case {case}: {repair:?}"
+                );
+            }
+            mesh.check_manifold()
+                .unwrap_or_else(|e| panic!("case {case}: {e} {repair:?}"));
+        }
+        assert!(interior_cases > 50, "{interior_cases}");
+    }
+}
