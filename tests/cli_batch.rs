@@ -624,3 +624,16 @@ fn a_same_stem_ply_without_faces_is_the_cloud() {
         ]
     );
 }
+
+/// The closing line counts one file as "1 file".
+#[test]
+fn one_file_is_counted_in_the_singular() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::create_dir_all(d.join("scans")).unwrap();
+    std::fs::copy(JAGGED, d.join("scans/a.stl")).unwrap();
+    let run = batch(d, &["scans", "--out-dir", "out"]);
+    assert_ok(&run);
+    let stdout = text(&run.stdout);
+    assert!(stdout.contains("\n1 file: 1 ok, 0 failed, 0 skipped"), "{stdout}");
+}
