@@ -18,7 +18,8 @@ use crate::commands::{batch, clean, detect, edges, mesh, trim};
     version,
     about,
     args_conflicts_with_subcommands = true,
-    subcommand_negates_reqs = true
+    subcommand_negates_reqs = true,
+    arg_required_else_help = true
 )]
 pub struct Cli {
     /// A stage on its own.

@@ -635,5 +635,8 @@ fn one_file_is_counted_in_the_singular() {
     let run = batch(d, &["scans", "--out-dir", "out"]);
     assert_ok(&run);
     let stdout = text(&run.stdout);
-    assert!(stdout.contains("\n1 file: 1 ok, 0 failed, 0 skipped"), "{stdout}");
+    assert!(
+        stdout.contains("\n1 file: 1 ok, 0 failed, 0 skipped"),
+        "{stdout}"
+    );
 }

@@ -382,3 +382,22 @@ fn clouds_out_of_range_are_a_clear_error() {
     assert_eq!(faces(1e45), faces(1.0));
     assert_eq!(faces(1e-28), faces(1.0));
 }
+
+/// `meshtrim` alone prints the help (the main job's usage and every
+/// command), not only the main job's missing arguments, and exits 2.
+#[test]
+fn bare_meshtrim_prints_the_help() {
+    let run = meshtrim(&[], None);
+    assert_eq!(run.status.code(), Some(2));
+    let help = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        help.contains("meshtrim [OPTIONS] <MESH> <CLOUD> <OUTPUT>"),
+        "{help}"
+    );
+    for command in ["detect", "edges", "trim", "mesh", "clean", "batch"] {
+        assert!(
+            help.contains(&format!("\n  {command} ")),
+            "{command}: {help}"
+        );
+    }
+}

@@ -244,7 +244,11 @@ impl Totals<'_> {
             Some(s) => format!(" (shard {s} of {} inputs)", self.inputs),
             None => String::new(),
         };
-        let files = if self.rows.len() == 1 { "file" } else { "files" };
+        let files = if self.rows.len() == 1 {
+            "file"
+        } else {
+            "files"
+        };
         format!(
             "{} {files}{shard}: {} ok, {} failed, {} skipped in {secs:.1} s ({:.2} files/s)",
             self.rows.len(),
