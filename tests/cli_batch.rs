@@ -155,7 +155,7 @@ fn directories_and_globs_expand_to_sorted_mirrored_outputs() {
     assert_eq!(report["files"][2]["output"], "out/sub/b.ply");
     let stdout = text(&run.stdout);
     assert!(
-        stdout.contains("ok      scans/sub/b.ply  loops=4  faces 15909→"),
+        stdout.contains("ok      trim   scans/sub/b.ply  loops=4  faces 15909→"),
         "{stdout}"
     );
     assert!(
@@ -303,7 +303,7 @@ fn skip_existing_resumes_without_rewriting() {
         .starts_with(b"ply\n"));
     let stdout = text(&run.stdout);
     assert!(
-        stdout.contains("skipped scans/a.ply (output exists)"),
+        stdout.contains("skipped trim   scans/a.ply (output exists)"),
         "{stdout}"
     );
     let rows = parse_csv(&std::fs::read_to_string(d.join("r.csv")).unwrap());
@@ -340,8 +340,23 @@ fn bad_files_fail_alone_and_the_reports_say_why() {
     assert_eq!(run.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("error: 2 of 4 files failed"), "{stderr}");
     assert!(!stderr.contains("panicked"), "{stderr}");
-    assert!(stdout.contains("failed  scans/bad.stl: "), "{stdout}");
-    assert!(stdout.contains("failed  scans/worse.ply: "), "{stdout}");
+    assert!(
+        stdout.contains("failed  clean  scans/bad.stl: "),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("failed  trim   scans/worse.ply: "),
+        "{stdout}"
+    );
+    // Each failed path is printed once.
+    for line in stdout.lines().filter(|l| l.starts_with("failed")) {
+        let path = line
+            .split_whitespace()
+            .nth(2)
+            .unwrap()
+            .trim_end_matches(':');
+        assert_eq!(line.matches(path).count(), 1, "{line}");
+    }
     assert!(stdout.contains("4 files: 2 ok, 2 failed, 0 skipped"));
     // The good files are written whole, the bad ones not at all, and no
     // temporary file is left behind.
@@ -388,7 +403,8 @@ fn bad_files_fail_alone_and_the_reports_say_why() {
     assert_eq!(bad[2..4], ["clean", "failed"]);
     assert!(!bad[4].is_empty() && bad[5..11].iter().all(String::is_empty));
     assert_eq!(worse[2..4], ["trim", "failed"]);
-    assert!(worse[4].contains("scans/worse.ply"), "{worse:?}");
+    // The row names the file; its error says what is wrong with it.
+    assert!(worse[4].starts_with("malformed PLY header"), "{worse:?}");
     // The same batch as JSON.
     let run = batch(
         d,
@@ -639,4 +655,78 @@ fn one_file_is_counted_in_the_singular() {
         stdout.contains("\n1 file: 1 ok, 0 failed, 0 skipped"),
         "{stdout}"
     );
+}
+
+/// A cloud named so that it pairs with no mesh is taken for a mesh to
+/// clean: its line says what it looks like and how to name it.
+#[test]
+fn a_misnamed_cloud_is_told_how_to_pair() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::create_dir_all(d.join("scans")).unwrap();
+    std::fs::copy(MESH, d.join("scans/blade.ply")).unwrap();
+    std::fs::copy(CLOUD, d.join("scans/blade_cloud.ply")).unwrap();
+    let run = batch(d, &["scans", "--out-dir", "out"]);
+    assert_eq!(run.status.code(), Some(1));
+    let stdout = text(&run.stdout);
+    let line = stdout
+        .lines()
+        .find(|l| l.contains("blade_cloud.ply"))
+        .unwrap_or_else(|| panic!("{stdout}"));
+    assert!(
+        line.starts_with("failed  clean  scans/blade_cloud.ply: "),
+        "{line}"
+    );
+    assert!(line.contains("looks like a point cloud"), "{line}");
+    assert!(line.contains("S.cloud.EXT"), "{line}");
+    assert_eq!(line.matches("blade_cloud.ply").count(), 1, "{line}");
+}
+
+/// A closed mesh given to clean (a Poisson envelope without its cloud)
+/// is copied, and its line says there was no border to clean.
+#[test]
+fn a_closed_mesh_cleaned_is_noted() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::create_dir_all(d.join("scans")).unwrap();
+    std::fs::write(d.join("scans/envelope.obj"), sphere_obj(12, 16)).unwrap();
+    let run = batch(d, &["scans", "--out-dir", "out"]);
+    assert_ok(&run);
+    let stdout = text(&run.stdout);
+    assert!(
+        stdout.contains("ok      clean  scans/envelope.obj  loops=0")
+            && stdout.contains("(no border: a closed mesh has nothing to clean"),
+        "{stdout}"
+    );
+}
+
+/// A closed UV sphere: `rings` latitudes between the poles, `sectors`
+/// longitudes, faces turning outward.
+fn sphere_obj(rings: usize, sectors: usize) -> String {
+    use std::f64::consts::PI;
+    let mut obj = String::from("v 0 0 1\nv 0 0 -1\n");
+    for r in 1..=rings {
+        let theta = PI * r as f64 / (rings + 1) as f64;
+        for s in 0..sectors {
+            let phi = 2.0 * PI * s as f64 / sectors as f64;
+            let (x, y, z) = (
+                theta.sin() * phi.cos(),
+                theta.sin() * phi.sin(),
+                theta.cos(),
+            );
+            obj += &format!("v {x} {y} {z}\n");
+        }
+    }
+    // OBJ indices are 1-based: the poles are 1 and 2, ring r's sector s is
+    // 3 + (r - 1)·sectors + s.
+    let at = |r: usize, s: usize| 3 + (r - 1) * sectors + s % sectors;
+    for s in 0..sectors {
+        obj += &format!("f 1 {} {}\n", at(1, s), at(1, s + 1));
+        obj += &format!("f 2 {} {}\n", at(rings, s + 1), at(rings, s));
+        for r in 1..rings {
+            let (a, b, c, d) = (at(r, s), at(r + 1, s), at(r + 1, s + 1), at(r, s + 1));
+            obj += &format!("f {a} {b} {c}\nf {a} {c} {d}\n");
+        }
+    }
+    obj
 }

@@ -39,6 +39,8 @@ pub struct Args {
 /// The summary of one cleanup (for `batch`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct CleanOutcome {
+    /// Border loops of the input.
+    pub loops_in: usize,
     /// Border loops replaced by their smoothed edge.
     pub loops: usize,
     /// Input faces.
@@ -118,15 +120,27 @@ pub struct LeftLoops {
 /// Runs `meshtrim clean`.
 pub fn run(args: &Args) -> Result<()> {
     crate::report::check_outputs(&args.output, args.report.as_deref(), &[&args.input])?;
-    let report = clean(&args.input, &args.output, &args.stages.stages())?;
+    let report = clean(
+        &args.input,
+        &args.output,
+        &args.stages.stages(),
+        "`clean` smooths the border of a mesh",
+    )?;
     crate::report::emit(&report, args.report.as_deref(), args.json)
 }
 
 /// Cleans one file without printing (the unit of `batch`).
-pub fn clean_file(input: &Path, output: &Path, stages: &Stages) -> Result<CleanOutcome> {
+/// `no_faces` is the advice for a file without faces.
+pub fn clean_file(
+    input: &Path,
+    output: &Path,
+    stages: &Stages,
+    no_faces: &str,
+) -> Result<CleanOutcome> {
     crate::report::check_outputs(output, None, &[input])?;
-    let r = clean(input, output, stages)?;
+    let r = clean(input, output, stages, no_faces)?;
     Ok(CleanOutcome {
+        loops_in: r.loops_in,
         loops: r.loops_smoothed,
         faces_in: r.faces_in,
         faces_out: r.faces_out,
@@ -137,9 +151,9 @@ pub fn clean_file(input: &Path, output: &Path, stages: &Stages) -> Result<CleanO
 }
 
 /// Reads, finds the local resolution, cleans, writes.
-fn clean(input: &Path, output: &Path, stages: &Stages) -> Result<Report> {
+fn clean(input: &Path, output: &Path, stages: &Stages, no_faces: &str) -> Result<Report> {
     let started = Instant::now();
-    let mesh = read_mesh_with_faces(input, "`clean` smooths the border of a mesh")?;
+    let mesh = read_mesh_with_faces(input, no_faces)?;
     let read_time = started.elapsed();
     let started = Instant::now();
     // Only β is needed: the mesh knows its border (BPD's labels would be

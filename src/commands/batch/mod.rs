@@ -166,6 +166,7 @@ fn process(job: &Job, skip_existing: bool, stages: &Stages) -> Row {
         algorithm_ms: None,
         write_ms: None,
         total_ms: 0.0,
+        note: None,
     };
     if skip_existing && job.output.exists() {
         return row;
@@ -181,21 +182,33 @@ fn process(job: &Job, skip_existing: bool, stages: &Stages) -> Row {
             row.read_ms = Some(o.read_ms);
             row.algorithm_ms = Some(o.algorithm_ms);
             row.write_ms = Some(o.write_ms);
+            row.note = o.note;
         }
         Err(e) => {
             row.status = Status::Failed;
-            row.error = Some(format!("{e:#}"));
+            // The line names the file already: the chain need not again.
+            let chain = format!("{e:#}");
+            let prefix = format!("{}: ", row.input);
+            row.error = Some(chain.strip_prefix(&prefix).unwrap_or(&chain).to_string());
         }
     }
     row.total_ms = millis(started.elapsed());
     row
 }
 
+/// A file without faces among the meshes is most likely a cloud misnamed.
+const NO_FACES: &str = "it looks like a point cloud: to trim the mesh S.EXT with it, name it \
+     S.cloud.EXT beside the mesh (or S.EXT with EXT one of pcd xyz txt csv asc pts)";
+
+/// A cleaned mesh without a border: nothing was smoothed.
+const CLOSED: &str = "no border: a closed mesh has nothing to clean; to trim a Poisson \
+     envelope, put its cloud S.cloud.EXT beside it";
+
 /// Cleans or trims one file, writing its output atomically.
 fn work(job: &Job, stages: &Stages) -> Result<Outcome> {
     match &job.cloud {
         CloudMatch::None => {
-            let o = clean_file(&job.input, &job.output, stages)?;
+            let o = clean_file(&job.input, &job.output, stages, NO_FACES)?;
             Ok(Outcome {
                 loops: o.loops,
                 faces_in: o.faces_in,
@@ -203,6 +216,7 @@ fn work(job: &Job, stages: &Stages) -> Result<Outcome> {
                 read_ms: o.read_ms,
                 algorithm_ms: o.clean_ms,
                 write_ms: o.write_ms,
+                note: (o.loops_in == 0).then_some(CLOSED),
             })
         }
         CloudMatch::One(cloud) => {
@@ -218,6 +232,7 @@ fn work(job: &Job, stages: &Stages) -> Result<Outcome> {
                 read_ms: r.read_ms,
                 algorithm_ms: ((r.detect_ms + r.edges_ms + r.trim_ms) * 10.0).round() / 10.0,
                 write_ms: r.write_ms,
+                note: None,
             })
         }
         CloudMatch::Several(clouds) => {

@@ -66,6 +66,8 @@ pub struct Outcome {
     pub algorithm_ms: f64,
     /// Writing, in milliseconds.
     pub write_ms: f64,
+    /// What the user should know about the file (a closed mesh cleaned).
+    pub note: Option<&'static str>,
 }
 
 /// One file of the batch, as the report lists it. The numbers are absent
@@ -96,26 +98,31 @@ pub struct Row {
     pub write_ms: Option<f64>,
     /// Wall-clock time of the file, in milliseconds.
     pub total_ms: f64,
+    /// What the user should know about the file, when anything.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<&'static str>,
 }
 
 impl Row {
     /// The line printed when the file is done.
     pub fn line(&self) -> String {
         let secs = self.total_ms / 1000.0;
+        let mode = self.mode.name();
+        let note = self.note.map(|n| format!("  ({n})")).unwrap_or_default();
         match self.status {
             Status::Ok => format!(
-                "ok      {}  loops={}  faces {}→{}  {secs:.2} s",
+                "ok      {mode:<5}  {}  loops={}  faces {}→{}  {secs:.2} s{note}",
                 self.input,
                 self.loops.unwrap_or(0),
                 self.faces_in.unwrap_or(0),
                 self.faces_out.unwrap_or(0)
             ),
             Status::Failed => format!(
-                "failed  {}: {}",
+                "failed  {mode:<5}  {}: {}",
                 self.input,
                 self.error.as_deref().unwrap_or("")
             ),
-            Status::Skipped => format!("skipped {} (output exists)", self.input),
+            Status::Skipped => format!("skipped {mode:<5}  {} (output exists)", self.input),
         }
     }
 
