@@ -72,9 +72,28 @@ pub(crate) fn same_file(a: &Path, b: &Path) -> bool {
     }
 }
 
+/// `x` in plain decimal notation with `digits` significant digits: a
+/// distance reads the same way in millimetres and in metres.
+pub(crate) fn significant(x: f64, digits: usize) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let magnitude = x.abs().log10().floor() as i64;
+    let decimals = (digits as i64 - 1 - magnitude).max(0) as usize;
+    format!("{x:.decimals$}")
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn significant_digits_in_plain_notation() {
+        assert_eq!(significant(1.0443, 4), "1.044");
+        assert_eq!(significant(0.0012345, 3), "0.00123");
+        assert_eq!(significant(1234.5, 3), "1234");
+        assert_eq!(significant(0.0, 4), "0");
+    }
 
     #[test]
     fn the_report_extension_is_json_in_any_case() {

@@ -14,6 +14,7 @@ use trim::{reconstruct_edges, trim_mesh, LoopFit, TrimOptions, TrimReport};
 use crate::commands::args::{parse_direction, parse_k, parse_vector, StageArgs, ViewArgs};
 use crate::io::mesh_out::write_mesh;
 use crate::io::{read_cloud, read_mesh_with_faces};
+use crate::report::significant;
 use crate::stages::{detect_read_cloud, millis, Detected, Stages};
 
 /// Arguments of the trimming (`meshtrim MESH CLOUD OUT`).
@@ -306,7 +307,10 @@ impl crate::report::Table for Report {
                 "area in / out",
                 format!("{:.6} / {:.6}", self.area_in, self.area_out),
             ),
-            ("border to edge, max", format!("{worst:.3e}")),
+            (
+                "border to edge, max",
+                format!("{} (the cloud's units)", significant(worst, 4)),
+            ),
             ("read time", format!("{:.1} ms", self.read_ms)),
             ("detect time", format!("{:.1} ms", self.detect_ms)),
             ("edges time", format!("{:.1} ms", self.edges_ms)),
