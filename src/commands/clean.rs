@@ -113,6 +113,8 @@ pub struct Report {
 pub struct LeftLoops {
     /// Their indices among the input's border loops.
     pub loops: Vec<usize>,
+    /// Their numbers of vertices.
+    pub vertices: Vec<usize>,
     /// Why.
     pub reason: String,
 }
@@ -201,6 +203,7 @@ impl Report {
                 .iter()
                 .map(|l| LeftLoops {
                     loops: l.loops.clone(),
+                    vertices: l.vertices.clone(),
                     reason: l.reason.to_string(),
                 })
                 .collect(),
@@ -306,7 +309,10 @@ impl crate::report::Table for Report {
         for l in &self.loops_left {
             rows.push((
                 "left unchanged",
-                format!("loops {:?}: {}", l.loops, l.reason),
+                format!(
+                    "loops {:?} ({:?} vertices): {}",
+                    l.loops, l.vertices, l.reason
+                ),
             ));
         }
         crate::report::rows(&rows)

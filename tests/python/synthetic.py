@@ -282,6 +282,31 @@ def curved_disc(spacing: float = 1.5, seed: int = 1) -> Cloud:
     return _make(f"curved disc h={spacing:g}", saddle(0.004), region, spacing, seed, 100.0)
 
 
+def cylinder(radius: float):
+    """The cylinder of ``radius`` about the y axis, by arc length u round
+    it from the top line (seen along z, u = 0 faces the viewer) and height
+    v: x = r sin(u / r), z = r cos(u / r)."""
+
+    def surface(u, v):
+        t = np.asarray(u, dtype=float) / radius
+        return np.stack([radius * np.sin(t), np.asarray(v, dtype=float) * np.ones_like(t), radius * np.cos(t)], axis=-1)
+
+    return surface
+
+
+def wrapped_cylinder(spacing: float = 1.5, seed: int = 1, wrap_deg: float = 110.0) -> Cloud:
+    """A cylinder of radius 40 seen from the side, as one range scan sees
+    it and more: the part covers +-``wrap_deg`` round the axis (past the
+    silhouettes at +-90 degrees) and 60 high, with a hole of radius 6
+    beside one silhouette (at 75 degrees). Its outer border wraps round the
+    object: no plane sees it as a height field."""
+    r = 40.0
+    half = math.radians(wrap_deg) * r
+    outer = np.array([[-half, 0.0], [half, 0.0], [half, 60.0], [-half, 60.0]])
+    region = Region(outer, [(math.radians(75.0) * r, 30.0, 6.0)])
+    return _make(f"wrapped cylinder h={spacing:g}", cylinder(r), region, spacing, seed, 2.0 * r)
+
+
 # The validation suite's cases by name (blade-like surface
 # with three holes at two resolutions, notched plate, curved disc with a
 # hole); the trim and clean suites both run them.

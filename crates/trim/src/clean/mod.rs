@@ -61,10 +61,12 @@
 mod assemble;
 mod band;
 mod gap;
+mod strip;
 
 use assemble::*;
 use band::*;
 use gap::*;
+use strip::*;
 
 use std::borrow::Cow;
 use std::collections::BTreeSet;
@@ -134,6 +136,8 @@ impl Default for CleanOptions {
 pub struct LeftLoops {
     /// Indices of the loops (in the input's border order).
     pub loops: Vec<usize>,
+    /// Their numbers of vertices.
+    pub vertices: Vec<usize>,
     /// Why they could not be replaced.
     pub reason: LeftReason,
 }
@@ -167,6 +171,21 @@ pub enum LeftReason {
     },
     /// The new faces would meet others at a non-manifold edge.
     NonManifold,
+    /// The kept mesh's new border beside the smoothed loop does not close
+    /// into one loop.
+    TangledWall,
+    /// The smoothed loop would cut the mesh in two.
+    SplitsMesh,
+    /// The smoothed loop doubles back on itself on the surface (across a
+    /// narrow notch), turning that many of the new faces over.
+    DoublesBack {
+        /// New faces turned over.
+        turned: usize,
+        /// New faces.
+        faces: usize,
+    },
+    /// The new faces would reach those of another border.
+    MeetsAnotherBorder,
 }
 
 impl std::fmt::Display for LeftReason {
@@ -190,6 +209,18 @@ impl std::fmt::Display for LeftReason {
             ),
             Self::NonManifold => {
                 write!(f, "its new faces would meet others at a non-manifold edge")
+            }
+            Self::TangledWall => write!(
+                f,
+                "the mesh's new border beside the smoothed loop does not close into one loop"
+            ),
+            Self::SplitsMesh => write!(f, "its smoothed loop would cut the mesh in two"),
+            Self::DoublesBack { turned, faces } => write!(
+                f,
+                "its smoothed loop doubles back on itself (a narrow notch): {turned} of {faces} new faces would turn over"
+            ),
+            Self::MeetsAnotherBorder => {
+                write!(f, "its new faces would reach those of another border")
             }
         }
     }
@@ -252,7 +283,6 @@ pub fn clean_mesh(
     let rings = smoothed_loops(mesh, beta, &borders, options);
     let report = CleanReport {
         loops_in: borders.len(),
-        loops_too_small: rings.iter().filter(|r| r.is_none()).count(),
         faces_in,
         slivers_dropped: dropped.slivers,
         repeated_faces_dropped: dropped.repeats,
@@ -261,7 +291,22 @@ pub fn clean_mesh(
     };
     let mut outcomes = replace_bands(mesh, beta, &borders, &rings);
     let out = assemble_manifold(mesh, &mut outcomes);
-    finish(out, &outcomes, report)
+    let (out, mut report) = finish(out, &outcomes, report)?;
+    // Small loops a strip absorbed count as replaced.
+    let mut replaced = vec![false; borders.len()];
+    for patch in outcomes.iter().filter_map(|o| o.patch.as_ref()) {
+        for &l in &patch.loops {
+            replaced[l] = true;
+        }
+    }
+    report.loops_smoothed = replaced.iter().filter(|&&r| r).count();
+    report.loops_too_small = (0..borders.len())
+        .filter(|&l| rings[l].is_none() && !replaced[l])
+        .count();
+    for left in &mut report.loops_left {
+        left.vertices = left.loops.iter().map(|&l| borders[l].len()).collect();
+    }
+    Ok((out, report))
 }
 
 /// What the cleanup needs of the mesh left once its empty faces are dropped:
@@ -319,7 +364,162 @@ fn replace_bands(
         topology: &topology,
         beta_median: median(beta),
     };
-    replace_all(&context)
+    let mut outcomes = replace_all(&context);
+    replace_left_by_strips(&context, &mut outcomes);
+    outcomes
+}
+
+/// The loops the planar way left, replaced by strips (see [`strip`]).
+/// A strip whose faces would reach a planar patch's takes the place of
+/// that patch, whose loops are made strips in turn: a border that wraps
+/// round the object matters more than the holes beside it, and a strip
+/// keeps clear of the borders it does not absorb. Loops are taken in
+/// order, so the result does not depend on the threads.
+fn replace_left_by_strips(cx: &Context, outcomes: &mut Vec<Outcome>) {
+    let mut queue: BTreeSet<usize> = outcomes
+        .iter()
+        .flat_map(|o| o.left.iter().flat_map(|x| x.loops.iter().copied()))
+        .collect();
+    let first: HashMap<usize, Result<Strip, StripFailure>> = {
+        let replaced = replaced_loops(cx, outcomes);
+        let loops: Vec<usize> = queue.iter().copied().collect();
+        loops
+            .par_iter()
+            .map(|&l| (l, replace_by_strip(cx, l, &replaced)))
+            .collect()
+    };
+    let mut first = first;
+    let mut reasons: HashMap<usize, LeftReason> = HashMap::default();
+    while let Some(l) = queue.pop_first() {
+        let mut attempt = first.remove(&l);
+        let mut demoted: Vec<(usize, Patch, Vec<u32>)> = Vec::new();
+        let strip = loop {
+            let replaced = replaced_loops(cx, outcomes);
+            if replaced[l] {
+                break None;
+            }
+            let strip = match attempt.take() {
+                Some(strip) => strip,
+                None => replace_by_strip(cx, l, &replaced),
+            };
+            let conflict = match &strip {
+                Ok(strip) => conflicting_outcomes(cx, outcomes, strip),
+                Err(StripFailure::MeetsReplaced(other)) => outcomes
+                    .iter()
+                    .position(|o| o.patch.as_ref().is_some_and(|p| p.loops.contains(other)))
+                    .into_iter()
+                    .collect(),
+                Err(_) => Vec::new(),
+            };
+            let planar: Vec<usize> = conflict
+                .iter()
+                .copied()
+                .filter(|&o| !outcomes[o].strip)
+                .collect();
+            if planar.is_empty() || planar.len() < conflict.len() {
+                break Some((strip, !conflict.is_empty()));
+            }
+            for o in planar {
+                if let Some(patch) = outcomes[o].patch.take() {
+                    demoted.push((o, patch, std::mem::take(&mut outcomes[o].band)));
+                }
+            }
+        };
+        let accepted = matches!(strip, Some((Ok(_), false)));
+        for (o, patch, band) in demoted {
+            if accepted {
+                queue.extend(patch.loops.iter().copied().filter(|&k| k != l));
+            } else {
+                outcomes[o].patch = Some(patch);
+                outcomes[o].band = band;
+            }
+        }
+        match strip {
+            None => {}
+            Some((Err(failure), _)) => {
+                reasons.insert(l, failure.reason());
+            }
+            Some((Ok(_), true)) => {
+                reasons.insert(l, LeftReason::MeetsAnotherBorder);
+            }
+            Some((Ok(strip), false)) => {
+                for &k in &strip.patch.loops {
+                    reasons.remove(&k);
+                }
+                outcomes.push(Outcome {
+                    band: strip.footprint,
+                    patch: Some(strip.patch),
+                    left: Vec::new(),
+                    strip: true,
+                });
+            }
+        }
+    }
+    let replaced = replaced_loops(cx, outcomes);
+    for outcome in outcomes.iter_mut() {
+        outcome
+            .left
+            .retain(|x| x.loops.iter().any(|&k| !replaced[k]));
+        for entry in outcome.left.iter_mut() {
+            entry.loops.retain(|&k| !replaced[k]);
+        }
+    }
+    let mut listed: Vec<bool> = vec![false; cx.rings.len()];
+    for entry in outcomes.iter_mut().flat_map(|o| o.left.iter_mut()) {
+        for &k in &entry.loops {
+            listed[k] = true;
+        }
+        if let Some(reason) = entry.loops.iter().find_map(|k| reasons.get(k)) {
+            entry.reason = *reason;
+        }
+    }
+    // Loops of demoted patches that no strip could replace.
+    let mut demoted: Vec<(usize, LeftReason)> = reasons
+        .into_iter()
+        .filter(|&(k, _)| !listed[k] && !replaced[k])
+        .collect();
+    demoted.sort_unstable_by_key(|&(k, _)| k);
+    if let Some(outcome) = outcomes.first_mut() {
+        outcome
+            .left
+            .extend(demoted.into_iter().map(|(k, reason)| LeftLoops {
+                loops: vec![k],
+                vertices: Vec::new(),
+                reason,
+            }));
+    }
+}
+
+/// Which loops the outcomes' patches replace (absorbed ones included).
+fn replaced_loops(cx: &Context, outcomes: &[Outcome]) -> Vec<bool> {
+    let mut replaced = vec![false; cx.rings.len()];
+    for patch in outcomes.iter().filter_map(|o| o.patch.as_ref()) {
+        for &l in &patch.loops {
+            replaced[l] = true;
+        }
+    }
+    replaced
+}
+
+/// The outcomes whose patches the strip's faces would reach: it removes a
+/// face beside one they remove, or they remove one beside its removed
+/// faces.
+fn conflicting_outcomes(cx: &Context, outcomes: &[Outcome], strip: &Strip) -> Vec<usize> {
+    let footprint: HashSet<u32> = strip.footprint.iter().copied().collect();
+    let removed: HashSet<u32> = strip.patch.removed.iter().copied().collect();
+    outcomes
+        .iter()
+        .enumerate()
+        .filter(|(_, o)| {
+            o.patch.as_ref().is_some_and(|p| {
+                p.removed.iter().any(|f| footprint.contains(f))
+                    || strip::footprint(cx, &p.removed)
+                        .iter()
+                        .any(|f| removed.contains(f))
+            })
+        })
+        .map(|(o, _)| o)
+        .collect()
 }
 
 /// The input with every patch applied. A safety net: a patch whose faces
@@ -336,6 +536,7 @@ fn assemble_manifold(mesh: &Mesh, outcomes: &mut [Outcome]) -> Mesh {
             if let Some(patch) = outcomes[g].patch.take() {
                 outcomes[g].left.push(LeftLoops {
                     loops: patch.loops,
+                    vertices: Vec::new(),
                     reason: LeftReason::NonManifold,
                 });
             }
@@ -389,6 +590,8 @@ struct Outcome {
     band: Vec<u32>,
     patch: Option<Patch>,
     left: Vec<LeftLoops>,
+    /// Whether the patch is a strip.
+    strip: bool,
 }
 
 /// Replaces every smoothable loop, merging loops whose bands overlap until
@@ -443,6 +646,7 @@ fn replace_group(cx: &Context, group: &[usize]) -> Outcome {
                         band: band.faces,
                         patch: Some(patch),
                         left,
+                        strip: false,
                     };
                 }
                 Err(Retry::Grow(_)) if depth < MAX_DEPTH => {
@@ -468,6 +672,7 @@ fn replace_group(cx: &Context, group: &[usize]) -> Outcome {
             active.retain(|l| !culprits.contains(l));
             left.push(LeftLoops {
                 loops: culprits,
+                vertices: Vec::new(),
                 reason: failure.reason,
             });
             continue 'attempt;
@@ -477,6 +682,7 @@ fn replace_group(cx: &Context, group: &[usize]) -> Outcome {
         band: Vec::new(),
         patch: None,
         left,
+        strip: false,
     }
 }
 

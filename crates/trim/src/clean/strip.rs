@@ -1,0 +1,855 @@
+//! A border loop replaced without any projection: the smoothed loop zipped
+//! to the kept mesh by a strip of new faces (the cleanup's second way, for
+//! the loops whose band is no height field over one plane: outer borders
+//! that wrap round the object, borders on steep or folded surface).
+//!
+//! 1. **Which side is the surface.** Every segment of the smoothed loop
+//!    gets the direction into the surface there: the mean direction from
+//!    the border vertices it was smoothed from to the faces around them,
+//!    made square to the segment. A vertex's *depth* is its distance from
+//!    the nearest point of the smoothed loop along that direction
+//!    (the pseudo-normal, the mean of two segments' directions, where the
+//!    nearest point is a vertex of the loop, so the sign is right at
+//!    corners).
+//! 2. **What goes.** From the old border inwards, ring by ring, every
+//!    vertex less than [`MARGIN`]·βᵢ deep goes, as in the planar way, and
+//!    with it every face that has such a vertex. Another border the cut
+//!    reaches goes with it when most of its vertices lie outside the
+//!    smoothed loop (it is absorbed: its hole or notch lies beyond the new
+//!    border), and is kept out of the cut otherwise, with the vertices
+//!    round it.
+//! 3. **The wall.** The edges where removed faces meet kept ones chain
+//!    into the kept mesh's new border. A vertex where the chain touches
+//!    itself (the cut pinches there) loses its faces too; kept islands the
+//!    cut surrounds go.
+//! 4. **The strip.** The wall's vertices are placed along the smoothed
+//!    loop by the arc length of their nearest point (tracked from vertex to
+//!    vertex, so that a neck of the surface cannot make it jump), and the
+//!    two polylines are zipped in that order: each new face joins one
+//!    segment of either polyline to a vertex of the other. Every corner is
+//!    a mesh vertex or a smoothed loop vertex, so the strip follows the
+//!    surface without any lifting, and its faces turn as the kept faces
+//!    beside them.
+
+use super::*;
+use crate::spatial::PointTree;
+
+/// Segments of the smoothed loop searched, ahead of the last wall vertex's
+/// nearest one, for the next wall vertex's nearest point …
+const TRACK_AHEAD: usize = 48;
+/// … and behind it.
+const TRACK_BEHIND: usize = 4;
+/// Borders one strip may absorb because they lie one face from others it
+/// absorbs.
+const MAX_ABSORBED: usize = 64;
+/// Vertices farther than this many β from the smoothed loop stay.
+const REACH: f64 = 3.0;
+/// Times the faces round a pinched wall vertex are removed before the loop
+/// is left.
+const PINCH_REPAIRS: usize = 16;
+/// Largest share of the new faces that may turn against the surface beside
+/// them (the smoothed loop doubling back on itself across a narrow notch).
+const MAX_TURNED: f64 = 0.15;
+
+/// Why a loop could not be replaced by a strip.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum StripFailure {
+    /// The cut runs more than [`MAX_DEPTH`] rings from the border.
+    TooDeep,
+    /// The kept mesh's new border does not close into one loop.
+    Wall,
+    /// The smoothed loop would cut the mesh in two.
+    Splits,
+    /// Too many new faces turn against the surface.
+    Turned { turned: usize, faces: usize },
+    /// The cut reaches a border replaced another way.
+    MeetsReplaced(usize),
+}
+
+impl StripFailure {
+    /// The reason reported for the loop left.
+    pub(super) fn reason(self) -> LeftReason {
+        match self {
+            Self::TooDeep => LeftReason::TooFarFromBorder { rings: MAX_DEPTH },
+            Self::Wall => LeftReason::TangledWall,
+            Self::Splits => LeftReason::SplitsMesh,
+            Self::Turned { turned, faces } => LeftReason::DoublesBack { turned, faces },
+            Self::MeetsReplaced(_) => LeftReason::MeetsAnotherBorder,
+        }
+    }
+}
+
+/// The smoothed loop with the direction into the surface along it.
+pub(super) struct Guide {
+    points: Vec<Point3>,
+    /// Unit direction into the surface, per segment (j to j + 1).
+    inward: Vec<Point3>,
+    /// Arc length at each vertex, from vertex 0; the last entry is the
+    /// loop's length.
+    arc: Vec<f64>,
+    tree: PointTree,
+}
+
+/// The nearest point of a guide: its segment, the position along it
+/// (0 to 1) and the squared distance.
+#[derive(Debug, Clone, Copy)]
+struct Nearest {
+    segment: usize,
+    t: f64,
+    d2: f64,
+}
+
+impl Guide {
+    /// The guide of border `l`'s smoothed loop, running as the border runs
+    /// (the surface on its left).
+    pub(super) fn new(cx: &Context, l: usize, ring: &Ring) -> Option<Guide> {
+        let border = &cx.borders[l];
+        let mut points = ring.p3.clone();
+        if !runs_as_border(border, &ring.reference) {
+            points.reverse();
+        }
+        let m = points.len();
+        if m < 3 {
+            return None;
+        }
+        // The direction into the surface at each smoothed vertex, from the
+        // border vertex nearest it.
+        let at_border: Vec<Point3> = border
+            .iter()
+            .map(|&v| cx.mesh.vertices[v as usize])
+            .collect();
+        let border_tree = PointTree::new(&at_border)?;
+        let into_faces: Vec<Point3> = points
+            .iter()
+            .map(|p| into_the_faces(cx, border[border_tree.nearest(p).0]))
+            .collect();
+        let inward = (0..m)
+            .map(|j| {
+                let k = (j + 1) % m;
+                let t = unit(sub(points[k], points[j]));
+                let d = add(into_faces[j], into_faces[k]);
+                unit(sub(d, scale(t, dot(d, t))))
+            })
+            .collect();
+        let mut arc = Vec::with_capacity(m + 1);
+        arc.push(0.0);
+        for j in 0..m {
+            let step = dist2(points[j], points[(j + 1) % m]).sqrt();
+            arc.push(arc[j] + step);
+        }
+        let tree = PointTree::new(&points)?;
+        Some(Guide {
+            points,
+            inward,
+            arc,
+            tree,
+        })
+    }
+
+    fn len(&self) -> usize {
+        self.points.len()
+    }
+
+    fn length(&self) -> f64 {
+        self.arc[self.len()]
+    }
+
+    fn on_segment(&self, j: usize, p: Point3) -> Nearest {
+        let a = self.points[j];
+        let b = self.points[(j + 1) % self.len()];
+        let ab = sub(b, a);
+        let l2 = norm2(ab);
+        let t = if l2 > 0.0 {
+            (dot(sub(p, a), ab) / l2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let q = add(a, scale(ab, t));
+        Nearest {
+            segment: j,
+            t,
+            d2: dist2(p, q),
+        }
+    }
+
+    /// The nearest point among the segments round the few nearest
+    /// vertices.
+    fn nearest(&self, p: Point3) -> Nearest {
+        let m = self.len();
+        let found = self.tree.nearest_n(
+            &p,
+            std::num::NonZeroUsize::new(4.min(m)).unwrap_or(NON_ZERO_ONE),
+        );
+        let mut best: Option<Nearest> = None;
+        for (_, j) in found {
+            for segment in [(j as usize + m - 1) % m, j as usize] {
+                let near = self.on_segment(segment, p);
+                if best.is_none_or(|b| near.d2 < b.d2) {
+                    best = Some(near);
+                }
+            }
+        }
+        best.unwrap_or(Nearest {
+            segment: 0,
+            t: 0.0,
+            d2: f64::INFINITY,
+        })
+    }
+
+    /// The nearest point among the segments from `around` − [`TRACK_BEHIND`]
+    /// to `around` + [`TRACK_AHEAD`].
+    fn nearest_near(&self, p: Point3, around: usize) -> Nearest {
+        let m = self.len();
+        let mut best = self.on_segment(around, p);
+        for step in 1..=TRACK_AHEAD.min(m) {
+            let near = self.on_segment((around + step) % m, p);
+            if near.d2 < best.d2 {
+                best = near;
+            }
+        }
+        for step in 1..=TRACK_BEHIND.min(m) {
+            let near = self.on_segment((around + m - step) % m, p);
+            if near.d2 < best.d2 {
+                best = near;
+            }
+        }
+        best
+    }
+
+    /// Whether a vertex at `p` of local resolution `beta` goes: it lies
+    /// less than [`MARGIN`]·β deep behind the smoothed loop, or beyond it,
+    /// and within [`REACH`]·β of it (farther, the direction into the
+    /// surface measured at the loop says nothing of it).
+    fn goes(&self, p: Point3, beta: f64) -> bool {
+        let (depth, distance) = self.depth(p);
+        depth < MARGIN * beta && distance < REACH * beta
+    }
+
+    /// How deep `p` lies in the surface behind the smoothed loop (negative
+    /// beyond it), and its distance from the loop.
+    fn depth(&self, p: Point3) -> (f64, f64) {
+        let near = self.nearest(p);
+        let m = self.len();
+        let j = near.segment;
+        let direction = if near.t <= 0.0 {
+            unit(add(self.inward[(j + m - 1) % m], self.inward[j]))
+        } else if near.t >= 1.0 {
+            unit(add(self.inward[j], self.inward[(j + 1) % m]))
+        } else {
+            self.inward[j]
+        };
+        let a = self.points[j];
+        let q = add(a, scale(sub(self.points[(j + 1) % m], a), near.t));
+        (dot(sub(p, q), direction), near.d2.sqrt())
+    }
+
+    /// The surface normal at segment `j` (the segment, then the direction
+    /// into the surface, turn counter-clockwise about it).
+    fn normal(&self, j: usize) -> Point3 {
+        let m = self.len();
+        let t = unit(sub(self.points[(j + 1) % m], self.points[j]));
+        cross(t, self.inward[j])
+    }
+}
+
+const NON_ZERO_ONE: std::num::NonZeroUsize = match std::num::NonZeroUsize::new(1) {
+    Some(n) => n,
+    None => unreachable!(),
+};
+
+/// Whether a smoothed loop whose vertices were smoothed from the border
+/// vertices `reference` runs the way the border does.
+fn runs_as_border(border: &[u32], reference: &[u32]) -> bool {
+    let n = border.len() as i64;
+    let position: HashMap<u32, i64> = border
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| (v, i as i64))
+        .collect();
+    let mut turn = 0i64;
+    for j in 0..reference.len() {
+        let (Some(&a), Some(&b)) = (
+            position.get(&reference[j]),
+            position.get(&reference[(j + 1) % reference.len()]),
+        ) else {
+            continue;
+        };
+        let mut step = (b - a).rem_euclid(n);
+        if step > n / 2 {
+            step -= n;
+        }
+        turn += step;
+    }
+    turn >= 0
+}
+
+/// The mean unit direction from border vertex `r` to the centroids of its
+/// faces: into the surface.
+fn into_the_faces(cx: &Context, r: u32) -> Point3 {
+    let p = cx.mesh.vertices[r as usize];
+    cx.topology
+        .faces_of(r)
+        .iter()
+        .map(|&f| {
+            let c = cx.mesh.faces[f as usize]
+                .map(|v| cx.mesh.vertices[v as usize])
+                .iter()
+                .fold([0.0; 3], |acc, &q| add(acc, scale(q, 1.0 / 3.0)));
+            unit(sub(c, p))
+        })
+        .fold([0.0; 3], add)
+}
+
+fn add(a: Point3, b: Point3) -> Point3 {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+fn scale(a: Point3, s: f64) -> Point3 {
+    a.map(|c| c * s)
+}
+
+/// `a` scaled to unit length (zero stays zero).
+fn unit(a: Point3) -> Point3 {
+    let l = norm2(a).sqrt();
+    if l > 0.0 {
+        scale(a, 1.0 / l)
+    } else {
+        a
+    }
+}
+
+/// A strip's patch, with the loops it absorbs and the faces whose
+/// neighbourhood it changes.
+pub(super) struct Strip {
+    pub(super) patch: Patch,
+    /// The removed faces and every face sharing a vertex with them.
+    pub(super) footprint: Vec<u32>,
+}
+
+/// Border `l` replaced by a strip (see the module doc). `replaced` marks
+/// the loops other patches replace: the cut may not reach them.
+pub(super) fn replace_by_strip(
+    cx: &Context,
+    l: usize,
+    replaced: &[bool],
+) -> Result<Strip, StripFailure> {
+    let ring = cx.rings[l].as_ref().ok_or(StripFailure::Wall)?;
+    let guide = Guide::new(cx, l, ring).ok_or(StripFailure::Wall)?;
+    let owner = border_owner(cx);
+    // A border kept out of the cut that lies one face from an absorbed one
+    // cannot keep the faces between them: it is absorbed too, and the cut
+    // made again.
+    let mut forced = BTreeSet::new();
+    let (cut, removed) = loop {
+        let cut = Cut::new(cx, l, &guide, &owner, replaced, &forced)?;
+        let removed = cut.removed_faces(cx);
+        let (kept, touched) = clear_of_other_borders(cx, l, &cut, &owner, removed);
+        let absorbable = touched
+            .iter()
+            .all(|&k| !replaced[k] && cx.borders[k].len() < cx.borders[l].len());
+        if touched.is_empty() || !absorbable || forced.len() >= MAX_ABSORBED {
+            break (cut, kept);
+        }
+        forced.extend(cut.absorbed.iter().copied());
+        forced.extend(touched);
+    };
+    let (removed, wall) = closed_wall(cx, removed)?;
+    let faces = zip(cx, &guide, &wall)?;
+    let footprint = footprint(cx, &removed);
+    let mut loops = vec![l];
+    loops.extend(cut.absorbed.iter().copied());
+    Ok(Strip {
+        patch: Patch {
+            loops,
+            removed,
+            vertices: guide.points.clone(),
+            faces,
+        },
+        footprint,
+    })
+}
+
+/// The border loop each border vertex is on.
+fn border_owner(cx: &Context) -> HashMap<u32, usize> {
+    cx.borders
+        .iter()
+        .enumerate()
+        .flat_map(|(l, b)| b.iter().map(move |&v| (v, l)))
+        .collect()
+}
+
+/// The vertices that go (step 2).
+struct Cut {
+    going: HashSet<u32>,
+    absorbed: BTreeSet<usize>,
+}
+
+impl Cut {
+    fn new(
+        cx: &Context,
+        l: usize,
+        guide: &Guide,
+        owner: &HashMap<u32, usize>,
+        replaced: &[bool],
+        forced: &BTreeSet<usize>,
+    ) -> Result<Cut, StripFailure> {
+        let mut cut = Cut {
+            going: HashSet::default(),
+            absorbed: forced.clone(),
+        };
+        let mut protected: HashSet<u32> = HashSet::default();
+        let mut seen: HashSet<u32> = HashSet::default();
+        let mut frontier: Vec<u32> = cx.borders[l].clone();
+        for &v in &frontier {
+            cut.going.insert(v);
+            seen.insert(v);
+        }
+        // A border that shares a vertex with this one (they touch at a
+        // pinched vertex) loses its faces there: it goes too.
+        for (other, border) in cx.borders.iter().enumerate() {
+            if other != l
+                && !forced.contains(&other)
+                && border.iter().any(|v| cut.going.contains(v))
+            {
+                if border.len() >= cx.borders[l].len() {
+                    return Err(StripFailure::Wall);
+                }
+                if replaced[other] {
+                    return Err(StripFailure::MeetsReplaced(other));
+                }
+                cut.absorbed.insert(other);
+            }
+        }
+        for &other in &cut.absorbed {
+            for &v in &cx.borders[other] {
+                if cut.going.insert(v) {
+                    seen.insert(v);
+                    frontier.push(v);
+                }
+            }
+        }
+        let goes = |v: u32| guide.goes(cx.mesh.vertices[v as usize], cx.beta[v as usize]);
+        for _ in 0..MAX_DEPTH {
+            let mut next = Vec::new();
+            for &v in &frontier {
+                for &f in cx.topology.faces_of(v) {
+                    for w in cx.mesh.faces[f as usize] {
+                        if !seen.insert(w) || protected.contains(&w) {
+                            continue;
+                        }
+                        if let Some(&other) = owner.get(&w) {
+                            if other != l && !cut.absorbed.contains(&other) {
+                                cut.meet_border(cx, l, other, guide, replaced, &mut protected)?;
+                                if !cut.absorbed.contains(&other) {
+                                    continue;
+                                }
+                                for &b in &cx.borders[other] {
+                                    if cut.going.insert(b) {
+                                        seen.insert(b);
+                                        next.push(b);
+                                    }
+                                }
+                                continue;
+                            }
+                        }
+                        if goes(w) {
+                            cut.going.insert(w);
+                            next.push(w);
+                        }
+                    }
+                }
+            }
+            if next.is_empty() {
+                return Ok(cut);
+            }
+            next.sort_unstable();
+            frontier = next;
+        }
+        Err(StripFailure::TooDeep)
+    }
+
+    /// The cut reaches border `other`: absorbed when most of its vertices
+    /// lie beyond the smoothed loop (or within the margin), else kept out
+    /// of the cut with the vertices round it.
+    fn meet_border(
+        &mut self,
+        cx: &Context,
+        l: usize,
+        other: usize,
+        guide: &Guide,
+        replaced: &[bool],
+        protected: &mut HashSet<u32>,
+    ) -> Result<(), StripFailure> {
+        let border = &cx.borders[other];
+        let beyond = border
+            .iter()
+            .filter(|&&v| guide.goes(cx.mesh.vertices[v as usize], cx.beta[v as usize]))
+            .count();
+        // A border one face from this one cannot keep the faces between.
+        let own: HashSet<u32> = cx.borders[l].iter().copied().collect();
+        let touching = border.iter().any(|&v| {
+            cx.topology
+                .faces_of(v)
+                .iter()
+                .any(|&f| cx.mesh.faces[f as usize].iter().any(|w| own.contains(w)))
+        });
+        // Only a smaller border is absorbed: never the outer border into a
+        // hole.
+        let smaller = border.len() < cx.borders[l].len();
+        if smaller && (touching || 2 * beyond > border.len()) {
+            if replaced[other] {
+                return Err(StripFailure::MeetsReplaced(other));
+            }
+            self.absorbed.insert(other);
+        } else if touching {
+            return Err(StripFailure::Wall);
+        } else {
+            for &v in border {
+                protected.insert(v);
+                for &f in cx.topology.faces_of(v) {
+                    protected.extend(cx.mesh.faces[f as usize]);
+                }
+            }
+            // Vertices found going before the border was met stay, but
+            // the old border goes whatever is near it.
+            self.going.retain(|v| !protected.contains(v));
+            self.going.extend(cx.borders[l].iter().copied());
+            for &k in &self.absorbed {
+                self.going.extend(cx.borders[k].iter().copied());
+            }
+        }
+        Ok(())
+    }
+
+    /// The faces with a vertex that goes, ascending.
+    fn removed_faces(&self, cx: &Context) -> Vec<u32> {
+        let faces: BTreeSet<u32> = self
+            .going
+            .iter()
+            .flat_map(|&v| cx.topology.faces_of(v).iter().copied())
+            .collect();
+        faces.into_iter().collect()
+    }
+}
+
+/// The removed faces without those that touch a border neither replaced
+/// nor absorbed (the cut reached it between two of its own vertices). When
+/// such a face holds a vertex that must go (of this border or an absorbed
+/// one), it is kept all the same, and the borders it touches are given
+/// too.
+fn clear_of_other_borders(
+    cx: &Context,
+    l: usize,
+    cut: &Cut,
+    owner: &HashMap<u32, usize>,
+    removed: Vec<u32>,
+) -> (Vec<u32>, BTreeSet<usize>) {
+    let stays_on_border = |v: &u32| {
+        owner
+            .get(v)
+            .filter(|&&k| k != l && !cut.absorbed.contains(&k) && !cut.going.contains(v))
+            .copied()
+    };
+    let must_go = |v: &u32| {
+        cx.borders[l].contains(v) || owner.get(v).is_some_and(|k| cut.absorbed.contains(k))
+    };
+    let mut kept = Vec::with_capacity(removed.len());
+    let mut touched = BTreeSet::new();
+    for f in removed {
+        let face = cx.mesh.faces[f as usize];
+        let others: Vec<usize> = face.iter().filter_map(stays_on_border).collect();
+        if others.is_empty() {
+            kept.push(f);
+        } else if face.iter().any(must_go) {
+            touched.extend(others);
+        }
+    }
+    (kept, touched)
+}
+
+/// The removed faces grown until the kept mesh's new border closes into
+/// one loop without touching itself (step 3), and that loop: directed as
+/// the kept faces run it.
+fn closed_wall(cx: &Context, mut removed: Vec<u32>) -> Result<(Vec<u32>, Vec<u32>), StripFailure> {
+    for _ in 0..=PINCH_REPAIRS {
+        let walls = wall_edges(cx, &removed);
+        let mut next: HashMap<u32, Vec<u32>> = HashMap::default();
+        for &(a, b) in &walls {
+            next.entry(a).or_default().push(b);
+        }
+        let mut pinched: Vec<u32> = next
+            .iter()
+            .filter(|(_, to)| to.len() > 1)
+            .map(|(&v, _)| v)
+            .collect();
+        if pinched.is_empty() {
+            let loops = chain(&next).ok_or(StripFailure::Wall)?;
+            match loops.len() {
+                0 => return Err(StripFailure::Wall),
+                1 => return Ok((removed, loops.into_iter().next().unwrap_or_default())),
+                _ => {
+                    let (grown, main) = without_islands(cx, removed, loops)?;
+                    removed = grown;
+                    if let Some(main) = main {
+                        return Ok((removed, main));
+                    }
+                    continue;
+                }
+            }
+        }
+        pinched.sort_unstable();
+        let mut all: BTreeSet<u32> = removed.into_iter().collect();
+        for v in pinched {
+            all.extend(cx.topology.faces_of(v).iter().copied());
+        }
+        removed = all.into_iter().collect();
+    }
+    Err(StripFailure::Wall)
+}
+
+/// The directed edges of kept faces whose other face is removed, ascending.
+fn wall_edges(cx: &Context, removed: &[u32]) -> Vec<(u32, u32)> {
+    let is_removed = |f: u32| removed.binary_search(&f).is_ok();
+    let mut walls = Vec::new();
+    for &f in removed {
+        let face = cx.mesh.faces[f as usize];
+        for k in 0..3 {
+            let (a, b) = (face[k], face[(k + 1) % 3]);
+            // The kept face on the other side runs the edge from b to a.
+            for &g in cx.topology.faces_of(b) {
+                if g != f && !is_removed(g) && runs(cx.mesh.faces[g as usize], b, a) {
+                    walls.push((b, a));
+                }
+            }
+        }
+    }
+    walls.sort_unstable();
+    walls.dedup();
+    walls
+}
+
+/// Whether `face` runs the edge from `a` to `b`.
+fn runs(face: [u32; 3], a: u32, b: u32) -> bool {
+    (0..3).any(|k| face[k] == a && face[(k + 1) % 3] == b)
+}
+
+/// The loops of a map where every vertex has one successor; `None` when a
+/// chain ends.
+fn chain(next: &HashMap<u32, Vec<u32>>) -> Option<Vec<Vec<u32>>> {
+    let mut starts: Vec<u32> = next.keys().copied().collect();
+    starts.sort_unstable();
+    let mut done: HashSet<u32> = HashSet::default();
+    let mut loops = Vec::new();
+    for s in starts {
+        if done.contains(&s) {
+            continue;
+        }
+        let mut lp = vec![s];
+        done.insert(s);
+        let mut v = *next.get(&s)?.first()?;
+        while v != s {
+            if !done.insert(v) {
+                return None;
+            }
+            lp.push(v);
+            v = *next.get(&v)?.first()?;
+        }
+        loops.push(lp);
+    }
+    Some(loops)
+}
+
+/// Where the wall has several loops: kept islands the cut surrounds (kept
+/// faces whose whole border is one wall loop, fewer than the removed ones)
+/// are removed too. The removed faces and, when only one loop is left that
+/// is no island, that loop; two loops bounding large kept parts mean the
+/// smoothed loop would cut the mesh in two.
+fn without_islands(
+    cx: &Context,
+    removed: Vec<u32>,
+    loops: Vec<Vec<u32>>,
+) -> Result<(Vec<u32>, Option<Vec<u32>>), StripFailure> {
+    let mut all: BTreeSet<u32> = removed.iter().copied().collect();
+    let mut mainland = Vec::new();
+    let limit = removed.len();
+    for lp in loops {
+        match island(cx, &removed, &lp, limit) {
+            Some(faces) => all.extend(faces),
+            None => mainland.push(lp),
+        }
+    }
+    let removed: Vec<u32> = all.into_iter().collect();
+    match mainland.len() {
+        0 => Err(StripFailure::Wall),
+        1 if removed.len() == limit => Ok((removed, mainland.pop())),
+        1 => Ok((removed, None)),
+        _ => Err(StripFailure::Splits),
+    }
+}
+
+/// The kept faces reached from wall loop `lp` without crossing removed
+/// faces, when they are fewer than `limit` and bounded by the loop alone.
+fn island(cx: &Context, removed: &[u32], lp: &[u32], limit: usize) -> Option<Vec<u32>> {
+    let is_removed = |f: u32| removed.binary_search(&f).is_ok();
+    let on_loop: HashSet<u32> = lp.iter().copied().collect();
+    let mut seen: BTreeSet<u32> = BTreeSet::new();
+    let mut stack: Vec<u32> = Vec::new();
+    for k in 0..lp.len() {
+        let (a, b) = (lp[k], lp[(k + 1) % lp.len()]);
+        for &g in cx.topology.faces_of(a) {
+            if !is_removed(g) && runs(cx.mesh.faces[g as usize], a, b) && seen.insert(g) {
+                stack.push(g);
+            }
+        }
+    }
+    while let Some(f) = stack.pop() {
+        if seen.len() > limit {
+            return None;
+        }
+        let face = cx.mesh.faces[f as usize];
+        for k in 0..3 {
+            let (a, b) = (face[k], face[(k + 1) % 3]);
+            let mut twin = None;
+            for &g in cx.topology.faces_of(a) {
+                if g != f && runs(cx.mesh.faces[g as usize], b, a) {
+                    twin = Some(g);
+                }
+            }
+            match twin {
+                // A mesh border other than the wall: the part is no island.
+                None if !(on_loop.contains(&a) && on_loop.contains(&b)) => return None,
+                Some(g) if !is_removed(g) && seen.insert(g) => stack.push(g),
+                _ => {}
+            }
+        }
+    }
+    Some(seen.into_iter().collect())
+}
+
+/// The strip's faces (step 4): the wall (as the kept faces run it) and the
+/// smoothed loop zipped in the order of their positions along the loop.
+/// Ids from the mesh's vertex count on are the guide's vertices.
+fn zip(cx: &Context, guide: &Guide, wall: &[u32]) -> Result<Vec<[u32; 3]>, StripFailure> {
+    let n = cx.mesh.vertices.len() as u32;
+    let m = guide.len();
+    let p = wall.len();
+    let length = guide.length();
+    let position = |v: u32| cx.mesh.vertices[v as usize];
+    // Start at the wall vertex nearest the smoothed loop.
+    let first = (0..p)
+        .min_by(|&a, &b| {
+            let da = guide.nearest(position(wall[a])).d2;
+            let db = guide.nearest(position(wall[b])).d2;
+            da.total_cmp(&db).then(a.cmp(&b))
+        })
+        .unwrap_or(0);
+    let wall: Vec<u32> = (0..p).map(|i| wall[(first + i) % p]).collect();
+    let start = guide.nearest(position(wall[0]));
+    let along = |near: Nearest| {
+        guide.arc[near.segment] + near.t * (guide.arc[near.segment + 1] - guide.arc[near.segment])
+    };
+    // Wall positions, unwrapped and made non-decreasing from the first.
+    let origin = along(start);
+    let mut wall_at = Vec::with_capacity(p + 1);
+    wall_at.push(0.0);
+    let mut segment = start.segment;
+    for &v in &wall[1..] {
+        let near = guide.nearest_near(position(v), segment);
+        segment = near.segment;
+        let raw = (along(near) - origin).rem_euclid(length);
+        let last: f64 = *wall_at.last().unwrap_or(&0.0);
+        let mut step = raw - last.rem_euclid(length);
+        if step > length / 2.0 {
+            step -= length;
+        } else if step < -length / 2.0 {
+            step += length;
+        }
+        wall_at.push((last + step.max(0.0)).min(length));
+    }
+    let turns = *wall_at.last().unwrap_or(&0.0);
+    if turns < length / 2.0 {
+        return Err(StripFailure::Wall);
+    }
+    wall_at.push(length);
+    // Guide vertices from the first at or after the start, placed
+    // relative to it and increasing.
+    let j0 = if start.t > 0.0 {
+        (start.segment + 1) % m
+    } else {
+        start.segment
+    };
+    let first_at = (guide.arc[j0] - origin).rem_euclid(length);
+    let guide_at: Vec<f64> = (0..=m)
+        .map(|k| {
+            let j = (j0 + k) % m;
+            match k {
+                0 => first_at,
+                _ if k == m => first_at + length,
+                _ => first_at + (guide.arc[j] - guide.arc[j0]).rem_euclid(length),
+            }
+        })
+        .collect();
+    let wid = |i: usize| wall[i % p];
+    let gid = |k: usize| n + ((j0 + k) % m) as u32;
+    let mut faces = Vec::with_capacity(p + m);
+    let (mut i, mut k) = (0, 0);
+    while i < p || k < m {
+        let advance_wall = k == m
+            || (i < p && {
+                // Both ways keep the order within a segment of the loop:
+                // the shorter new edge makes the rounder face.
+                let slack = guide_at[k + 1] - guide_at[k];
+                let wall_may = wall_at[i + 1] <= guide_at[k + 1] + slack;
+                let guide_may = guide_at[k + 1] <= wall_at[i + 1] + slack;
+                if wall_may && guide_may {
+                    let to_wall = dist2(position(wall[(i + 1) % p]), guide.points[(j0 + k) % m]);
+                    let to_guide = dist2(position(wall[i]), guide.points[(j0 + k + 1) % m]);
+                    to_wall <= to_guide
+                } else {
+                    wall_may
+                }
+            });
+        if advance_wall {
+            faces.push([wid(i + 1), wid(i), gid(k)]);
+            i += 1;
+        } else {
+            faces.push([gid(k), gid(k + 1), wid(i)]);
+            k += 1;
+        }
+    }
+    let turned = faces.iter().filter(|f| turns_against(cx, guide, f)).count();
+    if turned as f64 > MAX_TURNED * faces.len() as f64 {
+        return Err(StripFailure::Turned {
+            turned,
+            faces: faces.len(),
+        });
+    }
+    Ok(faces)
+}
+
+/// Whether a strip face turns against the surface at the nearest segment
+/// of the smoothed loop.
+fn turns_against(cx: &Context, guide: &Guide, face: &[u32; 3]) -> bool {
+    let n = cx.mesh.vertices.len() as u32;
+    let p = face.map(|id| {
+        if id < n {
+            cx.mesh.vertices[id as usize]
+        } else {
+            guide.points[(id - n) as usize]
+        }
+    });
+    let normal = cross(sub(p[1], p[0]), sub(p[2], p[0]));
+    let centre = scale(add(add(p[0], p[1]), p[2]), 1.0 / 3.0);
+    let near = guide.nearest(centre);
+    dot(normal, guide.normal(near.segment)) < 0.0
+}
+
+/// The removed faces and every face sharing a vertex with them, ascending.
+pub(super) fn footprint(cx: &Context, removed: &[u32]) -> Vec<u32> {
+    let faces: BTreeSet<u32> = removed
+        .iter()
+        .flat_map(|&f| cx.mesh.faces[f as usize])
+        .flat_map(|v| cx.topology.faces_of(v).iter().copied())
+        .collect();
+    faces.into_iter().collect()
+}
