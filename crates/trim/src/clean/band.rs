@@ -269,10 +269,9 @@ impl Projection {
         // range scan faces its scanner everywhere, so every face projects
         // the right way up along the mean normal even where a band that
         // curves round a silhouette has a best-fit plane at a steep angle.
-        let sum = faces.iter().fold([0.0; 3], |acc, &f| {
-            let n = face_normal(mesh, f);
-            [acc[0] + n[0], acc[1] + n[1], acc[2] + n[2]]
-        });
+        let sum = faces
+            .iter()
+            .fold([0.0; 3], |acc, &f| add(acc, face_normal(mesh, f)));
         let length = norm2(sum).sqrt();
         let normal = if length > 0.0 {
             sum.map(|c| c / length)

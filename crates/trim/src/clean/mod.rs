@@ -83,7 +83,7 @@ use crate::edges::cluster::MIN_LOOP_POINTS;
 use crate::edges::loop_from_tour;
 use crate::error::{CleanError, MeshError};
 use crate::frame::fit_plane;
-use crate::geom::{cross, dist2, dot, norm2, sub, Point3};
+use crate::geom::{add, cross, dist2, dot, norm2, sub, Point3};
 use crate::geom::{median, orient, orientation};
 use crate::mesh::repair::{repair_degenerate_faces, FaceRepair};
 use crate::mesh::topology::{check_manifold, Topology};
@@ -293,12 +293,7 @@ pub fn clean_mesh(
     let out = assemble_manifold(mesh, &mut outcomes);
     let (out, mut report) = finish(out, &outcomes, report)?;
     // Small loops a strip absorbed count as replaced.
-    let mut replaced = vec![false; borders.len()];
-    for patch in outcomes.iter().filter_map(|o| o.patch.as_ref()) {
-        for &l in &patch.loops {
-            replaced[l] = true;
-        }
-    }
+    let replaced = replaced_loops(borders.len(), &outcomes);
     report.loops_smoothed = replaced.iter().filter(|&&r| r).count();
     report.loops_too_small = (0..borders.len())
         .filter(|&l| rings[l].is_none() && !replaced[l])
@@ -380,69 +375,23 @@ fn replace_left_by_strips(cx: &Context, outcomes: &mut Vec<Outcome>) {
         .iter()
         .flat_map(|o| o.left.iter().flat_map(|x| x.loops.iter().copied()))
         .collect();
-    let first: HashMap<usize, Result<Strip, StripFailure>> = {
-        let replaced = replaced_loops(cx, outcomes);
+    let mut first: HashMap<usize, Result<Strip, StripFailure>> = {
+        let replaced = replaced_loops(cx.rings.len(), outcomes);
         let loops: Vec<usize> = queue.iter().copied().collect();
         loops
             .par_iter()
             .map(|&l| (l, replace_by_strip(cx, l, &replaced)))
             .collect()
     };
-    let mut first = first;
     let mut reasons: HashMap<usize, LeftReason> = HashMap::default();
     while let Some(l) = queue.pop_first() {
-        let mut attempt = first.remove(&l);
-        let mut demoted: Vec<(usize, Patch, Vec<u32>)> = Vec::new();
-        let strip = loop {
-            let replaced = replaced_loops(cx, outcomes);
-            if replaced[l] {
-                break None;
+        match strip_in_place_of_planar(cx, outcomes, l, first.remove(&l)) {
+            StripOutcome::AlreadyReplaced => {}
+            StripOutcome::Left(reason) => {
+                reasons.insert(l, reason);
             }
-            let strip = match attempt.take() {
-                Some(strip) => strip,
-                None => replace_by_strip(cx, l, &replaced),
-            };
-            let conflict = match &strip {
-                Ok(strip) => conflicting_outcomes(cx, outcomes, strip),
-                Err(StripFailure::MeetsReplaced(other)) => outcomes
-                    .iter()
-                    .position(|o| o.patch.as_ref().is_some_and(|p| p.loops.contains(other)))
-                    .into_iter()
-                    .collect(),
-                Err(_) => Vec::new(),
-            };
-            let planar: Vec<usize> = conflict
-                .iter()
-                .copied()
-                .filter(|&o| !outcomes[o].strip)
-                .collect();
-            if planar.is_empty() || planar.len() < conflict.len() {
-                break Some((strip, !conflict.is_empty()));
-            }
-            for o in planar {
-                if let Some(patch) = outcomes[o].patch.take() {
-                    demoted.push((o, patch, std::mem::take(&mut outcomes[o].band)));
-                }
-            }
-        };
-        let accepted = matches!(strip, Some((Ok(_), false)));
-        for (o, patch, band) in demoted {
-            if accepted {
-                queue.extend(patch.loops.iter().copied().filter(|&k| k != l));
-            } else {
-                outcomes[o].patch = Some(patch);
-                outcomes[o].band = band;
-            }
-        }
-        match strip {
-            None => {}
-            Some((Err(failure), _)) => {
-                reasons.insert(l, failure.reason());
-            }
-            Some((Ok(_), true)) => {
-                reasons.insert(l, LeftReason::MeetsAnotherBorder);
-            }
-            Some((Ok(strip), false)) => {
+            StripOutcome::Taken { strip, demoted } => {
+                queue.extend(demoted.into_iter().filter(|&k| k != l));
                 for &k in &strip.patch.loops {
                     reasons.remove(&k);
                 }
@@ -455,25 +404,106 @@ fn replace_left_by_strips(cx: &Context, outcomes: &mut Vec<Outcome>) {
             }
         }
     }
-    let replaced = replaced_loops(cx, outcomes);
+    relist_left(cx, outcomes, reasons);
+}
+
+/// What became of one loop's strip.
+enum StripOutcome {
+    /// Another strip absorbed the loop.
+    AlreadyReplaced,
+    /// The loop stays, for this reason.
+    Left(LeftReason),
+    /// The strip is taken, in place of the planar patches that replaced
+    /// the loops `demoted`.
+    Taken { strip: Strip, demoted: Vec<usize> },
+}
+
+/// Loop `l`'s strip (`attempt`, when made already), made again in place
+/// of every planar patch it reaches. Those patches are taken out only
+/// when the strip is taken.
+fn strip_in_place_of_planar(
+    cx: &Context,
+    outcomes: &mut [Outcome],
+    l: usize,
+    mut attempt: Option<Result<Strip, StripFailure>>,
+) -> StripOutcome {
+    let mut taken_out: Vec<(usize, Patch, Vec<u32>)> = Vec::new();
+    let result = loop {
+        let replaced = replaced_loops(cx.rings.len(), outcomes);
+        if replaced[l] {
+            break StripOutcome::AlreadyReplaced;
+        }
+        let strip = attempt
+            .take()
+            .unwrap_or_else(|| replace_by_strip(cx, l, &replaced));
+        let conflict = match &strip {
+            Ok(strip) => conflicting_outcomes(outcomes, strip),
+            Err(StripFailure::MeetsReplaced(other)) => outcomes
+                .iter()
+                .position(|o| o.patch.as_ref().is_some_and(|p| p.loops.contains(other)))
+                .into_iter()
+                .collect(),
+            Err(_) => Vec::new(),
+        };
+        let planar: Vec<usize> = conflict
+            .iter()
+            .copied()
+            .filter(|&o| !outcomes[o].strip)
+            .collect();
+        if planar.is_empty() || planar.len() < conflict.len() {
+            break match strip {
+                Err(failure) => StripOutcome::Left(failure.reason()),
+                Ok(_) if !conflict.is_empty() => StripOutcome::Left(LeftReason::MeetsAnotherBorder),
+                Ok(strip) => StripOutcome::Taken {
+                    strip,
+                    demoted: Vec::new(),
+                },
+            };
+        }
+        for o in planar {
+            if let Some(patch) = outcomes[o].patch.take() {
+                taken_out.push((o, patch, std::mem::take(&mut outcomes[o].band)));
+            }
+        }
+    };
+    match result {
+        StripOutcome::Taken { strip, .. } => StripOutcome::Taken {
+            strip,
+            demoted: taken_out
+                .into_iter()
+                .flat_map(|(_, patch, _)| patch.loops)
+                .collect(),
+        },
+        other => {
+            for (o, patch, band) in taken_out {
+                outcomes[o].patch = Some(patch);
+                outcomes[o].band = band;
+            }
+            other
+        }
+    }
+}
+
+/// The outcomes' lists of loops left, once the strips are in: replaced
+/// loops dropped, the strip's reason where one was tried, and the loops of
+/// planar patches a strip took the place of that no strip could replace.
+fn relist_left(cx: &Context, outcomes: &mut [Outcome], reasons: HashMap<usize, LeftReason>) {
+    let replaced = replaced_loops(cx.rings.len(), outcomes);
+    let mut listed: Vec<bool> = vec![false; cx.rings.len()];
     for outcome in outcomes.iter_mut() {
         outcome
             .left
             .retain(|x| x.loops.iter().any(|&k| !replaced[k]));
         for entry in outcome.left.iter_mut() {
             entry.loops.retain(|&k| !replaced[k]);
+            for &k in &entry.loops {
+                listed[k] = true;
+            }
+            if let Some(reason) = entry.loops.iter().find_map(|k| reasons.get(k)) {
+                entry.reason = *reason;
+            }
         }
     }
-    let mut listed: Vec<bool> = vec![false; cx.rings.len()];
-    for entry in outcomes.iter_mut().flat_map(|o| o.left.iter_mut()) {
-        for &k in &entry.loops {
-            listed[k] = true;
-        }
-        if let Some(reason) = entry.loops.iter().find_map(|k| reasons.get(k)) {
-            entry.reason = *reason;
-        }
-    }
-    // Loops of demoted patches that no strip could replace.
     let mut demoted: Vec<(usize, LeftReason)> = reasons
         .into_iter()
         .filter(|&(k, _)| !listed[k] && !replaced[k])
@@ -490,9 +520,10 @@ fn replace_left_by_strips(cx: &Context, outcomes: &mut Vec<Outcome>) {
     }
 }
 
-/// Which loops the outcomes' patches replace (absorbed ones included).
-fn replaced_loops(cx: &Context, outcomes: &[Outcome]) -> Vec<bool> {
-    let mut replaced = vec![false; cx.rings.len()];
+/// Which of the `count` loops the outcomes' patches replace (absorbed
+/// ones included).
+fn replaced_loops(count: usize, outcomes: &[Outcome]) -> Vec<bool> {
+    let mut replaced = vec![false; count];
     for patch in outcomes.iter().filter_map(|o| o.patch.as_ref()) {
         for &l in &patch.loops {
             replaced[l] = true;
@@ -501,22 +532,18 @@ fn replaced_loops(cx: &Context, outcomes: &[Outcome]) -> Vec<bool> {
     replaced
 }
 
-/// The outcomes whose patches the strip's faces would reach: it removes a
-/// face beside one they remove, or they remove one beside its removed
-/// faces.
-fn conflicting_outcomes(cx: &Context, outcomes: &[Outcome], strip: &Strip) -> Vec<usize> {
+/// The outcomes whose patches the strip's faces would reach: they remove
+/// a face that shares a vertex with one the strip removes (sharing a
+/// vertex goes both ways, so the strip's footprint tells it).
+fn conflicting_outcomes(outcomes: &[Outcome], strip: &Strip) -> Vec<usize> {
     let footprint: HashSet<u32> = strip.footprint.iter().copied().collect();
-    let removed: HashSet<u32> = strip.patch.removed.iter().copied().collect();
     outcomes
         .iter()
         .enumerate()
         .filter(|(_, o)| {
-            o.patch.as_ref().is_some_and(|p| {
-                p.removed.iter().any(|f| footprint.contains(f))
-                    || strip::footprint(cx, &p.removed)
-                        .iter()
-                        .any(|f| removed.contains(f))
-            })
+            o.patch
+                .as_ref()
+                .is_some_and(|p| p.removed.iter().any(|f| footprint.contains(f)))
         })
         .map(|(o, _)| o)
         .collect()

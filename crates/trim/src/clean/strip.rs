@@ -32,6 +32,7 @@
 //!    beside them.
 
 use super::*;
+use crate::geom::{scale, unit};
 use crate::spatial::PointTree;
 
 /// Segments of the smoothed loop searched, ahead of the last wall vertex's
@@ -137,6 +138,11 @@ impl Guide {
             let step = dist2(points[j], points[(j + 1) % m]).sqrt();
             arc.push(arc[j] + step);
         }
+        // A loop of one point (or of non-finite length) has no direction
+        // along it.
+        if !arc[m].is_finite() || arc[m] <= 0.0 {
+            return None;
+        }
         let tree = PointTree::new(&points)?;
         Some(Guide {
             points,
@@ -178,7 +184,7 @@ impl Guide {
         let m = self.len();
         let found = self.tree.nearest_n(
             &p,
-            std::num::NonZeroUsize::new(4.min(m)).unwrap_or(NON_ZERO_ONE),
+            std::num::NonZeroUsize::new(4.min(m)).unwrap_or(std::num::NonZeroUsize::MIN),
         );
         let mut best: Option<Nearest> = None;
         for (_, j) in found {
@@ -252,11 +258,6 @@ impl Guide {
     }
 }
 
-const NON_ZERO_ONE: std::num::NonZeroUsize = match std::num::NonZeroUsize::new(1) {
-    Some(n) => n,
-    None => unreachable!(),
-};
-
 /// Whether a smoothed loop whose vertices were smoothed from the border
 /// vertices `reference` runs the way the border does.
 fn runs_as_border(border: &[u32], reference: &[u32]) -> bool {
@@ -298,24 +299,6 @@ fn into_the_faces(cx: &Context, r: u32) -> Point3 {
             unit(sub(c, p))
         })
         .fold([0.0; 3], add)
-}
-
-fn add(a: Point3, b: Point3) -> Point3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-
-fn scale(a: Point3, s: f64) -> Point3 {
-    a.map(|c| c * s)
-}
-
-/// `a` scaled to unit length (zero stays zero).
-fn unit(a: Point3) -> Point3 {
-    let l = norm2(a).sqrt();
-    if l > 0.0 {
-        scale(a, 1.0 / l)
-    } else {
-        a
-    }
 }
 
 /// A strip's patch, with the loops it absorbs and the faces whose
@@ -616,10 +599,8 @@ fn wall_edges(cx: &Context, removed: &[u32]) -> Vec<(u32, u32)> {
         for k in 0..3 {
             let (a, b) = (face[k], face[(k + 1) % 3]);
             // The kept face on the other side runs the edge from b to a.
-            for &g in cx.topology.faces_of(b) {
-                if g != f && !is_removed(g) && runs(cx.mesh.faces[g as usize], b, a) {
-                    walls.push((b, a));
-                }
+            if face_running(cx, b, a).is_some_and(|g| !is_removed(g)) {
+                walls.push((b, a));
             }
         }
     }
@@ -631,6 +612,16 @@ fn wall_edges(cx: &Context, removed: &[u32]) -> Vec<(u32, u32)> {
 /// Whether `face` runs the edge from `a` to `b`.
 fn runs(face: [u32; 3], a: u32, b: u32) -> bool {
     (0..3).any(|k| face[k] == a && face[(k + 1) % 3] == b)
+}
+
+/// The face that runs the edge from `a` to `b` (one at most: the mesh is
+/// checked manifold and oriented).
+fn face_running(cx: &Context, a: u32, b: u32) -> Option<u32> {
+    cx.topology
+        .faces_of(a)
+        .iter()
+        .copied()
+        .find(|&g| runs(cx.mesh.faces[g as usize], a, b))
 }
 
 /// The loops of a map where every vertex has one successor; `None` when a
@@ -696,8 +687,8 @@ fn island(cx: &Context, removed: &[u32], lp: &[u32], limit: usize) -> Option<Vec
     let mut stack: Vec<u32> = Vec::new();
     for k in 0..lp.len() {
         let (a, b) = (lp[k], lp[(k + 1) % lp.len()]);
-        for &g in cx.topology.faces_of(a) {
-            if !is_removed(g) && runs(cx.mesh.faces[g as usize], a, b) && seen.insert(g) {
+        if let Some(g) = face_running(cx, a, b).filter(|&g| !is_removed(g)) {
+            if seen.insert(g) {
                 stack.push(g);
             }
         }
@@ -709,13 +700,7 @@ fn island(cx: &Context, removed: &[u32], lp: &[u32], limit: usize) -> Option<Vec
         let face = cx.mesh.faces[f as usize];
         for k in 0..3 {
             let (a, b) = (face[k], face[(k + 1) % 3]);
-            let mut twin = None;
-            for &g in cx.topology.faces_of(a) {
-                if g != f && runs(cx.mesh.faces[g as usize], b, a) {
-                    twin = Some(g);
-                }
-            }
-            match twin {
+            match face_running(cx, b, a) {
                 // A mesh border other than the wall: the part is no island.
                 None if !(on_loop.contains(&a) && on_loop.contains(&b)) => return None,
                 Some(g) if !is_removed(g) && seen.insert(g) => stack.push(g),
@@ -736,12 +721,12 @@ fn zip(cx: &Context, guide: &Guide, wall: &[u32]) -> Result<Vec<[u32; 3]>, Strip
     let length = guide.length();
     let position = |v: u32| cx.mesh.vertices[v as usize];
     // Start at the wall vertex nearest the smoothed loop.
+    let distance: Vec<f64> = wall
+        .iter()
+        .map(|&v| guide.nearest(position(v)).d2)
+        .collect();
     let first = (0..p)
-        .min_by(|&a, &b| {
-            let da = guide.nearest(position(wall[a])).d2;
-            let db = guide.nearest(position(wall[b])).d2;
-            da.total_cmp(&db).then(a.cmp(&b))
-        })
+        .min_by(|&a, &b| distance[a].total_cmp(&distance[b]).then(a.cmp(&b)))
         .unwrap_or(0);
     let wall: Vec<u32> = (0..p).map(|i| wall[(first + i) % p]).collect();
     let start = guide.nearest(position(wall[0]));
@@ -845,7 +830,7 @@ fn turns_against(cx: &Context, guide: &Guide, face: &[u32; 3]) -> bool {
 }
 
 /// The removed faces and every face sharing a vertex with them, ascending.
-pub(super) fn footprint(cx: &Context, removed: &[u32]) -> Vec<u32> {
+fn footprint(cx: &Context, removed: &[u32]) -> Vec<u32> {
     let faces: BTreeSet<u32> = removed
         .iter()
         .flat_map(|&f| cx.mesh.faces[f as usize])

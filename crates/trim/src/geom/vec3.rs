@@ -26,3 +26,21 @@ pub(crate) fn norm2(a: Point3) -> f64 {
 pub(crate) fn dist2(a: Point3, b: Point3) -> f64 {
     norm2(sub(a, b))
 }
+
+pub(crate) fn add(a: Point3, b: Point3) -> Point3 {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+pub(crate) fn scale(a: Point3, s: f64) -> Point3 {
+    a.map(|c| c * s)
+}
+
+/// `a` scaled to unit length (zero stays zero).
+pub(crate) fn unit(a: Point3) -> Point3 {
+    let l = norm2(a).sqrt();
+    if l > 0.0 {
+        scale(a, 1.0 / l)
+    } else {
+        a
+    }
+}
