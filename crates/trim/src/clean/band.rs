@@ -3,6 +3,8 @@
 //! mean normal, the smoothed loops in it, and the faces that go.
 
 use super::*;
+use crate::geom::segment_dist2;
+use crate::spatial::PointTree;
 
 /// The faces within some rings of a group's border, projected.
 pub(super) struct Band {
@@ -179,6 +181,7 @@ impl Band {
             }
             match self.triangulate_gap(cx, gap, &removed) {
                 Ok(mut patch) => {
+                    patch.reaches_far = removes_far_vertices(cx, &gap.rings, &removed);
                     patch.removed = removed;
                     return Ok(patch);
                 }
@@ -382,4 +385,39 @@ pub(super) fn untwist_failure(tangle: Tangle, rings: &[Ring]) -> Retry {
             leave(LeftReason::CrossesAnotherLoop, vec![smaller])
         }
     }
+}
+
+/// Whether the faces `removed` take away more than [`MAX_FAR_REMOVED`]
+/// vertices (all their faces) farther than [`REACH`]·β from the smoothed
+/// loops `rings` (measured to the segments round the nearest loop vertex).
+fn removes_far_vertices(cx: &Context, rings: &[Ring], removed: &[u32]) -> bool {
+    let mut points = Vec::new();
+    let mut segments = Vec::new();
+    for ring in rings {
+        let m = ring.p3.len();
+        for k in 0..m {
+            points.push(ring.p3[k]);
+            segments.push([ring.p3[(k + m - 1) % m], ring.p3[k], ring.p3[(k + 1) % m]]);
+        }
+    }
+    let Some(tree) = PointTree::new(&points) else {
+        return false;
+    };
+    let distance2 = |p: Point3| {
+        let [before, at, after] = segments[tree.nearest(&p).0];
+        segment_dist2(p, before, at).min(segment_dist2(p, at, after))
+    };
+    let is_removed = |f: &u32| removed.binary_search(f).is_ok();
+    let mut candidates: Vec<u32> = removed
+        .iter()
+        .flat_map(|&f| cx.mesh.faces[f as usize])
+        .collect();
+    candidates.sort_unstable();
+    candidates.dedup();
+    let far = candidates.into_iter().filter(|&v| {
+        let reach = REACH * cx.beta[v as usize];
+        cx.topology.faces_of(v).iter().all(is_removed)
+            && distance2(cx.mesh.vertices[v as usize]) > reach * reach
+    });
+    far.count() > MAX_FAR_REMOVED
 }

@@ -112,6 +112,14 @@ const REFINE_ANGLE: f64 = 20.0;
 const REFINE_MIN_AREA: f64 = 0.05;
 /// Times the faces round crossing walls are removed before a band gives up.
 const WALL_REPAIRS: usize = 8;
+/// Vertices farther than this many β from the smoothed loop stay in a
+/// strip; a planar patch that removes such a vertex gives way to a strip
+/// where one can be made.
+const REACH: f64 = 3.0;
+/// Vertices beyond [`REACH`]·β a planar patch may remove before it gives
+/// way to a strip: a stray vertex at the corner of a notch, not a piece of
+/// surface.
+const MAX_FAR_REMOVED: usize = 3;
 /// Rings of faces around a border the band starts with …
 const FIRST_DEPTH: u32 = 3;
 /// … and the most it grows to.
@@ -375,6 +383,11 @@ fn replace_left_by_strips(cx: &Context, outcomes: &mut Vec<Outcome>) {
         .iter()
         .flat_map(|o| o.left.iter().flat_map(|x| x.loops.iter().copied()))
         .collect();
+    let far_reaching: BTreeSet<usize> = outcomes
+        .iter()
+        .filter_map(|o| o.patch.as_ref().filter(|p| p.reaches_far))
+        .flat_map(|p| p.loops.iter().copied())
+        .collect();
     let mut first: HashMap<usize, Result<Strip, StripFailure>> = {
         let replaced = replaced_loops(cx.rings.len(), outcomes);
         let loops: Vec<usize> = queue.iter().copied().collect();
@@ -383,6 +396,7 @@ fn replace_left_by_strips(cx: &Context, outcomes: &mut Vec<Outcome>) {
             .map(|&l| (l, replace_by_strip(cx, l, &replaced)))
             .collect()
     };
+    queue.extend(far_reaching);
     let mut reasons: HashMap<usize, LeftReason> = HashMap::default();
     while let Some(l) = queue.pop_first() {
         match strip_in_place_of_planar(cx, outcomes, l, first.remove(&l)) {
@@ -419,7 +433,8 @@ enum StripOutcome {
 }
 
 /// Loop `l`'s strip (`attempt`, when made already), made again in place
-/// of every planar patch it reaches. Those patches are taken out only
+/// of every planar patch it reaches, and of its own planar patch when that
+/// reaches far ([`Patch::reaches_far`]). Those patches are taken out only
 /// when the strip is taken.
 fn strip_in_place_of_planar(
     cx: &Context,
@@ -428,6 +443,16 @@ fn strip_in_place_of_planar(
     mut attempt: Option<Result<Strip, StripFailure>>,
 ) -> StripOutcome {
     let mut taken_out: Vec<(usize, Patch, Vec<u32>)> = Vec::new();
+    let own_far_patch = outcomes.iter().position(|o| {
+        o.patch
+            .as_ref()
+            .is_some_and(|p| p.reaches_far && p.loops.contains(&l))
+    });
+    if let Some(o) = own_far_patch {
+        if let Some(patch) = outcomes[o].patch.take() {
+            taken_out.push((o, patch, std::mem::take(&mut outcomes[o].band)));
+        }
+    }
     let result = loop {
         let replaced = replaced_loops(cx.rings.len(), outcomes);
         if replaced[l] {
@@ -609,6 +634,11 @@ struct Patch {
     /// New faces: ids below the mesh's vertex count are input vertices,
     /// the others `vertex count + index into vertices`.
     faces: Vec<[u32; 3]>,
+    /// Whether it removes vertices farther than [`REACH`]·β from its
+    /// smoothed loops (more than [`MAX_FAR_REMOVED`]): the band's projection
+    /// took surface that turns away beyond a silhouette for a fold to cut. A strip, which needs no
+    /// projection, takes its place where one can be made.
+    reaches_far: bool,
 }
 
 /// One group's outcome: the band of its replaced loops (to detect bands

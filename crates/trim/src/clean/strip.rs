@@ -43,8 +43,6 @@ const TRACK_BEHIND: usize = 4;
 /// Borders one strip may absorb because they lie one face from others it
 /// absorbs.
 const MAX_ABSORBED: usize = 64;
-/// Vertices farther than this many β from the smoothed loop stay.
-const REACH: f64 = 3.0;
 /// Times the faces round a pinched wall vertex are removed before the loop
 /// is left.
 const PINCH_REPAIRS: usize = 16;
@@ -347,6 +345,7 @@ pub(super) fn replace_by_strip(
             removed,
             vertices: guide.points.clone(),
             faces,
+            reaches_far: false,
         },
         footprint,
     })

@@ -296,3 +296,122 @@ fn a_mesh_of_slivers_alone_has_no_faces() {
         CleanError::Mesh(MeshError::NoFaces)
     );
 }
+
+/// Part of a cylinder of radius `r` seen from the side: angles within
+/// ±`reach` round the axis (past both silhouettes when `reach` > 90°),
+/// heights 0 to `height`, triangulated from a jittered unit grid of
+/// (arc length, height) in the region, whose faces are kept where their
+/// circumradius is at most 1.5 spacings: the slivers along the convex hull
+/// go, so the border is a sawtooth.
+/// The viewer looks along -z; the outer border wraps round the axis, so
+/// no plane sees its band as a height field.
+fn jagged_cylinder(r: f64, reach: f64, height: f64, seed: u64) -> Mesh {
+    let mut rng = SplitMix64::new(seed);
+    let half = r * reach;
+    let inside = |u: f64, h: f64| u.abs() <= half && (0.0..=height).contains(&h);
+    let mut dt: DelaunayTriangulation<SpadePoint<f64>> = DelaunayTriangulation::new();
+    for j in -1..=(height.ceil() as i64 + 1) {
+        for i in -(half.ceil() as i64 + 1)..=(half.ceil() as i64 + 1) {
+            let u = i as f64 + 0.5 + rng.range(-0.3, 0.3);
+            let h = j as f64 + 0.5 + rng.range(-0.3, 0.3);
+            if inside(u, h) {
+                dt.insert(SpadePoint::new(u, h)).unwrap();
+            }
+        }
+    }
+    let vertices: Vec<Point3> = dt
+        .vertices()
+        .map(|v| {
+            let (u, h) = (v.position().x, v.position().y);
+            [r * (u / r).sin(), h, r * (u / r).cos()]
+        })
+        .collect();
+    let position = |v: u32| {
+        let p = dt.vertices().nth(v as usize).unwrap().position();
+        (p.x, p.y)
+    };
+    let faces = dt
+        .inner_faces()
+        .map(|f| f.vertices().map(|v| v.fix().index() as u32))
+        .filter(|f| circumradius(f.map(position)) <= 1.5)
+        .collect();
+    let mut mesh = Mesh { vertices, faces };
+    mesh.remove_unused_vertices();
+    mesh
+}
+
+fn circumradius([a, b, c]: [(f64, f64); 3]) -> f64 {
+    let side = |p: (f64, f64), q: (f64, f64)| (p.0 - q.0).hypot(p.1 - q.1);
+    let twice_area = ((b.0 - a.0) * (c.1 - a.1) - (b.1 - a.1) * (c.0 - a.0)).abs();
+    side(a, b) * side(b, c) * side(c, a) / (2.0 * twice_area)
+}
+
+/// Mean distance, along the surface, of the border to the true border of
+/// [`jagged_cylinder`]'s region, sampled at four points per border edge
+/// (a sawtooth's vertices may lie on the truth while its edges cut in).
+fn cylinder_border_error(mesh: &Mesh, r: f64, reach: f64, height: f64) -> f64 {
+    let distance = |[x, y, z]: Point3| {
+        let u = r * x.atan2(z);
+        (r * reach - u.abs())
+            .abs()
+            .min(y.abs())
+            .min((y - height).abs())
+    };
+    let mut d = Vec::new();
+    for border in mesh.boundary_loops() {
+        for (i, &a) in border.iter().enumerate() {
+            let b = border[(i + 1) % border.len()];
+            let (pa, pb) = (mesh.vertices[a as usize], mesh.vertices[b as usize]);
+            for t in [0.0, 0.25, 0.5, 0.75] {
+                d.push(distance(std::array::from_fn(|k| {
+                    pa[k] + t * (pb[k] - pa[k])
+                })));
+            }
+        }
+    }
+    d.iter().sum::<f64>() / d.len() as f64
+}
+
+/// The border of a cylinder seen from the side wraps past its silhouettes
+/// (±110° round the axis): it is replaced all the same, close to the true
+/// border, and the mesh stays a consistently oriented manifold whose
+/// vertices far from the border keep their coordinates. Measured, seeds
+/// 1-4: border 0.48-0.50 spacings from the truth before, 0.10-0.11 after;
+/// new faces' smallest angle 9.9-15.5°. (The planar way alone leaves the
+/// loop, its smoothed loop crossing itself in the band's projection; on
+/// seed 2 it used to cut away the surface beyond the silhouette.)
+#[test]
+fn a_border_wrapping_round_a_cylinder_is_replaced() {
+    let (r, reach, height) = (12.0, 110f64.to_radians(), 16.0);
+    for seed in 1..=4 {
+        a_border_wrapping_round_a_cylinder(
+            jagged_cylinder(r, reach, height, seed),
+            r,
+            reach,
+            height,
+        );
+    }
+}
+
+fn a_border_wrapping_round_a_cylinder(mesh: Mesh, r: f64, reach: f64, height: f64) {
+    let before = cylinder_border_error(&mesh, r, reach, height);
+    let (out, report) = clean(&mesh);
+    assert_eq!(report.loops_in, 1, "{report:?}");
+    assert_eq!(report.loops_smoothed, 1, "{report:?}");
+    assert!(report.loops_left.is_empty(), "{report:?}");
+    let after = cylinder_border_error(&out, r, reach, height);
+    assert!(
+        after < 0.25 && after < 0.8 * before,
+        "before {before}, after {after}"
+    );
+    assert!(report.min_angle_new > 5.0, "{report:?}");
+    check_manifold(&out).unwrap();
+    let kept: std::collections::HashSet<[u64; 3]> =
+        out.vertices.iter().map(|p| p.map(f64::to_bits)).collect();
+    let far = mesh.vertices.iter().filter(|&&[x, y, z]| {
+        let u = r * x.atan2(z);
+        (r * reach - u.abs()).min(y).min(height - y) > 4.0
+    });
+    assert!(far.clone().count() > 100);
+    assert!(far.into_iter().all(|p| kept.contains(&p.map(f64::to_bits))));
+}

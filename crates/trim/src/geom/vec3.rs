@@ -44,3 +44,15 @@ pub(crate) fn unit(a: Point3) -> Point3 {
         a
     }
 }
+
+/// Squared distance from `p` to the segment from `a` to `b`.
+pub(crate) fn segment_dist2(p: Point3, a: Point3, b: Point3) -> f64 {
+    let ab = sub(b, a);
+    let l2 = norm2(ab);
+    let t = if l2 > 0.0 {
+        (dot(sub(p, a), ab) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    dist2(p, add(a, scale(ab, t)))
+}
