@@ -332,13 +332,15 @@ def validation_clouds(seed: int = 1) -> list[Cloud]:
 # PLY output.
 
 
-def write_cloud_ply(path, points, normals=None) -> None:
-    """Binary little-endian PLY: ``double x y z`` (+ ``float nx ny nz``)."""
-    points = np.ascontiguousarray(points, dtype="<f8")
+def write_cloud_ply(path, points, normals=None, single=False) -> None:
+    """Binary little-endian PLY: ``double x y z`` (``float`` with
+    ``single``, as many scanners write) (+ ``float nx ny nz``)."""
+    kind, name = ("<f4", "float") if single else ("<f8", "double")
+    points = np.ascontiguousarray(points, dtype=kind)
     n = len(points)
     header = ["ply", "format binary_little_endian 1.0", f"element vertex {n}"]
-    header += [f"property double {c}" for c in "xyz"]
-    fields = [("x", "<f8"), ("y", "<f8"), ("z", "<f8")]
+    header += [f"property {name} {c}" for c in "xyz"]
+    fields = [("x", kind), ("y", kind), ("z", kind)]
     if normals is not None:
         header += [f"property float n{c}" for c in "xyz"]
         fields += [("nx", "<f4"), ("ny", "<f4"), ("nz", "<f4")]

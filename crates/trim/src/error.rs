@@ -84,6 +84,16 @@ pub enum CloudError {
         /// "one point" or "one line".
         what: &'static str,
     },
+    /// The points lie along a line or a curve, up to rounding or noise
+    /// well below their spacing: the neighbourhoods have no second
+    /// dimension.
+    #[error("the cloud has no surface: its {distinct} distinct points lie along a line or a curve (a single line profile?); its neighbourhoods are {thickness:.3} as wide as they are long at the median, where a surface's are 0.1 or more (a scan's 0.7 or more)")]
+    NoSurface {
+        /// Number of distinct points.
+        distinct: usize,
+        /// Median neighbourhood width over length.
+        thickness: f64,
+    },
 }
 
 /// Why a mesh was rejected.

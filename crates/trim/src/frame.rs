@@ -58,6 +58,13 @@ pub fn fit_plane_normal(points: &[Point3], members: &[u32]) -> Frame {
     ))))
 }
 
+/// The variances of `members`' positions along their principal axes,
+/// ascending (the covariance's eigenvalues, divided by the count).
+pub fn spread(points: &[Point3], members: &[u32]) -> [f64; 3] {
+    let (values, _) = symmetric_eigen3(&covariance(points, members));
+    values.map(|v| v.max(0.0) / members.len() as f64)
+}
+
 impl Frame {
     /// The frame of the unit `normal` alone: in-plane
     /// axes that follow from the normal's components alone, so a caller
