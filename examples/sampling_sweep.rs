@@ -53,7 +53,12 @@ fn main() -> anyhow::Result<()> {
                 noise.psi_truth.percent,
                 if noise.psi_truth.capped { "+" } else { "" },
             );
-            rows.push((seed, a.f1, noise.omega_truth.percent, noise.psi_truth.percent));
+            rows.push((
+                seed,
+                a.f1,
+                noise.omega_truth.percent,
+                noise.psi_truth.percent,
+            ));
         }
         summary.push((h, rows));
     }
@@ -63,9 +68,16 @@ fn main() -> anyhow::Result<()> {
     for (h, rows) in &summary {
         let mut f1: Vec<f64> = rows.iter().map(|r| r.1).collect();
         f1.sort_unstable_by(f64::total_cmp);
-        let count = |ok: &dyn Fn(&(u64, f64, f64, f64)) -> bool| rows.iter().filter(|r| ok(r)).count();
-        let weakest_f1 = rows.iter().min_by(|a, b| a.1.total_cmp(&b.1)).map_or(0, |r| r.0);
-        let weakest_psi = rows.iter().min_by(|a, b| a.3.total_cmp(&b.3)).map_or(0, |r| r.0);
+        let count =
+            |ok: &dyn Fn(&(u64, f64, f64, f64)) -> bool| rows.iter().filter(|r| ok(r)).count();
+        let weakest_f1 = rows
+            .iter()
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map_or(0, |r| r.0);
+        let weakest_psi = rows
+            .iter()
+            .min_by(|a, b| a.3.total_cmp(&b.3))
+            .map_or(0, |r| r.0);
         println!(
             "| {h} mm | {:.4} | {:.4} | {}/{} | {}/{} | {}/{} | {weakest_f1} | {weakest_psi} |",
             f1[0],

@@ -118,6 +118,34 @@ fn assert_blades_accurate(blade: fn(f64, u64) -> SyntheticCloud) {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
+/// Every one of ten samplings per resolution (seeds 1–10), both ways of
+/// sampling: F1 ≥ 0.98, or, where the sampling itself cannot give it (the
+/// ideal first layer's F1 below 0.99), within 0.01 of the ideal layer's.
+/// Measured (`cargo run --release --example sampling_sweep`): decimated
+/// 0.9953–1.0 over all 40; lattice 0.9829–0.9995 but the 34 mm seed 9
+/// (100 points), 0.9697 where the ideal layer reaches 0.9699.
+#[test]
+fn blades_over_ten_samplings_per_resolution() {
+    let mut failures = Vec::new();
+    for blade in [synthetic::blade, synthetic::decimated_blade] {
+        for h in [4.0, 8.0, 16.0, 34.0] {
+            for seed in 1..=10 {
+                let cloud = blade(h, seed);
+                let det = detect_boundary(&cloud.points, &BpdOptions::default()).unwrap();
+                let f1 = precision_recall(&cloud.points, &det.boundary, &cloud).f1;
+                let ideal = precision_recall(&cloud.points, &ideal_first_layer(&cloud), &cloud).f1;
+                if f1 < TARGET.min(ideal - IDEAL_SLACK) {
+                    failures.push(format!(
+                        "{} seed {seed}: F1 {f1:.4} (ideal {ideal:.4})",
+                        cloud.name
+                    ));
+                }
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
 /// On the jittered lattice the graded columns leave a ragged first layer
 /// (the ideal layer's precision is 0.98–0.99, docs/results.md), so the
 /// slack rule applies.

@@ -1069,7 +1069,11 @@ mod tests {
             .map(|i| {
                 let x = 0.5 * i as f64;
                 let z = 8.0 * (-((x - 100.0) / 25.0).powi(2)).exp();
-                [x, rng.random_range(-0.15..0.15), z + rng.random_range(-0.15..0.15)]
+                [
+                    x,
+                    rng.random_range(-0.15..0.15),
+                    z + rng.random_range(-0.15..0.15),
+                ]
             })
             .collect();
         for cloud in [&line, &curve] {
@@ -1078,7 +1082,9 @@ mod tests {
                 Err(CloudError::NoSurface { thickness, .. }) if thickness < MIN_THICKNESS
             ));
         }
-        let rows: Vec<Point3> = (0..600).map(|i| [(i / 3) as f64, (i % 3) as f64, 0.0]).collect();
+        let rows: Vec<Point3> = (0..600)
+            .map(|i| [(i / 3) as f64, (i % 3) as f64, 0.0])
+            .collect();
         assert!(detect_boundary(&rows, &opts).is_ok());
     }
 
