@@ -16,6 +16,14 @@ use testkit::evaluate::{noise_robustness, percent_sweep, precision_recall};
 use testkit::synthetic::{self, SyntheticCloud};
 use trim::{detect_boundary, BpdOptions};
 
+/// One sampling's scores.
+struct Row {
+    seed: u64,
+    f1: f64,
+    omega: f64,
+    psi: f64,
+}
+
 fn main() -> anyhow::Result<()> {
     let mut args = std::env::args().skip(1);
     let seeds: u64 = args.next().map_or(Ok(10), |s| s.parse())?;
@@ -53,12 +61,12 @@ fn main() -> anyhow::Result<()> {
                 noise.psi_truth.percent,
                 if noise.psi_truth.capped { "+" } else { "" },
             );
-            rows.push((
+            rows.push(Row {
                 seed,
-                a.f1,
-                noise.omega_truth.percent,
-                noise.psi_truth.percent,
-            ));
+                f1: a.f1,
+                omega: noise.omega_truth.percent,
+                psi: noise.psi_truth.percent,
+            });
         }
         summary.push((h, rows));
     }
@@ -66,28 +74,24 @@ fn main() -> anyhow::Result<()> {
     println!("| blade | F1 min | F1 median | F1 ≥ 0.98 | Ω ≥ 25 % | Ψ ≥ 75 % | weakest F1 seed | weakest Ψ seed |");
     println!("|---|---:|---:|---:|---:|---:|---:|---:|");
     for (h, rows) in &summary {
-        let mut f1: Vec<f64> = rows.iter().map(|r| r.1).collect();
+        let mut f1: Vec<f64> = rows.iter().map(|r| r.f1).collect();
         f1.sort_unstable_by(f64::total_cmp);
-        let count =
-            |ok: &dyn Fn(&(u64, f64, f64, f64)) -> bool| rows.iter().filter(|r| ok(r)).count();
-        let weakest_f1 = rows
-            .iter()
-            .min_by(|a, b| a.1.total_cmp(&b.1))
-            .map_or(0, |r| r.0);
-        let weakest_psi = rows
-            .iter()
-            .min_by(|a, b| a.3.total_cmp(&b.3))
-            .map_or(0, |r| r.0);
+        let count = |ok: fn(&Row) -> bool| rows.iter().filter(|r| ok(r)).count();
+        let weakest = |key: fn(&Row) -> f64| {
+            rows.iter()
+                .min_by(|a, b| key(a).total_cmp(&key(b)))
+                .map_or(0, |r| r.seed)
+        };
+        let n = rows.len();
         println!(
-            "| {h} mm | {:.4} | {:.4} | {}/{} | {}/{} | {}/{} | {weakest_f1} | {weakest_psi} |",
+            "| {h} mm | {:.4} | {:.4} | {}/{n} | {}/{n} | {}/{n} | {} | {} |",
             f1[0],
             f1[f1.len() / 2],
-            count(&|r| r.1 >= 0.98),
-            rows.len(),
-            count(&|r| r.2 >= 25.0),
-            rows.len(),
-            count(&|r| r.3 >= 75.0),
-            rows.len(),
+            count(|r| r.f1 >= 0.98),
+            count(|r| r.omega >= 25.0),
+            count(|r| r.psi >= 75.0),
+            weakest(|r| r.f1),
+            weakest(|r| r.psi),
         );
     }
     Ok(())
