@@ -3,7 +3,7 @@
 use std::path::{Path, PathBuf};
 
 mod common;
-use common::{assert_clean_failure, grid_obj, meshtrim};
+use common::{assert_clean_failure, grid_obj, meshtrim, stderr};
 
 const MESH: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -399,5 +399,59 @@ fn bare_meshtrim_prints_the_help() {
             help.contains(&format!("\n  {command} ")),
             "{command}: {help}"
         );
+    }
+}
+
+/// The view options have one help, the same wherever they are taken, and
+/// `--help` says why a scanner's line of sight matters.
+#[test]
+fn the_view_options_are_explained_once_for_every_command() {
+    let help_of = |args: &[&str]| {
+        let run = meshtrim(args, None);
+        assert!(run.status.success(), "{}", stderr(&run));
+        String::from_utf8_lossy(&run.stdout).into_owned()
+    };
+    let why = "err along their line of sight";
+    let paragraph = |help: &str, option: &str| {
+        let start = help
+            .find(option)
+            .unwrap_or_else(|| panic!("{option}: {help}"));
+        help[start..]
+            .split("\n      --")
+            .next()
+            .unwrap()
+            .to_string()
+    };
+    let detect = help_of(&["detect", "--help"]);
+    for args in [
+        vec!["--help"],
+        vec!["trim", "--help"],
+        vec!["edges", "--help"],
+        vec!["mesh", "--help"],
+    ] {
+        let help = help_of(&args);
+        for option in ["--view-along", "--view-from"] {
+            let text = paragraph(&help, option);
+            assert!(text.contains(why), "{args:?} {option}: {text}");
+            assert_eq!(text, paragraph(&detect, option), "{args:?} {option}");
+        }
+    }
+}
+
+/// The summary says how its face counts relate.
+#[test]
+fn the_summary_says_how_the_face_counts_relate() {
+    let dir = temp_dir();
+    let out = path(dir.path(), "out.ply");
+    let run = meshtrim(&[MESH, CLOUD, out.to_str().unwrap()], None);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let summary = String::from_utf8_lossy(&run.stdout);
+    for line in [
+        "faces split          803 by the border (their inner parts kept)",
+        "faces removed        4429 whole (beyond the border, in dropped pieces or out of reach)",
+        "pieces dropped       4 (no cloud support; their faces are among those removed)",
+        "faces out of reach   3140 parts of faces no cloud point reaches, dropped",
+    ] {
+        assert!(summary.contains(line), "{line}: {summary}");
     }
 }

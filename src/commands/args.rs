@@ -46,17 +46,39 @@ impl StageArgs {
 /// sight").
 #[derive(Debug, Clone, Copy, PartialEq, Default, Args)]
 pub struct ViewArgs {
-    /// The scanner's line of sight as a direction X,Y,Z in the cloud's
-    /// frame (either sense), for a distant scanner or a frame whose axis it
-    /// looked along, e.g. 0,0,1.
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_direction, allow_hyphen_values = true, conflicts_with = "view_from")]
+    /// The scanner's line of sight (help: `VIEW_ALONG_HELP`).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_direction, allow_hyphen_values = true, conflicts_with = "view_from", help = VIEW_ALONG_HELP, long_help = VIEW_ALONG_LONG_HELP)]
     pub view_along: Option<[f64; 3]>,
-    /// The scanner's position X,Y,Z in the cloud's frame (a depth camera's
-    /// centre: 0,0,0 for a cloud in the camera's own frame); the line of
-    /// sight to each point runs from there.
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vector, allow_hyphen_values = true)]
+    /// The scanner's position (help: `VIEW_FROM_HELP`).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vector, allow_hyphen_values = true, help = VIEW_FROM_HELP, long_help = VIEW_FROM_LONG_HELP)]
     pub view_from: Option<[f64; 3]>,
 }
+
+// The view options' help, one text for every command that takes them:
+// the one line `-h` shows, and under it in `--help` why the view matters.
+macro_rules! view_along_help {
+    () => {
+        "The scanner's line of sight as a direction X,Y,Z in the cloud's frame (either sense), for a distant scanner or a frame whose axis it looked along, e.g. 0,0,1"
+    };
+}
+macro_rules! view_from_help {
+    () => {
+        "The scanner's position X,Y,Z in the cloud's frame (a depth camera's centre: 0,0,0 for a cloud in the camera's own frame); the line of sight to each point runs from there"
+    };
+}
+macro_rules! view_why {
+    () => {
+        "Range scanners (depth cameras, laser line and structured-light scanners) err along their line of sight. Given it, detection projects each neighbourhood along it instead of along the neighbourhood's normal, so that depth noise and the terraces of a quantised depth do not open gaps where the surface is inclined to the scanner (docs/bpd.md, \"Scanner's line of sight\"). Without it, the paper's projection along each neighbourhood's normal."
+    };
+}
+/// `--view-along`'s one-line help.
+pub(crate) const VIEW_ALONG_HELP: &str = view_along_help!();
+/// `--view-from`'s one-line help.
+pub(crate) const VIEW_FROM_HELP: &str = view_from_help!();
+/// `--view-along`'s help with why the view matters.
+pub(crate) const VIEW_ALONG_LONG_HELP: &str = concat!(view_along_help!(), ".\n\n", view_why!());
+/// `--view-from`'s help with why the view matters.
+pub(crate) const VIEW_FROM_LONG_HELP: &str = concat!(view_from_help!(), ".\n\n", view_why!());
 
 impl ViewArgs {
     /// The view, if one was given.

@@ -11,7 +11,10 @@ use anyhow::{Context, Result};
 use serde::Serialize;
 use trim::{reconstruct_edges, trim_mesh, LoopFit, TrimOptions, TrimReport};
 
-use crate::commands::args::{parse_direction, parse_k, parse_vector, StageArgs, ViewArgs};
+use crate::commands::args::{
+    parse_direction, parse_k, parse_vector, StageArgs, ViewArgs, VIEW_ALONG_HELP,
+    VIEW_ALONG_LONG_HELP, VIEW_FROM_HELP, VIEW_FROM_LONG_HELP,
+};
 use crate::io::mesh_out::write_mesh;
 use crate::io::{read_cloud, read_mesh_with_faces};
 use crate::report::significant;
@@ -44,11 +47,11 @@ pub struct Args {
     /// estimated physical edge half a row beyond them.
     #[arg(long)]
     pub no_offset: bool,
-    /// The scanner's line of sight X,Y,Z (see `meshtrim detect --help`).
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_direction, allow_hyphen_values = true, conflicts_with = "view_from")]
+    /// The scanner's line of sight (as `ViewArgs`'s, same help).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_direction, allow_hyphen_values = true, conflicts_with = "view_from", help = VIEW_ALONG_HELP, long_help = VIEW_ALONG_LONG_HELP)]
     pub view_along: Option<[f64; 3]>,
-    /// The scanner's position X,Y,Z (see `meshtrim detect --help`).
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vector, allow_hyphen_values = true)]
+    /// The scanner's position (as `ViewArgs`'s, same help).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vector, allow_hyphen_values = true, help = VIEW_FROM_HELP, long_help = VIEW_FROM_LONG_HELP)]
     pub view_from: Option<[f64; 3]>,
     /// Print the report as one JSON object.
     #[arg(long)]
@@ -297,11 +300,41 @@ impl crate::report::Table for Report {
                 "faces in / out",
                 format!("{} / {}", self.faces_in, self.faces_out),
             ),
-            ("faces split", self.faces_split.to_string()),
-            ("faces removed", self.faces_removed.to_string()),
-            ("pieces dropped", self.pieces_dropped.to_string()),
-            ("pieces restored", self.pieces_restored.to_string()),
-            ("faces out of reach", self.faces_out_of_reach.to_string()),
+            (
+                "faces split",
+                format!(
+                    "{} by the border (their inner parts kept)",
+                    self.faces_split
+                ),
+            ),
+            (
+                "faces removed",
+                format!(
+                    "{} whole (beyond the border, in dropped pieces or out of reach)",
+                    self.faces_removed
+                ),
+            ),
+            (
+                "pieces dropped",
+                format!(
+                    "{} (no cloud support; their faces are among those removed)",
+                    self.pieces_dropped
+                ),
+            ),
+            (
+                "pieces restored",
+                format!(
+                    "{} (beyond the border, kept: the cloud supports them)",
+                    self.pieces_restored
+                ),
+            ),
+            (
+                "faces out of reach",
+                format!(
+                    "{} parts of faces no cloud point reaches, dropped",
+                    self.faces_out_of_reach
+                ),
+            ),
             ("faces repaired", self.faces_repaired.to_string()),
             (
                 "area in / out",
