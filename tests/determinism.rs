@@ -1,0 +1,68 @@
+//! The same bytes out whatever the number of threads, on a cloud large
+//! enough for every parallel path: 102,400 points, so that detection runs
+//! in several blocks of 16,384 points (the block size of its passes) and
+//! the per-thread pieces of the readers, the tree and the writers all split.
+
+use std::path::{Path, PathBuf};
+
+mod common;
+use common::{meshtrim_env, path_str, stderr};
+
+/// A wavy 320 × 320 jittered grid with a round hole, as XYZ text.
+fn large_cloud(dir: &Path) -> PathBuf {
+    let mut state: u64 = 0x9e37_79b9_7f4a_7c15;
+    let mut jitter = || {
+        state = state
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        ((state >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.4
+    };
+    let mut text = String::new();
+    for j in 0..320 {
+        for i in 0..330 {
+            let (x, y) = (i as f64 + jitter(), j as f64 + jitter());
+            if (x - 160.0).powi(2) + (y - 160.0).powi(2) < 400.0 {
+                continue;
+            }
+            let z = 4.0 * (x / 40.0).sin() * (y / 55.0).cos();
+            text.push_str(&format!("{x} {y} {z}\n"));
+        }
+    }
+    let path = dir.join("large.xyz");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// The bytes `args` (with `{out}` standing for a fresh output path) write
+/// on `threads` threads.
+fn output(dir: &Path, args: &[&str], name: &str, threads: &str) -> Vec<u8> {
+    let out = dir.join(format!("{threads}-{name}"));
+    let args: Vec<&str> = args
+        .iter()
+        .map(|&a| if a == "{out}" { path_str(&out) } else { a })
+        .collect();
+    let run = meshtrim_env(&args, &[("RAYON_NUM_THREADS", threads)]);
+    assert!(run.status.success(), "{args:?}: {}", stderr(&run));
+    std::fs::read(&out).unwrap()
+}
+
+#[test]
+fn a_large_cloud_gives_the_same_bytes_on_1_2_and_4_threads() {
+    let dir = tempfile::tempdir().unwrap();
+    let cloud = large_cloud(dir.path());
+    let cloud = path_str(&cloud);
+    for (args, name) in [
+        (vec!["detect", cloud, "-o", "{out}"], "labels.csv"),
+        (vec!["edges", cloud, "-o", "{out}"], "edges.json"),
+        (vec!["mesh", cloud, "{out}"], "mesh.ply"),
+    ] {
+        let one = output(dir.path(), &args, name, "1");
+        assert!(!one.is_empty(), "{name}");
+        for threads in ["2", "4"] {
+            assert!(
+                one == output(dir.path(), &args, name, threads),
+                "{name}: 1 and {threads} threads differ"
+            );
+        }
+    }
+}
