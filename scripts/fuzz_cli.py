@@ -18,9 +18,11 @@ cloud and mesh format meshtrim reads), in a temporary directory.
   plane, a cluster of near-coincident points; run through `detect`,
   `edges`, `mesh` and the main job.
 
-A run that exits with Rust's panic code (101) or prints "panicked" is
-reported and its input kept (in `fuzz-failures/`); errors with a message
-are what bad input should get. Exits 1 if any run panicked.
+A run that exits with Rust's panic code (101) or prints "panicked", dies
+by a signal (a stack overflow, an abort, the out-of-memory killer) or
+outlives --timeout is reported and its input kept (in `fuzz-failures/`);
+errors with a message are what bad input should get. Exits 1 if any run
+failed so. CI runs a short seeded pass (scripts/test.sh).
 """
 
 import argparse
@@ -40,11 +42,28 @@ POISSON = os.path.join(FIXTURES, "blade_small_poisson.ply")
 JAGGED = os.path.join(FIXTURES, "blade_jagged.stl")
 
 
+# Seconds a run may take before it counts as a hang.
+TIMEOUT = 120
+
+
 def run(cmd):
     try:
-        return subprocess.run([EXE] + cmd, capture_output=True, timeout=120)
+        return subprocess.run([EXE] + cmd, capture_output=True, timeout=TIMEOUT)
     except subprocess.TimeoutExpired:
         return None
+
+
+def failure(result):
+    """What went wrong with a run, or None when it exited on its own with
+    a message or success: a hang, a death by signal (stack overflow,
+    abort, out of memory), or a panic."""
+    if result is None:
+        return f"HANG (over {TIMEOUT} s)"
+    if result.returncode < 0:
+        return f"SIGNAL {-result.returncode}"
+    if result.returncode == 101 or b"panicked" in result.stderr:
+        return "PANIC"
+    return None
 
 
 def derive_sources(work):
@@ -199,11 +218,14 @@ def mutate_cloud(rng, points):
 
 
 def main():
+    global TIMEOUT
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seed", type=int, default=1)
     parser.add_argument("--cases", type=int, default=100, help="mutated inputs per kind")
     parser.add_argument("--kind", choices=["bytes", "mesh", "cloud", "all"], default="all")
+    parser.add_argument("--timeout", type=float, default=TIMEOUT, help="seconds before a run counts as a hang")
     args = parser.parse_args()
+    TIMEOUT = args.timeout
     if not os.access(EXE, os.X_OK):
         sys.exit(f"{EXE} not found: run `cargo build --release` first")
     rng = random.Random(args.seed)
@@ -217,15 +239,15 @@ def main():
             for cmd in commands(path, is_mesh, work):
                 runs += 1
                 result = run(cmd)
-                if result is None:
-                    print(f"timeout: {what}: meshtrim {' '.join(cmd)}")
-                elif result.returncode == 101 or b"panicked" in result.stderr:
+                wrong = failure(result)
+                if wrong:
                     panics += 1
                     os.makedirs(failures, exist_ok=True)
                     kept = os.path.join(failures, f"seed{args.seed}-{panics}{os.path.splitext(path)[1]}")
                     shutil.copy(path, kept)
-                    print(f"PANIC: {what}: meshtrim {cmd[0]} (input kept in {kept})")
-                    print(result.stderr.decode(errors="replace")[:400])
+                    print(f"{wrong}: {what}: meshtrim {' '.join(cmd)} (input kept in {kept})")
+                    if result is not None:
+                        print(result.stderr.decode(errors="replace")[:400])
                     return
 
         kinds = ["bytes", "mesh", "cloud"] if args.kind == "all" else [args.kind]
@@ -256,7 +278,7 @@ def main():
                 path = os.path.join(work, "case.xyz")
                 open(path, "w").write("".join("%r %r %r\n" % tuple(p) for p in ps))
                 check(path, False, f"cloud {op}")
-    print(f"{runs} runs, {panics} panicked")
+    print(f"{runs} runs, {panics} failed (panic, signal or hang)")
     sys.exit(1 if panics else 0)
 
 

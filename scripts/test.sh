@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Runs every test: Rust unit, integration and CLI tests, then the PyMeshLab
 # validation of the trimming (tests/python/, in the .venv-test venv, which
-# this creates or checks first: about 35 s the first time, 1.5 s after).
+# this creates or checks first: about 35 s the first time, 1.5 s after),
+# then a short seeded fuzzing pass of the CLI (scripts/fuzz_cli.py).
 #
 # The PCL scans the tests read are shipped in fixtures/scans; the other
 # real scans (the Stanford bunny's, MeshLab's, the Kinect blade) are read
@@ -40,3 +41,6 @@ fi
 bash scripts/python_env.sh
 cargo build --release --bin meshtrim
 MESHTRIM="$PWD/target/release/meshtrim" .venv-test/bin/python -m pytest -q -rs tests/python
+# A short seeded fuzzing pass of the CLI (about 40 s): no mutated input may
+# make it panic, die by a signal or hang.
+.venv-test/bin/python scripts/fuzz_cli.py --seed 2026 --cases 150 --timeout 60
