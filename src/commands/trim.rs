@@ -44,7 +44,9 @@ pub struct Args {
     #[arg(long)]
     pub no_anisotropy: bool,
     /// Use the paper's edges, through the boundary points, instead of the
-    /// estimated physical edge half a row beyond them.
+    /// estimated physical edge half a row beyond them: for clouds whose
+    /// outermost samples lie on the edge itself (a mesh's own vertices,
+    /// points sampled from CAD).
     #[arg(long)]
     pub no_offset: bool,
     /// The scanner's line of sight (as `ViewArgs`'s, same help).

@@ -1043,6 +1043,33 @@ pub fn flat_grid(spacing: f64) -> SyntheticCloud {
     )
 }
 
+/// [`plane_with_holes`] sampled as a mesh's own vertices are: the jittered
+/// lattice inside, and samples `spacing` apart exactly on the true border
+/// (the outer rectangle and the three circles), with the lattice's samples
+/// closer than half a spacing to the border dropped. The outermost samples
+/// lie on the edge, not inside it: the case the edge offset does not
+/// model.
+pub fn plane_with_border_samples(spacing: f64, seed: u64) -> SyntheticCloud {
+    let h = spacing;
+    let cloud = plane_with_holes(h, seed);
+    let region = cloud.region.clone();
+    let field = SpacingField::Uniform(h);
+    let mut samples: Vec<(Uv, f64)> = jittered_grid(&region, field, JITTER, None, seed)
+        .into_iter()
+        .filter(|&(p, _)| region.distance_to_boundary(p) >= 0.5 * h)
+        .collect();
+    for curve in region.boundary_curves(h) {
+        samples.extend(curve.into_iter().map(|p| (p, h)));
+    }
+    SyntheticCloud::build(
+        format!("plane, holes 2β/4β/8β, samples on the border, h={h}"),
+        Surface::Plane,
+        region,
+        field,
+        samples,
+    )
+}
+
 /// A line scan of the plane z = 0: straight scan lines at `angle` radians
 /// to the u axis (and so to the plate's borders), samples every `spacing`
 /// along a line and lines `ratio`·`spacing` apart, each line with a random
