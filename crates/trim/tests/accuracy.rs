@@ -467,3 +467,45 @@ fn flips_beyond_the_first_rows(
     }
     failures
 }
+
+/// The paper's noise levels against the truth, over ten samplings per
+/// resolution and two noise patterns (decimated blades, seeds 1–10,
+/// patterns 7 and 8, along the true normal): the median case must reach
+/// Ω ≥ 25 % and Ψ ≥ 75 % at every resolution. Measured (75 is the sweep's
+/// end): medians Ω 75 / 75 / 75 / 35 %, Ψ 75 % at 4 / 8 / 16 / 34 mm;
+/// Ψ ≥ 75 in 15, 15, 20, 20 cases of 20, Ω ≥ 25 in 20, 20, 20, 13. The
+/// single cases that fall short are a point the anisotropy map lets a gap
+/// open at (docs/results.md, "Ten samplings per resolution").
+#[test]
+fn noise_over_ten_samplings_and_two_patterns_at_the_median() {
+    let options = BpdOptions::default();
+    let mut failures = Vec::new();
+    for h in [4.0, 8.0, 16.0, 34.0] {
+        let (mut omega, mut psi) = (Vec::new(), Vec::new());
+        for seed in 1..=10 {
+            let cloud = synthetic::decimated_blade(h, seed);
+            for pattern in [7, 8] {
+                let r =
+                    noise_robustness(&cloud, &percent_sweep(5.0, 75.0), &options, pattern).unwrap();
+                omega.push(r.omega_truth.percent);
+                psi.push(r.psi_truth.percent);
+            }
+        }
+        let median = |v: &mut Vec<f64>| {
+            v.sort_unstable_by(f64::total_cmp);
+            (v[v.len() / 2 - 1] + v[v.len() / 2]) / 2.0
+        };
+        let (o, p) = (median(&mut omega), median(&mut psi));
+        eprintln!(
+            "{h} mm: median Ω {o} %, Ψ {p} %; worst Ω {} %, Ψ {} %; Ψ ≥ 75 in {} of 20, Ω ≥ 25 in {} of 20",
+            omega[0],
+            psi[0],
+            psi.iter().filter(|&&x| x >= 75.0).count(),
+            omega.iter().filter(|&&x| x >= 25.0).count()
+        );
+        if o < 25.0 || p < 75.0 {
+            failures.push(format!("{h} mm: median Ω {o} %, Ψ {p} %"));
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
