@@ -730,3 +730,45 @@ fn sphere_obj(rings: usize, sectors: usize) -> String {
     }
     obj
 }
+
+/// More shards than inputs: each input still in exactly one shard, the
+/// empty shards succeed with nothing to do; and shards run at the same
+/// time into one `--out-dir` (as the README's GNU parallel example does),
+/// with trim pairs, give the outputs of one unsharded run, byte for byte.
+#[test]
+fn shards_beyond_the_inputs_and_at_the_same_time_into_one_directory() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    for rel in ["in/a", "in/b", "in/sub/c"] {
+        pair(d, rel);
+    }
+    let whole = batch(d, &["in", "--out-dir", "whole"]);
+    assert_ok(&whole);
+    let n = 5;
+    let shards: Vec<_> = (1..=n)
+        .map(|k| {
+            Command::new(env!("CARGO_BIN_EXE_meshtrim"))
+                .args(["batch", "in", "--out-dir", "sharded", "--shard"])
+                .arg(format!("{k}/{n}"))
+                .current_dir(d)
+                .spawn()
+                .expect("run meshtrim")
+        })
+        .collect();
+    for mut child in shards {
+        assert!(child.wait().unwrap().success());
+    }
+    let (whole_files, sharded_files) = (
+        files_below(&d.join("whole")),
+        files_below(&d.join("sharded")),
+    );
+    assert_eq!(whole_files.len(), 3, "{whole_files:?}");
+    assert_eq!(whole_files, sharded_files);
+    for f in &whole_files {
+        assert!(
+            std::fs::read(d.join("whole").join(f)).unwrap()
+                == std::fs::read(d.join("sharded").join(f)).unwrap(),
+            "{f:?} differs"
+        );
+    }
+}

@@ -573,3 +573,27 @@ fn large_text_clouds_read_in_pieces_as_the_binary_ply() {
         );
     }
 }
+
+/// A run that fails leaves an existing output as it was and no temporary
+/// file beside it; an output where nothing can be written (its directory
+/// is a file) is a clear error naming it, and nothing is written.
+#[test]
+fn a_failing_run_leaves_the_existing_output_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("labels.csv");
+    std::fs::write(&out, b"earlier result").unwrap();
+    let (_d, bad) = input_file("bad.xyz", b"1 2 3\n4 five 6\n");
+    let run = meshtrim(&["detect", path_str(&bad), "-o", path_str(&out)]);
+    assert_eq!(run.status.code(), Some(1), "{}", stderr(&run));
+    assert_eq!(std::fs::read(&out).unwrap(), b"earlier result");
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+
+    let target = out.join("labels.csv");
+    let run = meshtrim(&["detect", FIXTURE, "-o", path_str(&target)]);
+    let err = stderr(&run);
+    assert_eq!(run.status.code(), Some(1), "{err}");
+    assert!(err.contains(&out.display().to_string()), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert_eq!(std::fs::read(&out).unwrap(), b"earlier result");
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+}
