@@ -40,7 +40,7 @@ else
 fi
 bash scripts/python_env.sh
 cargo build --release --bin meshtrim
-MESHTRIM="$PWD/target/release/meshtrim" .venv-test/bin/python -m pytest -q -rs tests/python
+MESHTRIM="$PWD/target/release/meshtrim" .venv-test/bin/python -m pytest -q -rsx tests/python
 # A short seeded fuzzing pass of the CLI (about 40 s): no mutated input may
 # make it panic, die by a signal or hang.
 .venv-test/bin/python scripts/fuzz_cli.py --seed 2026 --cases 150 --timeout 60

@@ -26,8 +26,9 @@ as far from the truth as the jagged input and farther than the default.
 Real scans (face000, lato000 from MeshLab's samples, the bunny's bun000
 range grid): exit 0, PyMeshLab finds no non-manifold edge, no more
 non-manifold vertices than in the input, nothing to merge or remove; the
-border loops (split at pinched vertices) do not grow; at least the measured
-share of the loops is smoothed.
+border loops (split at pinched vertices) do not grow; every outer border
+and every loop of 8 vertices or more is replaced; new faces have a floor
+on their angles (an expected failure where the product falls short).
 
 Measured (seed 1; spacings; area as a fraction of the true area):
 
@@ -305,14 +306,16 @@ def test_batch_cleans_a_directory(tmp_path):
 # Real scans.
 
 REAL = {
-    # name: (path, measured smoothed loops / loops in)
-    "face000": ("meshlab_scans/face000.ply", 40 / 44),
-    "lato000": ("meshlab_scans/lato000.ply", 17 / 19),
-    "Laurana50k": ("meshlab_scans/Laurana50k.ply", 1 / 4),
-    "bun000": ("stanford_bunny/bun000.ply", 4 / 4),
-    "bun045": ("stanford_bunny/bun045.ply", 8 / 8),
-    "bun090": ("stanford_bunny/bun090.ply", 12 / 20),
-    "chin": ("stanford_bunny/chin.ply", 15 / 17),
+    # name: path. What must be replaced is asserted as requirements below
+    # (every outer border; loops of 8 vertices or more), not as shares of
+    # today's output.
+    "face000": "meshlab_scans/face000.ply",
+    "lato000": "meshlab_scans/lato000.ply",
+    "Laurana50k": "meshlab_scans/Laurana50k.ply",
+    "bun000": "stanford_bunny/bun000.ply",
+    "bun045": "stanford_bunny/bun045.ply",
+    "bun090": "stanford_bunny/bun090.ply",
+    "chin": "stanford_bunny/chin.ply",
 }
 
 OUTER_SHRINK = {
@@ -341,8 +344,7 @@ def clean_scan(name, tmp_path_factory):
     result) and measures input and output."""
     if name in _SCANS:
         return _SCANS[name]
-    rel, share = REAL[name]
-    src = shared_data(rel)
+    src = shared_data(REAL[name])
     d = tmp_path_factory.mktemp(f"scan_{name}")
     out = d / f"{name}_clean.ply"
     report = d / "report.json"
@@ -353,7 +355,6 @@ def clean_scan(name, tmp_path_factory):
     rep = json.loads(report.read_text())
     s = {
         "name": name,
-        "share": share,
         "in": (iv, if_),
         "out": (ov, of),
         "report": rep,
@@ -397,7 +398,6 @@ def test_scan_loops(scan):
     left = sum(len(x["loops"]) for x in rep["loops_left"])
     assert rep["loops_smoothed"] + rep["loops_too_small"] + left == rep["loops_in"], rep
     assert all(x["reason"] for x in rep["loops_left"]), rep
-    assert rep["loops_smoothed"] >= scan["share"] * rep["loops_in"], rep
     assert rep["faces_out"] == len(scan["out"][1]), rep
 
 
@@ -509,6 +509,36 @@ def test_scan_new_faces_are_rarely_thin(scan):
         return
     assert very_thin <= max(2, 0.005 * len(angles)), (scan["name"], very_thin, len(angles))
     assert thin <= max(4, 0.02 * len(angles)), (scan["name"], thin, len(angles))
+
+
+MIN_NEW_ANGLE = 1.0
+"""The floor on the new faces' smallest angle, in degrees: below it a
+face's normal is at the mercy of its vertices' rounding."""
+
+SHORT_OF_THE_FLOOR = {
+    # name: smallest new angle measured (degrees). Where two smoothed
+    # borders, or a border and the range grid's own slivers along a
+    # silhouette, run within a fraction of a spacing, the strip or patch
+    # between them has a needle.
+    "face000": 0.03,
+    "bun000": 0.44,
+    "bun045": 0.10,
+    "bun090": 0.17,
+    "chin": 0.12,
+}
+
+
+@pytest.mark.parametrize("name", sorted(REAL))
+def test_scan_new_faces_have_a_floor(name, tmp_path_factory, request):
+    """No new face below MIN_NEW_ANGLE. The product falls short of it on
+    five scans: those are strict expected failures, so the suite says so,
+    and turns red the day one of them passes (then the entry goes)."""
+    if name in SHORT_OF_THE_FLOOR:
+        request.applymarker(
+            pytest.mark.xfail(strict=True, reason=f"smallest new angle {SHORT_OF_THE_FLOOR[name]} degrees")
+        )
+    scan = clean_scan(name, tmp_path_factory)
+    assert new_face_angles(scan).min() >= MIN_NEW_ANGLE
 
 
 # --------------------------------------------------------------------------
