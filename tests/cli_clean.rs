@@ -219,6 +219,12 @@ fn a_closed_mesh_is_written_unchanged_and_reports_no_new_angle() {
     let stdout = String::from_utf8_lossy(&run.stdout);
     assert!(stdout.contains("0 removed, 0 new"), "{stdout}");
     assert!(stdout.contains("none (no new faces)"), "{stdout}");
+    let (before, after) = (
+        meshtrim::io::read_mesh(&input).unwrap(),
+        meshtrim::io::read_mesh(&out).unwrap(),
+    );
+    assert_eq!(after.vertices, before.vertices);
+    assert_eq!(after.faces, before.faces);
 }
 
 /// The fixture with `extra` binary STL triangles appended, written to

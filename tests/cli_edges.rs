@@ -249,7 +249,9 @@ fn json_summary_has_the_documented_keys() {
     let n = |k: &str| v[k].as_f64().unwrap();
     assert!(n("boundary_points") > 0.0 && n("boundary_points") < n("points"));
     assert!(n("edges") >= n("loops") && n("corners") >= 4.0);
-    assert!(n("read_ms") >= 0.0 && n("detect_ms") >= 0.0 && n("edges_ms") >= 0.0);
+    // Detection and edges of 2,800 points take some time; reading may
+    // round to 0.
+    assert!(n("read_ms") >= 0.0 && n("detect_ms") > 0.0 && n("edges_ms") > 0.0);
 }
 
 #[test]

@@ -64,14 +64,16 @@ fn a_range_scan_seen_from_its_camera_has_one_outer_loop() {
     };
     let found = trim::detect_boundary(&cloud.points, &options).unwrap();
     let edges = reconstruct_edges(&cloud.points, &found, &EdgeOptions::default());
-    let largest = edges
+    let mut sizes: Vec<usize> = edges
         .loops
         .iter()
         .map(|l| l.boundary_points.len())
-        .max()
-        .unwrap_or(0);
-    assert!(edges.loops.len() <= 10, "{} loops", edges.loops.len());
-    assert!(largest >= 450, "largest loop {largest} points");
+        .collect();
+    sizes.sort_unstable_by(|a, b| b.cmp(a));
+    // One outer loop round the carton's view (measured 525 points), and
+    // the rest small holes (21, 6, 6): none a tenth of its size.
+    assert!(sizes.first().is_some_and(|&n| n >= 450), "{sizes:?}");
+    assert!(sizes[1..].iter().all(|&n| n * 10 < sizes[0]), "{sizes:?}");
 }
 
 /// Tests on the real scans that are not shipped in `fixtures/` (their
