@@ -269,6 +269,18 @@ pub fn noise_robustness(
     options: &BpdOptions,
     seed: u64,
 ) -> Result<NoiseRobustness, CloudError> {
+    noise_robustness_with(truth, percents, options, |p| truth.with_noise(p, seed))
+}
+
+/// [`noise_robustness`] with the noisy points of each level p (a fraction
+/// of the local resolution) from `noisy`: noise along a line of sight, in
+/// the tangent plane, or any other kind.
+pub fn noise_robustness_with(
+    truth: &SyntheticCloud,
+    percents: &[f64],
+    options: &BpdOptions,
+    noisy: impl Fn(f64) -> Vec<P3>,
+) -> Result<NoiseRobustness, CloudError> {
     let index = BoundaryIndex::new(truth);
     let deep: Vec<bool> = truth
         .points
@@ -291,7 +303,7 @@ pub fn noise_robustness(
         let labels = if percent == 0.0 {
             reference.clone()
         } else {
-            detect_boundary(&truth.with_noise(percent / 100.0, seed), options)?.boundary
+            detect_boundary(&noisy(percent / 100.0), options)?.boundary
         };
         let mut step = NoiseStep {
             percent,

@@ -538,6 +538,27 @@ impl SyntheticCloud {
             })
             .collect()
     }
+
+    /// The points moved within the surface's tangent plane, in a random
+    /// direction, by uniform(0, p) times their intended spacing: sampling
+    /// jitter rather than measurement noise (a scanner's timing or
+    /// encoder error along its lines).
+    pub fn with_tangent_noise(&self, p: f64, seed: u64) -> Vec<P3> {
+        let mut rng = SplitMix64::new(seed ^ 0x7461_6e67_656e_7421);
+        self.points
+            .iter()
+            .zip(&self.uv)
+            .zip(&self.spacing)
+            .map(|((x, &uv), h)| {
+                let (tu, tv) = self.surface.tangents(uv);
+                let (tu, tv) = (normalised(tu), normalised(tv));
+                let angle = rng.range(0.0, std::f64::consts::TAU);
+                let m = rng.unit() * p * h;
+                let (c, s) = (m * angle.cos(), m * angle.sin());
+                [0, 1, 2].map(|a| x[a] + c * tu[a] + s * tv[a])
+            })
+            .collect()
+    }
 }
 
 /// A range scan of `truth` as the tests see it, with depth quantised in

@@ -3,10 +3,12 @@
 //! to see the measured numbers.
 
 use testkit::{
-    evaluate::{ideal_first_layer, noise_robustness, percent_sweep, precision_recall},
+    evaluate::{
+        ideal_first_layer, noise_robustness, noise_robustness_with, percent_sweep, precision_recall,
+    },
     synthetic::{self, SyntheticCloud},
 };
-use trim::{detect_boundary, BpdOptions};
+use trim::{detect_boundary, BpdOptions, View};
 
 const TARGET: f64 = 0.98;
 
@@ -507,5 +509,84 @@ fn noise_over_ten_samplings_and_two_patterns_at_the_median() {
             failures.push(format!("{h} mm: median Ω {o} %, Ψ {p} %"));
         }
     }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// Ω and Ψ against the truth over ten samplings per resolution (decimated
+/// blades, seeds 1–10, noise pattern 7) with the noisy points of `noisy`
+/// (given the cloud and the level), detected with `options_of` the cloud;
+/// the failures of the medians to reach Ω ≥ 25 %, Ψ ≥ 75 %.
+fn medians_short_of_the_paper(
+    kind: &str,
+    noisy: impl Fn(&SyntheticCloud, f64) -> Vec<[f64; 3]>,
+    options_of: impl Fn(&SyntheticCloud) -> BpdOptions,
+) -> Vec<String> {
+    let mut failures = Vec::new();
+    for h in [4.0, 8.0, 16.0, 34.0] {
+        let (mut omega, mut psi) = (Vec::new(), Vec::new());
+        for seed in 1..=10 {
+            let cloud = synthetic::decimated_blade(h, seed);
+            let sweep = percent_sweep(5.0, 75.0);
+            let r =
+                noise_robustness_with(&cloud, &sweep, &options_of(&cloud), |p| noisy(&cloud, p))
+                    .unwrap();
+            omega.push(r.omega_truth.percent);
+            psi.push(r.psi_truth.percent);
+        }
+        omega.sort_unstable_by(f64::total_cmp);
+        psi.sort_unstable_by(f64::total_cmp);
+        let (o, p) = ((omega[4] + omega[5]) / 2.0, (psi[4] + psi[5]) / 2.0);
+        eprintln!(
+            "{kind}, {h} mm: median Ω {o} %, Ψ {p} %; worst Ω {} %, Ψ {} %",
+            omega[0], psi[0]
+        );
+        if o < 25.0 || p < 75.0 {
+            failures.push(format!("{kind}, {h} mm: median Ω {o} %, Ψ {p} %"));
+        }
+    }
+    failures
+}
+
+/// The line of sight of a range scanner looking at `cloud` 30° off its
+/// mean normal.
+fn oblique_sight(cloud: &SyntheticCloud) -> [f64; 3] {
+    let [nx, ny, nz] = cloud.mean_normal();
+    let (c, s) = (30f64.to_radians().cos(), 30f64.to_radians().sin());
+    [c * nx - s * ny, s * nx + c * ny, nz]
+}
+
+/// Depth noise along a range scanner's line of sight, 30° off the mean
+/// normal, with that line of sight given to detection (`--view-along`):
+/// the median case reaches the paper's levels at every resolution.
+/// (Without the view, measured: median Ψ 45 % at 4 mm, median Ω 20 % at
+/// 34 mm: the noise's component across the normal moves points within
+/// the surface.)
+#[test]
+fn depth_noise_along_a_given_line_of_sight_at_the_median() {
+    let failures = medians_short_of_the_paper(
+        "line of sight",
+        |cloud, p| cloud.with_depth_noise(oblique_sight(cloud), p, 7),
+        |cloud| BpdOptions {
+            view: Some(View::Along(oblique_sight(cloud))),
+            ..BpdOptions::default()
+        },
+    );
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// Noise within the tangent plane (sampling jitter of p spacings) changes
+/// the sampling itself, and BPD's gaps with it: the paper's levels, set
+/// for noise across the surface, are out of reach. Measured medians: Ω
+/// 7.5 / 12.5 / 12.5 / 2.5 %, Ψ 12.5 / 17.5 / 37.5 / 67.5 % at 4 / 8 / 16 /
+/// 34 mm. A strict expected failure: it fails the day the medians reach
+/// the levels, and then becomes a plain requirement.
+#[test]
+#[should_panic(expected = "tangent plane")]
+fn noise_in_the_tangent_plane_falls_short_of_the_paper() {
+    let failures = medians_short_of_the_paper(
+        "tangent plane",
+        |cloud, p| cloud.with_tangent_noise(p, 7),
+        |_| BpdOptions::default(),
+    );
     assert!(failures.is_empty(), "{failures:#?}");
 }
