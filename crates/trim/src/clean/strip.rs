@@ -32,7 +32,7 @@
 //!    beside them.
 
 use super::*;
-use crate::geom::{scale, unit};
+use crate::geom::{scale, segment_param, unit};
 use crate::spatial::PointTree;
 
 /// Segments of the smoothed loop searched, ahead of the last wall vertex's
@@ -161,14 +161,8 @@ impl Guide {
     fn on_segment(&self, j: usize, p: Point3) -> Nearest {
         let a = self.points[j];
         let b = self.points[(j + 1) % self.len()];
-        let ab = sub(b, a);
-        let l2 = norm2(ab);
-        let t = if l2 > 0.0 {
-            (dot(sub(p, a), ab) / l2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        let q = add(a, scale(ab, t));
+        let t = segment_param(p, a, b);
+        let q = add(a, scale(sub(b, a), t));
         Nearest {
             segment: j,
             t,

@@ -45,14 +45,20 @@ pub(crate) fn unit(a: Point3) -> Point3 {
     }
 }
 
-/// Squared distance from `p` to the segment from `a` to `b`.
-pub(crate) fn segment_dist2(p: Point3, a: Point3, b: Point3) -> f64 {
+/// Where the point of the segment from `a` to `b` nearest `p` lies, as a
+/// fraction of the way from `a` (0 for a segment of zero length).
+pub(crate) fn segment_param(p: Point3, a: Point3, b: Point3) -> f64 {
     let ab = sub(b, a);
     let l2 = norm2(ab);
-    let t = if l2 > 0.0 {
+    if l2 > 0.0 {
         (dot(sub(p, a), ab) / l2).clamp(0.0, 1.0)
     } else {
         0.0
-    };
-    dist2(p, add(a, scale(ab, t)))
+    }
+}
+
+/// Squared distance from `p` to the segment from `a` to `b`.
+pub(crate) fn segment_dist2(p: Point3, a: Point3, b: Point3) -> f64 {
+    let t = segment_param(p, a, b);
+    dist2(p, add(a, scale(sub(b, a), t)))
 }
