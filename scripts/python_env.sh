@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Creates (idempotently) the Python test venv at .venv-test/ with the pinned
-# packages of the PyMeshLab validation suite (tests/python/).
+# packages of the Python tests (tests/python/requirements.txt): the PyMeshLab
+# validation suite and the meshtrim package's tests.
 #
 #   bash scripts/python_env.sh            # create or check the venv
 #   .venv-test/bin/python -m pytest tests/python
@@ -11,9 +12,11 @@
 #   ($MESHTRIM_WHEELHOUSE, default ~/.cache/meshtrim/wheels).
 # - Offline: if PyPI cannot be reached, installs from that wheelhouse
 #   (pip --no-index), so a machine that has run this once can rebuild the venv.
-# - Headless: pymeshlab's manylinux wheel bundles Qt and MeshLab; no Debian
-#   package is needed. The final check builds a MeshSet and runs screened
-#   Poisson on a small cloud.
+# - Headless: pymeshlab's manylinux wheel bundles Qt and MeshLab; Open3D's
+#   needs one Debian package, libusb-1.0-0, installed here when missing (as
+#   root; otherwise the script says what to install). The final check
+#   imports every package, builds a MeshSet and runs screened Poisson on a
+#   small cloud.
 # Needs python3 >= 3.10 with the venv module (PYTHON overrides the interpreter).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -22,17 +25,9 @@ VENV=.venv-test
 PYTHON=${PYTHON:-python3}
 WHEELHOUSE=${MESHTRIM_WHEELHOUSE:-$HOME/.cache/meshtrim/wheels}
 
-# The pins. numpy: pymeshlab 2025.7.post1 declares plain "numpy" and converts
-# arrays through pybind11 at run time, so numpy 2.x works (checked below).
-# scipy: cKDTree for nearest-point distances. The last three are pytest's
-# dependencies, pinned so the venv is the same everywhere.
-REQUIREMENTS='pymeshlab==2025.7.post1
-numpy==2.2.6
-scipy==1.15.3
-pytest==8.3.5
-iniconfig==2.3.1
-packaging==26.3
-pluggy==1.7.0'
+# The pins, with why each package is there.
+REQUIREMENTS_FILE=tests/python/requirements.txt
+REQUIREMENTS=$(cat "$REQUIREMENTS_FILE")
 
 STAMP="$VENV/.meshtrim-requirements"
 log() { echo "python_env: $*" >&2; }
@@ -43,6 +38,10 @@ import numpy as np
 import pymeshlab
 import scipy.spatial
 import pytest  # noqa: F401
+import open3d  # noqa: F401  (fails without libusb-1.0)
+import trimesh  # noqa: F401
+import dask.bag  # noqa: F401
+import distributed  # noqa: F401
 
 # A small cap of a sphere: screened Poisson must produce faces.
 rng = np.random.default_rng(1)
@@ -58,6 +57,18 @@ assert m.vertex_scalar_array().shape[0] == m.vertex_number()
 EOF
 }
 
+# Open3D's wheel links libusb-1.0, which Debian ships apart.
+if ! ldconfig -p 2>/dev/null | grep -q 'libusb-1.0.so.0'; then
+    if [[ $(id -u) == 0 ]] && command -v apt-get >/dev/null; then
+        log "installing libusb-1.0-0 (Debian) for open3d"
+        apt-get install -y -q libusb-1.0-0 >/dev/null ||
+            { apt-get update -q >/dev/null && apt-get install -y -q libusb-1.0-0 >/dev/null; }
+    else
+        log "open3d needs libusb-1.0: install it (sudo apt-get install libusb-1.0-0) and run again"
+        exit 1
+    fi
+fi
+
 if [[ -f "$STAMP" && "$(cat "$STAMP")" == "$REQUIREMENTS" && -x "$VENV/bin/python" ]]; then
     if check 2>/dev/null; then
         log "$VENV is up to date"
@@ -72,9 +83,7 @@ if [[ ! -x "$VENV/bin/python" ]]; then
     "$PYTHON" -m venv "$VENV"
 fi
 rm -f "$STAMP"
-REQ_FILE=$(mktemp)
-trap 'rm -f "$REQ_FILE"' EXIT
-printf '%s\n' "$REQUIREMENTS" >"$REQ_FILE"
+REQ_FILE=$REQUIREMENTS_FILE
 PIP=("$VENV/bin/python" -m pip --disable-pip-version-check --no-input)
 
 if "${PIP[@]}" install --timeout 30 --retries 2 -r "$REQ_FILE"; then

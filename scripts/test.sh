@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
-# Runs every test: Rust unit, integration and CLI tests, then the PyMeshLab
-# validation of the trimming (tests/python/, in the .venv-test venv, which
-# this creates or checks first: about 35 s the first time, 1.5 s after),
+# Runs every test: Rust unit, integration and CLI tests, then the Python
+# tests (tests/python/: the PyMeshLab validation of the commands and the
+# meshtrim package's tests, in the .venv-test venv, which this creates or
+# checks first: about 1.5 min the first time, 3 s after; the package is
+# built and installed into it),
 # then a short seeded fuzzing pass of the CLI (scripts/fuzz_cli.py).
 #
 # The PCL scans the tests read are shipped in fixtures/scans; the other
@@ -25,7 +27,8 @@ data_found() {
 
 # Libraries, binaries and tests; the examples are compiled (and linted) by
 # `cargo clippy --all-targets` in CI, so they are not built again here.
-rust_tests=(cargo test --workspace --release --lib --bins --tests)
+# The Python package's native module is tested from Python (below).
+rust_tests=(cargo test --workspace --exclude meshtrim-python --release --lib --bins --tests)
 if data_found; then
     "${rust_tests[@]}"
 elif [ -n "${MESHTRIM_REQUIRE_DATA:-}" ]; then
@@ -40,6 +43,11 @@ else
 fi
 bash scripts/python_env.sh
 cargo build --release --bin meshtrim
+# The Python package (python/), built by maturin in release into the shared
+# target/ (so the CLI's compiled dependencies are reused) and installed into
+# the venv, replacing any earlier build.
+PATH="$PWD/.venv-test/bin:$PATH" .venv-test/bin/python -m pip install --quiet \
+    --disable-pip-version-check --no-build-isolation --no-deps --force-reinstall ./python
 MESHTRIM="$PWD/target/release/meshtrim" .venv-test/bin/python -m pytest -q -rsx tests/python
 # A short seeded fuzzing pass of the CLI (about 40 s): no mutated input may
 # make it panic, die by a signal or hang.

@@ -20,4 +20,4 @@ pub mod commands;
 mod console;
 pub mod io;
 mod report;
-mod stages;
+pub mod stages;

@@ -19,7 +19,8 @@ fn main() -> ExitCode {
             // `{:#}` joins the context chain: "error: FILE: what went wrong".
             // Written, not `eprintln!`ed: a closed stderr pipe must not turn
             // the error into a panic; the exit code still says it failed.
-            let _ = writeln!(std::io::stderr(), "error: {e:#}");
+            let message = meshtrim::stages::in_cli_words(&format!("{e:#}"));
+            let _ = writeln!(std::io::stderr(), "error: {message}");
             ExitCode::FAILURE
         }
     }

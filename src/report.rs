@@ -72,6 +72,11 @@ pub(crate) fn same_file(a: &Path, b: &Path) -> bool {
     }
 }
 
+/// A file name of a report, or "(in memory)" for the Python package's.
+pub(crate) fn shown(name: &Option<String>) -> String {
+    name.clone().unwrap_or_else(|| "(in memory)".to_string())
+}
+
 /// `x` in plain decimal notation with `digits` significant digits: a
 /// distance reads the same way in millimetres and in metres.
 pub(crate) fn significant(x: f64, digits: usize) -> String {

@@ -1,17 +1,15 @@
-//! The first stages every command runs, and the options of all stages:
-//! the shared arguments become the library's options here; a cloud is read
-//! and its boundary detected (with a progress bar on a terminal), with the
-//! time of each step.
+//! The options of all stages, as the library takes them; boundary
+//! detection with a progress bar on a terminal, which every command that
+//! works from a cloud runs first; and the library's error messages in the
+//! command line's words.
 
-use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use trim::{BpdOptions, CloudError, Detection, EdgeOptions};
 
-use crate::io::{read_cloud, Cloud, Point3};
+use crate::io::Point3;
 
 /// The options of detection and edge reconstruction, as the library takes
 /// them: what a command (or each file of a batch) runs with.
@@ -23,49 +21,17 @@ pub struct Stages {
     pub edges: EdgeOptions,
 }
 
-/// A cloud read from a file and its boundary points, with the time of each
-/// step: the start of every command that works from a cloud.
-pub(crate) struct Detected {
-    pub cloud: Cloud,
-    pub detection: Detection,
-    pub read_time: Duration,
-    pub detect_time: Duration,
-}
-
-/// Reads the cloud at `path` and runs BPD on it (with the progress bar),
-/// errors naming the file.
-pub(crate) fn read_and_detect(path: &Path, options: &BpdOptions) -> Result<Detected> {
-    let started = Instant::now();
-    let cloud = read_cloud(path)?;
-    let read_time = started.elapsed();
-    detect_read_cloud(path, cloud, read_time, options, true)
-}
-
-/// Runs BPD on `cloud`, read from `path` in `read_time`, with or without
-/// the progress bar (`meshtrim batch` runs several files at once under one
-/// bar of its own, so its files' detections show none); errors name the
-/// file.
-pub(crate) fn detect_read_cloud(
-    path: &Path,
-    cloud: Cloud,
-    read_time: Duration,
+/// BPD on `points`, with the progress bar or without.
+pub(crate) fn detect(
+    points: &[Point3],
     options: &BpdOptions,
     progress: bool,
-) -> Result<Detected> {
-    let started = Instant::now();
-    let detection = if progress {
-        detect_with_progress(&cloud.points, options)
+) -> Result<Detection, CloudError> {
+    if progress {
+        detect_with_progress(points, options)
     } else {
-        trim::detect_boundary(&cloud.points, options)
+        trim::detect_boundary(points, options)
     }
-    .map_err(in_cli_words)
-    .with_context(|| path.display().to_string())?;
-    Ok(Detected {
-        cloud,
-        detection,
-        read_time,
-        detect_time: started.elapsed(),
-    })
 }
 
 /// Milliseconds, rounded to 0.1 ms.
@@ -99,19 +65,16 @@ fn detect_with_progress(points: &[Point3], options: &BpdOptions) -> Result<Detec
     result
 }
 
-/// A library error in the command line's words. The library advises in
-/// terms of its parameters and functions: lower k, trim a Poisson mesh
-/// instead; here they are the flag `--k` and the command
-/// `meshtrim MESH CLOUD OUT`.
-pub(crate) fn in_cli_words(error: impl std::error::Error) -> anyhow::Error {
-    let message = error
-        .to_string()
-        .replace("lower k or", "lower --k or")
-        .replace(
-            "trim that mesh instead",
-            "use `meshtrim MESH CLOUD OUT` instead",
-        );
-    anyhow::Error::msg(message)
+/// An error message in the command line's words. The library (and the
+/// Python package, which passes its messages on) advises in terms of its
+/// parameters and functions: lower k, trim a Poisson mesh instead; on the
+/// command line they are the flag `--k` and the command
+/// `meshtrim MESH CLOUD OUT`. Applied where the CLI prints an error.
+pub fn in_cli_words(message: &str) -> String {
+    message.replace("lower k or", "lower --k or").replace(
+        "trim that mesh instead",
+        "use `meshtrim MESH CLOUD OUT` instead",
+    )
 }
 
 #[cfg(test)]
@@ -128,9 +91,7 @@ mod tests {
             total: 6,
             k: 30,
         };
-        assert!(in_cli_words(few)
-            .to_string()
-            .ends_with("; lower --k or use a denser cloud"));
+        assert!(in_cli_words(&few.to_string()).ends_with("; lower --k or use a denser cloud"));
         let folds = [
             DelaunayError::NotAHeightField {
                 percent: 2.0,
@@ -145,7 +106,7 @@ mod tests {
             DelaunayError::LoopsCross { a: 0, b: 1 },
         ];
         for error in folds {
-            let words = in_cli_words(error).to_string();
+            let words = in_cli_words(&error.to_string());
             assert!(
                 words.ends_with(
                     "mesh it with screened Poisson and use `meshtrim MESH CLOUD OUT` instead"

@@ -15,7 +15,8 @@ use trim::{clean_mesh, CleanOptions, CleanReport};
 use crate::commands::args::StageArgs;
 use crate::io::mesh_out::write_mesh;
 use crate::io::read_mesh_with_faces;
-use crate::stages::{in_cli_words, millis, Stages};
+use crate::report::shown;
+use crate::stages::{millis, Stages};
 
 /// Arguments of `meshtrim clean`.
 #[derive(Debug, Clone, clap::Args)]
@@ -58,10 +59,10 @@ pub struct CleanOutcome {
 /// What `clean` prints and `--report` writes.
 #[derive(Debug, Clone, Serialize)]
 pub struct Report {
-    /// Input and output, as given.
-    pub input: String,
+    /// Input and output, as given (none in memory).
+    pub input: Option<String>,
     /// The output.
-    pub output: String,
+    pub output: Option<String>,
     /// Vertices of the input.
     pub vertices: usize,
     /// Border loops of the input.
@@ -157,43 +158,50 @@ fn clean(input: &Path, output: &Path, stages: &Stages, no_faces: &str) -> Result
     let started = Instant::now();
     let mesh = read_mesh_with_faces(input, no_faces)?;
     let read_time = started.elapsed();
+    let name = input.display().to_string();
+    let (out, mut report) = clean_in_memory(&mesh, stages, &name)?;
+    let started = Instant::now();
+    write_mesh(output, &out.vertices, &out.faces)?;
+    report.read_ms = millis(read_time);
+    report.write_ms = millis(started.elapsed());
+    report.input = Some(name);
+    report.output = Some(output.display().to_string());
+    Ok(report)
+}
+
+/// Cleans `mesh` in memory: everything `meshtrim clean` does between
+/// reading and writing, and what the Python package runs. Errors begin
+/// with `name` (the file's path, or the argument's name). The report names
+/// no file and has no read or write time.
+pub fn clean_in_memory(
+    mesh: &trim::Mesh,
+    stages: &Stages,
+    name: &str,
+) -> Result<(trim::Mesh, Report)> {
     let started = Instant::now();
     // Only β is needed: the mesh knows its border (BPD's labels would be
     // thrown away), and β alone takes about half the time.
     let beta = trim::local_resolution(&mesh.vertices, &stages.detection)
-        .map_err(in_cli_words)
-        .with_context(|| format!("{}: the mesh's vertices", input.display()))?;
+        .with_context(|| format!("{name}: the mesh's vertices"))?;
     let resolution_time = started.elapsed();
     let started = Instant::now();
     let options = CleanOptions {
         offset: stages.edges.offset,
     };
-    let (out, cleaned) =
-        clean_mesh(&mesh, &beta, &options).with_context(|| input.display().to_string())?;
-    let clean_time = started.elapsed();
-    let started = Instant::now();
-    write_mesh(output, &out.vertices, &out.faces)?;
-    let times = [read_time, resolution_time, clean_time, started.elapsed()];
-    Ok(Report::new(
-        input,
-        output,
+    let (out, cleaned) = clean_mesh(mesh, &beta, &options).with_context(|| name.to_string())?;
+    let report = Report::new(
         mesh.vertices.len(),
         &cleaned,
-        times,
-    ))
+        [resolution_time, started.elapsed()],
+    );
+    Ok((out, report))
 }
 
 impl Report {
-    fn new(
-        input: &Path,
-        output: &Path,
-        vertices: usize,
-        r: &CleanReport,
-        [read, resolution, clean, write]: [Duration; 4],
-    ) -> Self {
+    fn new(vertices: usize, r: &CleanReport, [resolution, clean]: [Duration; 2]) -> Self {
         Report {
-            input: input.display().to_string(),
-            output: output.display().to_string(),
+            input: None,
+            output: None,
             vertices,
             loops_in: r.loops_in,
             loops_smoothed: r.loops_smoothed,
@@ -219,10 +227,10 @@ impl Report {
             min_angle_new: r.min_angle_new,
             area_in: r.area_in,
             area_out: r.area_out,
-            read_ms: millis(read),
+            read_ms: 0.0,
             resolution_ms: millis(resolution),
             clean_ms: millis(clean),
-            write_ms: millis(write),
+            write_ms: 0.0,
         }
     }
 }
@@ -245,7 +253,7 @@ impl crate::report::Table for Report {
         let mut rows = vec![
             (
                 "input",
-                format!("{} ({} vertices)", self.input, self.vertices),
+                format!("{} ({} vertices)", shown(&self.input), self.vertices),
             ),
             (
                 "loops",
@@ -271,7 +279,7 @@ impl crate::report::Table for Report {
             ("resolution time", format!("{:.1} ms", self.resolution_ms)),
             ("clean time", format!("{:.1} ms", self.clean_ms)),
             ("write time", format!("{:.1} ms", self.write_ms)),
-            ("output", self.output.clone()),
+            ("output", shown(&self.output)),
         ];
         if self.zero_area_faces_repaired + self.zero_area_faces_left > 0 {
             rows.insert(

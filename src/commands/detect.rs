@@ -1,19 +1,19 @@
 //! `meshtrim detect`: read a cloud, label its boundary points, report.
 
 use std::path::{Path, PathBuf};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
-use anyhow::{bail, Result};
+use anyhow::{bail, Context, Result};
 use serde::Serialize;
-use trim::{BpdOptions, Detection};
+use trim::{BpdOptions, Detection, View};
 
 use crate::commands::args::{bpd_options, parse_k, ViewArgs};
 use crate::console;
 use crate::io::atomic::write_atomic;
 use crate::io::labels::{LabelFormat, Labelled};
-use crate::io::Point3;
-use crate::report::same_file;
-use crate::stages::{millis, read_and_detect, Detected};
+use crate::io::{read_cloud, Point3};
+use crate::report::{same_file, shown};
+use crate::stages::{detect, millis};
 
 /// Arguments of `meshtrim detect`.
 #[derive(Debug, Clone, clap::Args)]
@@ -49,8 +49,8 @@ impl Args {
 /// What `detect` prints: the counts and timings of the paper's Table 1.
 #[derive(Debug, Clone, Serialize)]
 pub struct Summary {
-    /// The input file, as given.
-    pub file: String,
+    /// The input file, as given (none in memory).
+    pub file: Option<String>,
     /// Points read (after dropping non-finite PCD points).
     pub points: usize,
     /// Points left after merging exact duplicates.
@@ -93,16 +93,18 @@ pub fn run(args: &Args) -> Result<()> {
         .as_deref()
         .map(|out| check_output(out, &args.cloud))
         .transpose()?;
-    let Detected {
-        cloud,
-        detection,
-        read_time,
-        detect_time,
-    } = read_and_detect(&args.cloud, &args.bpd_options())?;
+    let started = Instant::now();
+    let cloud = read_cloud(&args.cloud)?;
+    let read_time = started.elapsed();
+    let name = args.cloud.display().to_string();
+    let (detection, mut summary) =
+        detect_in_memory(&cloud.points, &args.bpd_options(), true, &name)?;
     if let Some((path, format)) = &output {
         write_labels(path, *format, &cloud.points, &detection)?;
     }
-    let summary = Summary::new(args, &cloud, &detection, read_time, detect_time);
+    summary.file = Some(name);
+    summary.read_ms = millis(read_time);
+    summary.dropped_non_finite = cloud.dropped_non_finite;
     if args.json {
         console::print_line(&serde_json::to_string(&summary)?)
     } else {
@@ -142,32 +144,48 @@ fn write_labels(
     write_atomic(path, |w| format.write(w, data))
 }
 
+/// Labels the boundary points of the cloud `points` in memory: what
+/// `meshtrim detect` does between reading and writing, and what the Python
+/// package runs. Errors begin with `name` (the file's path, or the
+/// argument's name); `progress` shows the bar on a terminal. The summary
+/// names no file and has no read time.
+pub fn detect_in_memory(
+    points: &[Point3],
+    options: &BpdOptions,
+    progress: bool,
+    name: &str,
+) -> Result<(Detection, Summary)> {
+    let started = Instant::now();
+    let detection = detect(points, options, progress).with_context(|| name.to_string())?;
+    let summary = Summary::new(points.len(), &detection, options, started.elapsed());
+    Ok((detection, summary))
+}
+
 impl Summary {
-    fn new(
-        args: &Args,
-        cloud: &crate::io::Cloud,
-        detection: &Detection,
-        read_time: Duration,
-        detect_time: Duration,
-    ) -> Self {
+    fn new(points: usize, detection: &Detection, options: &BpdOptions, time: Duration) -> Self {
         let (beta_min, beta_mean, beta_max, beta_std) = stats(&detection.beta);
+        let (view_along, view_from) = match options.view {
+            Some(View::Along(d)) => (Some(d), None),
+            Some(View::From(o)) => (None, Some(o)),
+            None => (None, None),
+        };
         Summary {
-            file: args.cloud.display().to_string(),
-            points: cloud.points.len(),
-            distinct_points: cloud.points.len() - detection.duplicates,
+            file: None,
+            points,
+            distinct_points: points - detection.duplicates,
             duplicates: detection.duplicates,
-            dropped_non_finite: cloud.dropped_non_finite,
+            dropped_non_finite: 0,
             boundary_points: detection.boundary_count(),
             beta_min,
             beta_mean,
             beta_max,
             beta_std,
-            read_ms: millis(read_time),
-            detect_ms: millis(detect_time),
-            k: args.k,
-            anisotropy: !args.no_anisotropy,
-            view_along: args.view.view_along,
-            view_from: args.view.view_from,
+            read_ms: 0.0,
+            detect_ms: millis(time),
+            k: options.k,
+            anisotropy: options.anisotropy,
+            view_along,
+            view_from,
         }
     }
 
@@ -176,7 +194,7 @@ impl Summary {
         let share = 100.0 * self.boundary_points as f64 / self.points.max(1) as f64;
         let on_off = if self.anisotropy { "on" } else { "off" };
         let rows = [
-            ("file", self.file.clone()),
+            ("file", shown(&self.file)),
             ("points", self.points.to_string()),
             ("distinct points", self.distinct_points.to_string()),
             ("duplicates", self.duplicates.to_string()),

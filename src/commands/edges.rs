@@ -5,7 +5,7 @@ use std::path::Path;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use anyhow::{bail, Result};
+use anyhow::{bail, Context, Result};
 use serde::Serialize;
 use trim::{reconstruct_edges, Detection, Edges};
 
@@ -13,9 +13,9 @@ use crate::commands::args::StageArgs;
 use crate::console;
 use crate::io::atomic::write_atomic;
 use crate::io::edges_out::{EdgeData, EdgesFormat};
-use crate::io::Cloud;
-use crate::report::same_file;
-use crate::stages::{millis, read_and_detect, Detected};
+use crate::io::{read_cloud, Point3};
+use crate::report::{same_file, shown};
+use crate::stages::{detect, millis, Stages};
 
 /// Arguments of `meshtrim edges`.
 #[derive(Debug, Clone, clap::Args)]
@@ -39,8 +39,8 @@ pub struct Args {
 /// What `edges` prints: the counts of each stage and the timings.
 #[derive(Debug, Clone, Serialize)]
 pub struct Summary {
-    /// The input file, as given.
-    pub file: String,
+    /// The input file, as given (none in memory).
+    pub file: Option<String>,
     /// Points read (after dropping non-finite PCD points).
     pub points: usize,
     /// Points labelled boundary by BPD (duplicates counted).
@@ -70,24 +70,20 @@ pub struct Summary {
 pub fn run(args: &Args) -> Result<()> {
     // Check the output before the (possibly long) work.
     let format = check_output(&args.output, &args.cloud)?;
-    let stages = args.stages.stages();
-    let Detected {
-        cloud,
-        detection,
-        read_time,
-        detect_time,
-    } = read_and_detect(&args.cloud, &stages.detection)?;
     let started = Instant::now();
-    let edges = reconstruct_edges(&cloud.points, &detection, &stages.edges);
-    let edges_time = started.elapsed();
+    let cloud = read_cloud(&args.cloud)?;
+    let read_time = started.elapsed();
+    let name = args.cloud.display().to_string();
+    let stages = args.stages.stages();
+    let (detection, edges, mut summary) = edges_in_memory(&cloud.points, &stages, true, &name)?;
     let data = EdgeData {
         points: &cloud.points,
         boundary: &detection.boundary,
         edges: &edges,
     };
     write_atomic(&args.output, |w| format.write(w, data))?;
-    let times = [read_time, detect_time, edges_time];
-    let summary = Summary::new(args, &cloud, &detection, &edges, times);
+    summary.file = Some(name);
+    summary.read_ms = millis(read_time);
     if args.json {
         console::print_line(&serde_json::to_string(&summary)?)
     } else {
@@ -110,27 +106,49 @@ fn check_output(out: &Path, input: &Path) -> Result<EdgesFormat> {
     Ok(format)
 }
 
+/// Detects the boundary of the cloud `points` and reconstructs its
+/// smoothed edges, in memory: what `meshtrim edges` does between reading
+/// and writing, and what the Python package runs. Errors begin with `name`
+/// (the file's path, or the argument's name); `progress` shows detection's
+/// bar on a terminal. The summary names no file and has no read time.
+pub fn edges_in_memory(
+    points: &[Point3],
+    stages: &Stages,
+    progress: bool,
+    name: &str,
+) -> Result<(Detection, Edges, Summary)> {
+    let started = Instant::now();
+    let detection =
+        detect(points, &stages.detection, progress).with_context(|| name.to_string())?;
+    let detect_time = started.elapsed();
+    let started = Instant::now();
+    let edges = reconstruct_edges(points, &detection, &stages.edges);
+    let times = [detect_time, started.elapsed()];
+    let summary = Summary::new(points.len(), &detection, &edges, stages, times);
+    Ok((detection, edges, summary))
+}
+
 impl Summary {
     fn new(
-        args: &Args,
-        cloud: &Cloud,
+        points: usize,
         detection: &Detection,
         edges: &Edges,
-        [read, detect, reconstruct]: [Duration; 3],
+        stages: &Stages,
+        [detect, reconstruct]: [Duration; 2],
     ) -> Self {
         Summary {
-            file: args.cloud.display().to_string(),
-            points: cloud.points.len(),
+            file: None,
+            points,
             boundary_points: detection.boundary_count(),
             loops: edges.loops.len(),
             edges: edges.loops.iter().map(|l| l.edges.len()).sum(),
             corners: edges.loops.iter().map(|l| l.corners.len()).sum(),
             dropped_clusters: edges.dropped_clusters,
             thinned_points: edges.thinned_points,
-            read_ms: millis(read),
+            read_ms: 0.0,
             detect_ms: millis(detect),
             edges_ms: millis(reconstruct),
-            offset: !args.stages.no_offset,
+            offset: stages.edges.offset,
         }
     }
 
@@ -139,7 +157,7 @@ impl Summary {
         let share = 100.0 * self.boundary_points as f64 / self.points.max(1) as f64;
         let on_off = if self.offset { "on" } else { "off" };
         let rows = [
-            ("file", self.file.clone()),
+            ("file", shown(&self.file)),
             ("points", self.points.to_string()),
             (
                 "boundary points",
@@ -188,7 +206,7 @@ mod tests {
     #[test]
     fn table_rows() {
         let s = Summary {
-            file: "a.ply".into(),
+            file: Some("a.ply".into()),
             points: 200,
             boundary_points: 20,
             loops: 2,

@@ -11,7 +11,9 @@ use trim::{delaunay_mesh_with_report, reconstruct_edges, DelaunayOptions, Delaun
 
 use crate::commands::args::StageArgs;
 use crate::io::mesh_out::write_mesh;
-use crate::stages::{in_cli_words, millis, read_and_detect, Detected};
+use crate::io::{read_cloud, Point3};
+use crate::report::shown;
+use crate::stages::{detect, millis, Stages};
 
 /// Arguments of `meshtrim mesh`.
 #[derive(Debug, Clone, clap::Args)]
@@ -35,10 +37,10 @@ pub struct Args {
 /// What `mesh` prints and `--report` writes.
 #[derive(Debug, Clone, Serialize)]
 pub struct Report {
-    /// The cloud, as given.
-    pub cloud: String,
-    /// The output, as given.
-    pub output: String,
+    /// The cloud, as given (none in memory).
+    pub cloud: Option<String>,
+    /// The output, as given (none in memory).
+    pub output: Option<String>,
     /// Cloud points read.
     pub points: usize,
     /// Cloud points that are vertices of the output.
@@ -75,45 +77,58 @@ pub fn run(args: &Args) -> Result<()> {
     // Before the (possibly long) work: the output format, the report's
     // name, and neither may overwrite the cloud.
     crate::report::check_outputs(&args.output, args.report.as_deref(), &[&args.cloud])?;
-    let stages = args.stages.stages();
-    let Detected {
-        cloud,
-        detection,
-        read_time,
-        detect_time,
-    } = read_and_detect(&args.cloud, &stages.detection)?;
     let started = Instant::now();
-    let edges = reconstruct_edges(&cloud.points, &detection, &stages.edges);
-    let edges_time = started.elapsed();
-    let started = Instant::now();
-    let (mesh, made) = delaunay_mesh_with_report(
-        &cloud.points,
-        &detection,
-        &edges,
-        &DelaunayOptions::default(),
-    )
-    .map_err(in_cli_words)
-    .with_context(|| args.cloud.display().to_string())?;
-    let mesh_time = started.elapsed();
+    let cloud = read_cloud(&args.cloud)?;
+    let read_time = started.elapsed();
+    let name = args.cloud.display().to_string();
+    let (mesh, mut report) = mesh_in_memory(&cloud.points, &args.stages.stages(), true, &name)?;
     let started = Instant::now();
     write_mesh(&args.output, &mesh.vertices, &mesh.faces)?;
-    let write_time = started.elapsed();
-    let times = [read_time, detect_time, edges_time, mesh_time, write_time];
-    let report = Report::new(args, cloud.points.len(), mesh.faces.len(), &made, times);
+    report.read_ms = millis(read_time);
+    report.write_ms = millis(started.elapsed());
+    report.cloud = Some(name);
+    report.output = Some(args.output.display().to_string());
     crate::report::emit(&report, args.report.as_deref(), args.json)
+}
+
+/// Meshes the cloud `points` in memory (detection, edges, the constrained
+/// Delaunay triangulation): everything `meshtrim mesh` does between reading
+/// and writing, and what the Python package runs. Errors begin with `name`
+/// (the file's path, or the argument's name); `progress` shows detection's
+/// bar on a terminal. The report names no file and has no read or write
+/// time.
+pub fn mesh_in_memory(
+    points: &[Point3],
+    stages: &Stages,
+    progress: bool,
+    name: &str,
+) -> Result<(trim::Mesh, Report)> {
+    let started = Instant::now();
+    let detection =
+        detect(points, &stages.detection, progress).with_context(|| name.to_string())?;
+    let detect_time = started.elapsed();
+    let started = Instant::now();
+    let edges = reconstruct_edges(points, &detection, &stages.edges);
+    let edges_time = started.elapsed();
+    let started = Instant::now();
+    let (mesh, made) =
+        delaunay_mesh_with_report(points, &detection, &edges, &DelaunayOptions::default())
+            .with_context(|| name.to_string())?;
+    let times = [detect_time, edges_time, started.elapsed()];
+    let report = Report::new(points.len(), mesh.faces.len(), &made, times);
+    Ok((mesh, report))
 }
 
 impl Report {
     fn new(
-        args: &Args,
         points: usize,
         faces: usize,
         made: &DelaunayReport,
-        [read, detect, edges, mesh, write]: [Duration; 5],
+        [detect, edges, mesh]: [Duration; 3],
     ) -> Self {
         Report {
-            cloud: args.cloud.display().to_string(),
-            output: args.output.display().to_string(),
+            cloud: None,
+            output: None,
             points,
             points_used: made.points_used,
             points_outside: made.points_outside,
@@ -123,11 +138,11 @@ impl Report {
             diagonals_flipped: made.diagonals_flipped,
             faces,
             area: made.area,
-            read_ms: millis(read),
+            read_ms: 0.0,
             detect_ms: millis(detect),
             edges_ms: millis(edges),
             mesh_ms: millis(mesh),
-            write_ms: millis(write),
+            write_ms: 0.0,
         }
     }
 }
@@ -135,7 +150,10 @@ impl Report {
 impl crate::report::Table for Report {
     fn table(&self) -> String {
         let rows = [
-            ("cloud", format!("{} ({} points)", self.cloud, self.points)),
+            (
+                "cloud",
+                format!("{} ({} points)", shown(&self.cloud), self.points),
+            ),
             ("points used", self.points_used.to_string()),
             ("points outside", self.points_outside.to_string()),
             ("points on a loop", self.points_near_loop.to_string()),
@@ -148,7 +166,7 @@ impl crate::report::Table for Report {
             ("edges time", format!("{:.1} ms", self.edges_ms)),
             ("mesh time", format!("{:.1} ms", self.mesh_ms)),
             ("write time", format!("{:.1} ms", self.write_ms)),
-            ("output", self.output.clone()),
+            ("output", shown(&self.output)),
         ];
         crate::report::rows(&rows)
     }

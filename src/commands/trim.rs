@@ -16,9 +16,9 @@ use crate::commands::args::{
     VIEW_ALONG_LONG_HELP, VIEW_FROM_HELP, VIEW_FROM_LONG_HELP,
 };
 use crate::io::mesh_out::write_mesh;
-use crate::io::{read_cloud, read_mesh_with_faces};
-use crate::report::significant;
-use crate::stages::{detect_read_cloud, millis, Detected, Stages};
+use crate::io::{read_cloud, read_mesh_with_faces, Point3};
+use crate::report::{shown, significant};
+use crate::stages::{detect, millis, Stages};
 
 /// Arguments of the trimming (`meshtrim MESH CLOUD OUT`).
 #[derive(Debug, Clone, clap::Args)]
@@ -80,12 +80,12 @@ impl Args {
 /// What the trimming prints and `--report` writes.
 #[derive(Debug, Clone, Serialize)]
 pub struct Report {
-    /// Input mesh, cloud and output, as given.
-    pub mesh: String,
+    /// Input mesh, cloud and output, as given (none in memory).
+    pub mesh: Option<String>,
     /// The cloud.
-    pub cloud: String,
+    pub cloud: Option<String>,
     /// The output.
-    pub output: String,
+    pub output: Option<String>,
     /// Cloud points read.
     pub points: usize,
     /// Boundary points found by BPD.
@@ -186,47 +186,52 @@ pub fn trim_file(
         || read_cloud(cloud_path),
     );
     let mesh = mesh?;
-    // Checked here, before detection, so the error names the mesh: the
-    // library's own check reports "MESH with CLOUD".
-    trim::check_vertex_range(&mesh.vertices).with_context(|| mesh_path.display().to_string())?;
     let cloud = cloud?;
     let read_time = started.elapsed();
-    let Detected {
-        cloud,
-        detection,
-        read_time,
-        detect_time,
-    } = detect_read_cloud(
-        cloud_path,
-        cloud,
-        read_time,
-        &settings.stages.detection,
-        settings.progress,
-    )?;
-    let started = Instant::now();
-    let edges = reconstruct_edges(&cloud.points, &detection, &settings.stages.edges);
-    let edges_time = started.elapsed();
-    let started = Instant::now();
-    let (out, trimmed) = trim_mesh(
-        &mesh,
-        &cloud.points,
-        &detection,
-        &edges,
-        &TrimOptions::default(),
-    )
-    .with_context(|| format!("{} with {}", mesh_path.display(), cloud_path.display()))?;
-    let trim_time = started.elapsed();
+    let names = [mesh_path, cloud_path].map(|p| p.display().to_string());
+    let (out, mut report) = trim_in_memory(&mesh, &cloud.points, settings, &names)?;
     let started = Instant::now();
     write_mesh(output, &out.vertices, &out.faces)?;
-    let write_time = started.elapsed();
-    let times = [read_time, detect_time, edges_time, trim_time, write_time];
-    Ok(Report::new(
-        [mesh_path, cloud_path, output],
-        cloud.points.len(),
+    report.read_ms = millis(read_time);
+    report.write_ms = millis(started.elapsed());
+    report.mesh = Some(names[0].clone());
+    report.cloud = Some(names[1].clone());
+    report.output = Some(output.display().to_string());
+    Ok(report)
+}
+
+/// Trims `mesh` along the smoothed boundary of the cloud `points`, in
+/// memory: everything [`trim_file`] does between reading and writing, and
+/// what the Python package runs. Errors begin with what `names` call the
+/// mesh and the cloud (their paths, or the arguments' names). The report
+/// names no file and has no read or write time.
+pub fn trim_in_memory(
+    mesh: &trim::Mesh,
+    points: &[Point3],
+    settings: &TrimSettings,
+    [mesh_name, cloud_name]: &[String; 2],
+) -> Result<(trim::Mesh, Report)> {
+    // Checked before detection, so the error names the mesh: the
+    // library's own check reports "MESH with CLOUD".
+    trim::check_vertex_range(&mesh.vertices).with_context(|| mesh_name.clone())?;
+    let started = Instant::now();
+    let detection = detect(points, &settings.stages.detection, settings.progress)
+        .with_context(|| cloud_name.clone())?;
+    let detect_time = started.elapsed();
+    let started = Instant::now();
+    let edges = reconstruct_edges(points, &detection, &settings.stages.edges);
+    let edges_time = started.elapsed();
+    let started = Instant::now();
+    let (out, trimmed) = trim_mesh(mesh, points, &detection, &edges, &TrimOptions::default())
+        .with_context(|| format!("{mesh_name} with {cloud_name}"))?;
+    let trim_time = started.elapsed();
+    let report = Report::new(
+        points.len(),
         detection.boundary_count(),
         &trimmed,
-        times,
-    ))
+        [detect_time, edges_time, trim_time],
+    );
+    Ok((out, report))
 }
 
 /// Refuses unknown output formats and outputs that would overwrite an
@@ -241,11 +246,10 @@ fn check_paths(args: &Args) -> Result<()> {
 
 impl Report {
     fn new(
-        [mesh, cloud, output]: [&Path; 3],
         points: usize,
         boundary_points: usize,
         r: &TrimReport,
-        [read, detect, edges, trim, write]: [Duration; 5],
+        [detect, edges, trim]: [Duration; 3],
     ) -> Self {
         let fit = |l: &LoopFit| BorderFit {
             mean: l.mean,
@@ -253,9 +257,9 @@ impl Report {
             vertices: l.count,
         };
         Report {
-            mesh: mesh.display().to_string(),
-            cloud: cloud.display().to_string(),
-            output: output.display().to_string(),
+            mesh: None,
+            cloud: None,
+            output: None,
             points,
             boundary_points,
             loops: r.loops.len(),
@@ -272,11 +276,11 @@ impl Report {
             area_in: r.area_in,
             area_out: r.area_out,
             border_to_edge: r.loops.iter().map(fit).collect(),
-            read_ms: millis(read),
+            read_ms: 0.0,
             detect_ms: millis(detect),
             edges_ms: millis(edges),
             trim_ms: millis(trim),
-            write_ms: millis(write),
+            write_ms: 0.0,
         }
     }
 }
@@ -289,12 +293,14 @@ impl crate::report::Table for Report {
             .map(|f| f.max)
             .fold(0.0, f64::max);
         let rows = [
-            ("mesh", self.mesh.clone()),
+            ("mesh", shown(&self.mesh)),
             (
                 "cloud",
                 format!(
                     "{} ({} points, {} boundary)",
-                    self.cloud, self.points, self.boundary_points
+                    shown(&self.cloud),
+                    self.points,
+                    self.boundary_points
                 ),
             ),
             ("loops", self.loops.to_string()),
@@ -351,7 +357,7 @@ impl crate::report::Table for Report {
             ("edges time", format!("{:.1} ms", self.edges_ms)),
             ("trim time", format!("{:.1} ms", self.trim_ms)),
             ("write time", format!("{:.1} ms", self.write_ms)),
-            ("output", self.output.clone()),
+            ("output", shown(&self.output)),
         ];
         crate::report::rows(&rows)
     }

@@ -76,6 +76,9 @@ pub enum CloudError {
         /// Largest accepted |coordinate|.
         max: f64,
     },
+    /// The cloud has no points at all.
+    #[error("the cloud has no points")]
+    NoPoints,
     /// All points coincide or lie on one line: there is no surface.
     #[error("the cloud is degenerate: all {distinct} distinct points lie on {what}, so it has no surface and no boundary")]
     Degenerate {

@@ -27,7 +27,7 @@ use super::clean::clean_file;
 use super::trim::{trim_file, TrimSettings};
 use crate::commands::args::StageArgs;
 use crate::console;
-use crate::stages::{millis, Stages};
+use crate::stages::{in_cli_words, millis, Stages};
 
 /// Arguments of `meshtrim batch`.
 #[derive(Debug, Clone, clap::Args)]
@@ -187,7 +187,7 @@ fn process(job: &Job, skip_existing: bool, stages: &Stages) -> Row {
         Err(e) => {
             row.status = Status::Failed;
             // The line names the file already: the chain need not again.
-            let chain = format!("{e:#}");
+            let chain = in_cli_words(&format!("{e:#}"));
             let prefix = format!("{}: ", row.input);
             row.error = Some(chain.strip_prefix(&prefix).unwrap_or(&chain).to_string());
         }

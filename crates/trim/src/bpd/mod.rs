@@ -373,6 +373,9 @@ fn prepare(points: &[Point3], options: &BpdOptions) -> Result<Prepared, CloudErr
     if let Some(view) = &options.view {
         view.check()?;
     }
+    if points.is_empty() {
+        return Err(CloudError::NoPoints);
+    }
     check_finite(points)?;
     let in_order = SpatialOrder::of(points);
     if !in_order.keys_repeat() {
@@ -1049,6 +1052,14 @@ mod tests {
             detect_boundary(&few, &k3),
             Err(CloudError::KTooSmall { .. })
         ));
+        assert!(matches!(
+            detect_boundary(&[], &BpdOptions::default()),
+            Err(CloudError::NoPoints)
+        ));
+        assert_eq!(
+            local_resolution(&[], &BpdOptions::default()),
+            Err(CloudError::NoPoints)
+        );
     }
 
     /// Points along a line or a curve have no surface, whether rounding

@@ -1,0 +1,337 @@
+"""meshtrim: smooth, exact borders for meshes reconstructed from 3D scans.
+
+The functions of the ``meshtrim`` command line on numpy arrays, run by the
+same Rust library, with the same results bit for bit:
+
+- :func:`detect`: boundary points of a cloud and its local resolution β;
+- :func:`edges`: the smoothed boundary loops, corners and edges;
+- :func:`trim`: a mesh reconstructed from a cloud (screened Poisson) cut
+  along the cloud's smoothed boundary;
+- :func:`mesh`: a Delaunay mesh of the cloud bounded by that boundary;
+- :func:`clean`: a triangulated scan's jagged border replaced by its
+  smoothed edge;
+- :func:`read_cloud`, :func:`read_mesh`, :func:`write_mesh`: the CLI's
+  readers and writers.
+
+Points and vertices are ``(n, 3)`` arrays (float64, or anything numpy
+converts to it, e.g. float32), faces ``(m, 3)`` integer arrays; any memory
+layout. Results are new float64 and int64 arrays. Every function releases
+the GIL while the library works, so other Python threads run meanwhile.
+
+Adapters for host libraries are imported on demand:
+``meshtrim.pymeshlab``, ``meshtrim.open3d`` and ``meshtrim.trimesh``.
+
+Every problem with an input raises :class:`MeshtrimError` (a
+``ValueError``) with the message the CLI prints.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from dataclasses import dataclass, field
+from typing import Any, Optional, Sequence, Union
+
+import numpy as np
+
+from . import _meshtrim
+from ._meshtrim import MeshtrimError
+
+__all__ = [
+    "MeshtrimError",
+    "Detection",
+    "Edge",
+    "Loop",
+    "Edges",
+    "detect",
+    "edges",
+    "trim",
+    "mesh",
+    "clean",
+    "read_cloud",
+    "read_mesh",
+    "write_mesh",
+]
+
+__version__ = "0.1.0"
+
+_ADAPTERS = ("pymeshlab", "open3d", "trimesh")
+
+
+def __getattr__(name: str):
+    # The adapters import their host library: only when first used.
+    if name in _ADAPTERS:
+        import importlib
+
+        return importlib.import_module(f".{name}", __name__)
+    raise AttributeError(f"module 'meshtrim' has no attribute {name!r}")
+
+PathLike = Union[str, "os.PathLike[str]"]
+Vector = Optional[Sequence[float]]
+
+
+@dataclass(frozen=True)
+class Detection:
+    """Boundary points of a cloud (``meshtrim detect``).
+
+    ``boundary`` is a bool array with one label per point, ``beta`` each
+    point's local resolution β (the paper's eq. 3, the radius of the
+    empty-circle test). ``summary`` has the keys of
+    ``meshtrim detect --json``; the most used are attributes.
+    """
+
+    boundary: np.ndarray
+    beta: np.ndarray
+    summary: dict = field(repr=False)
+
+    @property
+    def boundary_points(self) -> int:
+        """Points labelled boundary (duplicates counted)."""
+        return self.summary["boundary_points"]
+
+    @property
+    def duplicates(self) -> int:
+        """Points that were exact copies of an earlier one."""
+        return self.summary["duplicates"]
+
+    @property
+    def detect_ms(self) -> float:
+        """Time of the library's detection, in milliseconds."""
+        return self.summary["detect_ms"]
+
+
+@dataclass(frozen=True)
+class Edge:
+    """A smoothed edge: from corner to corner, or a whole loop (closed)."""
+
+    closed: bool
+    points: np.ndarray
+
+
+@dataclass(frozen=True)
+class Loop:
+    """A closed boundary loop: its boundary points (indices into the
+    cloud, in loop order), its corners' positions and its smoothed edges,
+    as in ``meshtrim edges -o OUT.json``."""
+
+    closed: bool
+    boundary_points: np.ndarray
+    corners: np.ndarray
+    edges: list
+
+
+class Edges(list):
+    """The loops of :func:`edges` (a list of :class:`Loop`), with the
+    detection they came from and the summary of ``meshtrim edges --json``."""
+
+    def __init__(self, loops: list, detection: Detection, summary: dict):
+        super().__init__(loops)
+        self.detection = detection
+        self.summary = summary
+
+
+def _float_rows(array: Any, name: str) -> np.ndarray:
+    """``array`` as a C-order float64 ``(n, 3)`` array (no copy when it
+    already is one)."""
+    try:
+        a = np.asarray(array)
+    except Exception as e:  # e.g. ragged nested lists
+        raise MeshtrimError(f"{name}: not an array of numbers: {e}") from None
+    if a.dtype.kind not in "fiu":
+        raise MeshtrimError(f"{name}: expected real numbers, got dtype {a.dtype}")
+    if a.ndim != 2 or a.shape[1] != 3:
+        raise MeshtrimError(f"{name}: expected an array of shape (n, 3), got {a.shape}")
+    return np.ascontiguousarray(a, dtype=np.float64)
+
+
+def _face_rows(array: Any, vertices: int) -> np.ndarray:
+    """``array`` as a C-order uint32 ``(m, 3)`` array of indices below
+    ``vertices``."""
+    try:
+        a = np.asarray(array)
+    except Exception as e:
+        raise MeshtrimError(f"faces: not an array of numbers: {e}") from None
+    if a.ndim != 2 or a.shape[1] != 3:
+        raise MeshtrimError(f"faces: expected an array of shape (m, 3), got {a.shape}")
+    if a.dtype.kind == "f" and a.size and not np.all(np.mod(a, 1) == 0):
+        raise MeshtrimError("faces: expected integer vertex indices")
+    if a.dtype.kind not in "iuf" and a.size:
+        raise MeshtrimError(f"faces: expected integer vertex indices, got dtype {a.dtype}")
+    if a.size:
+        low, high = a.min(), a.max()
+        if low < 0:
+            face = int(np.argwhere(a < 0)[0][0])
+            raise MeshtrimError(f"faces: face {face} has a negative vertex index ({int(a[face].min())})")
+        if high >= vertices:
+            face = int(np.argwhere(a >= vertices)[0][0])
+            raise MeshtrimError(
+                f"faces: face {face} refers to vertex {int(a[face].max())}, "
+                f"but there are {vertices} vertices"
+            )
+    return np.ascontiguousarray(a, dtype=np.uint32)
+
+
+def _vector(value: Vector, name: str) -> Optional[tuple]:
+    if value is None:
+        return None
+    try:
+        v = tuple(float(c) for c in value)
+    except (TypeError, ValueError):
+        raise MeshtrimError(f"{name}: expected three numbers x, y, z") from None
+    if len(v) != 3:
+        raise MeshtrimError(f"{name}: expected three numbers x, y, z, got {len(v)}")
+    return v
+
+
+def _k(k: Any) -> int:
+    if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k < 2**31:
+        raise MeshtrimError(f"k: expected a whole number, got {k!r}")
+    return int(k)
+
+
+def _options(k, anisotropy, view_along, view_from) -> tuple:
+    return (
+        _k(k),
+        bool(anisotropy),
+        _vector(view_along, "view_along"),
+        _vector(view_from, "view_from"),
+    )
+
+
+def detect(
+    points: Any,
+    *,
+    k: int = 30,
+    anisotropy: bool = True,
+    view_along: Vector = None,
+    view_from: Vector = None,
+) -> Detection:
+    """Labels the boundary points of a cloud (``meshtrim detect``).
+
+    ``k`` is the neighbourhood size, the point itself included (the
+    paper's 30); ``anisotropy=False`` gives the paper's isotropic tests;
+    ``view_along`` (a direction) or ``view_from`` (the scanner's position)
+    is the range scanner's line of sight, when known.
+    """
+    k, anisotropy, along, from_ = _options(k, anisotropy, view_along, view_from)
+    pts = _float_rows(points, "points")
+    (boundary, beta), summary = _meshtrim.detect(pts, k, anisotropy, along, from_)
+    return Detection(boundary, beta, json.loads(summary))
+
+
+def edges(
+    points: Any,
+    *,
+    k: int = 30,
+    anisotropy: bool = True,
+    offset: bool = True,
+    view_along: Vector = None,
+    view_from: Vector = None,
+) -> Edges:
+    """The cloud's smoothed boundary loops (``meshtrim edges``): a list of
+    :class:`Loop`, each with its :class:`Edge` list.
+
+    ``offset=False`` gives the paper's edges through the boundary points
+    instead of the estimated physical edge half a row beyond them (for
+    clouds whose outermost samples lie on the edge itself). The other
+    options are :func:`detect`'s.
+    """
+    k, anisotropy, along, from_ = _options(k, anisotropy, view_along, view_from)
+    pts = _float_rows(points, "points")
+    (boundary, beta), raw, summary = _meshtrim.edges(
+        pts, k, anisotropy, bool(offset), along, from_
+    )
+    loops = [
+        Loop(closed, indices, corners, [Edge(c, p) for c, p in pieces])
+        for closed, indices, corners, pieces in raw
+    ]
+    summary = json.loads(summary)
+    return Edges(loops, Detection(boundary, beta, summary), summary)
+
+
+def trim(
+    vertices: Any,
+    faces: Any,
+    points: Any,
+    *,
+    k: int = 30,
+    anisotropy: bool = True,
+    offset: bool = True,
+    view_along: Vector = None,
+    view_from: Vector = None,
+) -> tuple:
+    """Trims a mesh reconstructed from the cloud ``points`` along the
+    cloud's smoothed boundary (``meshtrim MESH CLOUD OUT``).
+
+    Returns ``(vertices, faces, report)``: the trimmed mesh and a dict
+    with the keys of the CLI's ``--report`` JSON (file names ``None``,
+    read and write times 0). Options as :func:`edges`.
+    """
+    k, anisotropy, along, from_ = _options(k, anisotropy, view_along, view_from)
+    v = _float_rows(vertices, "vertices")
+    f = _face_rows(faces, len(v))
+    pts = _float_rows(points, "points")
+    out_v, out_f, report = _meshtrim.trim(v, f, pts, k, anisotropy, bool(offset), along, from_)
+    return out_v, out_f, json.loads(report)
+
+
+def mesh(
+    points: Any,
+    *,
+    k: int = 30,
+    anisotropy: bool = True,
+    offset: bool = True,
+    view_along: Vector = None,
+    view_from: Vector = None,
+) -> tuple:
+    """A Delaunay mesh of the cloud, bounded by its smoothed boundary
+    (``meshtrim mesh``). Returns ``(vertices, faces, report)``, the report
+    with the keys of the CLI's ``--report`` JSON. Options as :func:`edges`.
+    """
+    k, anisotropy, along, from_ = _options(k, anisotropy, view_along, view_from)
+    pts = _float_rows(points, "points")
+    out_v, out_f, report = _meshtrim.mesh(pts, k, anisotropy, bool(offset), along, from_)
+    return out_v, out_f, json.loads(report)
+
+
+def clean(
+    vertices: Any,
+    faces: Any,
+    *,
+    k: int = 30,
+    anisotropy: bool = True,
+    offset: bool = True,
+    view_along: Vector = None,
+    view_from: Vector = None,
+) -> tuple:
+    """Replaces a triangulated scan's jagged border by its smoothed edge
+    (``meshtrim clean``): the mesh's own vertices are the cloud. Returns
+    ``(vertices, faces, report)``, the report with the keys of the CLI's
+    ``--report`` JSON. Options as :func:`edges`.
+    """
+    k, anisotropy, along, from_ = _options(k, anisotropy, view_along, view_from)
+    v = _float_rows(vertices, "vertices")
+    f = _face_rows(faces, len(v))
+    out_v, out_f, report = _meshtrim.clean(v, f, k, anisotropy, bool(offset), along, from_)
+    return out_v, out_f, json.loads(report)
+
+
+def read_cloud(path: PathLike) -> np.ndarray:
+    """The points of a cloud file, as every command reads a cloud: PLY,
+    PCD, OBJ, XYZ/TXT/CSV/ASC/PTS, or a mesh's vertices (STL, glTF/GLB)."""
+    return _meshtrim.read_cloud(os.fspath(path))
+
+
+def read_mesh(path: PathLike) -> tuple:
+    """``(vertices, faces)`` of a mesh file (OBJ, PLY, STL, glTF/GLB),
+    polygons split into fans, as ``trim`` and ``clean`` read it."""
+    return _meshtrim.read_mesh(os.fspath(path))
+
+
+def write_mesh(path: PathLike, vertices: Any, faces: Any) -> None:
+    """Writes a mesh as the CLI writes its outputs: the format from the
+    extension (.obj, .ply and .stl binary, .gltf, .glb), missing parent
+    directories created, the file replaced atomically."""
+    v = _float_rows(vertices, "vertices")
+    f = _face_rows(faces, len(v))
+    _meshtrim.write_mesh(os.fspath(path), v, f)

@@ -1,0 +1,53 @@
+"""meshtrim on Open3D geometry: ``TriangleMesh`` and ``PointCloud`` in,
+new ``TriangleMesh`` out (the inputs are not changed).
+
+>>> poisson, _ = o3d.geometry.TriangleMesh.create_from_point_cloud_poisson(pcd)
+>>> trimmed = meshtrim.open3d.trim(poisson, pcd)
+
+Each mesh function takes :func:`meshtrim.trim`'s options as keywords, and
+with ``report=True`` returns ``(mesh, report)``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import open3d as o3d
+
+import meshtrim
+
+__all__ = ["trim", "clean", "mesh", "detect"]
+
+
+def _arrays(mesh: o3d.geometry.TriangleMesh) -> tuple:
+    return np.asarray(mesh.vertices), np.asarray(mesh.triangles)
+
+
+def _result(vertices: np.ndarray, faces: np.ndarray, report: dict, with_report: bool):
+    out = o3d.geometry.TriangleMesh(
+        o3d.utility.Vector3dVector(vertices),
+        o3d.utility.Vector3iVector(faces.astype(np.int32)),
+    )
+    return (out, report) if with_report else out
+
+
+def trim(mesh: o3d.geometry.TriangleMesh, cloud: o3d.geometry.PointCloud, *, report: bool = False, **options):
+    """``mesh`` (e.g. Open3D's Poisson) cut along the smoothed boundary of
+    ``cloud``: a new ``TriangleMesh``."""
+    vertices, faces = _arrays(mesh)
+    return _result(*meshtrim.trim(vertices, faces, np.asarray(cloud.points), **options), report)
+
+
+def clean(mesh: o3d.geometry.TriangleMesh, *, report: bool = False, **options):
+    """A scanned ``mesh`` with its jagged border smoothed: a new ``TriangleMesh``."""
+    return _result(*meshtrim.clean(*_arrays(mesh), **options), report)
+
+
+def mesh(cloud: o3d.geometry.PointCloud, *, report: bool = False, **options):
+    """A Delaunay ``TriangleMesh`` of ``cloud`` within its smoothed boundary."""
+    return _result(*meshtrim.mesh(np.asarray(cloud.points), **options), report)
+
+
+def detect(cloud: o3d.geometry.PointCloud, **options) -> meshtrim.Detection:
+    """The boundary points of ``cloud`` (see :func:`meshtrim.detect`);
+    ``cloud.select_by_index(np.flatnonzero(d.boundary))`` shows them."""
+    return meshtrim.detect(np.asarray(cloud.points), **options)

@@ -1,0 +1,34 @@
+"""meshtrim on trimesh objects: a new ``trimesh.Trimesh`` out, built with
+``process=False`` so that its arrays are meshtrim's exactly; the report is
+in ``result.metadata["meshtrim"]``.
+
+>>> cleaned = meshtrim.trimesh.clean(trimesh.load("scan.stl", process=False))
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import trimesh
+
+import meshtrim
+
+__all__ = ["trim", "clean"]
+
+
+def _result(vertices: np.ndarray, faces: np.ndarray, report: dict) -> trimesh.Trimesh:
+    out = trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
+    out.metadata["meshtrim"] = report
+    return out
+
+
+def trim(mesh: trimesh.Trimesh, points, **options) -> trimesh.Trimesh:
+    """``mesh`` cut along the smoothed boundary of the cloud ``points`` (an
+    ``(n, 3)`` array or a ``trimesh.PointCloud``)."""
+    if isinstance(points, trimesh.PointCloud):
+        points = points.vertices
+    return _result(*meshtrim.trim(mesh.vertices, mesh.faces, points, **options))
+
+
+def clean(mesh: trimesh.Trimesh, **options) -> trimesh.Trimesh:
+    """A scanned ``mesh`` with its jagged border smoothed."""
+    return _result(*meshtrim.clean(mesh.vertices, mesh.faces, **options))

@@ -1,0 +1,385 @@
+//! `meshtrim._meshtrim`: the Python package's native module.
+//!
+//! Each function runs what the CLI command of the same name runs between
+//! reading and writing (`meshtrim::commands::*::*_in_memory`), so the
+//! arrays and the report are the CLI's, bit for bit. The Python layer
+//! (`python/meshtrim/__init__.py`) checks shapes and converts dtypes; this
+//! module takes C-order float64 points and uint32 faces, copies each input
+//! once into the library's layout, releases the GIL for the work, and
+//! copies each result once into a new numpy array.
+//!
+//! Errors become `MeshtrimError` (a `ValueError`) with the message the CLI
+//! prints after "error: ", in the library's parameter words; a panic, which
+//! no input should cause, becomes one too rather than reaching the
+//! interpreter.
+
+use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::path::PathBuf;
+
+use library::{BpdOptions, Detection, EdgeOptions, Mesh, Point3, View};
+use meshtrim::commands;
+use meshtrim::stages::Stages;
+use numpy::ndarray::ArrayView2;
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyList;
+
+pyo3::create_exception!(
+    meshtrim,
+    MeshtrimError,
+    PyValueError,
+    "An input meshtrim cannot work on, with the message the CLI prints."
+);
+
+/// The options every function shares, as the CLI's flags give them.
+struct Options {
+    k: usize,
+    anisotropy: bool,
+    offset: bool,
+    view_along: Option<[f64; 3]>,
+    view_from: Option<[f64; 3]>,
+}
+
+impl Options {
+    /// The library's options; the view is checked by detection itself.
+    fn stages(&self) -> PyResult<Stages> {
+        let view = match (self.view_along, self.view_from) {
+            (Some(_), Some(_)) => {
+                return Err(MeshtrimError::new_err(
+                    "give view_along or view_from, not both",
+                ))
+            }
+            (Some(d), None) => Some(View::Along(d)),
+            (None, Some(o)) => Some(View::From(o)),
+            (None, None) => None,
+        };
+        Ok(Stages {
+            detection: BpdOptions {
+                k: self.k,
+                anisotropy: self.anisotropy,
+                view,
+            },
+            edges: EdgeOptions {
+                offset: self.offset,
+            },
+        })
+    }
+}
+
+/// Runs `work` without the GIL, so that other Python threads run
+/// meanwhile; its error or panic becomes a `MeshtrimError`.
+fn without_gil<T: Send>(
+    py: Python<'_>,
+    work: impl FnOnce() -> anyhow::Result<T> + Send,
+) -> PyResult<T> {
+    match py.detach(|| catch_unwind(AssertUnwindSafe(work))) {
+        Ok(Ok(value)) => Ok(value),
+        Ok(Err(error)) => Err(MeshtrimError::new_err(format!("{error:#}"))),
+        Err(panic) => {
+            let text = panic
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| panic.downcast_ref::<String>().cloned())
+                .unwrap_or_default();
+            Err(MeshtrimError::new_err(format!("internal error: {text}")))
+        }
+    }
+}
+
+/// The rows of an `(n, 3)` array (one copy).
+fn rows<T: numpy::Element + Copy>(
+    array: &PyReadonlyArray2<'_, T>,
+    name: &str,
+) -> PyResult<Vec<[T; 3]>> {
+    if array.shape()[1] != 3 {
+        return Err(MeshtrimError::new_err(format!(
+            "{name}: expected an array of shape (n, 3), got {:?}",
+            array.shape()
+        )));
+    }
+    Ok(match array.as_slice() {
+        Ok(flat) => flat.chunks_exact(3).map(|r| [r[0], r[1], r[2]]).collect(),
+        Err(_) => strided_rows(array.as_array()),
+    })
+}
+
+fn strided_rows<T: Copy>(view: ArrayView2<'_, T>) -> Vec<[T; 3]> {
+    view.rows()
+        .into_iter()
+        .map(|r| [r[0], r[1], r[2]])
+        .collect()
+}
+
+/// A mesh from its vertex and face arrays.
+fn mesh_of(
+    vertices: &PyReadonlyArray2<'_, f64>,
+    faces: &PyReadonlyArray2<'_, u32>,
+) -> PyResult<Mesh> {
+    Ok(Mesh {
+        vertices: rows(vertices, "vertices")?,
+        faces: rows(faces, "faces")?,
+    })
+}
+
+/// Points as a new `(n, 3)` float64 array.
+fn points_array<'py>(py: Python<'py>, points: &[Point3]) -> PyResult<Points<'py>> {
+    PyArray1::from_slice(py, points.as_flattened()).reshape([points.len(), 3])
+}
+
+/// Faces as a new `(m, 3)` int64 array (numpy's index type).
+fn faces_array<'py>(py: Python<'py>, faces: &[[u32; 3]]) -> PyResult<Faces<'py>> {
+    let flat: Vec<i64> = faces.as_flattened().iter().map(|&i| i64::from(i)).collect();
+    PyArray1::from_vec(py, flat).reshape([faces.len(), 3])
+}
+
+/// A new `(n, 3)` float64 array.
+type Points<'py> = Bound<'py, PyArray2<f64>>;
+/// A new `(m, 3)` int64 array.
+type Faces<'py> = Bound<'py, PyArray2<i64>>;
+/// Boundary labels and β per point.
+type Labels<'py> = (Bound<'py, PyArray1<bool>>, Bound<'py, PyArray1<f64>>);
+/// A mesh result: its arrays and the report as JSON.
+type MeshResult<'py> = (Points<'py>, Faces<'py>, String);
+
+fn mesh_result<'py>(
+    py: Python<'py>,
+    mesh: &Mesh,
+    report: &impl serde::Serialize,
+) -> PyResult<MeshResult<'py>> {
+    Ok((
+        points_array(py, &mesh.vertices)?,
+        faces_array(py, &mesh.faces)?,
+        to_json(report)?,
+    ))
+}
+
+fn labels<'py>(py: Python<'py>, detection: &Detection) -> Labels<'py> {
+    (
+        PyArray1::from_slice(py, &detection.boundary),
+        PyArray1::from_slice(py, &detection.beta),
+    )
+}
+
+fn to_json(value: &impl serde::Serialize) -> PyResult<String> {
+    serde_json::to_string(value).map_err(|e| MeshtrimError::new_err(e.to_string()))
+}
+
+/// Boundary labels, β per point, and the summary as JSON.
+#[pyfunction]
+#[pyo3(name = "detect", signature = (points, k, anisotropy, view_along, view_from))]
+fn detect_py<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    k: usize,
+    anisotropy: bool,
+    view_along: Option<[f64; 3]>,
+    view_from: Option<[f64; 3]>,
+) -> PyResult<(Labels<'py>, String)> {
+    let options = Options {
+        k,
+        anisotropy,
+        offset: true,
+        view_along,
+        view_from,
+    };
+    let detection_options = options.stages()?.detection;
+    let points = rows(&points, "points")?;
+    let (detection, summary) = without_gil(py, || {
+        commands::detect::detect_in_memory(&points, &detection_options, false, "points")
+    })?;
+    Ok((labels(py, &detection), to_json(&summary)?))
+}
+
+/// One loop as a tuple: (closed, boundary point indices, corners, edges),
+/// each edge (closed, points).
+type LoopTuple<'py> = (
+    bool,
+    Bound<'py, PyArray1<i64>>,
+    Bound<'py, PyArray2<f64>>,
+    Vec<(bool, Bound<'py, PyArray2<f64>>)>,
+);
+
+/// Labels, β, the loops and the summary as JSON.
+#[pyfunction]
+#[pyo3(name = "edges", signature = (points, k, anisotropy, offset, view_along, view_from))]
+fn edges_py<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    k: usize,
+    anisotropy: bool,
+    offset: bool,
+    view_along: Option<[f64; 3]>,
+    view_from: Option<[f64; 3]>,
+) -> PyResult<(Labels<'py>, Bound<'py, PyList>, String)> {
+    let stages = Options {
+        k,
+        anisotropy,
+        offset,
+        view_along,
+        view_from,
+    }
+    .stages()?;
+    let points = rows(&points, "points")?;
+    let (detection, found, summary) = without_gil(py, || {
+        commands::edges::edges_in_memory(&points, &stages, false, "points")
+    })?;
+    let mut loops = Vec::with_capacity(found.loops.len());
+    for l in &found.loops {
+        let indices: Vec<i64> = l.boundary_points.iter().map(|&i| i64::from(i)).collect();
+        let mut pieces = Vec::with_capacity(l.edges.len());
+        for e in &l.edges {
+            pieces.push((e.closed, points_array(py, &e.points)?));
+        }
+        let looped: LoopTuple = (
+            true,
+            PyArray1::from_vec(py, indices),
+            points_array(py, &l.corner_points(&points))?,
+            pieces,
+        );
+        loops.push(looped);
+    }
+    Ok((
+        labels(py, &detection),
+        PyList::new(py, loops)?,
+        to_json(&summary)?,
+    ))
+}
+
+/// The trimmed mesh and the report as JSON.
+#[pyfunction]
+#[pyo3(name = "trim", signature = (vertices, faces, points, k, anisotropy, offset, view_along, view_from))]
+#[allow(clippy::too_many_arguments)] // the CLI's options, as keywords
+fn trim_py<'py>(
+    py: Python<'py>,
+    vertices: PyReadonlyArray2<'py, f64>,
+    faces: PyReadonlyArray2<'py, u32>,
+    points: PyReadonlyArray2<'py, f64>,
+    k: usize,
+    anisotropy: bool,
+    offset: bool,
+    view_along: Option<[f64; 3]>,
+    view_from: Option<[f64; 3]>,
+) -> PyResult<MeshResult<'py>> {
+    let settings = commands::trim::TrimSettings {
+        stages: Options {
+            k,
+            anisotropy,
+            offset,
+            view_along,
+            view_from,
+        }
+        .stages()?,
+        progress: false,
+    };
+    let mesh = mesh_of(&vertices, &faces)?;
+    let points = rows(&points, "points")?;
+    let names = ["mesh".to_string(), "points".to_string()];
+    let (out, report) = without_gil(py, || {
+        commands::trim::trim_in_memory(&mesh, &points, &settings, &names)
+    })?;
+    mesh_result(py, &out, &report)
+}
+
+/// The Delaunay mesh of a cloud and the report as JSON.
+#[pyfunction]
+#[pyo3(name = "mesh", signature = (points, k, anisotropy, offset, view_along, view_from))]
+fn mesh_py<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f64>,
+    k: usize,
+    anisotropy: bool,
+    offset: bool,
+    view_along: Option<[f64; 3]>,
+    view_from: Option<[f64; 3]>,
+) -> PyResult<MeshResult<'py>> {
+    let stages = Options {
+        k,
+        anisotropy,
+        offset,
+        view_along,
+        view_from,
+    }
+    .stages()?;
+    let points = rows(&points, "points")?;
+    let (out, report) = without_gil(py, || {
+        commands::mesh::mesh_in_memory(&points, &stages, false, "points")
+    })?;
+    mesh_result(py, &out, &report)
+}
+
+/// The cleaned mesh and the report as JSON.
+#[pyfunction]
+#[pyo3(name = "clean", signature = (vertices, faces, k, anisotropy, offset, view_along, view_from))]
+#[allow(clippy::too_many_arguments)] // the CLI's options, as keywords
+fn clean_py<'py>(
+    py: Python<'py>,
+    vertices: PyReadonlyArray2<'py, f64>,
+    faces: PyReadonlyArray2<'py, u32>,
+    k: usize,
+    anisotropy: bool,
+    offset: bool,
+    view_along: Option<[f64; 3]>,
+    view_from: Option<[f64; 3]>,
+) -> PyResult<MeshResult<'py>> {
+    let stages = Options {
+        k,
+        anisotropy,
+        offset,
+        view_along,
+        view_from,
+    }
+    .stages()?;
+    let mesh = mesh_of(&vertices, &faces)?;
+    let (out, report) = without_gil(py, || {
+        commands::clean::clean_in_memory(&mesh, &stages, "mesh")
+    })?;
+    mesh_result(py, &out, &report)
+}
+
+/// A cloud's points, read as every command reads a cloud.
+#[pyfunction]
+fn read_cloud(py: Python<'_>, path: PathBuf) -> PyResult<Points<'_>> {
+    let cloud = without_gil(py, || meshtrim::io::read_cloud(&path))?;
+    points_array(py, &cloud.points)
+}
+
+/// A mesh's vertices and faces, read as `trim` and `clean` read a mesh.
+#[pyfunction]
+fn read_mesh(py: Python<'_>, path: PathBuf) -> PyResult<(Points<'_>, Faces<'_>)> {
+    let hint = "read it with read_cloud";
+    let mesh = without_gil(py, || meshtrim::io::read_mesh_with_faces(&path, hint))?;
+    Ok((
+        points_array(py, &mesh.vertices)?,
+        faces_array(py, &mesh.faces)?,
+    ))
+}
+
+/// Writes a mesh as the CLI writes its outputs (format by extension,
+/// atomically).
+#[pyfunction]
+fn write_mesh(
+    py: Python<'_>,
+    path: PathBuf,
+    vertices: PyReadonlyArray2<'_, f64>,
+    faces: PyReadonlyArray2<'_, u32>,
+) -> PyResult<()> {
+    let mesh = mesh_of(&vertices, &faces)?;
+    without_gil(py, || {
+        meshtrim::io::write_mesh(&path, &mesh.vertices, &mesh.faces)
+    })
+}
+
+#[pymodule]
+fn _meshtrim(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("MeshtrimError", m.py().get_type::<MeshtrimError>())?;
+    m.add_function(wrap_pyfunction!(detect_py, m)?)?;
+    m.add_function(wrap_pyfunction!(edges_py, m)?)?;
+    m.add_function(wrap_pyfunction!(trim_py, m)?)?;
+    m.add_function(wrap_pyfunction!(mesh_py, m)?)?;
+    m.add_function(wrap_pyfunction!(clean_py, m)?)?;
+    m.add_function(wrap_pyfunction!(read_cloud, m)?)?;
+    m.add_function(wrap_pyfunction!(read_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(write_mesh, m)?)?;
+    Ok(())
+}
