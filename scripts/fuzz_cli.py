@@ -90,15 +90,32 @@ def derive_sources(work):
         f.write((header + "binary\n").encode())
         for r in rows:
             f.write(struct.pack("<3f", *map(float, r)))
+    write_las_clouds(work, rows)
     for ext in ("stl", "obj", "gltf", "glb", "ply"):
         run(["clean", JAGGED, os.path.join(work, f"mesh.{ext}")])
     write_ascii_meshes(work)
     clouds = [CLOUD] + [os.path.join(work, n) for n in
                         ("cloud.csv", "cloud.xyz", "cloud.pts", "cloud.obj", "cloud_ascii.pcd",
-                         "cloud_binary.pcd")]
+                         "cloud_binary.pcd", "cloud.las", "cloud.laz")]
     meshes = [JAGGED, POISSON] + [os.path.join(work, f"mesh.{e}") for e in ("stl", "obj", "gltf", "glb", "ply")]
     meshes += [os.path.join(work, n) for n in ("mesh_ascii.stl", "mesh_ascii.ply")]
     return clouds, meshes
+
+
+def write_las_clouds(work, rows):
+    """The cloud as LAS 1.2 (point format 1) and LAZ 1.4 (point format 6),
+    written by laspy, the format's reference library."""
+    import laspy
+    import numpy as np
+
+    xyz = np.array(rows, dtype=float)
+    for name, point_format, version in (("cloud.las", 1, "1.2"), ("cloud.laz", 6, "1.4")):
+        header = laspy.LasHeader(point_format=point_format, version=version)
+        header.offsets = xyz.min(axis=0)
+        header.scales = [1e-5, 1e-5, 1e-5]
+        las = laspy.LasData(header)
+        las.x, las.y, las.z = xyz[:, 0], xyz[:, 1], xyz[:, 2]
+        las.write(os.path.join(work, name))
 
 
 def write_ascii_meshes(work):

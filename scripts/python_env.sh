@@ -42,6 +42,8 @@ import open3d  # noqa: F401  (fails without libusb-1.0)
 import trimesh  # noqa: F401
 import dask.bag  # noqa: F401
 import distributed  # noqa: F401
+import laspy  # noqa: F401
+import lazrs  # noqa: F401
 
 # A small cap of a sphere: screened Poisson must produce faces.
 rng = np.random.default_rng(1)

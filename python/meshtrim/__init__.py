@@ -318,7 +318,7 @@ def clean(
 
 def read_cloud(path: PathLike) -> np.ndarray:
     """The points of a cloud file, as every command reads a cloud: PLY,
-    PCD, OBJ, XYZ/TXT/CSV/ASC/PTS, or a mesh's vertices (STL, glTF/GLB)."""
+    PCD, OBJ, LAS/LAZ, XYZ/TXT/CSV/ASC/PTS, or a mesh's vertices (STL, glTF/GLB)."""
     return _meshtrim.read_cloud(os.fspath(path))
 
 

@@ -11,18 +11,19 @@ use crate::commands::args::{bpd_options, parse_k, ViewArgs};
 use crate::console;
 use crate::io::atomic::write_atomic;
 use crate::io::labels::{LabelFormat, Labelled};
-use crate::io::{read_cloud, Point3};
+use crate::io::{read_cloud, Cloud, Point3};
 use crate::report::{same_file, shown};
 use crate::stages::{detect, millis};
 
 /// Arguments of `meshtrim detect`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct Args {
-    /// Input point cloud: .ply, .pcd, .obj, .xyz/.txt/.csv/.asc/.pts, or a
+    /// Input point cloud: .ply, .pcd, .obj, .las/.laz, .xyz/.txt/.csv/.asc/.pts, or a
     /// mesh (.stl, .gltf, .glb) whose vertices are the cloud.
     pub cloud: PathBuf,
-    /// Write the points with their labels: OUT.ply (binary) or OUT.csv.
-    /// Missing parent directories are created.
+    /// Write the points with their labels: OUT.ply (binary), OUT.csv, or
+    /// OUT.las / OUT.laz (extra-bytes fields `boundary` and `beta`; a LAS
+    /// input's scale and offset). Missing parent directories are created.
     #[arg(short, long, value_name = "OUT")]
     pub output: Option<PathBuf>,
     /// Neighbourhood size, the point itself included.
@@ -100,7 +101,7 @@ pub fn run(args: &Args) -> Result<()> {
     let (detection, mut summary) =
         detect_in_memory(&cloud.points, &args.bpd_options(), true, &name)?;
     if let Some((path, format)) = &output {
-        write_labels(path, *format, &cloud.points, &detection)?;
+        write_labels(path, *format, &cloud, &detection)?;
     }
     summary.file = Some(name);
     summary.read_ms = millis(read_time);
@@ -120,7 +121,7 @@ pub fn run(args: &Args) -> Result<()> {
 fn check_output(out: &Path, input: &Path) -> Result<(PathBuf, LabelFormat)> {
     let Some(format) = LabelFormat::from_path(out) else {
         bail!(
-            "{}: unsupported output format: use .ply or .csv",
+            "{}: unsupported output format: use .ply, .csv, .las or .laz",
             out.display()
         );
     };
@@ -133,13 +134,14 @@ fn check_output(out: &Path, input: &Path) -> Result<(PathBuf, LabelFormat)> {
 fn write_labels(
     path: &Path,
     format: LabelFormat,
-    points: &[Point3],
+    cloud: &Cloud,
     detection: &Detection,
 ) -> Result<()> {
     let data = Labelled {
-        points,
+        points: &cloud.points,
         boundary: &detection.boundary,
         beta: &detection.beta,
+        scale_offset: cloud.scale_offset,
     };
     write_atomic(path, |w| format.write(w, data))
 }

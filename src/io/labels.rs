@@ -20,6 +20,8 @@ pub struct Labelled<'a> {
     pub boundary: &'a [bool],
     /// Local resolution of each point.
     pub beta: &'a [f64],
+    /// The input's LAS grid, when it was LAS or LAZ (for LAS output).
+    pub scale_offset: Option<super::las::ScaleOffset>,
 }
 
 /// Output formats of `detect`, chosen by the output's extension.
@@ -29,6 +31,10 @@ pub enum LabelFormat {
     Ply,
     /// CSV with a header line.
     Csv,
+    /// LAS 1.4 with `boundary` and `beta` extra-bytes dimensions.
+    Las,
+    /// LAZ: the same, compressed.
+    Laz,
 }
 
 impl LabelFormat {
@@ -38,6 +44,8 @@ impl LabelFormat {
         match ext.as_str() {
             "ply" => Some(LabelFormat::Ply),
             "csv" => Some(LabelFormat::Csv),
+            "las" => Some(LabelFormat::Las),
+            "laz" => Some(LabelFormat::Laz),
             _ => None,
         }
     }
@@ -47,6 +55,20 @@ impl LabelFormat {
         match self {
             LabelFormat::Ply => write_ply(w, data),
             LabelFormat::Csv => write_csv(w, data),
+            LabelFormat::Las | LabelFormat::Laz => {
+                let frame = data
+                    .scale_offset
+                    .unwrap_or_else(|| super::las::grid_for(data.points));
+                let compressed = self == LabelFormat::Laz;
+                super::las::write_labels_las(
+                    w,
+                    data.points,
+                    data.boundary,
+                    data.beta,
+                    frame,
+                    compressed,
+                )
+            }
         }
     }
 }
@@ -116,6 +138,7 @@ mod tests {
             points: &points,
             boundary: &boundary,
             beta: &beta,
+            scale_offset: None,
         };
         write_ply(&mut out, data).unwrap();
         assert_eq!(ply::read_ply(&out).unwrap().vertices, points);
@@ -133,6 +156,7 @@ mod tests {
             points: &points,
             boundary: &boundary,
             beta: &beta,
+            scale_offset: None,
         };
         write_csv(&mut out, data).unwrap();
         let s = String::from_utf8(out.clone()).unwrap();

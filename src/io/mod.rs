@@ -20,6 +20,7 @@ pub(crate) mod float_text;
 pub mod gltf_io;
 mod hash;
 pub mod labels;
+pub mod las;
 pub mod mesh_out;
 pub mod obj;
 pub mod pcd;
@@ -51,6 +52,8 @@ pub enum Format {
     Pcd,
     /// Wavefront OBJ (`v` and `f` lines).
     Obj,
+    /// ASPRS LAS 1.0–1.4, or LAZ (its compressed form).
+    Las,
     /// One point per line, the first three columns being x, y and z.
     Text,
     /// A mesh format that only meshes use (STL, glTF, GLB): its vertices
@@ -65,6 +68,7 @@ impl Format {
             Format::Ply => "ply",
             Format::Pcd => "pcd",
             Format::Obj => "obj",
+            Format::Las => "las",
             Format::Text => "text",
             Format::MeshVertices => "mesh vertices (stl, gltf, glb)",
         }
@@ -76,6 +80,7 @@ impl Format {
             "ply" => Some(Format::Ply),
             "pcd" => Some(Format::Pcd),
             "obj" => Some(Format::Obj),
+            "las" | "laz" => Some(Format::Las),
             "xyz" | "txt" | "csv" | "asc" | "pts" => Some(Format::Text),
             _ => None,
         }
@@ -92,6 +97,9 @@ pub struct Cloud {
     pub normals: Option<Vec<Point3>>,
     /// Points dropped because a coordinate was NaN or infinite (PCD only).
     pub dropped_non_finite: usize,
+    /// The integer grid of a LAS or LAZ file's coordinates, kept so that
+    /// labels written as LAS use the same one.
+    pub scale_offset: Option<las::ScaleOffset>,
     /// The format the file was read as.
     pub format: Format,
 }
@@ -148,6 +156,7 @@ fn read_cloud_inner(path: &Path) -> Result<Cloud> {
         Format::Obj => from_mesh(obj::read_obj(&bytes)?, format),
         Format::Pcd => pcd::read_pcd(&bytes)?,
         Format::Text => from_mesh(text::read_text(&bytes)?, format),
+        Format::Las => las::read_las(bytes)?,
     };
     if cloud.points.is_empty() {
         bail!("no points in the file ({} format)", format.name());
@@ -264,6 +273,7 @@ fn from_mesh(mesh: Mesh, format: Format) -> Cloud {
         normals: mesh.normals,
         dropped_non_finite: 0,
         format,
+        scale_offset: None,
     }
 }
 
@@ -285,13 +295,16 @@ pub fn detect_format(path: &Path, bytes: &[u8]) -> Result<Format> {
         return Ok(Format::Text);
     }
     bail!(
-        "unknown format: the extension '{ext}' is not one of ply, pcd, obj, xyz, txt, csv, asc, pts, \
-         and the content is neither a PLY, PCD or OBJ header nor lines of numbers"
+        "unknown format: the extension '{ext}' is not one of ply, pcd, obj, las, laz, xyz, txt, csv, \
+         asc, pts, and the content is neither a PLY, PCD, OBJ or LAS header nor lines of numbers"
     )
 }
 
 /// Recognises a format from the start of the file, if it is unambiguous.
 fn sniff(bytes: &[u8]) -> Option<Format> {
+    if las::is_las(bytes) {
+        return Some(Format::Las);
+    }
     let bytes = strip_bom(bytes);
     // `ply\r` covers `ply\r\n` and a lone `\r` (classic Mac OS).
     if bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r") {

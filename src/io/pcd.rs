@@ -541,6 +541,7 @@ fn keep_finite(raw: Raw) -> Cloud {
             normals: raw.normals,
             dropped_non_finite: 0,
             format: Format::Pcd,
+            scale_offset: None,
         };
     }
     let keep = |v: Vec<Point3>| -> Vec<Point3> {
@@ -556,6 +557,7 @@ fn keep_finite(raw: Raw) -> Cloud {
         normals: raw.normals.map(keep),
         dropped_non_finite: dropped,
         format: Format::Pcd,
+        scale_offset: None,
     }
 }
 

@@ -1,0 +1,53 @@
+"""Type stubs of meshtrim's native module (python/src/lib.rs).
+
+The public API is in ``meshtrim/__init__.py``, which checks shapes and
+converts dtypes before calling these: points and vertices arrive here as
+C-order float64 ``(n, 3)`` arrays, faces as C-order uint32 ``(m, 3)``.
+Reports and summaries are JSON text.
+"""
+
+from os import PathLike
+from typing import Optional, Tuple
+
+import numpy as np
+import numpy.typing as npt
+
+Points = npt.NDArray[np.float64]
+Faces = npt.NDArray[np.int64]
+Vector = Optional[Tuple[float, float, float]]
+Labels = Tuple[npt.NDArray[np.bool_], npt.NDArray[np.float64]]
+LoopTuple = Tuple[bool, npt.NDArray[np.int64], Points, list[Tuple[bool, Points]]]
+
+class MeshtrimError(ValueError): ...
+
+def detect(
+    points: Points, k: int, anisotropy: bool, view_along: Vector, view_from: Vector
+) -> Tuple[Labels, str]: ...
+def edges(
+    points: Points, k: int, anisotropy: bool, offset: bool, view_along: Vector, view_from: Vector
+) -> Tuple[Labels, list[LoopTuple], str]: ...
+def trim(
+    vertices: Points,
+    faces: npt.NDArray[np.uint32],
+    points: Points,
+    k: int,
+    anisotropy: bool,
+    offset: bool,
+    view_along: Vector,
+    view_from: Vector,
+) -> Tuple[Points, Faces, str]: ...
+def mesh(
+    points: Points, k: int, anisotropy: bool, offset: bool, view_along: Vector, view_from: Vector
+) -> Tuple[Points, Faces, str]: ...
+def clean(
+    vertices: Points,
+    faces: npt.NDArray[np.uint32],
+    k: int,
+    anisotropy: bool,
+    offset: bool,
+    view_along: Vector,
+    view_from: Vector,
+) -> Tuple[Points, Faces, str]: ...
+def read_cloud(path: str | PathLike[str]) -> Points: ...
+def read_mesh(path: str | PathLike[str]) -> Tuple[Points, Faces]: ...
+def write_mesh(path: str | PathLike[str], vertices: Points, faces: npt.NDArray[np.uint32]) -> None: ...

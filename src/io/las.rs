@@ -1,0 +1,298 @@
+//! LAS 1.0–1.4 and LAZ point clouds (the `las` crate; LAZ through its `laz`
+//! feature), in and out.
+//!
+//! **Reading.** Every point format (0–10) is read; only x, y, z are kept.
+//! LAZ chunks are decompressed in parallel, which needs the chunk table (a
+//! file whose table is lost is refused, as laspy refuses it). LAZ has no
+//! checksums: damage inside a chunk decodes into wrong points, which no
+//! reader can tell; a truncated file or a broken table is an error.
+//! A coordinate is `integer × scale + offset` in f64, computed as laspy
+//! computes it (a multiply, then an add), so the points are laspy's bit
+//! for bit and a survey cloud at a UTM-sized offset keeps its precision.
+//! The header's scale and offset are kept ([`ScaleOffset`]) so that
+//! `detect -o OUT.las` writes the points back on the same grid.
+//!
+//! **Writing** (`meshtrim detect CLOUD -o OUT.las|OUT.laz`): the points in
+//! input order, LAS 1.4 point format 0, with two extra-bytes dimensions,
+//! `boundary` (uint8, 1 = boundary) and `beta` (float64), which laspy, PDAL
+//! and CloudCompare read as scalar fields. The input's scale and offset
+//! when it was LAS or LAZ; otherwise, per axis, the offset is the middle of
+//! the points' range and the scale the finest power of ten whose grid
+//! spans that range in 32-bit integers.
+
+use std::io::{Cursor, Write};
+
+use anyhow::{anyhow, bail, Context, Result};
+use las::{Builder, PointDataBuilder, Transform, Vector, Vlr};
+
+use super::{Cloud, Format, Point3};
+
+/// Points read per chunk: a bounded buffer however large the file.
+const CHUNK: u64 = 1 << 20;
+
+/// Per axis, the grid of a LAS file's integer coordinates:
+/// `coordinate = integer × scale + offset`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ScaleOffset {
+    /// Scale of x, y and z.
+    pub scale: [f64; 3],
+    /// Offset of x, y and z.
+    pub offset: [f64; 3],
+}
+
+/// True when `bytes` start with a LAS (or LAZ) header's signature.
+pub fn is_las(bytes: &[u8]) -> bool {
+    bytes.starts_with(b"LASF")
+}
+
+/// Reads a LAS or LAZ file's points (see the module doc).
+pub fn read_las(bytes: Vec<u8>) -> Result<Cloud> {
+    let mut reader = las::Reader::new(Cursor::new(bytes))
+        .map_err(|e| anyhow!("cannot read the LAS header or the LAZ chunk table: {e}"))?;
+    let header = reader.header().clone();
+    let frame = frame_of(&header)?;
+    let total = header.number_of_points();
+    if total > u64::from(u32::MAX) {
+        bail!(
+            "the header announces {total} points; meshtrim reads at most {}",
+            u32::MAX
+        );
+    }
+    let mut points: Vec<Point3> = Vec::new();
+    let mut data = PointDataBuilder::new().for_header(&header).build();
+    while (points.len() as u64) < total {
+        let read = reader
+            .fill_points(CHUNK, &mut data)
+            .map_err(|e| anyhow!("point data from point {}: {e}", points.len()))?;
+        if read == 0 {
+            break;
+        }
+        points.reserve(data.len());
+        points.extend(
+            data.x()
+                .zip(data.y())
+                .zip(data.z())
+                .map(|((x, y), z)| [x, y, z]),
+        );
+    }
+    if (points.len() as u64) != total {
+        bail!(
+            "the header announces {total} points, but the point data holds {}",
+            points.len()
+        );
+    }
+    Ok(Cloud {
+        points,
+        normals: None,
+        dropped_non_finite: 0,
+        format: Format::Las,
+        scale_offset: Some(frame),
+    })
+}
+
+/// The header's scale and offset, checked: a zero or non-finite scale or
+/// a non-finite offset would make every coordinate meaningless.
+fn frame_of(header: &las::Header) -> Result<ScaleOffset> {
+    let t = header.transforms();
+    let axes = [("x", t.x), ("y", t.y), ("z", t.z)];
+    for (axis, transform) in axes {
+        if !(transform.scale.is_finite() && transform.scale != 0.0 && transform.offset.is_finite())
+        {
+            bail!(
+                "bad LAS header: the {axis} scale {} and offset {} do not give finite coordinates",
+                transform.scale,
+                transform.offset
+            );
+        }
+    }
+    Ok(ScaleOffset {
+        scale: axes.map(|(_, t)| t.scale),
+        offset: axes.map(|(_, t)| t.offset),
+    })
+}
+
+/// The grid for points that came from another format: per axis the middle
+/// of the range as offset, and the finest power-of-ten scale at which the
+/// range fits in ±2³⁰ steps (half of i32, so rounding cannot overflow) and
+/// which is still at least two f64 epsilons of the largest coordinate (a
+/// finer grid would not be a finer one in f64).
+pub fn grid_for(points: &[Point3]) -> ScaleOffset {
+    let mut frame = ScaleOffset {
+        scale: [1.0; 3],
+        offset: [0.0; 3],
+    };
+    for axis in 0..3 {
+        let (lo, hi) = points
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(p[axis]), hi.max(p[axis]))
+            });
+        if !(lo.is_finite() && hi.is_finite()) {
+            continue;
+        }
+        let half = (hi - lo) / 2.0;
+        let largest = lo.abs().max(hi.abs());
+        let finest = (half / f64::from(1u32 << 30)).max(largest * f64::EPSILON * 2.0);
+        frame.offset[axis] = lo + half;
+        frame.scale[axis] = if finest > 0.0 {
+            10f64.powi(finest.log10().ceil() as i32)
+        } else {
+            1.0 // every coordinate is 0
+        };
+    }
+    frame
+}
+
+/// Writes `points` with their labels as LAS (or LAZ when `compressed`):
+/// see the module doc.
+pub fn write_labels_las(
+    w: &mut dyn Write,
+    points: &[Point3],
+    boundary: &[bool],
+    beta: &[f64],
+    frame: ScaleOffset,
+    compressed: bool,
+) -> std::io::Result<()> {
+    let bytes = labels_las_bytes(points, boundary, beta, frame, compressed)
+        .map_err(std::io::Error::other)?;
+    w.write_all(&bytes)
+}
+
+fn labels_las_bytes(
+    points: &[Point3],
+    boundary: &[bool],
+    beta: &[f64],
+    frame: ScaleOffset,
+    compressed: bool,
+) -> Result<Vec<u8>> {
+    let mut builder = Builder::from((1, 4));
+    builder.generating_software = "meshtrim detect".to_string();
+    // No creation date: the same input gives the same bytes out.
+    builder.date = None;
+    builder.point_format = las::point::Format::new(0).context("LAS point format 0")?;
+    builder.point_format.extra_bytes = EXTRA_BYTES_LEN;
+    builder.point_format.is_compressed = compressed;
+    let axis = |i: usize| Transform {
+        scale: frame.scale[i],
+        offset: frame.offset[i],
+    };
+    builder.transforms = Vector {
+        x: axis(0),
+        y: axis(1),
+        z: axis(2),
+    };
+    builder.vlrs.push(extra_bytes_vlr());
+    let header = builder.into_header().context("LAS header")?;
+    let mut writer = las::Writer::new(Cursor::new(Vec::new()), header).context("LAS writer")?;
+    for (i, p) in points.iter().enumerate() {
+        let mut extra = Vec::with_capacity(EXTRA_BYTES_LEN as usize);
+        extra.push(u8::from(boundary[i]));
+        extra.extend_from_slice(&beta[i].to_le_bytes());
+        let point = las::Point {
+            x: p[0],
+            y: p[1],
+            z: p[2],
+            extra_bytes: extra,
+            ..Default::default()
+        };
+        writer.write_point(point).with_context(|| {
+            format!(
+                "point {i} ({}, {}, {}) does not fit the LAS grid",
+                p[0], p[1], p[2]
+            )
+        })?;
+    }
+    let cursor = writer.into_inner().context("finishing the LAS file")?;
+    Ok(cursor.into_inner())
+}
+
+/// Bytes of the two extra dimensions per point: uint8 + float64.
+const EXTRA_BYTES_LEN: u16 = 9;
+
+/// The LAS 1.4 "Extra Bytes" VLR (record 4 of LASF_Spec) describing
+/// `boundary` (data type 1, uint8) and `beta` (data type 10, float64).
+fn extra_bytes_vlr() -> Vlr {
+    let mut data = Vec::with_capacity(2 * 192);
+    data.extend(extra_bytes_descriptor(
+        1,
+        "boundary",
+        "1 = boundary point (meshtrim BPD)",
+    ));
+    data.extend(extra_bytes_descriptor(
+        10,
+        "beta",
+        "local resolution (meshtrim BPD)",
+    ));
+    Vlr {
+        user_id: "LASF_Spec".to_string(),
+        record_id: 4,
+        description: "Extra Bytes".to_string(),
+        data,
+    }
+}
+
+/// One 192-byte extra-bytes descriptor (LAS 1.4 R15, table 24): no
+/// no-data, min, max, scale or offset given (options 0).
+fn extra_bytes_descriptor(data_type: u8, name: &str, description: &str) -> [u8; 192] {
+    let mut d = [0u8; 192];
+    d[2] = data_type;
+    d[4..4 + name.len()].copy_from_slice(name.as_bytes());
+    let text = &description.as_bytes()[..description.len().min(32)];
+    d[160..160 + text.len()].copy_from_slice(text);
+    d
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_grid_spans_the_range_and_f64_steps() {
+        let survey = [
+            [612_345.0, 6_012_345.0, 0.0],
+            [612_345.6, 6_012_345.2, 0.002],
+        ];
+        let frame = grid_for(&survey);
+        // x: two f64 epsilons at 6e5 (2.7e-10) round up to 1e-9; y: at 6e6
+        // (2.7e-9) to 1e-8; z: the range's half, 0.001 / 2^30 (9.3e-13),
+        // to 1e-12.
+        assert_eq!(frame.scale, [1e-9, 1e-8, 1e-12]);
+        let middle = [612_345.3, 6_012_345.1, 0.001];
+        for (offset, m) in frame.offset.iter().zip(middle) {
+            assert!((offset - m).abs() < 1e-9, "{offset} {m}");
+        }
+        let flat = grid_for(&[[0.0, 1.0, -2.0]; 3]);
+        assert_eq!(flat.scale, [1.0, 1e-15, 1e-15]);
+    }
+
+    #[test]
+    fn labels_read_back_on_the_grid() {
+        let points: Vec<Point3> = (0..50)
+            .map(|i| [f64::from(i) * 0.1, f64::from(i % 7), 1e5 + f64::from(i)])
+            .collect();
+        let boundary: Vec<bool> = (0..50).map(|i| i % 3 == 0).collect();
+        let beta = vec![0.25; 50];
+        let frame = grid_for(&points);
+        for compressed in [false, true] {
+            let mut out = Vec::new();
+            write_labels_las(&mut out, &points, &boundary, &beta, frame, compressed).unwrap();
+            let cloud = read_las(out).unwrap();
+            assert_eq!(cloud.scale_offset, Some(frame));
+            for (read, p) in cloud.points.iter().zip(&points) {
+                for axis in 0..3 {
+                    let step = frame.scale[axis];
+                    assert!((read[axis] - p[axis]).abs() <= step, "{read:?} {p:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_descriptor_is_192_bytes_with_its_type_and_name() {
+        let d = extra_bytes_descriptor(10, "beta", "local resolution (meshtrim BPD)");
+        assert_eq!(d[2], 10);
+        assert_eq!(&d[4..8], b"beta");
+        assert_eq!(d[8], 0);
+        assert_eq!(&d[160..165], b"local");
+    }
+}
