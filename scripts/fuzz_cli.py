@@ -96,7 +96,7 @@ def derive_sources(work):
     write_ascii_meshes(work)
     clouds = [CLOUD] + [os.path.join(work, n) for n in
                         ("cloud.csv", "cloud.xyz", "cloud.pts", "cloud.obj", "cloud_ascii.pcd",
-                         "cloud_binary.pcd", "cloud.las", "cloud.laz")]
+                         "cloud_binary.pcd", "cloud.las", "cloud.laz", "cloud.e57")]
     meshes = [JAGGED, POISSON] + [os.path.join(work, f"mesh.{e}") for e in ("stl", "obj", "gltf", "glb", "ply")]
     meshes += [os.path.join(work, n) for n in ("mesh_ascii.stl", "mesh_ascii.ply")]
     return clouds, meshes
@@ -116,6 +116,21 @@ def write_las_clouds(work, rows):
         las = laspy.LasData(header)
         las.x, las.y, las.z = xyz[:, 0], xyz[:, 1], xyz[:, 2]
         las.write(os.path.join(work, name))
+    write_e57_cloud(work, xyz)
+
+
+def write_e57_cloud(work, xyz):
+    """The cloud as an E57 file of two posed scans, written by pye57
+    (libE57Format)."""
+    import numpy as np
+    import pye57
+
+    e57 = pye57.E57(os.path.join(work, "cloud.e57"), mode="w")
+    half = len(xyz) // 2
+    for block, translation in ((xyz[:half], [0.0, 0.0, 0.0]), (xyz[half:] - 10.0, [10.0, 10.0, 10.0])):
+        data = {"cartesianX": block[:, 0], "cartesianY": block[:, 1], "cartesianZ": block[:, 2]}
+        e57.write_scan_raw(data, rotation=np.array([1.0, 0, 0, 0]), translation=np.array(translation))
+    e57.close()
 
 
 def write_ascii_meshes(work):

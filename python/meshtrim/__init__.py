@@ -316,10 +316,14 @@ def clean(
     return out_v, out_f, json.loads(report)
 
 
-def read_cloud(path: PathLike) -> np.ndarray:
+def read_cloud(path: PathLike, *, scan: Optional[int] = None) -> np.ndarray:
     """The points of a cloud file, as every command reads a cloud: PLY,
-    PCD, OBJ, LAS/LAZ, XYZ/TXT/CSV/ASC/PTS, or a mesh's vertices (STL, glTF/GLB)."""
-    return _meshtrim.read_cloud(os.fspath(path))
+    PCD, OBJ, LAS/LAZ, E57, XYZ/TXT/CSV/ASC/PTS, or a mesh's vertices (STL,
+    glTF/GLB). An E57 file's scans are merged in the file's frame, each in
+    its pose; ``scan=N`` reads scan N alone (the CLI's ``--scan``)."""
+    if scan is not None:
+        scan = _k(scan)
+    return _meshtrim.read_cloud(os.fspath(path), scan)
 
 
 def read_mesh(path: PathLike) -> tuple:

@@ -271,6 +271,7 @@ fn trim_py<'py>(
         }
         .stages()?,
         progress: false,
+        cloud: Default::default(),
     };
     let mesh = mesh_of(&vertices, &faces)?;
     let points = rows(&points, "points")?;
@@ -337,10 +338,13 @@ fn clean_py<'py>(
     mesh_result(py, &out, &report)
 }
 
-/// A cloud's points, read as every command reads a cloud.
+/// A cloud's points, read as every command reads a cloud (`scan`: one
+/// scan of an E57 file, as `--scan`).
 #[pyfunction]
-fn read_cloud(py: Python<'_>, path: PathBuf) -> PyResult<Points<'_>> {
-    let cloud = without_gil(py, || meshtrim::io::read_cloud(&path))?;
+#[pyo3(signature = (path, scan=None))]
+fn read_cloud(py: Python<'_>, path: PathBuf, scan: Option<usize>) -> PyResult<Points<'_>> {
+    let options = meshtrim::io::CloudOptions { scan };
+    let cloud = without_gil(py, || meshtrim::io::read_cloud_with(&path, &options))?;
     points_array(py, &cloud.points)
 }
 

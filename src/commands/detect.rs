@@ -11,7 +11,7 @@ use crate::commands::args::{bpd_options, parse_k, ViewArgs};
 use crate::console;
 use crate::io::atomic::write_atomic;
 use crate::io::labels::{LabelFormat, Labelled};
-use crate::io::{read_cloud, Cloud, Point3};
+use crate::io::{read_cloud_with, Cloud, CloudOptions, Point3};
 use crate::report::{same_file, shown};
 use crate::stages::{detect, millis};
 
@@ -35,6 +35,11 @@ pub struct Args {
     /// Where a range scanner saw the cloud from.
     #[command(flatten)]
     pub view: ViewArgs,
+    /// Read only scan N of an E57 file (its 0-based data3D index); by
+    /// default every scan is read, each in its pose, merged in the file's
+    /// frame.
+    #[arg(long, value_name = "N")]
+    pub scan: Option<usize>,
     /// Print the summary as one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -58,7 +63,8 @@ pub struct Summary {
     pub distinct_points: usize,
     /// Points that were exact copies of an earlier one.
     pub duplicates: usize,
-    /// Points dropped by the reader for a NaN or infinite coordinate.
+    /// Points dropped by the reader: a NaN or infinite coordinate (PCD),
+    /// no position (E57's invalid states).
     pub dropped_non_finite: usize,
     /// Points labelled boundary (duplicates counted).
     pub boundary_points: usize,
@@ -95,7 +101,7 @@ pub fn run(args: &Args) -> Result<()> {
         .map(|out| check_output(out, &args.cloud))
         .transpose()?;
     let started = Instant::now();
-    let cloud = read_cloud(&args.cloud)?;
+    let cloud = read_cloud_with(&args.cloud, &CloudOptions { scan: args.scan })?;
     let read_time = started.elapsed();
     let name = args.cloud.display().to_string();
     let (detection, mut summary) =
@@ -200,7 +206,7 @@ impl Summary {
             ("points", self.points.to_string()),
             ("distinct points", self.distinct_points.to_string()),
             ("duplicates", self.duplicates.to_string()),
-            ("dropped non-finite", self.dropped_non_finite.to_string()),
+            ("dropped invalid", self.dropped_non_finite.to_string()),
             (
                 "boundary points",
                 format!("{} ({share:.1}%)", self.boundary_points),

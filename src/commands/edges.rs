@@ -13,7 +13,7 @@ use crate::commands::args::StageArgs;
 use crate::console;
 use crate::io::atomic::write_atomic;
 use crate::io::edges_out::{EdgeData, EdgesFormat};
-use crate::io::{read_cloud, Point3};
+use crate::io::{read_cloud_with, CloudOptions, Point3};
 use crate::report::{same_file, shown};
 use crate::stages::{detect, millis, Stages};
 
@@ -31,6 +31,11 @@ pub struct Args {
     /// Detection and edge options.
     #[command(flatten)]
     pub stages: StageArgs,
+    /// Read only scan N of an E57 file (its 0-based data3D index); by
+    /// default every scan is read, each in its pose, merged in the file's
+    /// frame.
+    #[arg(long, value_name = "N")]
+    pub scan: Option<usize>,
     /// Print the summary as one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -71,7 +76,7 @@ pub fn run(args: &Args) -> Result<()> {
     // Check the output before the (possibly long) work.
     let format = check_output(&args.output, &args.cloud)?;
     let started = Instant::now();
-    let cloud = read_cloud(&args.cloud)?;
+    let cloud = read_cloud_with(&args.cloud, &CloudOptions { scan: args.scan })?;
     let read_time = started.elapsed();
     let name = args.cloud.display().to_string();
     let stages = args.stages.stages();

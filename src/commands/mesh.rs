@@ -11,7 +11,7 @@ use trim::{delaunay_mesh_with_report, reconstruct_edges, DelaunayOptions, Delaun
 
 use crate::commands::args::StageArgs;
 use crate::io::mesh_out::write_mesh;
-use crate::io::{read_cloud, Point3};
+use crate::io::{read_cloud_with, CloudOptions, Point3};
 use crate::report::shown;
 use crate::stages::{detect, millis, Stages};
 
@@ -29,6 +29,11 @@ pub struct Args {
     /// Detection and edge options.
     #[command(flatten)]
     pub stages: StageArgs,
+    /// Read only scan N of an E57 file (its 0-based data3D index); by
+    /// default every scan is read, each in its pose, merged in the file's
+    /// frame.
+    #[arg(long, value_name = "N")]
+    pub scan: Option<usize>,
     /// Print the report as one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -78,7 +83,7 @@ pub fn run(args: &Args) -> Result<()> {
     // name, and neither may overwrite the cloud.
     crate::report::check_outputs(&args.output, args.report.as_deref(), &[&args.cloud])?;
     let started = Instant::now();
-    let cloud = read_cloud(&args.cloud)?;
+    let cloud = read_cloud_with(&args.cloud, &CloudOptions { scan: args.scan })?;
     let read_time = started.elapsed();
     let name = args.cloud.display().to_string();
     let (mesh, mut report) = mesh_in_memory(&cloud.points, &args.stages.stages(), true, &name)?;

@@ -16,7 +16,7 @@ use crate::commands::args::{
     VIEW_ALONG_LONG_HELP, VIEW_FROM_HELP, VIEW_FROM_LONG_HELP,
 };
 use crate::io::mesh_out::write_mesh;
-use crate::io::{read_cloud, read_mesh_with_faces, Point3};
+use crate::io::{read_cloud_with, read_mesh_with_faces, CloudOptions, Point3};
 use crate::report::{shown, significant};
 use crate::stages::{detect, millis, Stages};
 
@@ -55,6 +55,11 @@ pub struct Args {
     /// The scanner's position (as `ViewArgs`'s, same help).
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_vector, allow_hyphen_values = true, help = VIEW_FROM_HELP, long_help = VIEW_FROM_LONG_HELP)]
     pub view_from: Option<[f64; 3]>,
+    /// Read only scan N of an E57 file (its 0-based data3D index); by
+    /// default every scan is read, each in its pose, merged in the file's
+    /// frame.
+    #[arg(long, value_name = "N")]
+    pub scan: Option<usize>,
     /// Print the report as one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -154,6 +159,8 @@ pub struct TrimSettings {
     /// Whether detection may show its own progress bar (not in a batch,
     /// which has one bar for all files).
     pub progress: bool,
+    /// How the cloud is read (which scan of an E57 file).
+    pub cloud: CloudOptions,
 }
 
 /// Runs the trimming.
@@ -162,6 +169,7 @@ pub fn run(args: &Args) -> Result<()> {
     let settings = TrimSettings {
         stages: args.stage_args().stages(),
         progress: true,
+        cloud: CloudOptions { scan: args.scan },
     };
     let report = trim_file(&args.mesh, &args.cloud, &args.output, &settings)?;
     crate::report::emit(&report, args.report.as_deref(), args.json)
@@ -183,7 +191,7 @@ pub fn trim_file(
     let started = Instant::now();
     let (mesh, cloud) = rayon::join(
         || read_mesh_with_faces(mesh_path, "give a mesh (the cloud goes second)"),
-        || read_cloud(cloud_path),
+        || read_cloud_with(cloud_path, &settings.cloud),
     );
     let mesh = mesh?;
     let cloud = cloud?;

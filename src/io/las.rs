@@ -51,6 +51,7 @@ pub fn read_las(bytes: Vec<u8>) -> Result<Cloud> {
         .map_err(|e| anyhow!("cannot read the LAS header or the LAZ chunk table: {e}"))?;
     let header = reader.header().clone();
     let frame = frame_of(&header)?;
+    check_laz_items(&header)?;
     let total = header.number_of_points();
     if total > u64::from(u32::MAX) {
         bail!(
@@ -88,6 +89,24 @@ pub fn read_las(bytes: Vec<u8>) -> Result<Cloud> {
         format: Format::Las,
         scale_offset: Some(frame),
     })
+}
+
+/// A LAZ file's compressed items must make up the header's point record:
+/// the decoder asserts it (a panic) rather than returning an error.
+fn check_laz_items(header: &las::Header) -> Result<()> {
+    if !header.point_format().is_compressed {
+        return Ok(());
+    }
+    let vlr = header.laz_vlr().map_err(|e| anyhow!("bad LAZ VLR: {e}"))?;
+    let record = u64::from(header.point_format().len());
+    if vlr.items_size() != record {
+        bail!(
+            "the LAZ items ({} bytes a point) do not match the point record length ({record} \
+             bytes): the header or the LAZ VLR is corrupt",
+            vlr.items_size()
+        );
+    }
+    Ok(())
 }
 
 /// The header's scale and offset, checked: a zero or non-finite scale or

@@ -15,6 +15,7 @@
 //! other format a non-finite coordinate is an error.
 
 pub mod atomic;
+pub mod e57;
 pub mod edges_out;
 pub(crate) mod float_text;
 pub mod gltf_io;
@@ -54,6 +55,8 @@ pub enum Format {
     Obj,
     /// ASPRS LAS 1.0–1.4, or LAZ (its compressed form).
     Las,
+    /// ASTM E57 (one or several scans with their poses).
+    E57,
     /// One point per line, the first three columns being x, y and z.
     Text,
     /// A mesh format that only meshes use (STL, glTF, GLB): its vertices
@@ -69,6 +72,7 @@ impl Format {
             Format::Pcd => "pcd",
             Format::Obj => "obj",
             Format::Las => "las",
+            Format::E57 => "e57",
             Format::Text => "text",
             Format::MeshVertices => "mesh vertices (stl, gltf, glb)",
         }
@@ -81,6 +85,7 @@ impl Format {
             "pcd" => Some(Format::Pcd),
             "obj" => Some(Format::Obj),
             "las" | "laz" => Some(Format::Las),
+            "e57" => Some(Format::E57),
             "xyz" | "txt" | "csv" | "asc" | "pts" => Some(Format::Text),
             _ => None,
         }
@@ -95,7 +100,8 @@ pub struct Cloud {
     /// Per-point normals, when the file has them (PLY nx/ny/nz, PCD
     /// normal_x/normal_y/normal_z).
     pub normals: Option<Vec<Point3>>,
-    /// Points dropped because a coordinate was NaN or infinite (PCD only).
+    /// Points dropped by the reader: a NaN or infinite coordinate (PCD), or
+    /// no position (E57's invalid states).
     pub dropped_non_finite: usize,
     /// The integer grid of a LAS or LAZ file's coordinates, kept so that
     /// labels written as LAS use the same one.
@@ -121,7 +127,20 @@ pub struct Mesh {
 /// Fails, with the file name first in the message, on unreadable or
 /// malformed files and on files with no points.
 pub fn read_cloud(path: &Path) -> Result<Cloud> {
-    read_cloud_inner(path).with_context(|| path.display().to_string())
+    read_cloud_with(path, &CloudOptions::default())
+}
+
+/// How a cloud file is read, beyond its format.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct CloudOptions {
+    /// Read only this scan (the 0-based `data3D` index) of an E57 file;
+    /// `None` merges them all. An error for the other formats.
+    pub scan: Option<usize>,
+}
+
+/// [`read_cloud`] with `options`.
+pub fn read_cloud_with(path: &Path, options: &CloudOptions) -> Result<Cloud> {
+    read_cloud_inner(path, options).with_context(|| path.display().to_string())
 }
 
 /// Reads a mesh: PLY, OBJ, STL (ASCII or binary), glTF or GLB.
@@ -147,9 +166,15 @@ pub fn read_mesh_with_faces(path: &Path, hint: &str) -> Result<trim::Mesh> {
     })
 }
 
-fn read_cloud_inner(path: &Path) -> Result<Cloud> {
+fn read_cloud_inner(path: &Path, options: &CloudOptions) -> Result<Cloud> {
     let bytes = std::fs::read(path).context("cannot read")?;
     let format = cloud_format(path, &bytes)?;
+    if let (Some(n), false) = (options.scan, format == Format::E57) {
+        bail!(
+            "scan {n} asked for, but scans are numbered in E57 files only; this is a {} file",
+            format.name()
+        );
+    }
     let cloud = match format {
         Format::MeshVertices => from_mesh(parse_mesh(path, &bytes)?, format),
         Format::Ply => from_mesh(ply::read_ply(&bytes)?, format),
@@ -157,6 +182,7 @@ fn read_cloud_inner(path: &Path) -> Result<Cloud> {
         Format::Pcd => pcd::read_pcd(&bytes)?,
         Format::Text => from_mesh(text::read_text(&bytes)?, format),
         Format::Las => las::read_las(bytes)?,
+        Format::E57 => e57::read_e57(bytes, options.scan)?,
     };
     if cloud.points.is_empty() {
         bail!("no points in the file ({} format)", format.name());
@@ -295,8 +321,9 @@ pub fn detect_format(path: &Path, bytes: &[u8]) -> Result<Format> {
         return Ok(Format::Text);
     }
     bail!(
-        "unknown format: the extension '{ext}' is not one of ply, pcd, obj, las, laz, xyz, txt, csv, \
-         asc, pts, and the content is neither a PLY, PCD, OBJ or LAS header nor lines of numbers"
+        "unknown format: the extension '{ext}' is not one of ply, pcd, obj, las, laz, e57, xyz, txt, \
+         csv, asc, pts, and the content is neither a PLY, PCD, OBJ, LAS or E57 header nor lines \
+         of numbers"
     )
 }
 
@@ -304,6 +331,9 @@ pub fn detect_format(path: &Path, bytes: &[u8]) -> Result<Format> {
 fn sniff(bytes: &[u8]) -> Option<Format> {
     if las::is_las(bytes) {
         return Some(Format::Las);
+    }
+    if e57::is_e57(bytes) {
+        return Some(Format::E57);
     }
     let bytes = strip_bom(bytes);
     // `ply\r` covers `ply\r\n` and a lone `\r` (classic Mac OS).

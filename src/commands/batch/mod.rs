@@ -27,6 +27,7 @@ use super::clean::clean_file;
 use super::trim::{trim_file, TrimSettings};
 use crate::commands::args::StageArgs;
 use crate::console;
+use crate::io::CloudOptions;
 use crate::stages::{in_cli_words, millis, Stages};
 
 /// Arguments of `meshtrim batch`.
@@ -223,6 +224,7 @@ fn work(job: &Job, stages: &Stages) -> Result<Outcome> {
             let settings = TrimSettings {
                 stages: stages.clone(),
                 progress: false,
+                cloud: CloudOptions::default(),
             };
             let r = trim_file(&job.input, cloud, &job.output, &settings)?;
             Ok(Outcome {
