@@ -3,8 +3,8 @@
 //! CloudCompare).
 //!
 //! Every `data3D` scan is read in file order, each scan's points in file
-//! order, its pose (a unit quaternion and a translation) applied in f64,
-//! so the merged cloud is in the file's common frame; or one scan alone
+//! order, its pose (a quaternion, normalised, and a translation) applied
+//! in f64, so the merged cloud is in the file's common frame; or one scan alone
 //! (`--scan N`, the 0-based `data3D` index). Cartesian and spherical
 //! coordinates (range, azimuth, elevation, converted) are read, scaled
 //! integers and floats alike. A point whose `cartesianInvalidState` (or
@@ -16,6 +16,7 @@ use std::io::Cursor;
 
 use anyhow::{anyhow, bail, Context, Result};
 use e57::{CartesianCoordinate, E57Reader};
+use rayon::prelude::*;
 
 use super::{Cloud, Format, Point3};
 
@@ -28,9 +29,10 @@ pub fn is_e57(bytes: &[u8]) -> bool {
 }
 
 /// Reads the scans of an E57 file, all merged or the one numbered `scan`
-/// (see the module doc).
+/// (see the module doc). Scans are read in parallel, each by its own
+/// reader over the same bytes, and joined in file order.
 pub fn read_e57(bytes: Vec<u8>, scan: Option<usize>) -> Result<Cloud> {
-    let mut reader = E57Reader::new(Cursor::new(bytes)).map_err(|e| anyhow!("{e}"))?;
+    let reader = open(&bytes)?;
     let scans = reader.pointclouds();
     if scans.is_empty() {
         bail!("no scans: the file's data3D list is empty");
@@ -51,11 +53,16 @@ pub fn read_e57(bytes: Vec<u8>, scan: Option<usize>) -> Result<Cloud> {
             u32::MAX
         );
     }
+    let read: Vec<Result<Scan>> = chosen
+        .par_iter()
+        .map(|&n| read_scan(&bytes, &scans[n]).with_context(|| format!("scan {n}")))
+        .collect();
     let mut points: Vec<Point3> = Vec::with_capacity(records as usize);
     let mut dropped = 0;
-    for n in chosen {
-        dropped +=
-            read_scan(&mut reader, &scans[n], &mut points).with_context(|| format!("scan {n}"))?;
+    for scan in read {
+        let scan = scan?;
+        points.extend_from_slice(&scan.points);
+        dropped += scan.dropped;
     }
     Ok(Cloud {
         points,
@@ -66,16 +73,26 @@ pub fn read_e57(bytes: Vec<u8>, scan: Option<usize>) -> Result<Cloud> {
     })
 }
 
-/// Appends one scan's valid points, posed, to `points`; returns how many
-/// points had no position.
-fn read_scan(
-    reader: &mut E57Reader<Cursor<Vec<u8>>>,
-    scan: &e57::PointCloud,
-    points: &mut Vec<Point3>,
-) -> Result<usize> {
+fn open(bytes: &[u8]) -> Result<E57Reader<Cursor<&[u8]>>> {
+    E57Reader::new(Cursor::new(bytes)).map_err(|e| anyhow!("{e}"))
+}
+
+/// One scan's valid points, posed, and how many had no position.
+struct Scan {
+    points: Vec<Point3>,
+    dropped: usize,
+}
+
+fn read_scan(bytes: &[u8], scan: &e57::PointCloud) -> Result<Scan> {
+    let pose = Pose::of(scan)?;
+    let mut reader = open(bytes)?;
     let mut iter = reader.pointcloud_simple(scan).map_err(|e| anyhow!("{e}"))?;
-    iter.apply_pose(true);
+    // The pose is applied here, with the quaternion normalised.
+    iter.apply_pose(false);
     iter.spherical_to_cartesian(true);
+    iter.normalize_intensity(false);
+    iter.normalize_color(false);
+    let mut points = Vec::with_capacity(scan.records as usize);
     let mut dropped = 0;
     for (index, point) in iter.enumerate() {
         let point = point.map_err(|e| anyhow!("point {index}: {e}"))?;
@@ -84,10 +101,72 @@ fn read_scan(
                 if !(x.is_finite() && y.is_finite() && z.is_finite()) {
                     bail!("point {index} has a non-finite coordinate ({x}, {y}, {z})");
                 }
-                points.push([x, y, z]);
+                points.push(pose.apply([x, y, z]));
             }
             CartesianCoordinate::Direction { .. } | CartesianCoordinate::Invalid => dropped += 1,
         }
     }
-    Ok(dropped)
+    Ok(Scan { points, dropped })
+}
+
+/// A scan's pose as a rotation matrix (rows) and a translation.
+struct Pose {
+    rotation: [[f64; 3]; 3],
+    translation: Point3,
+}
+
+impl Pose {
+    /// The scan's pose; the identity when it has none. The quaternion is
+    /// normalised first: files store it rounded (seven digits are common),
+    /// and an unnormalised one would scale the scan by its squared norm.
+    fn of(scan: &e57::PointCloud) -> Result<Pose> {
+        let Some(t) = &scan.transform else {
+            return Ok(Pose {
+                rotation: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+                translation: [0.0; 3],
+            });
+        };
+        let q = &t.rotation;
+        let norm = (q.w * q.w + q.x * q.x + q.y * q.y + q.z * q.z).sqrt();
+        let translation = [t.translation.x, t.translation.y, t.translation.z];
+        if !(norm.is_finite() && norm > 0.0 && translation.iter().all(|c| c.is_finite())) {
+            bail!(
+                "the pose is not usable: rotation ({}, {}, {}, {}) is no quaternion or the translation is not finite",
+                q.w,
+                q.x,
+                q.y,
+                q.z
+            );
+        }
+        let [w, x, y, z] = [q.w, q.x, q.y, q.z].map(|c| c / norm);
+        Ok(Pose {
+            rotation: [
+                [
+                    1.0 - 2.0 * (y * y + z * z),
+                    2.0 * (x * y - w * z),
+                    2.0 * (x * z + w * y),
+                ],
+                [
+                    2.0 * (x * y + w * z),
+                    1.0 - 2.0 * (x * x + z * z),
+                    2.0 * (y * z - w * x),
+                ],
+                [
+                    2.0 * (x * z - w * y),
+                    2.0 * (y * z + w * x),
+                    1.0 - 2.0 * (x * x + y * y),
+                ],
+            ],
+            translation,
+        })
+    }
+
+    fn apply(&self, p: Point3) -> Point3 {
+        let row = |r: [f64; 3], t: f64| r[0] * p[0] + r[1] * p[1] + r[2] * p[2] + t;
+        [
+            row(self.rotation[0], self.translation[0]),
+            row(self.rotation[1], self.translation[1]),
+            row(self.rotation[2], self.translation[2]),
+        ]
+    }
 }

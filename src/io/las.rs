@@ -21,9 +21,12 @@
 //! spans that range in 32-bit integers.
 
 use std::io::{Cursor, Write};
+use std::sync::Arc;
 
 use anyhow::{anyhow, bail, Context, Result};
 use las::{Builder, PointDataBuilder, Transform, Vector, Vlr};
+
+use rayon::prelude::*;
 
 use super::{Cloud, Format, Point3};
 
@@ -47,7 +50,8 @@ pub fn is_las(bytes: &[u8]) -> bool {
 
 /// Reads a LAS or LAZ file's points (see the module doc).
 pub fn read_las(bytes: Vec<u8>) -> Result<Cloud> {
-    let mut reader = las::Reader::new(Cursor::new(bytes))
+    let bytes = Shared(Arc::new(bytes));
+    let mut reader = las::Reader::new(Cursor::new(bytes.clone()))
         .map_err(|e| anyhow!("cannot read the LAS header or the LAZ chunk table: {e}"))?;
     let header = reader.header().clone();
     let frame = frame_of(&header)?;
@@ -59,8 +63,39 @@ pub fn read_las(bytes: Vec<u8>) -> Result<Cloud> {
             u32::MAX
         );
     }
+    let points = if header.point_format().is_compressed {
+        read_compressed(&mut reader, &header, total)?
+    } else {
+        read_uncompressed(bytes.as_ref(), &header, frame, total)?
+    };
+    Ok(Cloud {
+        points,
+        normals: None,
+        dropped_non_finite: 0,
+        format: Format::Las,
+        scale_offset: Some(frame),
+    })
+}
+
+/// The file's bytes, shared by the `las` reader (which wants to own its
+/// source) and the direct decoding of uncompressed records.
+#[derive(Clone)]
+struct Shared(Arc<Vec<u8>>);
+
+impl AsRef<[u8]> for Shared {
+    fn as_ref(&self) -> &[u8] {
+        &self.0
+    }
+}
+
+/// LAZ points, decompressed chunk by chunk by the `las` reader.
+fn read_compressed(
+    reader: &mut las::Reader,
+    header: &las::Header,
+    total: u64,
+) -> Result<Vec<Point3>> {
     let mut points: Vec<Point3> = Vec::new();
-    let mut data = PointDataBuilder::new().for_header(&header).build();
+    let mut data = PointDataBuilder::new().for_header(header).build();
     while (points.len() as u64) < total {
         let read = reader
             .fill_points(CHUNK, &mut data)
@@ -82,13 +117,40 @@ pub fn read_las(bytes: Vec<u8>) -> Result<Cloud> {
             points.len()
         );
     }
-    Ok(Cloud {
-        points,
-        normals: None,
-        dropped_non_finite: 0,
-        format: Format::Las,
-        scale_offset: Some(frame),
-    })
+    Ok(points)
+}
+
+/// Uncompressed records decoded in place, in parallel: X, Y and Z are the
+/// first three little-endian i32 of a record in every point format, each
+/// `scale × integer + offset` as the `las` crate and laspy compute it.
+fn read_uncompressed(
+    bytes: &[u8],
+    header: &las::Header,
+    frame: ScaleOffset,
+    total: u64,
+) -> Result<Vec<Point3>> {
+    let raw = las::raw::Header::read_from(bytes).map_err(|e| anyhow!("bad LAS header: {e}"))?;
+    let start = raw.offset_to_point_data as usize;
+    let record = usize::from(header.point_format().len());
+    if record < 12 {
+        bail!("bad LAS header: point records of {record} bytes cannot hold x, y, z");
+    }
+    let held = bytes.len().saturating_sub(start) / record;
+    if (held as u64) < total {
+        bail!("the header announces {total} points, but the point data holds {held}");
+    }
+    let data = &bytes[start..start + total as usize * record];
+    let [sx, sy, sz] = frame.scale;
+    let [ox, oy, oz] = frame.offset;
+    Ok(data
+        .par_chunks_exact(record)
+        .with_min_len(1 << 14)
+        .map(|r| {
+            let int =
+                |at: usize| f64::from(i32::from_le_bytes([r[at], r[at + 1], r[at + 2], r[at + 3]]));
+            [sx * int(0) + ox, sy * int(4) + oy, sz * int(8) + oz]
+        })
+        .collect())
 }
 
 /// A LAZ file's compressed items must make up the header's point record:
