@@ -116,6 +116,22 @@ def test_one_scan_alone(tmp_path):
         meshtrim.read_cloud(path, scan=2)
 
 
+def test_a_rounded_quaternion_is_normalised(tmp_path):
+    # 45 degrees about z, as files store it: seven digits, a norm of
+    # 0.99999996. Unnormalised, it would shrink the scan by 8e-8 of its size.
+    rotation = np.array([0.9238795, 0.0, 0.0, 0.3826834])
+    a, _ = halves()
+    far = a + [5e4, 0.0, 0.0]  # 50 m away: a shrink would show as 4 micrometres
+    path = tmp_path / "rounded.e57"
+    write_scans(path, [far], [(rotation, np.zeros(3))])
+    xyz, _, _, _ = labels(path)
+    expected = pye57_points(path, 0)  # pye57 normalises (pyquaternion)
+    assert np.allclose(xyz, expected, rtol=0, atol=1e-9)
+    stored = pye57.E57(str(path)).read_scan_raw(0)
+    radius = np.hypot(stored["cartesianX"], stored["cartesianY"])
+    assert np.allclose(np.hypot(xyz[:, 0], xyz[:, 1]), radius, rtol=1e-12)
+
+
 def test_an_identity_pose_reads_pye57s_values_exactly(tmp_path):
     a, _ = halves()
     path = tmp_path / "one.e57"
