@@ -50,7 +50,7 @@ def labels_csv(path):
 
 @pytest.mark.parametrize(
     "point_format, version, ext",
-    [(0, "1.2", "las"), (1, "1.2", "las"), (3, "1.3", "laz"), (6, "1.4", "las"), (7, "1.4", "laz"), (10, "1.4", "laz")],
+    [(0, "1.1", "las"), (0, "1.2", "las"), (1, "1.2", "las"), (3, "1.3", "laz"), (6, "1.4", "las"), (7, "1.4", "laz"), (10, "1.4", "laz")],
 )
 def test_coordinates_are_laspys_and_labels_the_plys(tmp_path, point_format, version, ext):
     cloud = tmp_path / f"blade.{ext}"
