@@ -63,6 +63,33 @@ pub fn check_outputs(output: &Path, report: Option<&Path>, inputs: &[&Path]) -> 
     Ok(())
 }
 
+/// Refuses, before any work, an edges output (`--edges`) of an unknown
+/// format or that would overwrite one of the `inputs`.
+pub fn check_edges_output(path: &Path, inputs: &[&Path]) -> Result<()> {
+    crate::io::edges_out::edges_format(path)?;
+    if let Some(input) = inputs.iter().find(|input| same_file(path, input)) {
+        anyhow::bail!("{}: an output would overwrite this input", input.display());
+    }
+    Ok(())
+}
+
+/// Writes the smoothed edges of the cloud `points` to `path` (atomically),
+/// in the format its extension names: what `meshtrim edges -o` writes.
+pub fn write_edges(
+    path: &Path,
+    points: &[crate::io::Point3],
+    detection: &trim::Detection,
+    edges: &trim::Edges,
+) -> Result<()> {
+    let format = crate::io::edges_out::edges_format(path)?;
+    let data = crate::io::edges_out::EdgeData {
+        points,
+        boundary: &detection.boundary,
+        edges,
+    };
+    write_atomic(path, |w| format.write(w, data))
+}
+
 /// True when `a` and `b` name the same existing file (an output must never
 /// overwrite an input).
 pub(crate) fn same_file(a: &Path, b: &Path) -> bool {

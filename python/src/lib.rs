@@ -276,10 +276,10 @@ fn trim_py<'py>(
     let mesh = mesh_of(&vertices, &faces)?;
     let points = rows(&points, "points")?;
     let names = ["mesh".to_string(), "points".to_string()];
-    let (out, report) = without_gil(py, || {
+    let trimmed = without_gil(py, || {
         commands::trim::trim_in_memory(&mesh, &points, &settings, &names)
     })?;
-    mesh_result(py, &out, &report)
+    mesh_result(py, &trimmed.mesh, &trimmed.report)
 }
 
 /// The Delaunay mesh of a cloud and the report as JSON.
@@ -303,10 +303,10 @@ fn mesh_py<'py>(
     }
     .stages()?;
     let points = rows(&points, "points")?;
-    let (out, report) = without_gil(py, || {
+    let meshed = without_gil(py, || {
         commands::mesh::mesh_in_memory(&points, &stages, false, "points")
     })?;
-    mesh_result(py, &out, &report)
+    mesh_result(py, &meshed.mesh, &meshed.report)
 }
 
 /// The cleaned mesh and the report as JSON.

@@ -11,10 +11,9 @@ use trim::{reconstruct_edges, Detection, Edges};
 
 use crate::commands::args::StageArgs;
 use crate::console;
-use crate::io::atomic::write_atomic;
-use crate::io::edges_out::{EdgeData, EdgesFormat};
+use crate::io::edges_out::{edges_format, EdgesFormat};
 use crate::io::{read_cloud_with, CloudOptions, Point3};
-use crate::report::{same_file, shown};
+use crate::report::{same_file, shown, write_edges};
 use crate::stages::{detect, millis, Stages};
 
 /// Arguments of `meshtrim edges`.
@@ -24,8 +23,9 @@ pub struct Args {
     /// mesh (.stl, .gltf, .glb) whose vertices are the cloud.
     pub cloud: PathBuf,
     /// Write the loops and edges: OUT.json (everything), OUT.obj (the
-    /// smoothed edges as polylines) or OUT.svg (a picture). Missing parent
-    /// directories are created.
+    /// smoothed edges as polylines), OUT.svg (a picture) or OUT.dxf (3-D
+    /// polylines on layers OUTER and HOLES, corners on CORNERS, for CAD and
+    /// CAM). Missing parent directories are created.
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
     /// Detection and edge options.
@@ -74,19 +74,14 @@ pub struct Summary {
 /// Runs `meshtrim edges`.
 pub fn run(args: &Args) -> Result<()> {
     // Check the output before the (possibly long) work.
-    let format = check_output(&args.output, &args.cloud)?;
+    check_output(&args.output, &args.cloud)?;
     let started = Instant::now();
     let cloud = read_cloud_with(&args.cloud, &CloudOptions { scan: args.scan })?;
     let read_time = started.elapsed();
     let name = args.cloud.display().to_string();
     let stages = args.stages.stages();
     let (detection, edges, mut summary) = edges_in_memory(&cloud.points, &stages, true, &name)?;
-    let data = EdgeData {
-        points: &cloud.points,
-        boundary: &detection.boundary,
-        edges: &edges,
-    };
-    write_atomic(&args.output, |w| format.write(w, data))?;
+    write_edges(&args.output, &cloud.points, &detection, &edges)?;
     summary.file = Some(name);
     summary.read_ms = millis(read_time);
     if args.json {
@@ -99,12 +94,7 @@ pub fn run(args: &Args) -> Result<()> {
 
 /// The output's format; refuses unknown extensions and the input itself.
 fn check_output(out: &Path, input: &Path) -> Result<EdgesFormat> {
-    let Some(format) = EdgesFormat::from_path(out) else {
-        bail!(
-            "{}: unsupported output format: use .json, .obj or .svg",
-            out.display()
-        );
-    };
+    let format = edges_format(out)?;
     if same_file(out, input) {
         bail!("{}: the output would overwrite the input", out.display());
     }
@@ -196,7 +186,7 @@ mod tests {
         let err = check_output(Path::new("x.txt"), input).unwrap_err();
         assert_eq!(
             err.to_string(),
-            "x.txt: unsupported output format: use .json, .obj or .svg"
+            "x.txt: unsupported output format: use .json, .obj, .svg or .dxf"
         );
         assert_eq!(
             check_output(Path::new("out/e.SVG"), input).unwrap(),

@@ -7,12 +7,14 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use serde::Serialize;
-use trim::{delaunay_mesh_with_report, reconstruct_edges, DelaunayOptions, DelaunayReport};
+use trim::{
+    delaunay_mesh_with_report, reconstruct_edges, DelaunayOptions, DelaunayReport, Detection, Edges,
+};
 
 use crate::commands::args::StageArgs;
 use crate::io::mesh_out::write_mesh;
 use crate::io::{read_cloud_with, CloudOptions, Point3};
-use crate::report::shown;
+use crate::report::{shown, write_edges};
 use crate::stages::{detect, millis, Stages};
 
 /// Arguments of `meshtrim mesh`.
@@ -26,6 +28,11 @@ pub struct Args {
     /// Also write the report as JSON to this file.
     #[arg(long, value_name = "FILE.json")]
     pub report: Option<PathBuf>,
+    /// Also write the smoothed edges that bound the mesh: FILE.json, .obj,
+    /// .svg or .dxf, the bytes `meshtrim edges CLOUD -o FILE` writes with
+    /// the same options.
+    #[arg(long, value_name = "FILE")]
+    pub edges: Option<PathBuf>,
     /// Detection and edge options.
     #[command(flatten)]
     pub stages: StageArgs,
@@ -82,18 +89,42 @@ pub fn run(args: &Args) -> Result<()> {
     // Before the (possibly long) work: the output format, the report's
     // name, and neither may overwrite the cloud.
     crate::report::check_outputs(&args.output, args.report.as_deref(), &[&args.cloud])?;
+    if let Some(edges) = &args.edges {
+        crate::report::check_edges_output(edges, &[&args.cloud])?;
+    }
     let started = Instant::now();
     let cloud = read_cloud_with(&args.cloud, &CloudOptions { scan: args.scan })?;
     let read_time = started.elapsed();
     let name = args.cloud.display().to_string();
-    let (mesh, mut report) = mesh_in_memory(&cloud.points, &args.stages.stages(), true, &name)?;
+    let Meshed {
+        mesh,
+        mut report,
+        detection,
+        edges,
+    } = mesh_in_memory(&cloud.points, &args.stages.stages(), true, &name)?;
     let started = Instant::now();
     write_mesh(&args.output, &mesh.vertices, &mesh.faces)?;
+    if let Some(path) = &args.edges {
+        write_edges(path, &cloud.points, &detection, &edges)?;
+    }
     report.read_ms = millis(read_time);
     report.write_ms = millis(started.elapsed());
     report.cloud = Some(name);
     report.output = Some(args.output.display().to_string());
     crate::report::emit(&report, args.report.as_deref(), args.json)
+}
+
+/// A Delaunay mesh made in memory, with the detection and the edges that
+/// bound it.
+pub struct Meshed {
+    /// The mesh.
+    pub mesh: trim::Mesh,
+    /// The report, without file names or read and write times.
+    pub report: Report,
+    /// The cloud's boundary points.
+    pub detection: Detection,
+    /// The smoothed loops that bound the mesh.
+    pub edges: Edges,
 }
 
 /// Meshes the cloud `points` in memory (detection, edges, the constrained
@@ -107,7 +138,7 @@ pub fn mesh_in_memory(
     stages: &Stages,
     progress: bool,
     name: &str,
-) -> Result<(trim::Mesh, Report)> {
+) -> Result<Meshed> {
     let started = Instant::now();
     let detection =
         detect(points, &stages.detection, progress).with_context(|| name.to_string())?;
@@ -121,7 +152,12 @@ pub fn mesh_in_memory(
             .with_context(|| name.to_string())?;
     let times = [detect_time, edges_time, started.elapsed()];
     let report = Report::new(points.len(), mesh.faces.len(), &made, times);
-    Ok((mesh, report))
+    Ok(Meshed {
+        mesh,
+        report,
+        detection,
+        edges,
+    })
 }
 
 impl Report {

@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use serde::Serialize;
-use trim::{reconstruct_edges, trim_mesh, LoopFit, TrimOptions, TrimReport};
+use trim::{reconstruct_edges, trim_mesh, Detection, Edges, LoopFit, TrimOptions, TrimReport};
 
 use crate::commands::args::{
     parse_direction, parse_k, parse_vector, StageArgs, ViewArgs, VIEW_ALONG_HELP,
@@ -17,7 +17,7 @@ use crate::commands::args::{
 };
 use crate::io::mesh_out::write_mesh;
 use crate::io::{read_cloud_with, read_mesh_with_faces, CloudOptions, Point3};
-use crate::report::{shown, significant};
+use crate::report::{shown, significant, write_edges};
 use crate::stages::{detect, millis, Stages};
 
 /// Arguments of the trimming (`meshtrim MESH CLOUD OUT`).
@@ -37,6 +37,11 @@ pub struct Args {
     /// Also write the report as JSON to this file.
     #[arg(long, value_name = "FILE.json")]
     pub report: Option<PathBuf>,
+    /// Also write the smoothed edges the mesh was cut along: FILE.json,
+    /// .obj, .svg or .dxf, the bytes `meshtrim edges CLOUD -o FILE` writes
+    /// with the same options.
+    #[arg(long, value_name = "FILE")]
+    pub edges: Option<PathBuf>,
     /// Neighbourhood size of boundary detection, the point itself included.
     #[arg(long, default_value_t = 30, value_parser = parse_k)]
     pub k: usize,
@@ -171,18 +176,26 @@ pub fn run(args: &Args) -> Result<()> {
         progress: true,
         cloud: CloudOptions { scan: args.scan },
     };
-    let report = trim_file(&args.mesh, &args.cloud, &args.output, &settings)?;
+    let report = trim_file(
+        &args.mesh,
+        &args.cloud,
+        &args.output,
+        args.edges.as_deref(),
+        &settings,
+    )?;
     crate::report::emit(&report, args.report.as_deref(), args.json)
 }
 
 /// Trims the mesh at `mesh_path` along the boundary of the cloud at
 /// `cloud_path` and writes it (atomically) to `output`; prints nothing, so
-/// `meshtrim batch` can run it on many files at once. The caller checks
-/// the paths (see `check_paths`).
+/// `meshtrim batch` can run it on many files at once. With `edges_output`,
+/// also writes the smoothed edges there. The caller checks the paths (see
+/// `check_paths`).
 pub fn trim_file(
     mesh_path: &Path,
     cloud_path: &Path,
     output: &Path,
+    edges_output: Option<&Path>,
     settings: &TrimSettings,
 ) -> Result<Report> {
     // The two files are read at once (a binary PLY's reader runs on one
@@ -197,15 +210,36 @@ pub fn trim_file(
     let cloud = cloud?;
     let read_time = started.elapsed();
     let names = [mesh_path, cloud_path].map(|p| p.display().to_string());
-    let (out, mut report) = trim_in_memory(&mesh, &cloud.points, settings, &names)?;
+    let Trimmed {
+        mesh: out,
+        mut report,
+        detection,
+        edges,
+    } = trim_in_memory(&mesh, &cloud.points, settings, &names)?;
     let started = Instant::now();
     write_mesh(output, &out.vertices, &out.faces)?;
+    if let Some(path) = edges_output {
+        write_edges(path, &cloud.points, &detection, &edges)?;
+    }
     report.read_ms = millis(read_time);
     report.write_ms = millis(started.elapsed());
     report.mesh = Some(names[0].clone());
     report.cloud = Some(names[1].clone());
     report.output = Some(output.display().to_string());
     Ok(report)
+}
+
+/// A trim in memory: the mesh, the report, and the detection and edges it
+/// was cut along.
+pub struct Trimmed {
+    /// The trimmed mesh.
+    pub mesh: trim::Mesh,
+    /// The report, without file names or read and write times.
+    pub report: Report,
+    /// The cloud's boundary points.
+    pub detection: Detection,
+    /// The smoothed loops the mesh was cut along.
+    pub edges: Edges,
 }
 
 /// Trims `mesh` along the smoothed boundary of the cloud `points`, in
@@ -218,7 +252,7 @@ pub fn trim_in_memory(
     points: &[Point3],
     settings: &TrimSettings,
     [mesh_name, cloud_name]: &[String; 2],
-) -> Result<(trim::Mesh, Report)> {
+) -> Result<Trimmed> {
     // Checked before detection, so the error names the mesh: the
     // library's own check reports "MESH with CLOUD".
     trim::check_vertex_range(&mesh.vertices).with_context(|| mesh_name.clone())?;
@@ -239,17 +273,23 @@ pub fn trim_in_memory(
         &trimmed,
         [detect_time, edges_time, trim_time],
     );
-    Ok((out, report))
+    Ok(Trimmed {
+        mesh: out,
+        report,
+        detection,
+        edges,
+    })
 }
 
 /// Refuses unknown output formats and outputs that would overwrite an
 /// input, before any work.
 fn check_paths(args: &Args) -> Result<()> {
-    crate::report::check_outputs(
-        &args.output,
-        args.report.as_deref(),
-        &[&args.mesh, &args.cloud],
-    )
+    let inputs = [args.mesh.as_path(), args.cloud.as_path()];
+    crate::report::check_outputs(&args.output, args.report.as_deref(), &inputs)?;
+    if let Some(edges) = &args.edges {
+        crate::report::check_edges_output(edges, &inputs)?;
+    }
+    Ok(())
 }
 
 impl Report {

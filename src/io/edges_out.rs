@@ -1,6 +1,6 @@
 //! Output of `meshtrim edges`: the reconstructed boundary loops and edges.
 //!
-//! Three formats, chosen by the output's extension, all deterministic byte
+//! Four formats, chosen by the output's extension, all deterministic byte
 //! for byte (no timestamps, floats in Rust's or serde_json's shortest
 //! round-trip form, or rounded the same way every time in SVG):
 //!
@@ -9,7 +9,9 @@
 //! - OBJ: the smoothed edges as polylines (`l` lines), one `o` group per
 //!   loop;
 //! - SVG: a picture like the paper's Figure 4, the cloud seen along the
-//!   normal of its best-fit plane.
+//!   normal of its best-fit plane;
+//! - DXF: one closed 3-D polyline per loop on layers `OUTER` and `HOLES`,
+//!   the corners as points (`dxf.rs`).
 
 use std::fmt::Write as _;
 use std::io::Write;
@@ -40,6 +42,18 @@ pub enum EdgesFormat {
     Obj,
     /// A picture of the cloud, the raw loops and the smoothed edges.
     Svg,
+    /// DXF R12: 3-D polylines and corner points.
+    Dxf,
+}
+
+/// The format of an edges output, or the error naming what is accepted.
+pub fn edges_format(path: &std::path::Path) -> anyhow::Result<EdgesFormat> {
+    EdgesFormat::from_path(path).ok_or_else(|| {
+        anyhow::anyhow!(
+            "{}: unsupported output format: use .json, .obj, .svg or .dxf",
+            path.display()
+        )
+    })
 }
 
 impl EdgesFormat {
@@ -50,6 +64,7 @@ impl EdgesFormat {
             "json" => Some(EdgesFormat::Json),
             "obj" => Some(EdgesFormat::Obj),
             "svg" => Some(EdgesFormat::Svg),
+            "dxf" => Some(EdgesFormat::Dxf),
             _ => None,
         }
     }
@@ -60,6 +75,7 @@ impl EdgesFormat {
             EdgesFormat::Json => write_json(w, data),
             EdgesFormat::Obj => write_obj(w, data.edges),
             EdgesFormat::Svg => write_svg(w, data),
+            EdgesFormat::Dxf => dxf::write_dxf(w, data),
         }
     }
 }
@@ -463,6 +479,8 @@ fn num(x: f64) -> String {
         s.to_string()
     }
 }
+
+mod dxf;
 
 #[cfg(test)]
 mod tests;

@@ -226,7 +226,7 @@ fn work(job: &Job, stages: &Stages) -> Result<Outcome> {
                 progress: false,
                 cloud: CloudOptions::default(),
             };
-            let r = trim_file(&job.input, cloud, &job.output, &settings)?;
+            let r = trim_file(&job.input, cloud, &job.output, None, &settings)?;
             Ok(Outcome {
                 loops: r.loops,
                 faces_in: r.faces_in,
