@@ -8,6 +8,7 @@ use serde::Serialize;
 
 use crate::console;
 use crate::io::atomic::write_atomic;
+use crate::io::edges_out::step::LengthUnit;
 
 /// A command's report that can print itself as a two-column table.
 pub trait Table {
@@ -80,12 +81,14 @@ pub fn write_edges(
     points: &[crate::io::Point3],
     detection: &trim::Detection,
     edges: &trim::Edges,
+    units: LengthUnit,
 ) -> Result<()> {
     let format = crate::io::edges_out::edges_format(path)?;
     let data = crate::io::edges_out::EdgeData {
         points,
         boundary: &detection.boundary,
         edges,
+        units,
     };
     write_atomic(path, |w| format.write(w, data))
 }

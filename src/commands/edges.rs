@@ -11,6 +11,7 @@ use trim::{reconstruct_edges, Detection, Edges};
 
 use crate::commands::args::StageArgs;
 use crate::console;
+use crate::io::edges_out::step::LengthUnit;
 use crate::io::edges_out::{edges_format, EdgesFormat};
 use crate::io::{read_cloud_with, CloudOptions, Point3};
 use crate::report::{same_file, shown, write_edges};
@@ -23,9 +24,10 @@ pub struct Args {
     /// mesh (.stl, .gltf, .glb) whose vertices are the cloud.
     pub cloud: PathBuf,
     /// Write the loops and edges: OUT.json (everything), OUT.obj (the
-    /// smoothed edges as polylines), OUT.svg (a picture) or OUT.dxf (3-D
+    /// smoothed edges as polylines), OUT.svg (a picture), OUT.dxf (3-D
     /// polylines on layers OUTER and HOLES, corners on CORNERS, for CAD and
-    /// CAM). Missing parent directories are created.
+    /// CAM) or OUT.step (cubic B-spline curves, in --units). Missing parent
+    /// directories are created.
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
     /// Detection and edge options.
@@ -36,6 +38,10 @@ pub struct Args {
     /// frame.
     #[arg(long, value_name = "N")]
     pub scan: Option<usize>,
+    /// The length unit a STEP output declares (a cloud's file does not say
+    /// its unit): mm, m or in.
+    #[arg(long, value_enum, default_value_t = LengthUnit::Mm)]
+    pub units: LengthUnit,
     /// Print the summary as one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -81,7 +87,7 @@ pub fn run(args: &Args) -> Result<()> {
     let name = args.cloud.display().to_string();
     let stages = args.stages.stages();
     let (detection, edges, mut summary) = edges_in_memory(&cloud.points, &stages, true, &name)?;
-    write_edges(&args.output, &cloud.points, &detection, &edges)?;
+    write_edges(&args.output, &cloud.points, &detection, &edges, args.units)?;
     summary.file = Some(name);
     summary.read_ms = millis(read_time);
     if args.json {
@@ -186,7 +192,7 @@ mod tests {
         let err = check_output(Path::new("x.txt"), input).unwrap_err();
         assert_eq!(
             err.to_string(),
-            "x.txt: unsupported output format: use .json, .obj, .svg or .dxf"
+            "x.txt: unsupported output format: use .json, .obj, .svg, .dxf or .step"
         );
         assert_eq!(
             check_output(Path::new("out/e.SVG"), input).unwrap(),

@@ -12,6 +12,7 @@ use trim::{
 };
 
 use crate::commands::args::StageArgs;
+use crate::io::edges_out::step::LengthUnit;
 use crate::io::mesh_out::write_mesh;
 use crate::io::{read_cloud_with, CloudOptions, Point3};
 use crate::report::{shown, write_edges};
@@ -29,7 +30,7 @@ pub struct Args {
     #[arg(long, value_name = "FILE.json")]
     pub report: Option<PathBuf>,
     /// Also write the smoothed edges that bound the mesh: FILE.json, .obj,
-    /// .svg or .dxf, the bytes `meshtrim edges CLOUD -o FILE` writes with
+    /// .svg, .dxf or .step, the bytes `meshtrim edges CLOUD -o FILE` writes with
     /// the same options.
     #[arg(long, value_name = "FILE")]
     pub edges: Option<PathBuf>,
@@ -41,6 +42,10 @@ pub struct Args {
     /// frame.
     #[arg(long, value_name = "N")]
     pub scan: Option<usize>,
+    /// The length unit a STEP output declares (a cloud's file does not say
+    /// its unit): mm, m or in.
+    #[arg(long, value_enum, default_value_t = LengthUnit::Mm)]
+    pub units: LengthUnit,
     /// Print the report as one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -105,7 +110,7 @@ pub fn run(args: &Args) -> Result<()> {
     let started = Instant::now();
     write_mesh(&args.output, &mesh.vertices, &mesh.faces)?;
     if let Some(path) = &args.edges {
-        write_edges(path, &cloud.points, &detection, &edges)?;
+        write_edges(path, &cloud.points, &detection, &edges, args.units)?;
     }
     report.read_ms = millis(read_time);
     report.write_ms = millis(started.elapsed());

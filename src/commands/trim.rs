@@ -15,6 +15,7 @@ use crate::commands::args::{
     parse_direction, parse_k, parse_vector, StageArgs, ViewArgs, VIEW_ALONG_HELP,
     VIEW_ALONG_LONG_HELP, VIEW_FROM_HELP, VIEW_FROM_LONG_HELP,
 };
+use crate::io::edges_out::step::LengthUnit;
 use crate::io::mesh_out::write_mesh;
 use crate::io::{read_cloud_with, read_mesh_with_faces, CloudOptions, Point3};
 use crate::report::{shown, significant, write_edges};
@@ -38,7 +39,7 @@ pub struct Args {
     #[arg(long, value_name = "FILE.json")]
     pub report: Option<PathBuf>,
     /// Also write the smoothed edges the mesh was cut along: FILE.json,
-    /// .obj, .svg or .dxf, the bytes `meshtrim edges CLOUD -o FILE` writes
+    /// .obj, .svg, .dxf or .step, the bytes `meshtrim edges CLOUD -o FILE` writes
     /// with the same options.
     #[arg(long, value_name = "FILE")]
     pub edges: Option<PathBuf>,
@@ -65,6 +66,10 @@ pub struct Args {
     /// frame.
     #[arg(long, value_name = "N")]
     pub scan: Option<usize>,
+    /// The length unit a STEP output declares (a cloud's file does not say
+    /// its unit): mm, m or in.
+    #[arg(long, value_enum, default_value_t = LengthUnit::Mm)]
+    pub units: LengthUnit,
     /// Print the report as one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -180,7 +185,7 @@ pub fn run(args: &Args) -> Result<()> {
         &args.mesh,
         &args.cloud,
         &args.output,
-        args.edges.as_deref(),
+        args.edges.as_deref().map(|path| (path, args.units)),
         &settings,
     )?;
     crate::report::emit(&report, args.report.as_deref(), args.json)
@@ -189,13 +194,13 @@ pub fn run(args: &Args) -> Result<()> {
 /// Trims the mesh at `mesh_path` along the boundary of the cloud at
 /// `cloud_path` and writes it (atomically) to `output`; prints nothing, so
 /// `meshtrim batch` can run it on many files at once. With `edges_output`,
-/// also writes the smoothed edges there. The caller checks the paths (see
+/// also writes the smoothed edges there (in that unit, for STEP). The caller checks the paths (see
 /// `check_paths`).
 pub fn trim_file(
     mesh_path: &Path,
     cloud_path: &Path,
     output: &Path,
-    edges_output: Option<&Path>,
+    edges_output: Option<(&Path, LengthUnit)>,
     settings: &TrimSettings,
 ) -> Result<Report> {
     // The two files are read at once (a binary PLY's reader runs on one
@@ -218,8 +223,8 @@ pub fn trim_file(
     } = trim_in_memory(&mesh, &cloud.points, settings, &names)?;
     let started = Instant::now();
     write_mesh(output, &out.vertices, &out.faces)?;
-    if let Some(path) = edges_output {
-        write_edges(path, &cloud.points, &detection, &edges)?;
+    if let Some((path, units)) = edges_output {
+        write_edges(path, &cloud.points, &detection, &edges, units)?;
     }
     report.read_ms = millis(read_time);
     report.write_ms = millis(started.elapsed());

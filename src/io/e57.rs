@@ -57,7 +57,7 @@ pub fn read_e57(bytes: Vec<u8>, scan: Option<usize>) -> Result<Cloud> {
         .par_iter()
         .map(|&n| read_scan(&bytes, &scans[n]).with_context(|| format!("scan {n}")))
         .collect();
-    let mut points: Vec<Point3> = Vec::with_capacity(records as usize);
+    let mut points: Vec<Point3> = Vec::with_capacity(reservation(records, bytes.len()));
     let mut dropped = 0;
     for scan in read {
         let scan = scan?;
@@ -77,6 +77,14 @@ fn open(bytes: &[u8]) -> Result<E57Reader<Cursor<&[u8]>>> {
     E57Reader::new(Cursor::new(bytes)).map_err(|e| anyhow!("{e}"))
 }
 
+/// Points to reserve room for: as many as the file announces, but no more
+/// than it has bytes (a corrupt count must not make the reader allocate
+/// what the machine does not have; a real file this dense grows the
+/// vector as it is read).
+fn reservation(records: u64, file_bytes: usize) -> usize {
+    records.min(file_bytes as u64) as usize
+}
+
 /// One scan's valid points, posed, and how many had no position.
 struct Scan {
     points: Vec<Point3>,
@@ -92,7 +100,7 @@ fn read_scan(bytes: &[u8], scan: &e57::PointCloud) -> Result<Scan> {
     iter.spherical_to_cartesian(true);
     iter.normalize_intensity(false);
     iter.normalize_color(false);
-    let mut points = Vec::with_capacity(scan.records as usize);
+    let mut points = Vec::with_capacity(reservation(scan.records, bytes.len()));
     let mut dropped = 0;
     for (index, point) in iter.enumerate() {
         let point = point.map_err(|e| anyhow!("point {index}: {e}"))?;

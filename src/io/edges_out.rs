@@ -1,6 +1,6 @@
 //! Output of `meshtrim edges`: the reconstructed boundary loops and edges.
 //!
-//! Four formats, chosen by the output's extension, all deterministic byte
+//! Five formats, chosen by the output's extension, all deterministic byte
 //! for byte (no timestamps, floats in Rust's or serde_json's shortest
 //! round-trip form, or rounded the same way every time in SVG):
 //!
@@ -11,7 +11,9 @@
 //! - SVG: a picture like the paper's Figure 4, the cloud seen along the
 //!   normal of its best-fit plane;
 //! - DXF: one closed 3-D polyline per loop on layers `OUTER` and `HOLES`,
-//!   the corners as points (`dxf.rs`).
+//!   the corners as points (`dxf.rs`);
+//! - STEP: one cubic B-spline curve per edge through its points, the
+//!   corners as points ([`step`]).
 
 use std::fmt::Write as _;
 use std::io::Write;
@@ -31,6 +33,9 @@ pub struct EdgeData<'a> {
     pub boundary: &'a [bool],
     /// The reconstructed loops.
     pub edges: &'a Edges,
+    /// The length unit a STEP file declares (the cloud's file does not
+    /// say it).
+    pub units: step::LengthUnit,
 }
 
 /// Output formats of `edges`, chosen by the output's extension.
@@ -44,13 +49,15 @@ pub enum EdgesFormat {
     Svg,
     /// DXF R12: 3-D polylines and corner points.
     Dxf,
+    /// STEP AP214: cubic B-spline curves and corner points.
+    Step,
 }
 
 /// The format of an edges output, or the error naming what is accepted.
 pub fn edges_format(path: &std::path::Path) -> anyhow::Result<EdgesFormat> {
     EdgesFormat::from_path(path).ok_or_else(|| {
         anyhow::anyhow!(
-            "{}: unsupported output format: use .json, .obj, .svg or .dxf",
+            "{}: unsupported output format: use .json, .obj, .svg, .dxf or .step",
             path.display()
         )
     })
@@ -65,6 +72,7 @@ impl EdgesFormat {
             "obj" => Some(EdgesFormat::Obj),
             "svg" => Some(EdgesFormat::Svg),
             "dxf" => Some(EdgesFormat::Dxf),
+            "step" | "stp" => Some(EdgesFormat::Step),
             _ => None,
         }
     }
@@ -76,6 +84,7 @@ impl EdgesFormat {
             EdgesFormat::Obj => write_obj(w, data.edges),
             EdgesFormat::Svg => write_svg(w, data),
             EdgesFormat::Dxf => dxf::write_dxf(w, data),
+            EdgesFormat::Step => step::write_step(w, data),
         }
     }
 }
@@ -481,6 +490,7 @@ fn num(x: f64) -> String {
 }
 
 mod dxf;
+pub mod step;
 
 #[cfg(test)]
 mod tests;

@@ -30,8 +30,9 @@ use rayon::prelude::*;
 
 use super::{Cloud, Format, Point3};
 
-/// Points read per chunk: a bounded buffer however large the file.
-const CHUNK: u64 = 1 << 20;
+/// Bytes of decompressed records read per chunk: a bounded buffer however
+/// many points the header announces or however long it says a record is.
+const CHUNK_BYTES: u64 = 64 << 20;
 
 /// Per axis, the grid of a LAS file's integer coordinates:
 /// `coordinate = integer × scale + offset`.
@@ -50,6 +51,7 @@ pub fn is_las(bytes: &[u8]) -> bool {
 
 /// Reads a LAS or LAZ file's points (see the module doc).
 pub fn read_las(bytes: Vec<u8>) -> Result<Cloud> {
+    check_chunk_table(&bytes)?;
     let bytes = Shared(Arc::new(bytes));
     let mut reader = las::Reader::new(Cursor::new(bytes.clone()))
         .map_err(|e| anyhow!("cannot read the LAS header or the LAZ chunk table: {e}"))?;
@@ -96,9 +98,10 @@ fn read_compressed(
 ) -> Result<Vec<Point3>> {
     let mut points: Vec<Point3> = Vec::new();
     let mut data = PointDataBuilder::new().for_header(header).build();
+    let chunk = (CHUNK_BYTES / u64::from(header.point_format().len()).max(1)).max(1);
     while (points.len() as u64) < total {
         let read = reader
-            .fill_points(CHUNK, &mut data)
+            .fill_points(chunk, &mut data)
             .map_err(|e| anyhow!("point data from point {}: {e}", points.len()))?;
         if read == 0 {
             break;
@@ -151,6 +154,58 @@ fn read_uncompressed(
             [sx * int(0) + ox, sy * int(4) + oy, sz * int(8) + oz]
         })
         .collect())
+}
+
+/// A LAZ file's chunk table must fit its point data: the decoder
+/// allocates the table's announced number of chunks before reading it, so
+/// a corrupt count would take the process down instead of failing. Every
+/// chunk holds at least one byte of compressed points, so the count cannot
+/// exceed the bytes between the start of point data and the table. Files
+/// that are not LAZ, or whose table offset is missing, are left to the
+/// reader.
+fn check_chunk_table(bytes: &[u8]) -> Result<()> {
+    let Ok(raw) = las::raw::Header::read_from(bytes) else {
+        return Ok(()); // the reader reports the bad header
+    };
+    // Bits 7 and 6 of the point format byte mark compressed (LAZ) data.
+    if raw.point_data_record_format & 0xC0 == 0 {
+        return Ok(());
+    }
+    let start = raw.offset_to_point_data as usize;
+    let i64_at = |at: usize| -> Option<i64> {
+        let b = bytes.get(at..at.checked_add(8)?)?;
+        Some(i64::from_le_bytes(b.try_into().ok()?))
+    };
+    let Some(mut table) = i64_at(start) else {
+        bail!("the file ends before its LAZ point data");
+    };
+    if table <= start as i64 {
+        // The writer could not seek back: the offset is the file's last 8 bytes.
+        table = i64_at(bytes.len().saturating_sub(8)).unwrap_or(-1);
+        if table <= start as i64 {
+            return Ok(());
+        }
+    }
+    let table = table as u64;
+    let count_at = table.saturating_add(4);
+    let Some(count) = bytes
+        .get(count_at as usize..(count_at as usize).saturating_add(4))
+        .and_then(|b| b.try_into().ok())
+        .map(u32::from_le_bytes)
+    else {
+        bail!(
+            "the LAZ chunk table (at byte {table}) lies beyond the file's end ({} bytes)",
+            bytes.len()
+        );
+    };
+    let data = table - start as u64;
+    if u64::from(count) > data {
+        bail!(
+            "the LAZ chunk table announces {count} chunks in {data} bytes of compressed points: \
+             the table is corrupt"
+        );
+    }
+    Ok(())
 }
 
 /// A LAZ file's compressed items must make up the header's point record:

@@ -90,5 +90,5 @@ def test_a_bad_edges_output_is_refused_before_any_work(tmp_path):
         capture_output=True,
         text=True,
     )
-    assert r.returncode == 1 and "e.txt: unsupported output format: use .json, .obj, .svg or .dxf" in r.stderr
+    assert r.returncode == 1 and "e.txt: unsupported output format: use .json, .obj, .svg, .dxf or .step" in r.stderr
     assert not out.exists()

@@ -54,6 +54,7 @@
 
 mod anisotropy;
 mod bpd;
+mod bspline;
 mod clean;
 mod cloud;
 mod delaunay;
@@ -76,6 +77,7 @@ pub use bpd::{
     detect_boundary, detect_boundary_with_progress, local_resolution, BpdOptions, Decision,
     Detection, View,
 };
+pub use bspline::{interpolate as interpolate_bspline, BSpline};
 pub use clean::{clean_mesh, CleanOptions, CleanReport, LeftLoops, LeftReason};
 pub use cloud::Point3;
 pub use delaunay::{delaunay_mesh, delaunay_mesh_with_report, DelaunayOptions, DelaunayReport};

@@ -55,6 +55,7 @@ fn render(format: EdgesFormat) -> String {
         points: &points,
         boundary: &boundary,
         edges: &edges,
+        units: Default::default(),
     };
     let mut out = Vec::new();
     format.write(&mut out, data).unwrap();
@@ -168,6 +169,7 @@ fn svg_subsamples_interior_points() {
         points: &points,
         boundary: &boundary,
         edges: &edges,
+        units: Default::default(),
     };
     write_svg(&mut out, data).unwrap();
     let text = String::from_utf8(out).unwrap();

@@ -1,0 +1,121 @@
+"""The smoothed edges as STEP B-spline curves (`meshtrim edges CLOUD -o
+OUT.step`), read back by OpenCASCADE through gmsh: one B-spline curve per
+JSON edge, every edge point on its curve within 0.01 beta, the curve within
+a quarter spacing of the edge polyline between points (no overshoot),
+consecutive edges meeting at their corners, closed loops closed, the unit
+declared."""
+
+from __future__ import annotations
+
+import csv
+import json
+
+import gmsh
+import numpy as np
+import pytest
+from scipy.spatial import cKDTree
+
+import synthetic
+from meshtrim_cli import ROOT, run_meshtrim, shared_data
+
+
+def read_step(path, target_unit="MM"):
+    """The curves OpenCASCADE reads from `path`, in file order: a function
+    evaluating each at parameters, and its closest-point query."""
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.option.setString("Geometry.OCCTargetUnit", target_unit)
+    try:
+        gmsh.model.occ.importShapes(str(path))
+        gmsh.model.occ.synchronize()
+        curves = []
+        for dim, tag in gmsh.model.getEntities(1):
+            assert gmsh.model.getType(dim, tag) == "BSpline"
+            lo, hi = gmsh.model.getParametrizationBounds(dim, tag)
+            u = np.linspace(lo[0], hi[0], 4001)
+            samples = np.array(gmsh.model.getValue(dim, tag, u)).reshape(-1, 3)
+            curves.append({"tag": tag, "samples": samples})
+        closest = lambda tag, pts: np.array(gmsh.model.getClosestPoint(1, tag, pts.ravel())[0]).reshape(-1, 3)
+        for c in curves:
+            c["closest"] = closest
+        return curves, closest
+    except Exception:
+        gmsh.finalize()
+        raise
+
+
+def segment_distance(points, polyline):
+    """Each point's distance to the polyline."""
+    a, b = polyline[:-1], polyline[1:]
+    ab = b - a
+    t = np.einsum("pkj,kj->pk", points[:, None, :] - a[None], ab) / np.maximum(np.einsum("kj,kj->k", ab, ab), 1e-300)
+    t = np.clip(t, 0, 1)
+    nearest = a[None] + t[..., None] * ab[None]
+    return np.linalg.norm(points[:, None, :] - nearest, axis=2).min(axis=1)
+
+
+def cases(tmp_path):
+    plate = tmp_path / "plate.ply"
+    synthetic.write_cloud_ply(plate, synthetic.notched_plate(1.0, 2).points)
+    return {
+        "blade_holes": ROOT / "fixtures" / "meshes" / "blade_holes.ply",
+        "notched_plate": plate,
+        "bunny": shared_data("stanford_bunny/bun_zipper.ply"),
+    }
+
+
+@pytest.mark.parametrize("name", ["blade_holes", "notched_plate", "bunny"])
+def test_step_curves_fit_the_json_edges(tmp_path, name):
+    cloud = cases(tmp_path)[name]
+    run_meshtrim("edges", cloud, "-o", tmp_path / "e.json")
+    run_meshtrim("edges", cloud, "-o", tmp_path / "e.step")
+    run_meshtrim("detect", cloud, "-o", tmp_path / "labels.csv")
+    with open(tmp_path / "labels.csv") as f:
+        rows = list(csv.DictReader(f))
+    xyz = np.array([[float(r[c]) for c in "xyz"] for r in rows])
+    beta = np.array([float(r["beta"]) for r in rows])
+    spacing = float(np.median(cKDTree(xyz).query(xyz, k=2)[0][:, 1]))
+    loops = json.loads((tmp_path / "e.json").read_text())["loops"]
+    edges = [e for l in loops for e in l["edges"]]
+    curves, closest = read_step(tmp_path / "e.step")
+    try:
+        assert len(curves) == len(edges) > 0
+        for curve, edge in zip(curves, edges):
+            points = np.array(edge["points"])
+            # Every edge point on its curve, within 0.01 beta (of the
+            # nearest cloud point: the local resolution there).
+            local_beta = beta[cKDTree(xyz).query(points)[1]]
+            off = np.linalg.norm(closest(curve["tag"], points) - points, axis=1)
+            assert np.all(off <= 0.01 * local_beta), off.max()
+            # Between points, within a quarter spacing of the polyline.
+            polyline = np.vstack([points, points[:1]]) if edge["closed"] else points
+            assert segment_distance(curve["samples"], polyline).max() <= 0.25 * spacing
+            ends = curve["samples"][[0, -1]]
+            if edge["closed"]:
+                assert np.linalg.norm(ends[0] - ends[1]) < 1e-9 * np.abs(points).max()
+            else:
+                assert np.allclose(ends, points[[0, -1]], rtol=0, atol=1e-9 * np.abs(points).max())
+        # Consecutive edges of a loop meet at their corners.
+        for l in loops:
+            open_edges = [e for e in l["edges"] if not e["closed"]]
+            for a, b in zip(open_edges, open_edges[1:] + open_edges[:1]):
+                assert a["points"][-1] == b["points"][0]
+    finally:
+        gmsh.finalize()
+
+
+def test_the_unit_is_declared(tmp_path):
+    cloud = ROOT / "fixtures" / "meshes" / "blade_holes.ply"
+    first = {}
+    for unit, scale in [("mm", 1.0), ("m", 1000.0), ("in", 25.4)]:
+        out = tmp_path / f"e_{unit}.step"
+        run_meshtrim("edges", cloud, "-o", out, "--units", unit)
+        curves, _ = read_step(out, "MM")
+        try:
+            first[unit] = curves[0]["samples"][0] / scale
+        finally:
+            gmsh.finalize()
+    assert np.allclose(first["m"], first["mm"]) and np.allclose(first["in"], first["mm"])
+    again = tmp_path / "again.step"
+    run_meshtrim("edges", cloud, "-o", again, "--units", "in")
+    assert again.read_bytes() == (tmp_path / "e_in.step").read_bytes()
