@@ -73,6 +73,8 @@ pub struct Summary {
     /// Time of edge reconstruction (clustering, ordering, corners,
     /// smoothing, offset), in milliseconds.
     pub edges_ms: f64,
+    /// Time to write the output (curve fitting included), in milliseconds.
+    pub write_ms: f64,
     /// Whether the edges were moved out to the surface's estimated edge.
     pub offset: bool,
 }
@@ -87,7 +89,9 @@ pub fn run(args: &Args) -> Result<()> {
     let name = args.cloud.display().to_string();
     let stages = args.stages.stages();
     let (detection, edges, mut summary) = edges_in_memory(&cloud.points, &stages, true, &name)?;
+    let started = Instant::now();
     write_edges(&args.output, &cloud.points, &detection, &edges, args.units)?;
+    summary.write_ms = millis(started.elapsed());
     summary.file = Some(name);
     summary.read_ms = millis(read_time);
     if args.json {
@@ -149,6 +153,7 @@ impl Summary {
             read_ms: 0.0,
             detect_ms: millis(detect),
             edges_ms: millis(reconstruct),
+            write_ms: 0.0,
             offset: stages.edges.offset,
         }
     }
@@ -173,6 +178,7 @@ impl Summary {
             ("read time", format!("{:.1} ms", self.read_ms)),
             ("detect time", format!("{:.1} ms", self.detect_ms)),
             ("edges time", format!("{:.1} ms", self.edges_ms)),
+            ("write time", format!("{:.1} ms", self.write_ms)),
         ];
         rows.iter()
             .map(|(label, value)| format!("{label:<20} {value}\n"))
@@ -218,11 +224,13 @@ mod tests {
             read_ms: 1.0,
             detect_ms: 2.5,
             edges_ms: 0.25,
+            write_ms: 0.5,
             offset: false,
         };
         let t = s.table();
         assert!(t.contains("boundary points      20 (10.0%)\n"), "{t}");
         assert!(t.contains("offset               off\n"), "{t}");
-        assert_eq!(t.lines().count(), 12);
+        assert!(t.contains("write time           0.5 ms\n"), "{t}");
+        assert_eq!(t.lines().count(), 13);
     }
 }
