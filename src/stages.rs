@@ -6,8 +6,9 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
+use anyhow::Context;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use trim::{BpdOptions, CloudError, Detection, EdgeOptions};
+use trim::{reconstruct_edges, BpdOptions, CloudError, Detection, EdgeOptions, Edges};
 
 use crate::io::Point3;
 
@@ -32,6 +33,24 @@ pub(crate) fn detect(
     } else {
         trim::detect_boundary(points, options)
     }
+}
+
+/// The cloud's boundary and its smoothed edges, each stage timed: what
+/// `edges`, `trim` and `mesh` run first. A detection error begins with
+/// `name` (the cloud's file, or the argument's name).
+pub(crate) fn detect_and_reconstruct(
+    points: &[Point3],
+    stages: &Stages,
+    progress: bool,
+    name: &str,
+) -> anyhow::Result<(Detection, Edges, [Duration; 2])> {
+    let started = Instant::now();
+    let detection =
+        detect(points, &stages.detection, progress).with_context(|| name.to_string())?;
+    let detect_time = started.elapsed();
+    let started = Instant::now();
+    let edges = reconstruct_edges(points, &detection, &stages.edges);
+    Ok((detection, edges, [detect_time, started.elapsed()]))
 }
 
 /// Milliseconds, rounded to 0.1 ms.

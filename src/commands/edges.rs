@@ -5,9 +5,9 @@ use std::path::Path;
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use serde::Serialize;
-use trim::{reconstruct_edges, Detection, Edges};
+use trim::{Detection, Edges};
 
 use crate::commands::args::StageArgs;
 use crate::console;
@@ -15,7 +15,7 @@ use crate::io::edges_out::step::LengthUnit;
 use crate::io::edges_out::{edges_format, EdgesFormat};
 use crate::io::{read_cloud_with, CloudOptions, Point3};
 use crate::report::{same_file, shown, write_edges};
-use crate::stages::{detect, millis, Stages};
+use crate::stages::{detect_and_reconstruct, millis, Stages};
 
 /// Arguments of `meshtrim edges`.
 #[derive(Debug, Clone, clap::Args)]
@@ -122,13 +122,7 @@ pub fn edges_in_memory(
     progress: bool,
     name: &str,
 ) -> Result<(Detection, Edges, Summary)> {
-    let started = Instant::now();
-    let detection =
-        detect(points, &stages.detection, progress).with_context(|| name.to_string())?;
-    let detect_time = started.elapsed();
-    let started = Instant::now();
-    let edges = reconstruct_edges(points, &detection, &stages.edges);
-    let times = [detect_time, started.elapsed()];
+    let (detection, edges, times) = detect_and_reconstruct(points, stages, progress, name)?;
     let summary = Summary::new(points.len(), &detection, &edges, stages, times);
     Ok((detection, edges, summary))
 }

@@ -7,16 +7,14 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use serde::Serialize;
-use trim::{
-    delaunay_mesh_with_report, reconstruct_edges, DelaunayOptions, DelaunayReport, Detection, Edges,
-};
+use trim::{delaunay_mesh_with_report, DelaunayOptions, DelaunayReport, Detection, Edges};
 
 use crate::commands::args::StageArgs;
 use crate::io::edges_out::step::LengthUnit;
 use crate::io::mesh_out::write_mesh;
 use crate::io::{read_cloud_with, CloudOptions, Point3};
 use crate::report::{shown, write_edges};
-use crate::stages::{detect, millis, Stages};
+use crate::stages::{detect_and_reconstruct, millis, Stages};
 
 /// Arguments of `meshtrim mesh`.
 #[derive(Debug, Clone, clap::Args)]
@@ -144,13 +142,8 @@ pub fn mesh_in_memory(
     progress: bool,
     name: &str,
 ) -> Result<Meshed> {
-    let started = Instant::now();
-    let detection =
-        detect(points, &stages.detection, progress).with_context(|| name.to_string())?;
-    let detect_time = started.elapsed();
-    let started = Instant::now();
-    let edges = reconstruct_edges(points, &detection, &stages.edges);
-    let edges_time = started.elapsed();
+    let (detection, edges, [detect_time, edges_time]) =
+        detect_and_reconstruct(points, stages, progress, name)?;
     let started = Instant::now();
     let (mesh, made) =
         delaunay_mesh_with_report(points, &detection, &edges, &DelaunayOptions::default())

@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result};
 use serde::Serialize;
-use trim::{reconstruct_edges, trim_mesh, Detection, Edges, LoopFit, TrimOptions, TrimReport};
+use trim::{trim_mesh, Detection, Edges, LoopFit, TrimOptions, TrimReport};
 
 use crate::commands::args::{
     parse_direction, parse_k, parse_vector, StageArgs, ViewArgs, VIEW_ALONG_HELP,
@@ -19,7 +19,7 @@ use crate::io::edges_out::step::LengthUnit;
 use crate::io::mesh_out::write_mesh;
 use crate::io::{read_cloud_with, read_mesh_with_faces, CloudOptions, Point3};
 use crate::report::{shown, significant, write_edges};
-use crate::stages::{detect, millis, Stages};
+use crate::stages::{detect_and_reconstruct, millis, Stages};
 
 /// Arguments of the trimming (`meshtrim MESH CLOUD OUT`).
 #[derive(Debug, Clone, clap::Args)]
@@ -261,13 +261,8 @@ pub fn trim_in_memory(
     // Checked before detection, so the error names the mesh: the
     // library's own check reports "MESH with CLOUD".
     trim::check_vertex_range(&mesh.vertices).with_context(|| mesh_name.clone())?;
-    let started = Instant::now();
-    let detection = detect(points, &settings.stages.detection, settings.progress)
-        .with_context(|| cloud_name.clone())?;
-    let detect_time = started.elapsed();
-    let started = Instant::now();
-    let edges = reconstruct_edges(points, &detection, &settings.stages.edges);
-    let edges_time = started.elapsed();
+    let (detection, edges, [detect_time, edges_time]) =
+        detect_and_reconstruct(points, &settings.stages, settings.progress, cloud_name)?;
     let started = Instant::now();
     let (out, trimmed) = trim_mesh(mesh, points, &detection, &edges, &TrimOptions::default())
         .with_context(|| format!("{mesh_name} with {cloud_name}"))?;
