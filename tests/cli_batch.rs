@@ -703,6 +703,45 @@ fn a_closed_mesh_cleaned_is_noted() {
     );
 }
 
+/// A closed mesh cut open (a sphere without its south pole's fan) given to
+/// clean: cleaned, and its line says it wraps round an object and how to
+/// trim an envelope instead; a one-sided scan beside it gets no such note.
+#[test]
+fn an_envelope_cut_open_cleaned_is_noted() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::create_dir_all(d.join("scans")).unwrap();
+    let cut: String = sphere_obj(12, 16)
+        .lines()
+        .filter(|l| !(l.starts_with("f 2 ")))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    std::fs::write(d.join("scans/envelope.obj"), cut).unwrap();
+    std::fs::copy(JAGGED, d.join("scans/scan.stl")).unwrap();
+    let run = batch(d, &["scans", "--out-dir", "out"]);
+    assert_ok(&run);
+    let stdout = text(&run.stdout);
+    let line = |name: &str| {
+        stdout
+            .lines()
+            .find(|l| l.contains(name))
+            .unwrap_or_else(|| panic!("{stdout}"))
+            .to_string()
+    };
+    let envelope = line("envelope.obj");
+    assert!(
+        envelope.starts_with("ok      clean  scans/envelope.obj  loops=1"),
+        "{envelope}"
+    );
+    assert!(
+        envelope.contains("(it wraps round an object, as an envelope cut open does")
+            && envelope.contains("S.cloud.EXT"),
+        "{envelope}"
+    );
+    let scan = line("scan.stl");
+    assert!(!scan.contains('('), "{scan}");
+}
+
 /// A closed UV sphere: `rings` latitudes between the poles, `sectors`
 /// longitudes, faces turning outward.
 fn sphere_obj(rings: usize, sectors: usize) -> String {

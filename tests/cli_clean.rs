@@ -187,7 +187,31 @@ fn coordinates_out_of_range_are_a_clear_error() {
 fn a_closed_mesh_is_written_unchanged_and_reports_no_new_angle() {
     let dir = tempfile::tempdir().unwrap();
     let (input, out) = (dir.path().join("cylinder.obj"), dir.path().join("out.obj"));
-    // A closed cylinder: 24 sides, 8 rings, both ends capped by a fan.
+    std::fs::write(&input, cylinder_obj(true)).unwrap();
+    let run = meshtrim(&["clean", s(&input), s(&out)], None);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(stdout.contains("0 removed, 0 new"), "{stdout}");
+    assert!(stdout.contains("none (no new faces)"), "{stdout}");
+    assert!(
+        stdout.contains("warning              no border: a closed mesh has nothing to clean"),
+        "{stdout}"
+    );
+    let (before, after) = (
+        meshtrim::io::read_mesh(&input).unwrap(),
+        meshtrim::io::read_mesh(&out).unwrap(),
+    );
+    assert_eq!(after.vertices, before.vertices);
+    assert_eq!(after.faces, before.faces);
+}
+
+/// A cylinder of 24 sides and 8 rings, faces outward, its top capped by a
+/// fan and its bottom too when `bottom_cap`.
+fn cylinder_obj(bottom_cap: bool) -> String {
     let (sides, rings) = (24u32, 8u32);
     let mut text = String::new();
     for r in 0..rings {
@@ -206,25 +230,45 @@ fn a_closed_mesh_is_written_unchanged_and_reports_no_new_angle() {
         }
     }
     for k in 0..sides {
-        text += &format!("f {bottom} {} {}\n", at(0, k + 1), at(0, k));
+        if bottom_cap {
+            text += &format!("f {bottom} {} {}\n", at(0, k + 1), at(0, k));
+        }
         text += &format!("f {top} {} {}\n", at(rings - 1, k), at(rings - 1, k + 1));
     }
-    std::fs::write(&input, text).unwrap();
-    let run = meshtrim(&["clean", s(&input), s(&out)], None);
+    text
+}
+
+/// A closed surface cut open (a cylinder without its bottom cap): cleaned,
+/// with a warning that it wraps round an object and how to trim an
+/// envelope instead; the jagged scan gets no warning.
+#[test]
+fn an_envelope_cut_open_is_cleaned_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, out) = (dir.path().join("cup.obj"), dir.path().join("out.obj"));
+    std::fs::write(&input, cylinder_obj(false)).unwrap();
+    let run = meshtrim(&["clean", s(&input), s(&out), "--json"], None);
     assert!(
         run.status.success(),
         "{}",
         String::from_utf8_lossy(&run.stderr)
     );
+    let json: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+    // The open end's ring faces away from the cap: the wall's far half.
+    let share = json["area_facing_one_way"].as_f64().unwrap();
+    assert!(share > 0.5 && share < 0.75, "{json}");
+    let run = meshtrim(&["clean", s(&input), s(&out)], None);
     let stdout = String::from_utf8_lossy(&run.stdout);
-    assert!(stdout.contains("0 removed, 0 new"), "{stdout}");
-    assert!(stdout.contains("none (no new faces)"), "{stdout}");
-    let (before, after) = (
-        meshtrim::io::read_mesh(&input).unwrap(),
-        meshtrim::io::read_mesh(&out).unwrap(),
+    assert!(
+        stdout.contains("warning              the surface wraps round an object")
+            && stdout.contains("trim it with its cloud instead: meshtrim MESH CLOUD OUT"),
+        "{stdout}"
     );
-    assert_eq!(after.vertices, before.vertices);
-    assert_eq!(after.faces, before.faces);
+    let run = meshtrim(&["clean", JAGGED, s(&out)], None);
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        run.status.success() && !stdout.contains("warning"),
+        "{stdout}"
+    );
 }
 
 /// The fixture with `extra` binary STL triangles appended, written to

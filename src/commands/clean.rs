@@ -54,7 +54,17 @@ pub struct CleanOutcome {
     pub clean_ms: f64,
     /// Writing time, ms.
     pub write_ms: f64,
+    /// The input's largest share of area facing one direction.
+    pub area_facing_one_way: f64,
 }
+
+/// Below this share of its area facing one direction, a mesh with a
+/// border wraps round an object: more likely an envelope cut open than a
+/// scan's jagged border, so `clean` says how to trim it instead. Measured
+/// (docs/clean.md): one-sided range scans 0.94 and more (bun090, whose
+/// faces at its silhouette turn past 90°), meshes round whole objects
+/// 0.76 and less (Laurana50k, open at its base; bun_zipper 0.54).
+pub const WRAPS_BELOW: f64 = 0.85;
 
 /// What `clean` prints and `--report` writes.
 #[derive(Debug, Clone, Serialize)]
@@ -99,6 +109,10 @@ pub struct Report {
     pub area_in: f64,
     /// Area of the output.
     pub area_out: f64,
+    /// The input's largest share of area that faces one direction: near 1
+    /// for a scan seen from one side, lower for a surface wrapping round
+    /// an object (see [`WRAPS_BELOW`]).
+    pub area_facing_one_way: f64,
     /// Reading time, ms.
     pub read_ms: f64,
     /// Local resolution (β of every vertex) time, ms.
@@ -150,6 +164,7 @@ pub fn clean_file(
         read_ms: r.read_ms,
         clean_ms: ((r.resolution_ms + r.clean_ms) * 10.0).round() / 10.0,
         write_ms: r.write_ms,
+        area_facing_one_way: r.area_facing_one_way,
     })
 }
 
@@ -227,6 +242,7 @@ impl Report {
             min_angle_new: r.min_angle_new,
             area_in: r.area_in,
             area_out: r.area_out,
+            area_facing_one_way: r.area_facing_one_way,
             read_ms: 0.0,
             resolution_ms: millis(resolution),
             clean_ms: millis(clean),
@@ -236,6 +252,26 @@ impl Report {
 }
 
 impl Report {
+    /// What to do instead, when the mesh is not a scan's border to clean.
+    fn warning(&self) -> Option<String> {
+        if self.loops_in == 0 {
+            return Some(
+                "no border: a closed mesh has nothing to clean; to trim a \
+                 reconstruction's envelope, give it its cloud: meshtrim MESH CLOUD OUT"
+                    .to_string(),
+            );
+        }
+        (self.area_facing_one_way < WRAPS_BELOW).then(|| {
+            format!(
+                "the surface wraps round an object (no direction sees more than {:.0}% of \
+                 its area, where a one-sided scan shows nearly all of it to its scanner): \
+                 if it is a reconstruction's envelope cut open, trim it with its cloud \
+                 instead: meshtrim MESH CLOUD OUT",
+                100.0 * self.area_facing_one_way
+            )
+        })
+    }
+
     /// The smallest angle of the new faces, or "none" when there are none
     /// (the number is then 0, which would read as a degenerate face).
     fn smallest_new_angle(&self) -> String {
@@ -313,6 +349,9 @@ impl crate::report::Table for Report {
                     format!("{} (faces naming a vertex twice)", self.slivers_dropped),
                 ),
             );
+        }
+        if let Some(warning) = self.warning() {
+            rows.push(("warning", warning));
         }
         for l in &self.loops_left {
             rows.push((

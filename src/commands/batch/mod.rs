@@ -23,7 +23,7 @@ use anyhow::{anyhow, bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
-use super::clean::clean_file;
+use super::clean::{clean_file, WRAPS_BELOW};
 use super::trim::{trim_file, TrimSettings};
 use crate::commands::args::StageArgs;
 use crate::console;
@@ -205,6 +205,10 @@ const NO_FACES: &str = "it looks like a point cloud: to trim the mesh S.EXT with
 const CLOSED: &str = "no border: a closed mesh has nothing to clean; to trim a Poisson \
      envelope, put its cloud S.cloud.EXT beside it";
 
+/// A cleaned mesh wrapping round an object: perhaps an envelope cut open.
+const WRAPS: &str = "it wraps round an object, as an envelope cut open does: to trim a \
+     reconstruction's envelope instead, put its cloud S.cloud.EXT beside it";
+
 /// Cleans or trims one file, writing its output atomically.
 fn work(job: &Job, stages: &Stages) -> Result<Outcome> {
     match &job.cloud {
@@ -217,7 +221,11 @@ fn work(job: &Job, stages: &Stages) -> Result<Outcome> {
                 read_ms: o.read_ms,
                 algorithm_ms: o.clean_ms,
                 write_ms: o.write_ms,
-                note: (o.loops_in == 0).then_some(CLOSED),
+                note: if o.loops_in == 0 {
+                    Some(CLOSED)
+                } else {
+                    (o.area_facing_one_way < WRAPS_BELOW).then_some(WRAPS)
+                },
             })
         }
         CloudMatch::One(cloud) => {

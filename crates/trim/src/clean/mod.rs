@@ -266,6 +266,10 @@ pub struct CleanReport {
     pub area_in: f64,
     /// Area of the output.
     pub area_out: f64,
+    /// The input's largest share of area facing one direction
+    /// ([`Mesh::area_facing_one_way`]): near 1 for a scan seen from one
+    /// side, lower for a surface wrapping round an object.
+    pub area_facing_one_way: f64,
     /// Smallest angle of the new faces, in degrees; 0 when no face was
     /// added (`faces_added` is 0).
     pub min_angle_new: f64,
@@ -295,6 +299,7 @@ pub fn clean_mesh(
         slivers_dropped: dropped.slivers,
         repeated_faces_dropped: dropped.repeats,
         area_in: mesh.area(),
+        area_facing_one_way: mesh.area_facing_one_way(),
         ..Default::default()
     };
     let mut outcomes = replace_bands(mesh, beta, &borders, &rings);

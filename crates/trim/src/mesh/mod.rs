@@ -10,7 +10,7 @@ use crate::error::MeshError;
 
 pub(crate) mod repair;
 pub(crate) mod topology;
-use crate::geom::{cross, norm2, sub, Point3};
+use crate::geom::{add, cross, dot, norm2, sub, Point3};
 
 /// An indexed triangle mesh.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -80,6 +80,47 @@ impl Mesh {
     /// Total area.
     pub fn area(&self) -> f64 {
         (0..self.faces.len()).map(|f| self.face_area(f)).sum()
+    }
+
+    /// The largest share of the area that faces one direction (whose
+    /// normals make less than 90° with it), over all directions: 1 for a
+    /// surface seen from one side (every face of a single range scan faces
+    /// its scanner), about one half for a closed surface, and between for
+    /// a surface that wraps round an object with an opening (a cup: 0.6).
+    /// The faces' normals are binned on a cube map of
+    /// [`FACING_BINS_PER_SIDE`]² cells per side (a bin counts by its
+    /// faces' summed normal, so faces of one bin go to the same side), and
+    /// every cell's centre is tried as the direction: linear in the faces,
+    /// the share of the best of those directions. A mesh without area
+    /// gives 0.
+    pub fn area_facing_one_way(&self) -> f64 {
+        // Per bin, the sum of its faces' area vectors (each face's normal
+        // times twice its area) and their area.
+        let mut bins = vec![([0.0; 3], 0.0); 6 * FACING_BINS_PER_SIDE * FACING_BINS_PER_SIDE];
+        for f in &self.faces {
+            let [a, b, c] = f.map(|i| self.vertices[i as usize]);
+            let normal = cross(sub(b, a), sub(c, a));
+            let area = norm2(normal).sqrt();
+            if area > 0.0 {
+                let bin = &mut bins[cube_map_bin(normal)];
+                *bin = (add(bin.0, normal), bin.1 + area);
+            }
+        }
+        let bins: Vec<(Point3, f64)> = bins.into_iter().filter(|b| b.1 > 0.0).collect();
+        let total: f64 = bins.iter().map(|b| b.1).sum();
+        if total == 0.0 {
+            return 0.0;
+        }
+        let facing = |d: Point3| -> f64 {
+            bins.iter()
+                .filter(|&&(normal, _)| dot(normal, d) > 0.0)
+                .map(|&(_, area)| area)
+                .sum()
+        };
+        let best = (0..6 * FACING_BINS_PER_SIDE * FACING_BINS_PER_SIDE)
+            .map(|bin| facing(cube_map_direction(bin)))
+            .fold(0.0, f64::max);
+        best / total
     }
 
     /// How many faces use each undirected edge (the plain way, for the
@@ -239,6 +280,39 @@ fn directed_edge(face: [u32; 3], low: u32, high: u32) -> (u32, u32) {
         .unwrap_or((low, high))
 }
 
+/// Cells per side of a cube face in [`Mesh::area_facing_one_way`]'s normal
+/// bins: 16 gives bins about 6° wide.
+pub const FACING_BINS_PER_SIDE: usize = 16;
+
+/// The cube-map cell of the direction `n` (not zero): the cube face of its
+/// largest coordinate, then the cell of the other two divided by it.
+fn cube_map_bin(n: Point3) -> usize {
+    let axis = (0..3)
+        .max_by(|&i, &j| n[i].abs().total_cmp(&n[j].abs()))
+        .unwrap_or(0);
+    let side = 2 * axis + usize::from(n[axis] < 0.0);
+    let cell = |c: f64| {
+        let t = (c / n[axis].abs() + 1.0) / 2.0;
+        ((t * FACING_BINS_PER_SIDE as f64) as usize).min(FACING_BINS_PER_SIDE - 1)
+    };
+    let [u, v] = [(axis + 1) % 3, (axis + 2) % 3].map(|k| cell(n[k]));
+    (side * FACING_BINS_PER_SIDE + u) * FACING_BINS_PER_SIDE + v
+}
+
+/// The unit direction through the centre of cube-map cell `bin`.
+fn cube_map_direction(bin: usize) -> Point3 {
+    let cells = FACING_BINS_PER_SIDE;
+    let (side, u, v) = (bin / (cells * cells), (bin / cells) % cells, bin % cells);
+    let axis = side / 2;
+    let centre = |cell: usize| 2.0 * (cell as f64 + 0.5) / cells as f64 - 1.0;
+    let mut d = [0.0; 3];
+    d[axis] = if side % 2 == 0 { 1.0 } else { -1.0 };
+    d[(axis + 1) % 3] = centre(u);
+    d[(axis + 2) % 3] = centre(v);
+    let length = norm2(d).sqrt();
+    d.map(|c| c / length)
+}
+
 /// [`Mesh::sorted_edges`] of a list of faces (which need not be a whole
 /// mesh's: the faces of one part of it, say).
 pub fn sorted_edges_of(faces: &[[u32; 3]]) -> Vec<(u32, u32, u32)> {
@@ -294,6 +368,56 @@ pub(crate) mod tests {
             })
             .collect();
         Mesh { vertices, faces }
+    }
+
+    /// A closed box: its 12 faces, outward.
+    fn cube() -> Mesh {
+        let vertices = (0..8)
+            .map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64])
+            .collect();
+        let faces = vec![
+            [0, 2, 1],
+            [1, 2, 3],
+            [4, 5, 6],
+            [5, 7, 6],
+            [0, 1, 4],
+            [1, 5, 4],
+            [2, 6, 3],
+            [3, 6, 7],
+            [0, 4, 2],
+            [2, 4, 6],
+            [1, 3, 5],
+            [3, 7, 5],
+        ];
+        Mesh { vertices, faces }
+    }
+
+    #[test]
+    fn area_facing_one_way_tells_one_side_from_wrapping_round() {
+        // A flat grid and the same grid bent into a half cylinder (seen
+        // from one side): all of it.
+        assert_eq!(grid(8).area_facing_one_way(), 1.0);
+        let mut half_cylinder = grid(8);
+        for v in &mut half_cylinder.vertices {
+            let angle = 0.95 * std::f64::consts::PI * (v[0] / 8.0 - 0.5);
+            *v = [angle.sin(), v[1], angle.cos()];
+        }
+        assert_eq!(half_cylinder.area_facing_one_way(), 1.0);
+        // A closed box: three sides of six at best.
+        let share = |m: &Mesh| m.area_facing_one_way();
+        assert!((share(&cube()) - 0.5).abs() < 1e-12, "{}", share(&cube()));
+        // Open at the top, a cup: the bottom and two walls of five.
+        let mut cup = cube();
+        cup.faces.retain(|f| !f.iter().all(|&v| v >= 4));
+        assert!((share(&cup) - 0.6).abs() < 1e-12);
+        assert_eq!(Mesh::default().area_facing_one_way(), 0.0);
+    }
+
+    #[test]
+    fn every_cube_map_bin_holds_its_own_direction() {
+        for bin in 0..6 * FACING_BINS_PER_SIDE * FACING_BINS_PER_SIDE {
+            assert_eq!(cube_map_bin(cube_map_direction(bin)), bin);
+        }
     }
 
     #[test]
