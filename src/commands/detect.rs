@@ -148,6 +148,7 @@ fn write_labels(
         boundary: &detection.boundary,
         beta: &detection.beta,
         scale_offset: cloud.scale_offset,
+        grid: cloud.grid.as_deref(),
     };
     write_atomic(path, |w| format.write(w, data))
 }

@@ -10,15 +10,17 @@
 //! integers and floats alike. A point whose `cartesianInvalidState` (or
 //! `sphericalInvalidState`) is not 0 has no position (at most a direction)
 //! and is dropped and counted, as PCD's NaN points are. Every page's CRC is
-//! checked. Row and column indices, intensity and colour are not kept.
+//! checked. Row and column indices (`rowIndex`, `columnIndex`) are kept with
+//! each point's scan, when a scan read has them, for `detect`'s CSV and PLY
+//! outputs; intensity and colour are not kept.
 
 use std::io::Cursor;
 
 use anyhow::{anyhow, bail, Context, Result};
-use e57::{CartesianCoordinate, E57Reader};
+use e57::{CartesianCoordinate, E57Reader, RecordName};
 use rayon::prelude::*;
 
-use super::{Cloud, Format, Point3};
+use super::{Cloud, Format, GridIndex, Point3};
 
 /// The file signature at the start of every E57 file.
 const SIGNATURE: &[u8] = b"ASTM-E57";
@@ -53,15 +55,21 @@ pub fn read_e57(bytes: Vec<u8>, scan: Option<usize>) -> Result<Cloud> {
             u32::MAX
         );
     }
+    let with_grid = chosen.iter().any(|&n| has_grid(&scans[n]));
     let read: Vec<Result<Scan>> = chosen
         .par_iter()
-        .map(|&n| read_scan(&bytes, &scans[n]).with_context(|| format!("scan {n}")))
+        .map(|&n| {
+            read_scan(&bytes, &scans[n], with_grid.then_some(n))
+                .with_context(|| format!("scan {n}"))
+        })
         .collect();
     let mut points: Vec<Point3> = Vec::with_capacity(reservation(records, bytes.len()));
+    let mut grid: Vec<GridIndex> = Vec::new();
     let mut dropped = 0;
     for scan in read {
         let scan = scan?;
         points.extend_from_slice(&scan.points);
+        grid.extend_from_slice(&scan.grid);
         dropped += scan.dropped;
     }
     Ok(Cloud {
@@ -70,6 +78,7 @@ pub fn read_e57(bytes: Vec<u8>, scan: Option<usize>) -> Result<Cloud> {
         dropped_non_finite: dropped,
         format: Format::E57,
         scale_offset: None,
+        grid: with_grid.then_some(grid),
     })
 }
 
@@ -85,13 +94,24 @@ fn reservation(records: u64, file_bytes: usize) -> usize {
     records.min(file_bytes as u64) as usize
 }
 
-/// One scan's valid points, posed, and how many had no position.
+/// True when the scan's records hold row or column indices.
+fn has_grid(scan: &e57::PointCloud) -> bool {
+    scan.prototype
+        .iter()
+        .any(|r| matches!(r.name, RecordName::RowIndex | RecordName::ColumnIndex))
+}
+
+/// One scan's valid points, posed, their grid indices (when asked for),
+/// and how many had no position.
 struct Scan {
     points: Vec<Point3>,
+    grid: Vec<GridIndex>,
     dropped: usize,
 }
 
-fn read_scan(bytes: &[u8], scan: &e57::PointCloud) -> Result<Scan> {
+/// Reads one scan; with `grid_of` (its `data3D` index), also each valid
+/// point's row and column (−1 where the scan has none).
+fn read_scan(bytes: &[u8], scan: &e57::PointCloud, grid_of: Option<usize>) -> Result<Scan> {
     let pose = Pose::of(scan)?;
     let mut reader = open(bytes)?;
     let mut iter = reader.pointcloud_simple(scan).map_err(|e| anyhow!("{e}"))?;
@@ -101,6 +121,7 @@ fn read_scan(bytes: &[u8], scan: &e57::PointCloud) -> Result<Scan> {
     iter.normalize_intensity(false);
     iter.normalize_color(false);
     let mut points = Vec::with_capacity(reservation(scan.records, bytes.len()));
+    let mut grid = Vec::new();
     let mut dropped = 0;
     for (index, point) in iter.enumerate() {
         let point = point.map_err(|e| anyhow!("point {index}: {e}"))?;
@@ -110,11 +131,32 @@ fn read_scan(bytes: &[u8], scan: &e57::PointCloud) -> Result<Scan> {
                     bail!("point {index} has a non-finite coordinate ({x}, {y}, {z})");
                 }
                 points.push(pose.apply([x, y, z]));
+                if let Some(n) = grid_of {
+                    grid.push(grid_index(n, point.row, point.column, index)?);
+                }
             }
             CartesianCoordinate::Direction { .. } | CartesianCoordinate::Invalid => dropped += 1,
         }
     }
-    Ok(Scan { points, dropped })
+    Ok(Scan {
+        points,
+        grid,
+        dropped,
+    })
+}
+
+/// A point's [`GridIndex`]; the e57 crate gives −1 for a missing index.
+/// Indices beyond 32 bits (no scanner's image is that large) are refused.
+fn grid_index(scan: usize, row: i64, column: i64, index: usize) -> Result<GridIndex> {
+    let small = |value: i64, what: &str| {
+        i32::try_from(value)
+            .map_err(|_| anyhow!("point {index}: {what} index {value} is beyond 32 bits"))
+    };
+    Ok(GridIndex {
+        scan: u32::try_from(scan).map_err(|_| anyhow!("scan {scan}: too many scans"))?,
+        row: small(row, "row")?,
+        column: small(column, "column")?,
+    })
 }
 
 /// A scan's pose as a rotation matrix (rows) and a translation.

@@ -9,7 +9,7 @@ use std::io::Write;
 use byteorder::{LittleEndian, WriteBytesExt};
 
 use super::float_text::push_f64;
-use super::Point3;
+use super::{GridIndex, Point3};
 
 /// Points with their boundary labels and local resolution β.
 #[derive(Debug, Clone, Copy)]
@@ -22,6 +22,9 @@ pub struct Labelled<'a> {
     pub beta: &'a [f64],
     /// The input's LAS grid, when it was LAS or LAZ (for LAS output).
     pub scale_offset: Option<super::las::ScaleOffset>,
+    /// Each point's scan, row and column, when the input had them (E57):
+    /// written by the CSV and PLY outputs.
+    pub grid: Option<&'a [GridIndex]>,
 }
 
 /// Output formats of `detect`, chosen by the output's extension.
@@ -74,7 +77,7 @@ impl LabelFormat {
 }
 
 /// Binary little-endian PLY: double x, y, z, uchar boundary (1 = boundary),
-/// double beta.
+/// double beta, and with a grid uint scan, int row, int column.
 pub fn write_ply(w: &mut dyn Write, data: Labelled) -> std::io::Result<()> {
     writeln!(w, "ply\nformat binary_little_endian 1.0")?;
     writeln!(
@@ -83,24 +86,45 @@ pub fn write_ply(w: &mut dyn Write, data: Labelled) -> std::io::Result<()> {
     )?;
     writeln!(w, "element vertex {}", data.points.len())?;
     writeln!(w, "property double x\nproperty double y\nproperty double z")?;
-    writeln!(
-        w,
-        "property uchar boundary\nproperty double beta\nend_header"
-    )?;
-    for ((p, &b), &beta) in data.points.iter().zip(data.boundary).zip(data.beta) {
+    writeln!(w, "property uchar boundary\nproperty double beta")?;
+    if data.grid.is_some() {
+        writeln!(
+            w,
+            "property uint scan\nproperty int row\nproperty int column"
+        )?;
+    }
+    writeln!(w, "end_header")?;
+    for (i, ((p, &b), &beta)) in data
+        .points
+        .iter()
+        .zip(data.boundary)
+        .zip(data.beta)
+        .enumerate()
+    {
         for &c in p {
             w.write_f64::<LittleEndian>(c)?;
         }
         w.write_u8(u8::from(b))?;
         w.write_f64::<LittleEndian>(beta)?;
+        if let Some(g) = data.grid.map(|grid| grid[i]) {
+            w.write_u32::<LittleEndian>(g.scan)?;
+            w.write_i32::<LittleEndian>(g.row)?;
+            w.write_i32::<LittleEndian>(g.column)?;
+        }
     }
     Ok(())
 }
 
-/// CSV with header `x,y,z,boundary,beta`, floats in shortest round-trip form
-/// (lines formatted in parallel pieces, written in order).
+/// CSV with header `x,y,z,boundary,beta` (and `scan,row,column` with a
+/// grid), floats in shortest round-trip form (lines formatted in parallel
+/// pieces, written in order).
 pub fn write_csv(w: &mut dyn Write, data: Labelled) -> std::io::Result<()> {
-    writeln!(w, "x,y,z,boundary,beta")?;
+    let grid_columns = if data.grid.is_some() {
+        ",scan,row,column"
+    } else {
+        ""
+    };
+    writeln!(w, "x,y,z,boundary,beta{grid_columns}")?;
     let n = data
         .points
         .len()
@@ -113,6 +137,9 @@ pub fn write_csv(w: &mut dyn Write, data: Labelled) -> std::io::Result<()> {
         }
         out.extend_from_slice(if data.boundary[i] { b"1," } else { b"0," });
         push_f64(out, data.beta[i]);
+        if let Some(g) = data.grid.map(|grid| grid[i]) {
+            out.extend_from_slice(format!(",{},{},{}", g.scan, g.row, g.column).as_bytes());
+        }
         out.push(b'\n');
     })
 }
@@ -139,6 +166,7 @@ mod tests {
             boundary: &boundary,
             beta: &beta,
             scale_offset: None,
+            grid: None,
         };
         write_ply(&mut out, data).unwrap();
         assert_eq!(ply::read_ply(&out).unwrap().vertices, points);
@@ -157,6 +185,7 @@ mod tests {
             boundary: &boundary,
             beta: &beta,
             scale_offset: None,
+            grid: None,
         };
         write_csv(&mut out, data).unwrap();
         let s = String::from_utf8(out.clone()).unwrap();
@@ -165,5 +194,45 @@ mod tests {
             "{s}"
         );
         assert_eq!(text::read_text(&out).unwrap().vertices, points);
+    }
+
+    #[test]
+    fn grid_indices_follow_the_labels() {
+        let (points, boundary, beta) = sample();
+        let grid = [
+            GridIndex {
+                scan: 0,
+                row: 7,
+                column: 3,
+            },
+            GridIndex {
+                scan: 1,
+                row: -1,
+                column: -1,
+            },
+        ];
+        let data = Labelled {
+            points: &points,
+            boundary: &boundary,
+            beta: &beta,
+            scale_offset: None,
+            grid: Some(&grid),
+        };
+        let mut csv = Vec::new();
+        write_csv(&mut csv, data).unwrap();
+        let csv = String::from_utf8(csv).unwrap();
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(lines[0], "x,y,z,boundary,beta,scan,row,column");
+        assert!(lines[1].ends_with(",1,0.25,0,7,3"), "{csv}");
+        assert!(lines[2].ends_with(",0.0000001,1,-1,-1"), "{csv}");
+        let mut ply = Vec::new();
+        write_ply(&mut ply, data).unwrap();
+        assert_eq!(ply::read_ply(&ply).unwrap().vertices, points);
+        let body = ply.len() - (ply.windows(11).position(|w| w == b"end_header\n").unwrap() + 11);
+        assert_eq!(body, 2 * (33 + 12));
+        assert_eq!(
+            &ply[ply.len() - 12..],
+            [1, 0, 0, 0, 255, 255, 255, 255, 255, 255, 255, 255]
+        );
     }
 }

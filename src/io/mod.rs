@@ -108,6 +108,21 @@ pub struct Cloud {
     pub scale_offset: Option<las::ScaleOffset>,
     /// The format the file was read as.
     pub format: Format,
+    /// Each point's place in its scanner's image (E57 `rowIndex` and
+    /// `columnIndex`), when a scan read has them.
+    pub grid: Option<Vec<GridIndex>>,
+}
+
+/// A point's place in a scanner's image grid: the scan (its `data3D`
+/// index), row and column; −1 where the scan has no such index.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct GridIndex {
+    /// The `data3D` index of the point's scan.
+    pub scan: u32,
+    /// Row index, or −1.
+    pub row: i32,
+    /// Column index, or −1.
+    pub column: i32,
 }
 
 /// A mesh as read from a file: vertices in file order, faces triangulated.
@@ -300,6 +315,7 @@ fn from_mesh(mesh: Mesh, format: Format) -> Cloud {
         dropped_non_finite: 0,
         format,
         scale_offset: None,
+        grid: None,
     }
 }
 

@@ -542,6 +542,7 @@ fn keep_finite(raw: Raw) -> Cloud {
             dropped_non_finite: 0,
             format: Format::Pcd,
             scale_offset: None,
+            grid: None,
         };
     }
     let keep = |v: Vec<Point3>| -> Vec<Point3> {
@@ -558,6 +559,7 @@ fn keep_finite(raw: Raw) -> Cloud {
         dropped_non_finite: dropped,
         format: Format::Pcd,
         scale_offset: None,
+        grid: None,
     }
 }
 

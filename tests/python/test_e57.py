@@ -37,12 +37,16 @@ def halves():
 POSES = [(quaternion([0, 0, 1], 30), np.array([1000.0, -200.0, 50.0])), (quaternion([1, 1, 0], -70), np.array([0.0, 0.0, 0.0]))]
 
 
-def write_scans(path, scans, poses, states=None):
+def write_scans(path, scans, poses, states=None, grids=None):
+    """Writes the scans with pye57; `states[i]` their invalid states,
+    `grids[i]` (rows, columns) their image indices, where not None."""
     e = pye57.E57(str(path), mode="w")
     for i, (points, (rotation, translation)) in enumerate(zip(scans, poses)):
         data = {"cartesianX": points[:, 0], "cartesianY": points[:, 1], "cartesianZ": points[:, 2]}
         if states is not None:
             data["cartesianInvalidState"] = states[i]
+        if grids is not None and grids[i] is not None:
+            data["rowIndex"], data["columnIndex"] = grids[i]
         e.write_scan_raw(data, rotation=rotation, translation=translation)
     e.close()
 
@@ -152,6 +156,59 @@ def test_invalid_points_are_dropped_and_counted(tmp_path):
     assert summary["dropped_non_finite"] == dropped
     assert summary["points"] == len(a) - dropped
     assert np.array_equal(xyz, a[states == 0].astype(np.float32).astype(np.float64))
+
+
+def test_row_and_column_indices_are_kept_beside_the_labels(tmp_path):
+    """A structured scan's rowIndex and columnIndex, with some points
+    invalid, and a second scan without them: detect's CSV and PLY give each
+    written point its scan, row and column (-1 where the scan has none),
+    as pye57 reads them; the labels are those of the same file without
+    indices."""
+    a, b = halves()
+    rows = (np.arange(len(a)) // 97).astype(np.uint16)
+    columns = (np.arange(len(a)) % 97).astype(np.uint16)
+    states = [np.zeros(len(a), dtype=np.int8), np.zeros(len(b), dtype=np.int8)]
+    states[0][5::13] = 2
+    path = tmp_path / "grid.e57"
+    write_scans(path, [a, b], POSES, states=states, grids=[(rows, columns), None])
+    plain = tmp_path / "plain.e57"
+    write_scans(plain, [a, b], POSES, states=states)
+    read = pye57.E57(str(path)).read_scan_raw(0)
+    valid = read["cartesianInvalidState"] == 0
+    expected = np.concatenate(
+        [
+            np.column_stack([np.zeros(valid.sum()), read["rowIndex"][valid], read["columnIndex"][valid]]),
+            np.column_stack([np.ones(len(b)), -np.ones(len(b)), -np.ones(len(b))]),
+        ]
+    ).astype(np.int64)
+    out = tmp_path / "labels.csv"
+    run_meshtrim("detect", path, "-o", out)
+    with open(out) as f:
+        table = list(csv.DictReader(f))
+    assert list(table[0]) == ["x", "y", "z", "boundary", "beta", "scan", "row", "column"]
+    got = np.array([[int(r["scan"]), int(r["row"]), int(r["column"])] for r in table])
+    assert np.array_equal(got, expected)
+    xyz, boundary, beta, _ = labels(plain)
+    assert np.array_equal(np.array([[float(r[c]) for c in "xyz"] for r in table]), xyz)
+    assert np.array_equal(np.array([r["boundary"] == "1" for r in table]), boundary)
+    # The PLY, read by trimesh's PLY parser.
+    import trimesh
+
+    ply = tmp_path / "labels.ply"
+    run_meshtrim("detect", path, "-o", ply)
+    vertex = trimesh.load(ply, process=False).metadata["_ply_raw"]["vertex"]["data"]
+    assert np.array_equal(np.column_stack([vertex["scan"], vertex["row"], vertex["column"]]), expected)
+    assert np.array_equal(vertex["boundary"] == 1, boundary)
+    # One scan alone: its own index as its scan; a scan without indices
+    # alone writes no grid columns.
+    alone = tmp_path / "alone.csv"
+    run_meshtrim("detect", path, "-o", alone, "--scan", "0")
+    with open(alone) as f:
+        got = np.array([[int(r["scan"]), int(r["row"]), int(r["column"])] for r in csv.DictReader(f)])
+    assert np.array_equal(got, expected[: valid.sum()])
+    run_meshtrim("detect", path, "-o", alone, "--scan", "1")
+    with open(alone) as f:
+        assert next(csv.reader(f)) == ["x", "y", "z", "boundary", "beta"]
 
 
 def write_spherical(path, r, azimuth, elevation, state):
