@@ -88,7 +88,7 @@ impl Mesh {
     /// its scanner), about one half for a closed surface, and between for
     /// a surface that wraps round an object with an opening (a cup: 0.6).
     /// The faces' normals are binned on a cube map of
-    /// [`FACING_BINS_PER_SIDE`]² cells per side (a bin counts by its
+    /// 16² cells per side (a bin counts by its
     /// faces' summed normal, so faces of one bin go to the same side), and
     /// every cell's centre is tried as the direction: linear in the faces,
     /// the share of the best of those directions. A mesh without area
@@ -282,7 +282,7 @@ fn directed_edge(face: [u32; 3], low: u32, high: u32) -> (u32, u32) {
 
 /// Cells per side of a cube face in [`Mesh::area_facing_one_way`]'s normal
 /// bins: 16 gives bins about 6° wide.
-pub const FACING_BINS_PER_SIDE: usize = 16;
+const FACING_BINS_PER_SIDE: usize = 16;
 
 /// The cube-map cell of the direction `n` (not zero): the cube face of its
 /// largest coordinate, then the cell of the other two divided by it.
