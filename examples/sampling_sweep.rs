@@ -10,7 +10,8 @@
 //! spacings, neighbourhood span).
 //!
 //! `cargo run --release --example sampling_sweep [SEEDS] [GENERATOR]`
-//! (default 10 seeds from 1; GENERATOR `lattice` (default) or `decimated`)
+//! (default 10 seeds from 1; GENERATOR `lattice` (default) or `decimated`;
+//! a third argument `isotropic` turns the anisotropy map off)
 
 use testkit::evaluate::{noise_robustness, percent_sweep, precision_recall};
 use testkit::synthetic::{self, SyntheticCloud};
@@ -33,7 +34,10 @@ fn main() -> anyhow::Result<()> {
         "decimated" => synthetic::decimated_blade,
         other => anyhow::bail!("unknown generator {other}: lattice or decimated"),
     };
-    let options = BpdOptions::default();
+    let options = BpdOptions {
+        anisotropy: args.next().as_deref() != Some("isotropic"),
+        ..BpdOptions::default()
+    };
     println!("| blade | seed | points | precision | recall | F1 | ideal recall | Ω truth % | Ψ truth % |");
     println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|");
     let mut summary = Vec::new();
