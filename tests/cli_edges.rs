@@ -344,7 +344,7 @@ fn unknown_output_extension_is_refused_before_reading() {
         &absent,
         "edges",
         Path::new("OUT"),
-        "use .json, .obj, .svg, .dxf or .step",
+        "use .json, .obj, .svg, .dxf, .step or .igs",
     );
 }
 

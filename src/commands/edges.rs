@@ -26,8 +26,8 @@ pub struct Args {
     /// Write the loops and edges: OUT.json (everything), OUT.obj (the
     /// smoothed edges as polylines), OUT.svg (a picture), OUT.dxf (3-D
     /// polylines on layers OUTER and HOLES, corners on CORNERS, for CAD and
-    /// CAM) or OUT.step (cubic B-spline curves, in --units). Missing parent
-    /// directories are created.
+    /// CAM), OUT.step (cubic B-spline curves, in --units) or OUT.igs (the
+    /// same curves as IGES). Missing parent directories are created.
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
     /// Detection and edge options.
@@ -38,7 +38,7 @@ pub struct Args {
     /// frame.
     #[arg(long, value_name = "N")]
     pub scan: Option<usize>,
-    /// The length unit a STEP output declares (a cloud's file does not say
+    /// The length unit a STEP or IGES output declares (a cloud's file does not say
     /// its unit): mm, m or in.
     #[arg(long, value_enum, default_value_t = LengthUnit::Mm)]
     pub units: LengthUnit,
@@ -192,7 +192,7 @@ mod tests {
         let err = check_output(Path::new("x.txt"), input).unwrap_err();
         assert_eq!(
             err.to_string(),
-            "x.txt: unsupported output format: use .json, .obj, .svg, .dxf or .step"
+            "x.txt: unsupported output format: use .json, .obj, .svg, .dxf, .step or .igs"
         );
         assert_eq!(
             check_output(Path::new("out/e.SVG"), input).unwrap(),

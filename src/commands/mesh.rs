@@ -28,7 +28,7 @@ pub struct Args {
     #[arg(long, value_name = "FILE.json")]
     pub report: Option<PathBuf>,
     /// Also write the smoothed edges that bound the mesh: FILE.json, .obj,
-    /// .svg, .dxf or .step, the bytes `meshtrim edges CLOUD -o FILE` writes with
+    /// .svg, .dxf, .step or .igs, the bytes `meshtrim edges CLOUD -o FILE` writes with
     /// the same options.
     #[arg(long, value_name = "FILE")]
     pub edges: Option<PathBuf>,
@@ -40,7 +40,7 @@ pub struct Args {
     /// frame.
     #[arg(long, value_name = "N")]
     pub scan: Option<usize>,
-    /// The length unit a STEP output declares (a cloud's file does not say
+    /// The length unit a STEP or IGES output declares (a cloud's file does not say
     /// its unit): mm, m or in.
     #[arg(long, value_enum, default_value_t = LengthUnit::Mm)]
     pub units: LengthUnit,

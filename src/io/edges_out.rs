@@ -1,6 +1,6 @@
 //! Output of `meshtrim edges`: the reconstructed boundary loops and edges.
 //!
-//! Five formats, chosen by the output's extension, all deterministic byte
+//! Six formats, chosen by the output's extension, all deterministic byte
 //! for byte (no timestamps, floats in Rust's or serde_json's shortest
 //! round-trip form, or rounded the same way every time in SVG):
 //!
@@ -13,7 +13,9 @@
 //! - DXF: one closed 3-D polyline per loop on layers `OUTER` and `HOLES`,
 //!   the corners as points (`dxf.rs`);
 //! - STEP: one cubic B-spline curve per edge through its points, the
-//!   corners as points ([`step`]).
+//!   corners as points ([`step`]);
+//! - IGES: the same curves and points as IGES entities 126 and 116
+//!   (`iges.rs`).
 
 use std::fmt::Write as _;
 use std::io::Write;
@@ -51,13 +53,15 @@ pub enum EdgesFormat {
     Dxf,
     /// STEP AP214: cubic B-spline curves and corner points.
     Step,
+    /// IGES 5.3: the same curves (entity 126) and points (entity 116).
+    Iges,
 }
 
 /// The format of an edges output, or the error naming what is accepted.
 pub fn edges_format(path: &std::path::Path) -> anyhow::Result<EdgesFormat> {
     EdgesFormat::from_path(path).ok_or_else(|| {
         anyhow::anyhow!(
-            "{}: unsupported output format: use .json, .obj, .svg, .dxf or .step",
+            "{}: unsupported output format: use .json, .obj, .svg, .dxf, .step or .igs",
             path.display()
         )
     })
@@ -73,6 +77,7 @@ impl EdgesFormat {
             "svg" => Some(EdgesFormat::Svg),
             "dxf" => Some(EdgesFormat::Dxf),
             "step" | "stp" => Some(EdgesFormat::Step),
+            "igs" | "iges" => Some(EdgesFormat::Iges),
             _ => None,
         }
     }
@@ -85,6 +90,7 @@ impl EdgesFormat {
             EdgesFormat::Svg => write_svg(w, data),
             EdgesFormat::Dxf => dxf::write_dxf(w, data),
             EdgesFormat::Step => step::write_step(w, data),
+            EdgesFormat::Iges => iges::write_iges(w, data),
         }
     }
 }
@@ -490,6 +496,7 @@ fn num(x: f64) -> String {
 }
 
 mod dxf;
+mod iges;
 pub mod step;
 
 #[cfg(test)]

@@ -65,7 +65,7 @@ def test_the_notched_plate_has_corners(tmp_path):
     assert len(corners) == 8  # the outline of the plate with its notch
 
 
-@pytest.mark.parametrize("ext", ["json", "obj", "svg", "dxf"])
+@pytest.mark.parametrize("ext", ["json", "obj", "svg", "dxf", "step", "igs"])
 def test_trim_and_mesh_write_the_edges_they_used(tmp_path, ext):
     meshes = ROOT / "fixtures" / "meshes"
     cloud, poisson = meshes / "blade_small.ply", meshes / "blade_small_poisson.ply"
@@ -90,5 +90,5 @@ def test_a_bad_edges_output_is_refused_before_any_work(tmp_path):
         capture_output=True,
         text=True,
     )
-    assert r.returncode == 1 and "e.txt: unsupported output format: use .json, .obj, .svg, .dxf or .step" in r.stderr
+    assert r.returncode == 1 and "e.txt: unsupported output format: use .json, .obj, .svg, .dxf, .step or .igs" in r.stderr
     assert not out.exists()

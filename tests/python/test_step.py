@@ -1,5 +1,5 @@
-"""The smoothed edges as STEP B-spline curves (`meshtrim edges CLOUD -o
-OUT.step`), read back by OpenCASCADE through gmsh: one B-spline curve per
+"""The smoothed edges as STEP and IGES B-spline curves (`meshtrim edges
+CLOUD -o OUT.step|OUT.igs`), read back by OpenCASCADE through gmsh: one B-spline curve per
 JSON edge, every edge point on its curve within 0.01 beta, the curve within
 a quarter spacing of the edge polyline between points (no overshoot),
 consecutive edges meeting at their corners, closed loops closed, the unit
@@ -20,11 +20,14 @@ from meshtrim_cli import ROOT, run_meshtrim, shared_data
 
 
 def read_step(path, target_unit="MM"):
-    """The curves OpenCASCADE reads from `path`, in file order: a function
-    evaluating each at parameters, and its closest-point query."""
+    """The curves OpenCASCADE reads from `path` (STEP or IGES), in file
+    order: a function evaluating each at parameters, and its closest-point
+    query. STEP is converted to `target_unit`; OpenCASCADE's IGES reader
+    converts to millimetres itself (gmsh cannot set its target unit)."""
     gmsh.initialize()
     gmsh.option.setNumber("General.Terminal", 0)
-    gmsh.option.setString("Geometry.OCCTargetUnit", target_unit)
+    if path.suffix != ".igs":
+        gmsh.option.setString("Geometry.OCCTargetUnit", target_unit)
     try:
         gmsh.model.occ.importShapes(str(path))
         gmsh.model.occ.synchronize()
@@ -64,11 +67,12 @@ def cases(tmp_path):
     }
 
 
+@pytest.mark.parametrize("suffix", [".step", ".igs"])
 @pytest.mark.parametrize("name", ["blade_holes", "notched_plate", "bunny"])
-def test_step_curves_fit_the_json_edges(tmp_path, name):
+def test_curves_fit_the_json_edges(tmp_path, name, suffix):
     cloud = cases(tmp_path)[name]
     run_meshtrim("edges", cloud, "-o", tmp_path / "e.json")
-    run_meshtrim("edges", cloud, "-o", tmp_path / "e.step")
+    run_meshtrim("edges", cloud, "-o", (tmp_path / "e").with_suffix(suffix))
     run_meshtrim("detect", cloud, "-o", tmp_path / "labels.csv")
     with open(tmp_path / "labels.csv") as f:
         rows = list(csv.DictReader(f))
@@ -77,7 +81,7 @@ def test_step_curves_fit_the_json_edges(tmp_path, name):
     spacing = float(np.median(cKDTree(xyz).query(xyz, k=2)[0][:, 1]))
     loops = json.loads((tmp_path / "e.json").read_text())["loops"]
     edges = [e for l in loops for e in l["edges"]]
-    curves, closest = read_step(tmp_path / "e.step")
+    curves, closest = read_step((tmp_path / "e").with_suffix(suffix))
     try:
         assert len(curves) == len(edges) > 0
         for curve, edge in zip(curves, edges):
@@ -104,11 +108,12 @@ def test_step_curves_fit_the_json_edges(tmp_path, name):
         gmsh.finalize()
 
 
-def test_the_unit_is_declared(tmp_path):
+@pytest.mark.parametrize("suffix", [".step", ".igs"])
+def test_the_unit_is_declared(tmp_path, suffix):
     cloud = ROOT / "fixtures" / "meshes" / "blade_holes.ply"
     first = {}
     for unit, scale in [("mm", 1.0), ("m", 1000.0), ("in", 25.4)]:
-        out = tmp_path / f"e_{unit}.step"
+        out = tmp_path / f"e_{unit}{suffix}"
         run_meshtrim("edges", cloud, "-o", out, "--units", unit)
         curves, _ = read_step(out, "MM")
         try:
@@ -116,6 +121,28 @@ def test_the_unit_is_declared(tmp_path):
         finally:
             gmsh.finalize()
     assert np.allclose(first["m"], first["mm"]) and np.allclose(first["in"], first["mm"])
-    again = tmp_path / "again.step"
+    again = tmp_path / f"again{suffix}"
     run_meshtrim("edges", cloud, "-o", again, "--units", "in")
-    assert again.read_bytes() == (tmp_path / "e_in.step").read_bytes()
+    assert again.read_bytes() == (tmp_path / f"e_in{suffix}").read_bytes()
+
+
+def test_iges_records_and_corners(tmp_path):
+    """The IGES file's fixed records: 80 columns, sections in order with
+    their own sequence numbers, the Terminate record's counts; one point
+    entity (116) per corner and one curve (126) per JSON edge."""
+    cloud = ROOT / "fixtures" / "meshes" / "blade_holes.ply"
+    run_meshtrim("edges", cloud, "-o", tmp_path / "e.igs")
+    run_meshtrim("edges", cloud, "-o", tmp_path / "e.json")
+    lines = (tmp_path / "e.igs").read_text().splitlines()
+    assert all(len(l) == 80 for l in lines)
+    sections = [l[72] for l in lines]
+    assert "".join(dict.fromkeys(sections)) == "SGDPT"
+    counts = {s: sections.count(s) for s in "SGDP"}
+    for s in "SGDP":
+        numbers = [int(l[73:]) for l in lines if l[72] == s]
+        assert numbers == list(range(1, counts[s] + 1))
+    assert lines[-1][:32] == "".join(f"{s}{counts[s]:>7}" for s in "SGDP")
+    kinds = [int(l[:8]) for l in lines if l[72] == "D"][::2]
+    loops = json.loads((tmp_path / "e.json").read_text())["loops"]
+    assert kinds.count(116) == sum(len(l["corners"]) for l in loops) == 4
+    assert kinds.count(126) == sum(len(l["edges"]) for l in loops)

@@ -95,6 +95,40 @@ fn tangents(points: &[Point3], params: &[f64], closed: bool) -> Vec<Point3> {
 }
 
 impl BSpline {
+    /// The same curve with its interior knots of multiplicity 2, C¹ in its
+    /// parameter as well as in shape (readers that split curves at knots
+    /// of lower continuity, such as OpenCASCADE's IGES reader, keep it
+    /// whole). Knot removal drops each interior data point from the
+    /// control points: it is exactly the mean of the control points beside
+    /// it weighted by the parameter steps, so the curve still passes
+    /// through it, to rounding rather than to the bit. Ends are unchanged.
+    pub fn with_double_knots(&self) -> BSpline {
+        let last = self.control_points.len() - 1;
+        let control_points = self
+            .control_points
+            .iter()
+            .enumerate()
+            .filter(|&(i, _)| i == 0 || i == last || i % 3 != 0)
+            .map(|(_, &p)| p)
+            .collect();
+        let inner = self.multiplicities.len() - 1;
+        let multiplicities = (0..=inner)
+            .map(|i| {
+                if i == 0 || i == inner {
+                    self.degree + 1
+                } else {
+                    2
+                }
+            })
+            .collect();
+        BSpline {
+            degree: self.degree,
+            control_points,
+            knots: self.knots.clone(),
+            multiplicities,
+        }
+    }
+
     /// The full knot vector, each knot repeated by its multiplicity.
     pub fn knot_vector(&self) -> Vec<f64> {
         self.knots
@@ -247,6 +281,27 @@ mod tests {
                     let got = curve.point_at(params[i] + s * h);
                     assert!(dist(got, expected) < 1e-9, "seed {seed}");
                 }
+            }
+        }
+    }
+
+    #[test]
+    fn double_knots_give_the_same_curve() {
+        for seed in 1..10 {
+            for closed in [false, true] {
+                let points = wavy(2 + 3 * seed as usize, seed);
+                let curve = interpolate(&points, closed).unwrap();
+                let c1 = curve.with_double_knots();
+                let total: usize = c1.multiplicities.iter().sum();
+                assert_eq!(total, c1.control_points.len() + c1.degree + 1);
+                let scale = points.iter().flatten().fold(0f64, |m, c| m.max(c.abs()));
+                for k in 0..=1000 {
+                    let u = f64::from(k) / 1000.0;
+                    let d = dist(curve.point_at(u), c1.point_at(u));
+                    assert!(d < 1e-12 * scale, "seed {seed} closed {closed} u {u}: {d}");
+                }
+                assert_eq!(c1.point_at(0.0), points[0]);
+                assert_eq!(c1.control_points.last(), curve.control_points.last());
             }
         }
     }

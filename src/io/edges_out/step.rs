@@ -186,7 +186,7 @@ fn refs(ids: &[usize]) -> String {
 
 /// A STEP REAL in the shortest digits that read back as `v`: always with
 /// a decimal point, the exponent as `E` (`1.5`, `-2.`, `1.E-07` style).
-fn real(v: f64) -> String {
+pub(super) fn real(v: f64) -> String {
     let text = format!("{v:?}");
     let (mantissa, exponent) = match text.split_once('e') {
         Some((m, e)) => (m.to_string(), Some(e.to_string())),
