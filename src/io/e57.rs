@@ -188,25 +188,9 @@ impl Pose {
                 q.z
             );
         }
-        let [w, x, y, z] = [q.w, q.x, q.y, q.z].map(|c| c / norm);
+        let unit = [q.w, q.x, q.y, q.z].map(|c| c / norm);
         Ok(Pose {
-            rotation: [
-                [
-                    1.0 - 2.0 * (y * y + z * z),
-                    2.0 * (x * y - w * z),
-                    2.0 * (x * z + w * y),
-                ],
-                [
-                    2.0 * (x * y + w * z),
-                    1.0 - 2.0 * (x * x + z * z),
-                    2.0 * (y * z - w * x),
-                ],
-                [
-                    2.0 * (x * z - w * y),
-                    2.0 * (y * z + w * x),
-                    1.0 - 2.0 * (x * x + y * y),
-                ],
-            ],
+            rotation: trim::rotation_from_quaternion(unit),
             translation,
         })
     }

@@ -27,6 +27,14 @@ pub struct Labelled<'a> {
     pub grid: Option<&'a [GridIndex]>,
 }
 
+impl Labelled<'_> {
+    /// The grid indices when there is one per point; a grid of another
+    /// length is not written (the columns would not line up).
+    fn full_grid(&self) -> Option<&[GridIndex]> {
+        self.grid.filter(|grid| grid.len() == self.points.len())
+    }
+}
+
 /// Output formats of `detect`, chosen by the output's extension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LabelFormat {
@@ -87,7 +95,8 @@ pub fn write_ply(w: &mut dyn Write, data: Labelled) -> std::io::Result<()> {
     writeln!(w, "element vertex {}", data.points.len())?;
     writeln!(w, "property double x\nproperty double y\nproperty double z")?;
     writeln!(w, "property uchar boundary\nproperty double beta")?;
-    if data.grid.is_some() {
+    let grid = data.full_grid();
+    if grid.is_some() {
         writeln!(
             w,
             "property uint scan\nproperty int row\nproperty int column"
@@ -106,7 +115,7 @@ pub fn write_ply(w: &mut dyn Write, data: Labelled) -> std::io::Result<()> {
         }
         w.write_u8(u8::from(b))?;
         w.write_f64::<LittleEndian>(beta)?;
-        if let Some(g) = data.grid.map(|grid| grid[i]) {
+        if let Some(g) = grid.map(|grid| grid[i]) {
             w.write_u32::<LittleEndian>(g.scan)?;
             w.write_i32::<LittleEndian>(g.row)?;
             w.write_i32::<LittleEndian>(g.column)?;
@@ -119,7 +128,8 @@ pub fn write_ply(w: &mut dyn Write, data: Labelled) -> std::io::Result<()> {
 /// grid), floats in shortest round-trip form (lines formatted in parallel
 /// pieces, written in order).
 pub fn write_csv(w: &mut dyn Write, data: Labelled) -> std::io::Result<()> {
-    let grid_columns = if data.grid.is_some() {
+    let grid = data.full_grid();
+    let grid_columns = if grid.is_some() {
         ",scan,row,column"
     } else {
         ""
@@ -137,8 +147,9 @@ pub fn write_csv(w: &mut dyn Write, data: Labelled) -> std::io::Result<()> {
         }
         out.extend_from_slice(if data.boundary[i] { b"1," } else { b"0," });
         push_f64(out, data.beta[i]);
-        if let Some(g) = data.grid.map(|grid| grid[i]) {
-            out.extend_from_slice(format!(",{},{},{}", g.scan, g.row, g.column).as_bytes());
+        if let Some(g) = grid.map(|grid| grid[i]) {
+            // Writing to a Vec cannot fail.
+            let _ = write!(out, ",{},{},{}", g.scan, g.row, g.column);
         }
         out.push(b'\n');
     })

@@ -84,6 +84,7 @@ pub use delaunay::{delaunay_mesh, delaunay_mesh_with_report, DelaunayOptions, De
 pub use edges::{reconstruct_edges, Edge, EdgeOptions, Edges, Loop};
 pub use error::{CleanError, CloudError, DelaunayError, MeshError, TrimError};
 pub use frame::{fit_plane, Frame};
+pub use geom::rotation_from_quaternion;
 pub use mesh::repair::FaceRepair;
 pub use mesh::{check_vertex_range, Mesh};
 pub use spatial::neighbours::NeighbourIndex;

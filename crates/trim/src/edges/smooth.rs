@@ -622,24 +622,7 @@ mod tests {
             .collect();
         let betas: Vec<f64> = (0..300).map(|i| 0.5 + 1.5 * i as f64 / 299.0).collect();
         // Rotation from a unit quaternion, scale and translation.
-        let (w, x, y, z) = (0.5f64, 0.5f64, -0.5f64, 0.5f64);
-        let rot = [
-            [
-                1.0 - 2.0 * (y * y + z * z),
-                2.0 * (x * y - w * z),
-                2.0 * (x * z + w * y),
-            ],
-            [
-                2.0 * (x * y + w * z),
-                1.0 - 2.0 * (x * x + z * z),
-                2.0 * (y * z - w * x),
-            ],
-            [
-                2.0 * (x * z - w * y),
-                2.0 * (y * z + w * x),
-                1.0 - 2.0 * (x * x + y * y),
-            ],
-        ];
+        let rot = crate::geom::rotation_from_quaternion([0.5, 0.5, -0.5, 0.5]);
         let scale = 3.7;
         let shift = [100.0, -50.0, 20.0];
         let tf = |p: &Point3| -> Point3 {

@@ -8,10 +8,10 @@ mod vec3;
 
 pub(crate) use predicates::{orient, orientation, segments_meet};
 pub(crate) use union_find::UnionFind;
-pub use vec3::Point3;
 pub(crate) use vec3::{
     add, cross, dist2, dot, norm2, scale, segment_dist2, segment_param, sub, unit,
 };
+pub use vec3::{rotation_from_quaternion, Point3};
 
 /// The median of the finite values (the upper one of an even count), or 1
 /// when there is none: a scale that is never zero or NaN.

@@ -62,3 +62,25 @@ pub(crate) fn segment_dist2(p: Point3, a: Point3, b: Point3) -> f64 {
     let t = segment_param(p, a, b);
     dist2(p, add(a, scale(sub(b, a), t)))
 }
+
+/// The rotation matrix (rows) of the unit quaternion `[w, x, y, z]` (the
+/// caller normalises it; a scanner's pose stores one).
+pub fn rotation_from_quaternion([w, x, y, z]: [f64; 4]) -> [[f64; 3]; 3] {
+    [
+        [
+            1.0 - 2.0 * (y * y + z * z),
+            2.0 * (x * y - w * z),
+            2.0 * (x * z + w * y),
+        ],
+        [
+            2.0 * (x * y + w * z),
+            1.0 - 2.0 * (x * x + z * z),
+            2.0 * (y * z - w * x),
+        ],
+        [
+            2.0 * (x * z - w * y),
+            2.0 * (y * z + w * x),
+            1.0 - 2.0 * (x * x + y * y),
+        ],
+    ]
+}
