@@ -472,14 +472,15 @@ fn flips_beyond_the_first_rows(
 
 /// The paper's noise levels against the truth, over ten samplings per
 /// resolution and two noise patterns (decimated blades, seeds 1–10,
-/// patterns 7 and 8, along the true normal): the median case must reach
-/// Ω ≥ 25 % and Ψ ≥ 75 % at every resolution. Measured (75 is the sweep's
-/// end): medians Ω 75 / 75 / 75 / 35 %, Ψ 75 % at 4 / 8 / 16 / 34 mm;
-/// Ψ ≥ 75 in 15, 15, 20, 20 cases of 20, Ω ≥ 25 in 20, 20, 20, 13. The
-/// single cases that fall short are a point the anisotropy map lets a gap
-/// open at (docs/results.md, "Ten samplings per resolution").
+/// patterns 7 and 8, along the true normal): Ψ ≥ 75 % in at least nine
+/// cases of ten at every resolution, and the median case at Ω ≥ 25 %.
+/// Measured (75 is the sweep's end): Ψ ≥ 75 in 20 cases of 20 at 4, 8,
+/// 16 and 34 mm; Ω ≥ 25 in 20, 20, 20, 13, medians Ω 75 / 75 / 75 /
+/// 35 %. Ω at 34 mm is the limit of 100-point clouds: a border point about
+/// 0.7 spacings in whose empty circle exceeds β by under 1 % (docs/results.md,
+/// "Ten samplings per resolution").
 #[test]
-fn noise_over_ten_samplings_and_two_patterns_at_the_median() {
+fn noise_over_ten_samplings_and_two_patterns() {
     let options = BpdOptions::default();
     let mut failures = Vec::new();
     for h in [4.0, 8.0, 16.0, 34.0] {
@@ -498,15 +499,17 @@ fn noise_over_ten_samplings_and_two_patterns_at_the_median() {
             (v[v.len() / 2 - 1] + v[v.len() / 2]) / 2.0
         };
         let (o, p) = (median(&mut omega), median(&mut psi));
+        let psi_reached = psi.iter().filter(|&&x| x >= 75.0).count();
         eprintln!(
-            "{h} mm: median Ω {o} %, Ψ {p} %; worst Ω {} %, Ψ {} %; Ψ ≥ 75 in {} of 20, Ω ≥ 25 in {} of 20",
+            "{h} mm: median Ω {o} %, Ψ {p} %; worst Ω {} %, Ψ {} %; Ψ ≥ 75 in {psi_reached} of 20, Ω ≥ 25 in {} of 20",
             omega[0],
             psi[0],
-            psi.iter().filter(|&&x| x >= 75.0).count(),
             omega.iter().filter(|&&x| x >= 25.0).count()
         );
-        if o < 25.0 || p < 75.0 {
-            failures.push(format!("{h} mm: median Ω {o} %, Ψ {p} %"));
+        if o < 25.0 || psi_reached < 18 {
+            failures.push(format!(
+                "{h} mm: median Ω {o} %, Ψ ≥ 75 in {psi_reached} of 20"
+            ));
         }
     }
     assert!(failures.is_empty(), "{failures:#?}");

@@ -63,6 +63,18 @@ pub fn surrounding_path_is_open(nb: &[Point2], s: &mut PolarScratch) -> bool {
     if width <= 0.0 {
         return true;
     }
+    if TAU - width < SURROUNDED_BELOW_GAP {
+        return false;
+    }
+    linked_path_is_open(nb, theta_min, width, s)
+}
+
+/// Eqs. 2–5 on neighbours whose angles are in `s.theta` and occupy the
+/// sector from `theta_min`, `width` wide: links a path greedily from the
+/// start point and says whether it fails to wind once round P_i.
+// Always inlined: its loop is the one the AVX2 variant of the caller is for.
+#[inline(always)]
+fn linked_path_is_open(nb: &[Point2], theta_min: f64, width: f64, s: &mut PolarScratch) -> bool {
     // Radii into `r` first, normalised in place below (eq. 2). Local
     // coordinates are small and finite, so the plain formula cannot overflow.
     s.r.clear();
@@ -132,6 +144,14 @@ pub fn surrounding_path_is_open(nb: &[Point2], s: &mut PolarScratch) -> bool {
     }
     alpha.abs() < TAU - TIE
 }
+
+/// Largest empty angular gap round P_i (radians, 60°) below which P_i is
+/// surrounded without linking a path: the neighbours taken in angular
+/// order then already form a path that winds once round it, each step
+/// turning less than this. The linking of eq. 5 is greedy, and on
+/// blue-noise samplings it can fail to close round a point deep inside
+/// the surface (docs/bpd.md, "Points surrounded in every direction").
+const SURROUNDED_BELOW_GAP: f64 = PI / 3.0;
 
 /// Angles (radians) and costs closer than this are ties. Far above the
 /// rounding of the local coordinates (about 10⁻¹¹ of a spacing for a cloud
@@ -380,6 +400,34 @@ mod tests {
                 [radius * t.cos(), radius * t.sin()]
             })
             .collect()
+    }
+
+    /// Twelve neighbours of a blue-noise sampling (no two closer than 0.8)
+    /// all round P_i, the largest angular gap 44°: the greedy linking of
+    /// eq. 5 does not close round P_i, the angular-gap rule does.
+    #[test]
+    fn point_with_no_wide_gap_is_surrounded_where_the_linking_fails() {
+        let nb = [
+            [0.95, 0.03],
+            [-0.50, 1.30],
+            [1.56, 0.63],
+            [-1.62, 1.15],
+            [0.30, 1.71],
+            [-1.93, -0.33],
+            [1.39, -1.02],
+            [-0.43, -1.93],
+            [0.37, 0.86],
+            [0.46, -0.90],
+            [-0.87, -0.58],
+            [-0.92, 0.54],
+        ];
+        let mut s = PolarScratch::default();
+        s.theta.extend(nb.iter().map(|p| atan2(p[1], p[0])));
+        let (theta_min, width) = occupied_sector(&s.theta, &mut s.sector);
+        let gap = TAU - width;
+        assert!(gap < SURROUNDED_BELOW_GAP, "gap {gap}");
+        assert!(linked_path_is_open(&nb, theta_min, width, &mut s));
+        assert!(!surrounding_path_is_open(&nb, &mut s));
     }
 
     #[test]
