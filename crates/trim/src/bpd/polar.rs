@@ -8,6 +8,9 @@
 //! - the angular sector spanned by them runs from θ_min to θ_max, taken as
 //!   the complement of the largest empty angular gap (so the sector holds
 //!   every neighbour and θ_max − θ_min < 2π);
+//! - meshtrim's rule: when that gap is under 60°, P_i is surrounded (the
+//!   neighbours in angular order wind once round it) and no path is
+//!   linked (`SURROUNDED_BELOW_GAP`);
 //! - normalisation, eqs. 2–3: r_j = (R_j − R_min)/(R_max − R_min),
 //!   ϑ_j = (θ_j − θ_min)/(θ_max − θ_min) (r_j = 0 when all R_j are equal);
 //! - start point, eq. 4: the minimum of γ_j = r_j + |ϑ_j − ϑ_bis| with
@@ -63,7 +66,9 @@ pub fn surrounding_path_is_open(nb: &[Point2], s: &mut PolarScratch) -> bool {
     if width <= 0.0 {
         return true;
     }
-    if TAU - width < SURROUNDED_BELOW_GAP {
+    // A gap of exactly 60° (hexagonal quantised samplings) goes to the
+    // linking, whatever the rounding.
+    if TAU - width < SURROUNDED_BELOW_GAP - TIE {
         return false;
     }
     linked_path_is_open(nb, theta_min, width, s)
