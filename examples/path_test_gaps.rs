@@ -81,6 +81,9 @@ fn measure(cloud: &SyntheticCloud, noise: f64, gaps: &mut Gaps) {
     }
 }
 
+/// A sampling of the blade at a resolution (mm) and seed.
+type Blade = fn(f64, u64) -> SyntheticCloud;
+
 /// "n (min–max°)", or "0".
 fn range(gaps: &[f64]) -> String {
     if gaps.is_empty() {
@@ -94,7 +97,7 @@ fn range(gaps: &[f64]) -> String {
 fn main() {
     println!("| sampling | interior points left to the path test | their largest gap | border points left to it | their smallest gap | border points left to it with a gap below 60° | labelled by the path test: within a spacing (gaps) | deeper (gaps) |");
     println!("|---|---:|---:|---:|---:|---:|---|---|");
-    let generators: [(&str, fn(f64, u64) -> SyntheticCloud); 2] = [
+    let generators: [(&str, Blade); 2] = [
         ("decimated", synthetic::decimated_blade),
         ("jittered lattice", synthetic::blade),
     ];
