@@ -16,8 +16,14 @@
 //! the C² curve's tangents depend on every point and it overshoots around
 //! the short, sharply turning loops of real scans (small holes of four to
 //! six points); this one bends only between the points around each turn.
+//!
+//! Round the sharpest turns of those small loops even the Catmull–Rom
+//! handles swing out of the polygon, so a point's tangent is shortened
+//! where a segment would stray from its chord by more than
+//! [`MAX_BULGE`] of the curve's median chord (`limited`); the curve still
+//! passes through every point and stays C¹.
 
-use crate::geom::Point3;
+use crate::geom::{dist2, dot, norm2, sub, Point3};
 
 /// A clamped B-spline curve of degree `degree`: knots as distinct values
 /// with multiplicities (as STEP writes them), control points.
@@ -46,7 +52,12 @@ pub fn interpolate(points: &[Point3], closed: bool) -> Option<BSpline> {
         return None;
     }
     let params = centripetal_parameters(&through)?;
-    let tangents = tangents(&through, &params, closed);
+    let tangents = limited(
+        tangents(&through, &params, closed),
+        &through,
+        &params,
+        closed,
+    );
     let mut control_points = Vec::with_capacity(3 * n - 2);
     for i in 0..n - 1 {
         let h = (params[i + 1] - params[i]) / 3.0;
@@ -92,6 +103,66 @@ fn tangents(points: &[Point3], params: &[f64], closed: bool) -> Vec<Point3> {
         out.push(t);
     }
     out
+}
+
+/// Farthest a segment may stray from its chord, as a share of the curve's
+/// median chord (its points' typical spacing).
+pub const MAX_BULGE: f64 = 0.15;
+
+/// The tangents shortened where a segment would bulge more than
+/// [`MAX_BULGE`] of the median chord from its own chord: round a sharp
+/// turn of a small loop the Catmull–Rom handles swing out of the polygon.
+/// A segment strays from its chord by at most 3/4 of its handles' larger
+/// offset across the chord (3(1−t)t ≤ 3/4 in the Bézier form), so the
+/// handles are scaled until that bound holds. Each point's tangent is
+/// scaled as a whole (both of its handles, keeping its direction), so the
+/// curve stays C¹ and still passes through every point exactly; where no
+/// segment bulges the curve is the plain centripetal Catmull–Rom one.
+fn limited(
+    mut tangents: Vec<Point3>,
+    points: &[Point3],
+    params: &[f64],
+    closed: bool,
+) -> Vec<Point3> {
+    let n = points.len();
+    let mut chords: Vec<f64> = (0..n - 1)
+        .map(|i| dist2(points[i], points[i + 1]).sqrt())
+        .collect();
+    let bound = {
+        chords.sort_unstable_by(f64::total_cmp);
+        MAX_BULGE * chords[chords.len() / 2]
+    };
+    let mut scale = vec![1.0f64; n];
+    for i in 0..n - 1 {
+        let chord = sub(points[i + 1], points[i]);
+        let step = (params[i + 1] - params[i]) / 3.0;
+        for end in [i, i + 1] {
+            let bulge = 0.75 * across(tangents[end].map(|c| c * step), chord);
+            if bulge > bound {
+                scale[end] = scale[end].min(bound / bulge);
+            }
+        }
+    }
+    if closed {
+        // The seam's two ends are one point: one tangent.
+        let both = scale[0].min(scale[n - 1]);
+        scale[0] = both;
+        scale[n - 1] = both;
+    }
+    for (t, s) in tangents.iter_mut().zip(scale) {
+        *t = t.map(|c| c * s);
+    }
+    tangents
+}
+
+/// Length of the part of `v` square to `chord` (all of `v` for a zero chord).
+fn across(v: Point3, chord: Point3) -> f64 {
+    let c2 = norm2(chord);
+    if c2 == 0.0 {
+        return norm2(v).sqrt();
+    }
+    let along = dot(v, chord) / c2;
+    norm2(sub(v, chord.map(|c| c * along))).sqrt()
 }
 
 impl BSpline {
@@ -272,7 +343,7 @@ mod tests {
             let points = wavy(6 + seed as usize, seed);
             let curve = interpolate(&points, false).unwrap();
             let params = centripetal_parameters(&points).unwrap();
-            let tangents = tangents(&points, &params, false);
+            let tangents = limited(tangents(&points, &params, false), &points, &params, false);
             for i in 0..points.len() - 1 {
                 let h = params[i + 1] - params[i];
                 for s in [0.1, 0.5, 0.9] {
@@ -304,6 +375,74 @@ mod tests {
                 assert_eq!(c1.control_points.last(), curve.control_points.last());
             }
         }
+    }
+
+    /// Distance from `p` to the segment `a`–`b`.
+    fn to_segment(p: Point3, a: Point3, b: Point3) -> f64 {
+        let ab = sub(b, a);
+        let t = (dot(sub(p, a), ab) / norm2(ab)).clamp(0.0, 1.0);
+        dist(p, [0, 1, 2].map(|c| a[c] + t * ab[c]))
+    }
+
+    /// Small loops with sharp turns (five to eight points at radii 0.3 to
+    /// 1.7 round a circle): every segment stays within MAX_BULGE of the median chord
+    /// of its own chord, where the plain Catmull–Rom curve strays farther.
+    #[test]
+    fn sharp_turns_do_not_bulge() {
+        let mut plain_worst = 0.0f64;
+        for seed in 0..200u64 {
+            let n = 5 + (seed % 4) as usize;
+            let points: Vec<Point3> = (0..n)
+                .map(|i| {
+                    let jag = ((seed * 7 + i as u64 * 13) % 11) as f64 / 10.0;
+                    let a = std::f64::consts::TAU * (i as f64 + 0.4 * jag) / n as f64;
+                    let r = 0.3 + 1.4 * jag;
+                    [r * a.cos(), r * a.sin(), 0.0]
+                })
+                .collect();
+            let through = curve_points(&points, true);
+            let params = centripetal_parameters(&through).unwrap();
+            let mut chords: Vec<f64> = through.windows(2).map(|w| dist(w[0], w[1])).collect();
+            chords.sort_unstable_by(f64::total_cmp);
+            let bound = MAX_BULGE * chords[chords.len() / 2];
+            let curve = interpolate(&points, true).unwrap();
+            let plain = tangents(&through, &params, true);
+            for i in 0..n {
+                let h = params[i + 1] - params[i];
+                for k in 1..50 {
+                    let s = f64::from(k) / 50.0;
+                    let on = curve.point_at(params[i] + s * h);
+                    let off = to_segment(on, through[i], through[i + 1]);
+                    assert!(
+                        off <= bound * (1.0 + 1e-9),
+                        "seed {seed} segment {i}: {off} > {bound}"
+                    );
+                    let free = hermite(through[i], through[i + 1], plain[i], plain[i + 1], h, s);
+                    plain_worst =
+                        plain_worst.max(to_segment(free, through[i], through[i + 1]) / bound);
+                }
+            }
+        }
+        assert!(
+            plain_worst > 1.0,
+            "the plain curve bulges only {plain_worst} of the bound"
+        );
+    }
+
+    /// Where nothing bulges (a finely sampled circle), the limit leaves the
+    /// plain Catmull–Rom tangents alone.
+    #[test]
+    fn smooth_curves_keep_their_tangents() {
+        let points: Vec<Point3> = (0..64)
+            .map(|i| {
+                let a = std::f64::consts::TAU * f64::from(i) / 64.0;
+                [a.cos(), a.sin(), 0.1 * a.sin()]
+            })
+            .collect();
+        let through = curve_points(&points, true);
+        let params = centripetal_parameters(&through).unwrap();
+        let plain = tangents(&through, &params, true);
+        assert_eq!(limited(plain.clone(), &through, &params, true), plain);
     }
 
     #[test]
