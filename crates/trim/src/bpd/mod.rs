@@ -22,8 +22,7 @@ use std::ops::Range;
 use rayon::prelude::*;
 
 use crate::anisotropy::{
-    apply, own_sampling_vectors, sampling_moment, sampling_tensor_of_moments, whitening_map,
-    SamplingMoment,
+    apply, own_sampling_moment, sampling_tensor_of_moments, whitening_map, SamplingMoment,
 };
 use crate::cloud::{check_finite, check_not_degenerate, merge_duplicates, Sites, PASS_PIECE};
 use crate::error::CloudError;
@@ -531,7 +530,7 @@ fn sampling_at(
     let shear = shear_towards(view, &frame, points[members[0] as usize]);
     project_sheared(points, members, &frame, shear, projected);
     Sampling {
-        moment: sampling_moment(&own_sampling_vectors(projected, &frame)),
+        moment: own_sampling_moment(projected, &frame),
         normal: frame.normal,
     }
 }
