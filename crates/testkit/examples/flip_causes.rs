@@ -11,7 +11,7 @@
 //! `cargo run --release -p meshtrim-testkit --example flip_causes`
 
 use testkit::synthetic;
-use trim::internals::{own_sampling_moment, project};
+use trim::internals::{own_sampling_moment, project, MomentScratch};
 use trim::{detect_boundary, fit_plane, BpdOptions, NeighbourIndex, Point3};
 
 fn lists_and_moments(pts: &[Point3]) -> (Vec<Vec<u32>>, Vec<[f64; 6]>) {
@@ -20,6 +20,7 @@ fn lists_and_moments(pts: &[Point3]) -> (Vec<Vec<u32>>, Vec<[f64; 6]>) {
     let mut out = Vec::new();
     let mut proj = Vec::new();
     let mut vecs = Vec::new();
+    let mut scratch = MomentScratch::default();
     for i in 0..pts.len() {
         index.nearest(i, 30, &mut out);
         lists.push(out.clone());
@@ -27,7 +28,7 @@ fn lists_and_moments(pts: &[Point3]) -> (Vec<Vec<u32>>, Vec<[f64; 6]>) {
     for list in &lists {
         let f = fit_plane(pts, list);
         project(pts, list, &f, &mut proj);
-        vecs.push(own_sampling_moment(&proj, &f));
+        vecs.push(own_sampling_moment(&proj, &f, &mut scratch));
     }
     (lists, vecs)
 }

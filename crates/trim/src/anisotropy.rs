@@ -80,11 +80,23 @@ const GATE_COS2: (f64, f64) = (0.413_175_911_166_535, 0.116_977_778_440_511);
 /// xx, xy, xz, yy, yz, zz).
 pub type SamplingMoment = [f64; 6];
 
+/// Buffers of [`own_sampling_moment`], kept between calls.
+#[derive(Debug, Default)]
+pub struct MomentScratch {
+    offsets: Vec<Point2>,
+    norm2: Vec<f64>,
+    gated: Vec<f64>,
+}
+
 /// S of the investigated point `projected[0]` (blended, see the module doc)
 /// within its projected neighbourhood, lifted to 3D with the frame's axes.
 /// Zero when every member coincides with the point.
-pub fn own_sampling_moment(projected: &[Point2], frame: &Frame) -> SamplingMoment {
-    let [a, b, c] = planar_sampling_moment(projected);
+pub fn own_sampling_moment(
+    projected: &[Point2],
+    frame: &Frame,
+    scratch: &mut MomentScratch,
+) -> SamplingMoment {
+    let [a, b, c] = fast_planar_sampling_moment(projected, scratch);
     let (u, v) = (frame.u, frame.v);
     let entry =
         |p: usize, q: usize| a * u[p] * u[q] + b * (u[p] * v[q] + v[p] * u[q]) + c * v[p] * v[q];
@@ -98,8 +110,89 @@ pub fn own_sampling_moment(projected: &[Point2], frame: &Frame) -> SamplingMomen
     ]
 }
 
-/// The blended S of `pts[0]` in the plane, as `[xx, xy, yy]`.
-pub(crate) fn planar_sampling_moment(pts: &[Point2]) -> [f64; 3] {
+/// [`planar_sampling_moment`] with each member's squared distance found
+/// once, the gate computed without branches, and the gated distances kept
+/// between the two passes over the e2 candidates: the same weights up to
+/// rounding.
+// Baseline and AVX2 variants, chosen at run time (crate doc, "Vector kernels").
+#[multiversion::multiversion(targets("x86_64+avx2"))]
+fn fast_planar_sampling_moment(pts: &[Point2], s: &mut MomentScratch) -> [f64; 3] {
+    let origin = pts[0];
+    s.offsets.clear();
+    s.norm2.clear();
+    for q in &pts[1..] {
+        let e = [q[0] - origin[0], q[1] - origin[1]];
+        let n = norm2(e);
+        if n > 0.0 {
+            s.offsets.push(e);
+            s.norm2.push(n);
+        }
+    }
+    let nearest = s.norm2.iter().copied().fold(f64::INFINITY, f64::min);
+    if !nearest.is_finite() {
+        return [0.0; 3];
+    }
+    let reach2 = (1.0 + BLEND_REACH) * (1.0 + BLEND_REACH);
+    let mut moment = [0.0; 3];
+    let mut total = 0.0;
+    for (&e1, &n1) in s.offsets.iter().zip(&s.norm2) {
+        if n1 >= reach2 * nearest {
+            continue;
+        }
+        let weight = blend_weight(n1, nearest);
+        let mut m = fast_across_moment(&s.offsets, &s.norm2, &mut s.gated, e1, n1);
+        add_outer(&mut m, e1);
+        add_scaled(&mut moment, m, weight);
+        total += weight;
+    }
+    moment.map(|m| m / total)
+}
+
+/// [`across_moment`] over the offsets and their squared lengths.
+#[inline(always)]
+fn fast_across_moment(
+    offsets: &[Point2],
+    norm2s: &[f64],
+    gated: &mut Vec<f64>,
+    e1: Point2,
+    n1: f64,
+) -> [f64; 3] {
+    let (closed, open) = GATE_COS2;
+    gated.clear();
+    // Branch-free, so that the loop runs in vector lanes: a closed gate
+    // divides by zero, which gives the infinite distance it should.
+    gated.extend(offsets.iter().zip(norm2s).map(|(e, &n)| {
+        let dot = e[0] * e1[0] + e[1] * e1[1];
+        let both = n * n1;
+        let t = ((closed * both - dot * dot) / ((closed - open) * both)).clamp(0.0, 1.0);
+        let gate = t * t * (3.0 - 2.0 * t);
+        n / (gate * gate)
+    }));
+    let nearest = gated
+        .iter()
+        .fold(f64::INFINITY, |m, &g| if g < m { g } else { m });
+    let mut moment = [0.0; 3];
+    if !nearest.is_finite() {
+        return moment;
+    }
+    let reach2 = (1.0 + BLEND_REACH) * (1.0 + BLEND_REACH);
+    let mut total = 0.0;
+    for (&e, &g) in offsets.iter().zip(gated.iter()) {
+        if g < reach2 * nearest {
+            let weight = blend_weight(g, nearest);
+            let mut m = [0.0; 3];
+            add_outer(&mut m, across_part(e, e1));
+            add_scaled(&mut moment, m, weight);
+            total += weight;
+        }
+    }
+    moment.map(|m| m / total)
+}
+
+/// The blended S of `pts[0]` in the plane, as `[xx, xy, yy]`: the plain
+/// form of the module doc's rule, the reference for the fast one.
+#[cfg(test)]
+fn planar_sampling_moment(pts: &[Point2]) -> [f64; 3] {
     let origin = pts[0];
     let offsets = || {
         pts[1..]
@@ -124,6 +217,7 @@ pub(crate) fn planar_sampling_moment(pts: &[Point2]) -> [f64; 3] {
     moment.map(|m| m / total)
 }
 
+#[cfg(test)]
 /// The blended e2 e2ᵀ for one e1, of the candidates' parts across e1's
 /// line: the candidates weighted by their squared distance over their
 /// squared gate, against the smallest such value; zero when no neighbour
@@ -158,7 +252,7 @@ fn across_moment(offsets: impl Iterator<Item = Point2> + Clone, e1: Point2) -> [
 /// The part of `e` perpendicular to `e1`: the spacing across e1's line.
 /// On a line scan the neighbours on the next line, straight across or a
 /// step along, all give the line spacing, so blending them keeps T exact.
-#[inline]
+#[inline(always)]
 fn across_part(e: Point2, e1: Point2) -> Point2 {
     let along = (e[0] * e1[0] + e[1] * e1[1]) / norm2(e1);
     [e[0] - along * e1[0], e[1] - along * e1[1]]
@@ -166,7 +260,7 @@ fn across_part(e: Point2, e1: Point2) -> Point2 {
 
 /// 1 at `nearest` (a squared distance), falling smoothly (C¹) to 0 at
 /// (1 + [`BLEND_REACH`])² times it.
-#[inline]
+#[inline(always)]
 fn blend_weight(d2: f64, nearest: f64) -> f64 {
     let span = (1.0 + BLEND_REACH) * (1.0 + BLEND_REACH) - 1.0;
     let x = (d2 / nearest - 1.0) / span;
@@ -179,7 +273,7 @@ fn blend_weight(d2: f64, nearest: f64) -> f64 {
 
 /// How much `e` counts as across `e1`'s line: 0 within 50° of it, 1 beyond
 /// 70°, a smoothstep in cos² between.
-#[inline]
+#[cfg(test)]
 fn across_gate(e: Point2, e1: Point2) -> f64 {
     let dot = e[0] * e1[0] + e[1] * e1[1];
     let cos2 = dot * dot / (norm2(e) * norm2(e1));
@@ -188,11 +282,12 @@ fn across_gate(e: Point2, e1: Point2) -> f64 {
     t * t * (3.0 - 2.0 * t)
 }
 
-#[inline]
+#[inline(always)]
 fn norm2(e: Point2) -> f64 {
     e[0] * e[0] + e[1] * e[1]
 }
 
+#[inline(always)]
 fn add_scaled(sum: &mut [f64; 3], s: [f64; 3], weight: f64) {
     for (m, x) in sum.iter_mut().zip(s) {
         *m += weight * x;
@@ -257,6 +352,7 @@ pub fn whitening_map(t: [f64; 3]) -> Map2 {
     ]
 }
 
+#[inline(always)]
 fn add_outer(t: &mut [f64; 3], e: Point2) {
     t[0] += e[0] * e[0];
     t[1] += e[0] * e[1];
@@ -317,7 +413,7 @@ mod tests {
             normal: [1.0, 0.0, 0.0],
         };
         let pts = [[0.0, 0.0], [1.0, 0.0], [0.2, 3.0], [-5.0, 0.0]];
-        let s = own_sampling_moment(&pts, &frame);
+        let s = own_sampling_moment(&pts, &frame, &mut MomentScratch::default());
         assert_eq!(s, [0.0, 0.0, 0.0, 1.0, 0.0, 9.0]);
     }
 
@@ -371,12 +467,59 @@ mod tests {
         }
     }
 
+    /// The fast moment equals the plain rule's to rounding, on random
+    /// neighbourhoods, jittered lattices (many ties) and line scans.
+    #[test]
+    fn fast_moment_matches_the_reference() {
+        let mut rng = testkit::SplitMix64::new(11);
+        let mut scratch = MomentScratch::default();
+        for case in 0..3000 {
+            let n = 2 + (rng.unit() * 40.0) as usize;
+            let pts: Vec<Point2> = match case % 3 {
+                0 => (0..n)
+                    .map(|_| [rng.range(-3.0, 3.0), rng.range(-3.0, 3.0)])
+                    .collect(),
+                1 => (0..n)
+                    .map(|i| {
+                        let (c, r) = ((i % 6) as f64, (i / 6) as f64);
+                        let j = 0.02 * rng.range(-1.0, 1.0);
+                        [c + 0.5 * (r % 2.0) + j, 0.866 * r + j]
+                    })
+                    .collect(),
+                _ => (0..n)
+                    .map(|i| {
+                        [
+                            (i % 7) as f64 * 0.25,
+                            (i / 7) as f64 + rng.range(-0.05, 0.05),
+                        ]
+                    })
+                    .collect(),
+            };
+            let plain = planar_sampling_moment(&pts);
+            let fast = fast_planar_sampling_moment(&pts, &mut scratch);
+            let size = plain[0] + plain[2];
+            assert!(
+                moment_distance(plain, fast) <= 1e-12 * size.max(1e-300),
+                "case {case}: {plain:?} {fast:?}"
+            );
+        }
+    }
+
     #[test]
     fn a_point_with_all_neighbours_on_it_has_no_moment() {
-        assert_eq!(planar_sampling_moment(&[[1.0, 2.0]; 5]), [0.0; 3]);
-        // Collinear neighbours: e1 only, no e2 across.
-        let line = [[0.0, 0.0], [1.0, 0.0], [-1.0, 0.0], [2.0, 0.0]];
-        assert_eq!(planar_sampling_moment(&line), [1.0, 0.0, 0.0]);
+        let mut scratch = MomentScratch::default();
+        for moment in [planar_sampling_moment, |p: &[Point2]| {
+            fast_planar_sampling_moment(p, &mut MomentScratch::default())
+        }] {
+            assert_eq!(moment(&[[1.0, 2.0]; 5]), [0.0; 3]);
+            // Collinear neighbours: e1 only, no e2 across.
+            let line = [[0.0, 0.0], [1.0, 0.0], [-1.0, 0.0], [2.0, 0.0]];
+            assert_eq!(moment(&line), [1.0, 0.0, 0.0]);
+        }
+        assert_eq!(
+            fast_planar_sampling_moment(&[[0.0, 0.0]], &mut scratch),
+            [0.0; 3]
+        );
     }
 
     /// Projecting the summed moments gives the tensor of the projected
