@@ -447,10 +447,10 @@ fn the_summary_says_how_the_face_counts_relate() {
     assert!(run.status.success(), "{}", stderr(&run));
     let summary = String::from_utf8_lossy(&run.stdout);
     for line in [
-        "faces split          802 by the border (their inner parts kept)",
-        "faces removed        4444 whole (beyond the border, in dropped pieces or out of reach)",
+        "faces split          803 by the border (their inner parts kept)",
+        "faces removed        4429 whole (beyond the border, in dropped pieces or out of reach)",
         "pieces dropped       4 (no cloud support; their faces are among those removed)",
-        "faces out of reach   3129 parts of faces no cloud point reaches, dropped",
+        "faces out of reach   3140 parts of faces no cloud point reaches, dropped",
     ] {
         assert!(summary.contains(line), "{line}: {summary}");
     }

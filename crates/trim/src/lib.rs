@@ -96,7 +96,7 @@ pub use trimming::{trim_mesh, LoopFit, TrimOptions, TrimReport};
 /// they change with the algorithm.
 #[doc(hidden)]
 pub mod internals {
-    pub use crate::anisotropy::{own_sampling_moment, MomentScratch};
+    pub use crate::anisotropy::own_sampling_vectors;
     pub use crate::edges::split::supported as step_is_supported;
     pub use crate::frame::project;
 }

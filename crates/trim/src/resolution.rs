@@ -146,8 +146,7 @@ pub fn beta_of(distances: &[f64]) -> f64 {
     mean + 2.0 * var.sqrt()
 }
 
-#[cfg(test)]
-fn dist2(a: Point2, b: Point2) -> f64 {
+pub(crate) fn dist2(a: Point2, b: Point2) -> f64 {
     let (dx, dy) = (a[0] - b[0], a[1] - b[1]);
     dx * dx + dy * dy
 }

@@ -22,7 +22,7 @@ use std::ops::Range;
 use rayon::prelude::*;
 
 use crate::anisotropy::{
-    apply, own_sampling_moment, sampling_tensor_of_moments, whitening_map, MomentScratch,
+    apply, own_sampling_vectors, sampling_moment, sampling_tensor_of_moments, whitening_map,
     SamplingMoment,
 };
 use crate::cloud::{check_finite, check_not_degenerate, merge_duplicates, Sites, PASS_PIECE};
@@ -463,11 +463,11 @@ fn neighbourhoods(
                 .collect();
             for block in blocks_of_runs(&mut jobs, block_len(points.len()), |job| &job.0) {
                 block.par_iter_mut().for_each_init(
-                    || (RunScratch::default(), Vec::new(), MomentScratch::default()),
-                    |(scratch, projected, moment), (run, out, out_sampling)| {
+                    || (RunScratch::default(), Vec::new()),
+                    |(scratch, projected), (run, out, out_sampling)| {
                         index.nearest_of_run(run.clone(), k, out, scratch);
                         for (members, o) in out.chunks_exact(k).zip(out_sampling.iter_mut()) {
-                            *o = sampling_at(&points, members, view, projected, moment);
+                            *o = sampling_at(&points, members, view, projected);
                         }
                     },
                 );
@@ -485,9 +485,9 @@ fn neighbourhoods(
                     progress(p);
                 }
             }
-            let (mut projected, mut moment) = (Vec::new(), MomentScratch::default());
+            let mut projected = Vec::new();
             for (members, o) in lists.chunks_exact(k).zip(sampling.iter_mut().flatten()) {
-                *o = sampling_at(&points, members, view, &mut projected, &mut moment);
+                *o = sampling_at(&points, members, view, &mut projected);
             }
         }
     }
@@ -526,13 +526,12 @@ fn sampling_at(
     members: &[u32],
     view: Option<&View>,
     projected: &mut Vec<Point2>,
-    moment: &mut MomentScratch,
 ) -> Sampling {
     let frame = fit_plane_normal(points, members);
     let shear = shear_towards(view, &frame, points[members[0] as usize]);
     project_sheared(points, members, &frame, shear, projected);
     Sampling {
-        moment: own_sampling_moment(projected, &frame, moment),
+        moment: sampling_moment(&own_sampling_vectors(projected, &frame)),
         normal: frame.normal,
     }
 }
