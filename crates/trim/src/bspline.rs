@@ -23,7 +23,7 @@
 //! [`MAX_BULGE`] of the curve's median chord (`limited`); the curve still
 //! passes through every point and stays C¹.
 
-use crate::geom::{dist2, dot, norm2, sub, Point3};
+use crate::geom::{dot, norm2, sub, Point3};
 
 /// A clamped B-spline curve of degree `degree`: knots as distinct values
 /// with multiplicities (as STEP writes them), control points.
@@ -125,16 +125,14 @@ fn limited(
     closed: bool,
 ) -> Vec<Point3> {
     let n = points.len();
-    let mut chords: Vec<f64> = (0..n - 1)
-        .map(|i| dist2(points[i], points[i + 1]).sqrt())
-        .collect();
+    let chords: Vec<Point3> = points.windows(2).map(|w| sub(w[1], w[0])).collect();
     let bound = {
-        chords.sort_unstable_by(f64::total_cmp);
-        MAX_BULGE * chords[chords.len() / 2]
+        let mut lengths: Vec<f64> = chords.iter().map(|&c| norm2(c).sqrt()).collect();
+        lengths.sort_unstable_by(f64::total_cmp);
+        MAX_BULGE * lengths[lengths.len() / 2]
     };
     let mut scale = vec![1.0f64; n];
-    for i in 0..n - 1 {
-        let chord = sub(points[i + 1], points[i]);
+    for (i, &chord) in chords.iter().enumerate() {
         let step = (params[i + 1] - params[i]) / 3.0;
         for end in [i, i + 1] {
             let bulge = 0.75 * across(tangents[end].map(|c| c * step), chord);
