@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Edge export speed: `meshtrim edges` on a ~1M-point cloud (the seeded,
 # twisted sheet with three holes of bench/bpd.sh) written as each edges
-# format, the write time (for STEP and IGES the B-spline fit included) against the
+# format, the write time (for STEP, IGES and DXF splines the B-spline fit included) against the
 # detection time of the same run. Median of BENCH_ROUNDS runs (default 3)
 # per format; prints a markdown table.
 #
@@ -17,11 +17,14 @@ BENCH_REPEAT=1 ./target/release/examples/bench_bpd "$n" sheet "$work/sheet.ply" 
 
 echo "| output | points | loops | edges | corners | detect ms | edges ms | write ms | write / detect | file MB |"
 echo "|---|---|---|---|---|---|---|---|---|---|"
-for format in json obj svg dxf step igs; do
-    out="$work/edges.$format"
+# "dxf+splines" is a .dxf written with --dxf-splines.
+for format in json obj svg dxf dxf+splines step igs; do
+    flags=()
+    [ "$format" = dxf+splines ] && flags=(--dxf-splines)
+    out="$work/edges.${format%+splines}"
     runs=()
     for _ in $(seq "$rounds"); do
-        runs+=("$(./target/release/meshtrim edges "$work/sheet.ply" -o "$out" --json)")
+        runs+=("$(./target/release/meshtrim edges "$work/sheet.ply" -o "$out" "${flags[@]}" --json)")
     done
     python3 - "$format" "$(stat -c %s "$out")" "${runs[@]}" <<'PY'
 import json, statistics, sys

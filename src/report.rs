@@ -8,7 +8,7 @@ use serde::Serialize;
 
 use crate::console;
 use crate::io::atomic::write_atomic;
-use crate::io::edges_out::step::LengthUnit;
+use crate::io::edges_out::EdgeFileOptions;
 
 /// A command's report that can print itself as a two-column table.
 pub trait Table {
@@ -81,14 +81,14 @@ pub fn write_edges(
     points: &[crate::io::Point3],
     detection: &trim::Detection,
     edges: &trim::Edges,
-    units: LengthUnit,
+    options: EdgeFileOptions,
 ) -> Result<()> {
     let format = crate::io::edges_out::edges_format(path)?;
     let data = crate::io::edges_out::EdgeData {
         points,
         boundary: &detection.boundary,
         edges,
-        units,
+        options,
     };
     write_atomic(path, |w| format.write(w, data))
 }

@@ -1,9 +1,13 @@
 //! Argument groups that several commands share: the stages' options and
 //! the scanner's view, with their value parsers.
 
+use std::path::Path;
+
 use clap::Args;
 use trim::{BpdOptions, EdgeOptions, View};
 
+use crate::io::edges_out::step::LengthUnit;
+use crate::io::edges_out::{EdgeFileOptions, EdgesFormat};
 use crate::stages::Stages;
 
 /// The options of detection and edge reconstruction that every command
@@ -35,6 +39,51 @@ impl StageArgs {
             edges: EdgeOptions {
                 offset: !self.no_offset,
             },
+        }
+    }
+}
+
+/// How an edges file is written, beyond the format its extension names.
+#[derive(Debug, Clone, Copy, PartialEq, Args)]
+pub struct EdgeFileArgs {
+    /// The length unit declared (help: `UNITS_HELP`).
+    #[arg(long, value_enum, default_value_t = LengthUnit::Mm, help = UNITS_HELP)]
+    pub units: LengthUnit,
+    /// DXF splines (help: `DXF_SPLINES_HELP`).
+    #[arg(long, help = DXF_SPLINES_HELP)]
+    pub dxf_splines: bool,
+}
+
+/// `--units`' help, for every command that writes edges.
+pub(crate) const UNITS_HELP: &str = "The length unit a STEP, IGES or DXF-with-splines output declares (a cloud's file does not say its unit): mm, m or in";
+
+/// `--dxf-splines`' help.
+pub(crate) const DXF_SPLINES_HELP: &str = "DXF output: also each edge as a cubic SPLINE on layer SPLINES, the curve of the STEP output (the file is then AutoCAD 2000, not R12, and declares --units)";
+
+impl EdgeFileArgs {
+    /// The writers' options.
+    pub fn options(&self) -> EdgeFileOptions {
+        EdgeFileOptions {
+            units: self.units,
+            dxf_splines: self.dxf_splines,
+        }
+    }
+
+    /// Refuses `--dxf-splines` unless the edges go to a DXF file
+    /// (`output`, none when the command writes no edges).
+    pub fn check(&self, output: Option<&Path>) -> anyhow::Result<()> {
+        if !self.dxf_splines {
+            return Ok(());
+        }
+        match output {
+            None => anyhow::bail!("--dxf-splines needs an edges output: --edges FILE.dxf"),
+            Some(path) if EdgesFormat::from_path(path) != Some(EdgesFormat::Dxf) => {
+                anyhow::bail!(
+                    "{}: --dxf-splines writes splines into a .dxf file, and this is not one",
+                    path.display()
+                )
+            }
+            Some(_) => Ok(()),
         }
     }
 }

@@ -9,9 +9,8 @@ use anyhow::{bail, Result};
 use serde::Serialize;
 use trim::{Detection, Edges};
 
-use crate::commands::args::StageArgs;
+use crate::commands::args::{EdgeFileArgs, StageArgs};
 use crate::console;
-use crate::io::edges_out::step::LengthUnit;
 use crate::io::edges_out::{edges_format, EdgesFormat};
 use crate::io::{read_cloud_with, CloudOptions, Point3};
 use crate::report::{same_file, shown, write_edges};
@@ -26,7 +25,7 @@ pub struct Args {
     /// Write the loops and edges: OUT.json (everything), OUT.obj (the
     /// smoothed edges as polylines), OUT.svg (a picture), OUT.dxf (3-D
     /// polylines on layers OUTER and HOLES, corners on CORNERS, for CAD and
-    /// CAM), OUT.step (cubic B-spline curves, in --units) or OUT.igs (the
+    /// CAM; with --dxf-splines also curves), OUT.step (cubic B-spline curves, in --units) or OUT.igs (the
     /// same curves as IGES). Missing parent directories are created.
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
@@ -38,10 +37,9 @@ pub struct Args {
     /// frame.
     #[arg(long, value_name = "N")]
     pub scan: Option<usize>,
-    /// The length unit a STEP or IGES output declares (a cloud's file does not say
-    /// its unit): mm, m or in.
-    #[arg(long, value_enum, default_value_t = LengthUnit::Mm)]
-    pub units: LengthUnit,
+    /// The unit declared, DXF splines.
+    #[command(flatten)]
+    pub file: EdgeFileArgs,
     /// Print the summary as one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -83,6 +81,7 @@ pub struct Summary {
 pub fn run(args: &Args) -> Result<()> {
     // Check the output before the (possibly long) work.
     check_output(&args.output, &args.cloud)?;
+    args.file.check(Some(&args.output))?;
     let started = Instant::now();
     let cloud = read_cloud_with(&args.cloud, &CloudOptions { scan: args.scan })?;
     let read_time = started.elapsed();
@@ -90,7 +89,13 @@ pub fn run(args: &Args) -> Result<()> {
     let stages = args.stages.stages();
     let (detection, edges, mut summary) = edges_in_memory(&cloud.points, &stages, true, &name)?;
     let started = Instant::now();
-    write_edges(&args.output, &cloud.points, &detection, &edges, args.units)?;
+    write_edges(
+        &args.output,
+        &cloud.points,
+        &detection,
+        &edges,
+        args.file.options(),
+    )?;
     summary.write_ms = millis(started.elapsed());
     summary.file = Some(name);
     summary.read_ms = millis(read_time);

@@ -9,8 +9,7 @@ use anyhow::{Context, Result};
 use serde::Serialize;
 use trim::{delaunay_mesh_with_report, DelaunayOptions, DelaunayReport, Detection, Edges};
 
-use crate::commands::args::StageArgs;
-use crate::io::edges_out::step::LengthUnit;
+use crate::commands::args::{EdgeFileArgs, StageArgs};
 use crate::io::mesh_out::write_mesh;
 use crate::io::{read_cloud_with, CloudOptions, Point3};
 use crate::report::{shown, write_edges};
@@ -40,10 +39,9 @@ pub struct Args {
     /// frame.
     #[arg(long, value_name = "N")]
     pub scan: Option<usize>,
-    /// The length unit a STEP or IGES output declares (a cloud's file does not say
-    /// its unit): mm, m or in.
-    #[arg(long, value_enum, default_value_t = LengthUnit::Mm)]
-    pub units: LengthUnit,
+    /// The unit declared, DXF splines.
+    #[command(flatten)]
+    pub file: EdgeFileArgs,
     /// Print the report as one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -95,6 +93,7 @@ pub fn run(args: &Args) -> Result<()> {
     if let Some(edges) = &args.edges {
         crate::report::check_edges_output(edges, &[&args.cloud])?;
     }
+    args.file.check(args.edges.as_deref())?;
     let started = Instant::now();
     let cloud = read_cloud_with(&args.cloud, &CloudOptions { scan: args.scan })?;
     let read_time = started.elapsed();
@@ -108,7 +107,7 @@ pub fn run(args: &Args) -> Result<()> {
     let started = Instant::now();
     write_mesh(&args.output, &mesh.vertices, &mesh.faces)?;
     if let Some(path) = &args.edges {
-        write_edges(path, &cloud.points, &detection, &edges, args.units)?;
+        write_edges(path, &cloud.points, &detection, &edges, args.file.options())?;
     }
     report.read_ms = millis(read_time);
     report.write_ms = millis(started.elapsed());

@@ -12,10 +12,11 @@ use serde::Serialize;
 use trim::{trim_mesh, Detection, Edges, LoopFit, TrimOptions, TrimReport};
 
 use crate::commands::args::{
-    parse_direction, parse_k, parse_vector, StageArgs, ViewArgs, VIEW_ALONG_HELP,
-    VIEW_ALONG_LONG_HELP, VIEW_FROM_HELP, VIEW_FROM_LONG_HELP,
+    parse_direction, parse_k, parse_vector, EdgeFileArgs, StageArgs, ViewArgs, DXF_SPLINES_HELP,
+    UNITS_HELP, VIEW_ALONG_HELP, VIEW_ALONG_LONG_HELP, VIEW_FROM_HELP, VIEW_FROM_LONG_HELP,
 };
 use crate::io::edges_out::step::LengthUnit;
+use crate::io::edges_out::EdgeFileOptions;
 use crate::io::mesh_out::write_mesh;
 use crate::io::{read_cloud_with, read_mesh_with_faces, CloudOptions, Point3};
 use crate::report::{shown, significant, write_edges};
@@ -66,19 +67,29 @@ pub struct Args {
     /// frame.
     #[arg(long, value_name = "N")]
     pub scan: Option<usize>,
-    /// The length unit a STEP or IGES output declares (a cloud's file does not say
-    /// its unit): mm, m or in.
-    #[arg(long, value_enum, default_value_t = LengthUnit::Mm)]
+    /// The length unit declared (as `EdgeFileArgs`'s, same help).
+    #[arg(long, value_enum, default_value_t = LengthUnit::Mm, help = UNITS_HELP)]
     pub units: LengthUnit,
+    /// DXF splines (as `EdgeFileArgs`'s, same help).
+    #[arg(long, help = DXF_SPLINES_HELP)]
+    pub dxf_splines: bool,
     /// Print the report as one JSON object.
     #[arg(long)]
     pub json: bool,
 }
 
 impl Args {
-    /// The detection and edge options. (The main job's arguments spell
-    /// them out: clap cannot tell whether a flattened group inside the
-    /// optional top-level arguments was given.)
+    /// How the edges file is written. (The main job's arguments spell
+    /// their groups out: clap cannot tell whether a flattened group inside
+    /// the optional top-level arguments was given.)
+    pub fn edge_file_args(&self) -> EdgeFileArgs {
+        EdgeFileArgs {
+            units: self.units,
+            dxf_splines: self.dxf_splines,
+        }
+    }
+
+    /// The detection and edge options (spelled out, as above).
     pub fn stage_args(&self) -> StageArgs {
         StageArgs {
             k: self.k,
@@ -185,7 +196,9 @@ pub fn run(args: &Args) -> Result<()> {
         &args.mesh,
         &args.cloud,
         &args.output,
-        args.edges.as_deref().map(|path| (path, args.units)),
+        args.edges
+            .as_deref()
+            .map(|path| (path, args.edge_file_args().options())),
         &settings,
     )?;
     crate::report::emit(&report, args.report.as_deref(), args.json)
@@ -200,7 +213,7 @@ pub fn trim_file(
     mesh_path: &Path,
     cloud_path: &Path,
     output: &Path,
-    edges_output: Option<(&Path, LengthUnit)>,
+    edges_output: Option<(&Path, EdgeFileOptions)>,
     settings: &TrimSettings,
 ) -> Result<Report> {
     // The two files are read at once (a binary PLY's reader runs on one
@@ -223,8 +236,8 @@ pub fn trim_file(
     } = trim_in_memory(&mesh, &cloud.points, settings, &names)?;
     let started = Instant::now();
     write_mesh(output, &out.vertices, &out.faces)?;
-    if let Some((path, units)) = edges_output {
-        write_edges(path, &cloud.points, &detection, &edges, units)?;
+    if let Some((path, options)) = edges_output {
+        write_edges(path, &cloud.points, &detection, &edges, options)?;
     }
     report.read_ms = millis(read_time);
     report.write_ms = millis(started.elapsed());
@@ -289,7 +302,7 @@ fn check_paths(args: &Args) -> Result<()> {
     if let Some(edges) = &args.edges {
         crate::report::check_edges_output(edges, &inputs)?;
     }
-    Ok(())
+    args.edge_file_args().check(args.edges.as_deref())
 }
 
 impl Report {

@@ -11,7 +11,8 @@
 //! - SVG: a picture like the paper's Figure 4, the cloud seen along the
 //!   normal of its best-fit plane;
 //! - DXF: one closed 3-D polyline per loop on layers `OUTER` and `HOLES`,
-//!   the corners as points (`dxf.rs`);
+//!   the corners as points, and on request each edge as a spline on
+//!   `SPLINES` (`dxf.rs`);
 //! - STEP: one cubic B-spline curve per edge through its points, the
 //!   corners as points ([`step`]);
 //! - IGES: the same curves and points as IGES entities 126 and 116
@@ -35,9 +36,18 @@ pub struct EdgeData<'a> {
     pub boundary: &'a [bool],
     /// The reconstructed loops.
     pub edges: &'a Edges,
-    /// The length unit a STEP file declares (the cloud's file does not
-    /// say it).
+    /// How the file is written: the unit it declares, DXF splines.
+    pub options: EdgeFileOptions,
+}
+
+/// Choices of an edges file beyond its format.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct EdgeFileOptions {
+    /// The length unit a STEP, IGES or DXF-with-splines file declares (the
+    /// cloud's file does not say it).
     pub units: step::LengthUnit,
+    /// DXF: also each edge as a spline, in an R2000 file (`dxf.rs`).
+    pub dxf_splines: bool,
 }
 
 /// Output formats of `edges`, chosen by the output's extension.
@@ -49,7 +59,7 @@ pub enum EdgesFormat {
     Obj,
     /// A picture of the cloud, the raw loops and the smoothed edges.
     Svg,
-    /// DXF R12: 3-D polylines and corner points.
+    /// DXF: 3-D polylines and corner points (R12), with splines (R2000).
     Dxf,
     /// STEP AP214: cubic B-spline curves and corner points.
     Step,

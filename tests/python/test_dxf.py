@@ -2,7 +2,9 @@
 back by ezdxf, the reference Python DXF library: the file passes ezdxf's
 audit, each loop is one closed 3-D polyline whose vertices are the JSON
 output's edge points to the last bit, loops sit on OUTER or HOLES by
-enclosure, corners are POINTs on CORNERS."""
+enclosure, corners are POINTs on CORNERS. With `--dxf-splines` the file is
+AutoCAD 2000 and also holds each edge as a cubic SPLINE through its
+points, with the length unit declared."""
 
 from __future__ import annotations
 
@@ -13,6 +15,7 @@ import numpy as np
 import pytest
 
 import synthetic
+from curves import cases, median_spacing, segment_distance
 from meshtrim_cli import ROOT, run_meshtrim
 
 
@@ -65,17 +68,89 @@ def test_the_notched_plate_has_corners(tmp_path):
     assert len(corners) == 8  # the outline of the plate with its notch
 
 
-@pytest.mark.parametrize("ext", ["json", "obj", "svg", "dxf", "step", "igs"])
+@pytest.mark.parametrize("ext", ["json", "obj", "svg", "dxf", "step", "igs", "dxf --dxf-splines"])
 def test_trim_and_mesh_write_the_edges_they_used(tmp_path, ext):
+    ext, *flags = ext.split()
     meshes = ROOT / "fixtures" / "meshes"
     cloud, poisson = meshes / "blade_small.ply", meshes / "blade_small_poisson.ply"
-    run_meshtrim(poisson, cloud, tmp_path / "trimmed.ply", "--edges", tmp_path / f"trim.{ext}", "--k", 25)
-    run_meshtrim("edges", cloud, "-o", tmp_path / f"edges.{ext}", "--k", 25)
+    run_meshtrim(poisson, cloud, tmp_path / "trimmed.ply", "--edges", tmp_path / f"trim.{ext}", "--k", 25, *flags)
+    run_meshtrim("edges", cloud, "-o", tmp_path / f"edges.{ext}", "--k", 25, *flags)
     assert (tmp_path / f"trim.{ext}").read_bytes() == (tmp_path / f"edges.{ext}").read_bytes()
     holes = meshes / "blade_holes.ply"
-    run_meshtrim("mesh", holes, tmp_path / "meshed.ply", "--edges", tmp_path / f"mesh.{ext}", "--no-offset")
-    run_meshtrim("edges", holes, "-o", tmp_path / f"holes.{ext}", "--no-offset")
+    run_meshtrim("mesh", holes, tmp_path / "meshed.ply", "--edges", tmp_path / f"mesh.{ext}", "--no-offset", *flags)
+    run_meshtrim("edges", holes, "-o", tmp_path / f"holes.{ext}", "--no-offset", *flags)
     assert (tmp_path / f"mesh.{ext}").read_bytes() == (tmp_path / f"holes.{ext}").read_bytes()
+    if flags:
+        assert b"SPLINE" in (tmp_path / f"mesh.{ext}").read_bytes()
+
+
+@pytest.mark.parametrize("name", ["blade_holes", "notched_plate", "bunny"])
+def test_dxf_splines_pass_through_the_edge_points(tmp_path, name):
+    cloud = cases(tmp_path)[name]
+    run_meshtrim("edges", cloud, "-o", tmp_path / "e.json")
+    run_meshtrim("edges", cloud, "-o", tmp_path / "r12.dxf")
+    run_meshtrim("edges", cloud, "-o", tmp_path / "e.dxf", "--dxf-splines")
+    loops = json.loads((tmp_path / "e.json").read_text())["loops"]
+    edges = [e for l in loops for e in l["edges"]]
+    doc = ezdxf.readfile(tmp_path / "e.dxf")
+    auditor = doc.audit()
+    assert not auditor.has_errors, [str(e.message) for e in auditor.errors]
+    assert doc.dxfversion == "AC1015" and doc.header["$INSUNITS"] == 4
+    # The polylines and corners of the R12 file, to the bit.
+    r12 = ezdxf.readfile(tmp_path / "r12.dxf").modelspace()
+    msp = doc.modelspace()
+    for kind in ["POLYLINE", "POINT"]:
+        assert [e.dxf.layer for e in msp.query(kind)] == [e.dxf.layer for e in r12.query(kind)]
+    vertices = lambda msp: [[list(v.dxf.location) for v in p.vertices] for p in msp.query("POLYLINE")]
+    assert vertices(msp) == vertices(r12)
+    assert [list(p.dxf.location) for p in msp.query("POINT")] == [list(p.dxf.location) for p in r12.query("POINT")]
+    xyz = np.array([list(v.dxf.location) for p in msp.query("POLYLINE") for v in p.vertices])
+    scale = np.abs(xyz).max()
+    spacing = median_spacing(cloud, tmp_path)
+    splines = msp.query("SPLINE")
+    assert len(splines) == len(edges) > 0
+    for spline, edge in zip(splines, edges):
+        assert spline.dxf.layer == "SPLINES" and spline.dxf.degree == 3
+        assert spline.closed == edge["closed"]
+        curve = spline.construction_tool()
+        points = np.array(edge["points"])
+        through = np.vstack([points, points[:1]]) if edge["closed"] else points
+        # Each edge point at its own knot: the knots are the points'
+        # parameters, each interior one doubled.
+        knots = np.unique(curve.knots())
+        assert len(knots) == len(through)
+        on = np.array([list(curve.point(k)) for k in knots])
+        assert np.abs(on - through).max() <= 1e-9 * scale
+        # Between points, within a quarter spacing of the polyline.
+        samples = np.array([list(p) for p in curve.approximate(4000)])
+        assert segment_distance(samples, through).max() <= 0.25 * spacing
+    again = tmp_path / "again.dxf"
+    run_meshtrim("edges", cloud, "-o", again, "--dxf-splines")
+    assert again.read_bytes() == (tmp_path / "e.dxf").read_bytes()
+
+
+@pytest.mark.parametrize("unit, code", [("mm", 4), ("m", 6), ("in", 1)])
+def test_dxf_splines_declare_the_unit(tmp_path, unit, code):
+    cloud = ROOT / "fixtures" / "meshes" / "blade_holes.ply"
+    run_meshtrim("edges", cloud, "-o", tmp_path / "e.dxf", "--dxf-splines", "--units", unit)
+    assert ezdxf.readfile(tmp_path / "e.dxf").header["$INSUNITS"] == code
+
+
+def test_dxf_splines_need_a_dxf_output(tmp_path):
+    import subprocess
+
+    from meshtrim_cli import MESHTRIM
+
+    meshes = ROOT / "fixtures" / "meshes"
+    runs = [
+        (["edges", meshes / "blade_holes.ply", "-o", tmp_path / "e.json"], tmp_path / "e.json", "e.json: --dxf-splines writes splines into a .dxf file, and this is not one"),
+        ([meshes / "blade_small_poisson.ply", meshes / "blade_small.ply", tmp_path / "t.ply"], tmp_path / "t.ply", "--dxf-splines needs an edges output: --edges FILE.dxf"),
+        (["mesh", meshes / "blade_holes.ply", tmp_path / "m.ply", "--edges", tmp_path / "m.step"], tmp_path / "m.ply", "m.step: --dxf-splines writes splines into a .dxf file"),
+    ]
+    for args, output, message in runs:
+        r = subprocess.run([str(MESHTRIM), *map(str, args), "--dxf-splines"], capture_output=True, text=True)
+        assert r.returncode == 1 and message in r.stderr, (r.returncode, r.stderr)
+        assert not output.exists()
 
 
 def test_a_bad_edges_output_is_refused_before_any_work(tmp_path):

@@ -15,8 +15,8 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-import synthetic
-from meshtrim_cli import ROOT, run_meshtrim, shared_data
+from curves import cases, segment_distance
+from meshtrim_cli import ROOT, run_meshtrim
 
 
 def read_step(path, target_unit="MM"):
@@ -45,26 +45,6 @@ def read_step(path, target_unit="MM"):
     except Exception:
         gmsh.finalize()
         raise
-
-
-def segment_distance(points, polyline):
-    """Each point's distance to the polyline."""
-    a, b = polyline[:-1], polyline[1:]
-    ab = b - a
-    t = np.einsum("pkj,kj->pk", points[:, None, :] - a[None], ab) / np.maximum(np.einsum("kj,kj->k", ab, ab), 1e-300)
-    t = np.clip(t, 0, 1)
-    nearest = a[None] + t[..., None] * ab[None]
-    return np.linalg.norm(points[:, None, :] - nearest, axis=2).min(axis=1)
-
-
-def cases(tmp_path):
-    plate = tmp_path / "plate.ply"
-    synthetic.write_cloud_ply(plate, synthetic.notched_plate(1.0, 2).points)
-    return {
-        "blade_holes": ROOT / "fixtures" / "meshes" / "blade_holes.ply",
-        "notched_plate": plate,
-        "bunny": shared_data("stanford_bunny/bun_zipper.ply"),
-    }
 
 
 @pytest.mark.parametrize("suffix", [".step", ".igs"])

@@ -46,7 +46,7 @@ pub fn write_iges(w: &mut dyn Write, data: EdgeData) -> std::io::Result<()> {
             }
         }
     }
-    w.write_all(file(&entities, data.units, largest).as_bytes())
+    w.write_all(file(&entities, data.options.units, largest).as_bytes())
 }
 
 /// One entity: its type number, its parameters (without the type) and a

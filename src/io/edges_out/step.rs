@@ -41,7 +41,7 @@ pub enum LengthUnit {
 /// Writes the edges as STEP (see the module doc).
 pub fn write_step(w: &mut dyn Write, data: EdgeData) -> std::io::Result<()> {
     let mut file = StepFile::default();
-    let context = file.context(data.units);
+    let context = file.context(data.options.units);
     let mut items = Vec::new();
     for l in &data.edges.loops {
         for e in &l.edges {

@@ -55,7 +55,7 @@ fn render(format: EdgesFormat) -> String {
         points: &points,
         boundary: &boundary,
         edges: &edges,
-        units: Default::default(),
+        options: Default::default(),
     };
     let mut out = Vec::new();
     format.write(&mut out, data).unwrap();
@@ -169,7 +169,7 @@ fn svg_subsamples_interior_points() {
         points: &points,
         boundary: &boundary,
         edges: &edges,
-        units: Default::default(),
+        options: Default::default(),
     };
     write_svg(&mut out, data).unwrap();
     let text = String::from_utf8(out).unwrap();
@@ -187,4 +187,145 @@ fn numbers_are_rounded_without_trailing_zeros() {
     assert_eq!(num(0.1), "0.1");
     assert_eq!(num(-0.001), "0");
     assert_eq!(num(999.999), "1000");
+}
+
+/// The groups of a DXF file as (code, value) pairs.
+fn dxf_groups(text: &str) -> Vec<(u16, &str)> {
+    let lines: Vec<&str> = text.lines().collect();
+    lines
+        .chunks_exact(2)
+        .map(|pair| (pair[0].trim().parse().unwrap(), pair[1]))
+        .collect()
+}
+
+fn render_dxf(options: EdgeFileOptions) -> String {
+    let (points, boundary, edges) = sample();
+    let data = EdgeData {
+        points: &points,
+        boundary: &boundary,
+        edges: &edges,
+        options,
+    };
+    let mut out = Vec::new();
+    EdgesFormat::Dxf.write(&mut out, data).unwrap();
+    String::from_utf8(out).unwrap()
+}
+
+#[test]
+fn dxf_with_splines_has_unique_handles_and_known_owners() {
+    let text = render_dxf(EdgeFileOptions {
+        dxf_splines: true,
+        ..Default::default()
+    });
+    let groups = dxf_groups(&text);
+    // 5 is a handle (but in the header $HANDSEED's value), 105 a dimension
+    // style's; 330 an owner, 350 a dictionary entry.
+    let objects = groups.iter().position(|g| *g == (2, "TABLES")).unwrap();
+    let handles: Vec<u64> = groups[objects..]
+        .iter()
+        .filter(|(code, _)| matches!(code, 5 | 105))
+        .map(|(_, v)| u64::from_str_radix(v, 16).unwrap())
+        .collect();
+    let unique: std::collections::BTreeSet<u64> = handles.iter().copied().collect();
+    assert_eq!(unique.len(), handles.len(), "handles are unique");
+    let seed = groups
+        .windows(2)
+        .find(|w| w[0] == (9, "$HANDSEED"))
+        .map(|w| u64::from_str_radix(w[1].1, 16).unwrap())
+        .unwrap();
+    assert!(
+        unique.iter().all(|&h| 0 < h && h < seed),
+        "the seed is beyond every handle"
+    );
+    for (code, value) in &groups {
+        if matches!(code, 330 | 350) && *value != "0" {
+            let h = u64::from_str_radix(value, 16).unwrap();
+            assert!(
+                unique.contains(&h),
+                "{code} names {value}, which is no object"
+            );
+        }
+    }
+    let kinds: Vec<&str> = groups.iter().filter(|g| g.0 == 0).map(|g| g.1).collect();
+    assert_eq!(
+        kinds.iter().filter(|&&k| k == "SPLINE").count(),
+        3,
+        "one per edge"
+    );
+    assert_eq!(
+        kinds.iter().filter(|&&k| k == "POINT").count(),
+        2,
+        "one per corner"
+    );
+    assert!(text.contains("AC1015") && text.ends_with("  0\nEOF\n"));
+}
+
+#[test]
+fn dxf_splines_interpolate_the_edge_points() {
+    let text = render_dxf(EdgeFileOptions {
+        dxf_splines: true,
+        ..Default::default()
+    });
+    let groups = dxf_groups(&text);
+    let (_, edges) = (sample().0, sample().2);
+    let splines: Vec<usize> = (0..groups.len())
+        .filter(|&i| groups[i] == (0, "SPLINE"))
+        .collect();
+    for (&at, edge) in splines
+        .iter()
+        .zip(edges.loops.iter().flat_map(|l| &l.edges))
+    {
+        let entity: Vec<(u16, &str)> = groups[at + 1..]
+            .iter()
+            .take_while(|g| g.0 != 0)
+            .copied()
+            .collect();
+        let values = |code: u16| -> Vec<f64> {
+            entity
+                .iter()
+                .filter(|g| g.0 == code)
+                .map(|g| g.1.parse().unwrap())
+                .collect()
+        };
+        let knots = values(40);
+        let (x, y, z) = (values(10), values(20), values(30));
+        assert_eq!(values(71), [3.0]);
+        assert_eq!(values(72), [knots.len() as f64]);
+        assert_eq!(values(73), [x.len() as f64]);
+        assert_eq!(knots.len(), x.len() + 4, "a cubic's knot count");
+        assert_eq!(values(70), [if edge.closed { 1.0 } else { 0.0 }]);
+        // The curve the file holds is the one STEP and IGES write.
+        let curve = trim::interpolate_bspline(&edge.points, edge.closed)
+            .unwrap()
+            .with_double_knots();
+        assert_eq!(knots, curve.knot_vector());
+        let control: Vec<Point3> = (0..x.len()).map(|i| [x[i], y[i], z[i]]).collect();
+        assert_eq!(control, curve.control_points);
+        // It starts at the edge's first point and passes through each.
+        assert_eq!(control[0], edge.points[0]);
+        for (p, &k) in edge.points.iter().zip(&curve.knots) {
+            let on = curve.point_at(k);
+            assert!((0..3).all(|c| (on[c] - p[c]).abs() < 1e-12), "{on:?} {p:?}");
+        }
+    }
+}
+
+#[test]
+fn dxf_declares_the_unit_only_with_splines() {
+    for (units, code) in [
+        (step::LengthUnit::Mm, "4"),
+        (step::LengthUnit::M, "6"),
+        (step::LengthUnit::In, "1"),
+    ] {
+        let text = render_dxf(EdgeFileOptions {
+            units,
+            dxf_splines: true,
+        });
+        assert!(
+            text.contains(&format!("$INSUNITS\n 70\n{code}\n")),
+            "{units:?}"
+        );
+    }
+    let r12 = render_dxf(EdgeFileOptions::default());
+    assert!(r12.contains("AC1009") && !r12.contains("$INSUNITS") && !r12.contains("SPLINE"));
 }
