@@ -524,33 +524,27 @@ impl Tables<'_> {
     /// An empty block (its entities are in the ENTITIES section) owned by
     /// `record`; `paper` for the paper space's.
     fn block(&mut self, name: &str, record: u64, paper: bool) {
-        let begin = self.take();
-        let out = &mut *self.out;
-        group(out, 0, "BLOCK");
-        group(out, 5, &hex(begin));
-        group(out, 330, &hex(record));
-        group(out, 100, "AcDbEntity");
+        self.block_part("BLOCK", record, paper, "AcDbBlockBegin");
+        group(self.out, 2, name);
+        group(self.out, 70, "0");
+        point(self.out, 10, [0.0; 3]);
+        group(self.out, 3, name);
+        group(self.out, 1, "");
+        self.block_part("ENDBLK", record, paper, "AcDbBlockEnd");
+    }
+
+    /// The head of a block's begin or end (`kind`), on layer 0.
+    fn block_part(&mut self, kind: &str, record: u64, paper: bool, class: &str) {
+        let handle = self.take();
+        group(self.out, 0, kind);
+        group(self.out, 5, &hex(handle));
+        group(self.out, 330, &hex(record));
+        group(self.out, 100, "AcDbEntity");
         if paper {
-            group(out, 67, "1");
+            group(self.out, 67, "1");
         }
-        group(out, 8, "0");
-        group(out, 100, "AcDbBlockBegin");
-        group(out, 2, name);
-        group(out, 70, "0");
-        point(out, 10, [0.0; 3]);
-        group(out, 3, name);
-        group(out, 1, "");
-        let end = self.take();
-        let out = &mut *self.out;
-        group(out, 0, "ENDBLK");
-        group(out, 5, &hex(end));
-        group(out, 330, &hex(record));
-        group(out, 100, "AcDbEntity");
-        if paper {
-            group(out, 67, "1");
-        }
-        group(out, 8, "0");
-        group(out, 100, "AcDbBlockEnd");
+        group(self.out, 8, "0");
+        group(self.out, 100, class);
     }
 }
 
