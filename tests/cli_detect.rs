@@ -6,7 +6,7 @@ use std::process::{Command, Output};
 use byteorder::{ByteOrder, LittleEndian};
 
 mod common;
-use common::{meshtrim_env, path_str, stderr, BLADE_HOLES as FIXTURE};
+use common::{meshtrim_env, output_bytes, path_str, stderr, BLADE_HOLES as FIXTURE};
 
 fn meshtrim(args: &[&str]) -> Output {
     meshtrim_env(args, &[])
@@ -127,13 +127,12 @@ fn json_summary_is_consistent() {
 fn output_is_deterministic_across_runs_and_threads() {
     let dir = tempfile::tempdir().unwrap();
     let run = |name: &str, threads: &str| {
-        let out = dir.path().join(name);
-        let r = meshtrim_env(
-            &["detect", FIXTURE, "-o", path_str(&out)],
-            &[("RAYON_NUM_THREADS", threads)],
-        );
-        assert!(r.status.success(), "{}", stderr(&r));
-        std::fs::read(out).unwrap()
+        output_bytes(
+            dir.path(),
+            &["detect", FIXTURE, "-o", "{out}"],
+            name,
+            threads,
+        )
     };
     let a = run("a.ply", "2");
     assert_eq!(a, run("b.ply", "2"));

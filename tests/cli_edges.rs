@@ -6,7 +6,7 @@ use std::process::Output;
 use serde_json::Value;
 
 mod common;
-use common::{meshtrim_env, path_str, stderr, BLADE_HOLES as FIXTURE};
+use common::{meshtrim_env, output_bytes, path_str, stderr, BLADE_HOLES as FIXTURE};
 
 /// Points in the fixture (see fixtures/meshes/README.md).
 const FIXTURE_POINTS: usize = 7219;
@@ -265,13 +265,12 @@ fn json_summary_has_the_documented_keys() {
 fn outputs_are_deterministic_across_runs_and_threads() {
     let dir = tempfile::tempdir().unwrap();
     let run = |name: &str, threads: &str| {
-        let out = dir.path().join(name);
-        let r = meshtrim_env(
-            &["edges", FIXTURE, "-o", path_str(&out)],
-            &[("RAYON_NUM_THREADS", threads)],
-        );
-        assert!(r.status.success(), "{}", stderr(&r));
-        std::fs::read(out).unwrap()
+        output_bytes(
+            dir.path(),
+            &["edges", FIXTURE, "-o", "{out}"],
+            name,
+            threads,
+        )
     };
     let a = run("a.json", "2");
     assert_eq!(a, run("b.json", "2"));

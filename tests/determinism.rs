@@ -6,7 +6,7 @@
 use std::path::{Path, PathBuf};
 
 mod common;
-use common::{meshtrim_env, path_str, stderr};
+use common::{output_bytes, path_str};
 
 /// A wavy 320 × 320 jittered grid with a round hole, as XYZ text.
 fn large_cloud(dir: &Path) -> PathBuf {
@@ -33,19 +33,6 @@ fn large_cloud(dir: &Path) -> PathBuf {
     path
 }
 
-/// The bytes `args` (with `{out}` standing for a fresh output path) write
-/// on `threads` threads.
-fn output(dir: &Path, args: &[&str], name: &str, threads: &str) -> Vec<u8> {
-    let out = dir.join(format!("{threads}-{name}"));
-    let args: Vec<&str> = args
-        .iter()
-        .map(|&a| if a == "{out}" { path_str(&out) } else { a })
-        .collect();
-    let run = meshtrim_env(&args, &[("RAYON_NUM_THREADS", threads)]);
-    assert!(run.status.success(), "{args:?}: {}", stderr(&run));
-    std::fs::read(&out).unwrap()
-}
-
 #[test]
 fn a_large_cloud_gives_the_same_bytes_on_1_2_and_4_threads() {
     let dir = tempfile::tempdir().unwrap();
@@ -56,11 +43,11 @@ fn a_large_cloud_gives_the_same_bytes_on_1_2_and_4_threads() {
         (vec!["edges", cloud, "-o", "{out}"], "edges.json"),
         (vec!["mesh", cloud, "{out}"], "mesh.ply"),
     ] {
-        let one = output(dir.path(), &args, name, "1");
+        let one = output_bytes(dir.path(), &args, name, "1");
         assert!(!one.is_empty(), "{name}");
         for threads in ["2", "4"] {
             assert!(
-                one == output(dir.path(), &args, name, threads),
+                one == output_bytes(dir.path(), &args, name, threads),
                 "{name}: 1 and {threads} threads differ"
             );
         }

@@ -1,6 +1,6 @@
 //! Shared helpers of the integration tests.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// A real scan by its path under the shared data directory (see its
 /// SOURCES.md). The PCL scans are shipped in `fixtures/scans/pcl_test`
@@ -56,6 +56,21 @@ pub fn meshtrim_env(args: &[&str], env: &[(&str, &str)]) -> std::process::Output
         cmd.env(key, value);
     }
     cmd.output().expect("the meshtrim binary runs")
+}
+
+/// The bytes `meshtrim args` writes on `threads` threads, `{out}` in
+/// `args` standing for a fresh output path in `dir` (named by the thread
+/// count and `name`); the run must succeed.
+#[allow(dead_code)]
+pub fn output_bytes(dir: &Path, args: &[&str], name: &str, threads: &str) -> Vec<u8> {
+    let out = dir.join(format!("{threads}-{name}"));
+    let args: Vec<&str> = args
+        .iter()
+        .map(|&a| if a == "{out}" { path_str(&out) } else { a })
+        .collect();
+    let run = meshtrim_env(&args, &[("RAYON_NUM_THREADS", threads)]);
+    assert!(run.status.success(), "{args:?}: {}", stderr(&run));
+    std::fs::read(&out).unwrap()
 }
 
 /// A run's stderr as text.
