@@ -83,14 +83,13 @@ pub fn write_edges(
     edges: &trim::Edges,
     options: EdgeFileOptions,
 ) -> Result<()> {
-    let format = crate::io::edges_out::edges_format(path)?;
     let data = crate::io::edges_out::EdgeData {
         points,
         boundary: &detection.boundary,
         edges,
         options,
     };
-    write_atomic(path, |w| format.write(w, data))
+    crate::io::edges_out::write_file(path, data)
 }
 
 /// True when `a` and `b` name the same existing file (an output must never

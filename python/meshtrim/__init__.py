@@ -51,6 +51,7 @@ __all__ = [
     "read_cloud",
     "read_mesh",
     "write_mesh",
+    "write_edges",
 ]
 
 __version__ = "0.1.0"
@@ -314,6 +315,57 @@ def clean(
     f = _face_rows(faces, len(v))
     out_v, out_f, report = _meshtrim.clean(v, f, k, anisotropy, bool(offset), along, from_)
     return out_v, out_f, json.loads(report)
+
+
+def write_edges(
+    path: PathLike,
+    edges: Sequence[Loop],
+    points: Any,
+    *,
+    units: str = "mm",
+    dxf_splines: bool = False,
+) -> None:
+    """Writes loops of :func:`edges` as ``meshtrim edges CLOUD -o PATH``
+    writes them, byte for byte: the format from the extension (.json,
+    .obj, .svg, .dxf, .step or .stp, .igs or .iges), missing parent
+    directories created, the file replaced atomically.
+
+    ``edges`` is what :func:`edges` returned for ``points``, or some of its
+    loops (a list of :class:`Loop`). ``units`` is the length unit a STEP,
+    IGES or DXF-with-splines file declares (mm, m or in); ``dxf_splines``
+    also writes each edge as a spline into a DXF file (the CLI's
+    ``--dxf-splines``). The SVG picture marks the detection's boundary
+    points when ``edges`` carries its detection, otherwise the loops'.
+    """
+    pts = _float_rows(points, "points")
+    detection = getattr(edges, "detection", None)
+    labelled = detection is not None and len(detection.boundary) == len(pts)
+    if labelled:
+        boundary = np.ascontiguousarray(detection.boundary, dtype=bool)
+    else:
+        boundary = np.zeros(len(pts), dtype=bool)
+    loops = []
+    for i, loop in enumerate(edges):
+        if not isinstance(loop, Loop):
+            raise MeshtrimError(f"edges[{i}]: expected a Loop, got {type(loop).__name__}")
+        indices = np.asarray(loop.boundary_points)
+        if indices.ndim != 1 or (indices.size and indices.dtype.kind not in "iu"):
+            raise MeshtrimError(f"edges[{i}].boundary_points: expected a 1-D array of point indices")
+        corners = loop.corners if np.size(loop.corners) else np.empty((0, 3))
+        pieces = [
+            (bool(e.closed), _float_rows(e.points, f"edges[{i}].edges[{j}].points"))
+            for j, e in enumerate(loop.edges)
+        ]
+        if not labelled:
+            boundary[indices[(indices >= 0) & (indices < len(pts))]] = True
+        loops.append(
+            (
+                np.ascontiguousarray(indices, dtype=np.int64),
+                _float_rows(corners, f"edges[{i}].corners"),
+                pieces,
+            )
+        )
+    _meshtrim.write_edges(os.fspath(path), pts, boundary, loops, str(units), bool(dxf_splines))
 
 
 def read_cloud(path: PathLike, *, scan: Optional[int] = None) -> np.ndarray:

@@ -16,11 +16,14 @@
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
 
-use library::{BpdOptions, Detection, EdgeOptions, Mesh, Point3, View};
+use library::{BpdOptions, Detection, Edge, EdgeOptions, Edges, Loop, Mesh, Point3, View};
 use meshtrim::commands;
+use meshtrim::io::edges_out::{self, step::LengthUnit, EdgeData, EdgeFileOptions, EdgesFormat};
 use meshtrim::stages::Stages;
 use numpy::ndarray::ArrayView2;
-use numpy::{PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
+use numpy::{
+    PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods,
+};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyList;
@@ -92,11 +95,19 @@ fn rows<T: numpy::Element + Copy>(
     array: &PyReadonlyArray2<'_, T>,
     name: &str,
 ) -> PyResult<Vec<[T; 3]>> {
+    rows_or_message(array, name).map_err(MeshtrimError::new_err)
+}
+
+/// [`rows`], its error as the message alone.
+fn rows_or_message<T: numpy::Element + Copy>(
+    array: &PyReadonlyArray2<'_, T>,
+    name: &str,
+) -> Result<Vec<[T; 3]>, String> {
     if array.shape()[1] != 3 {
-        return Err(MeshtrimError::new_err(format!(
+        return Err(format!(
             "{name}: expected an array of shape (n, 3), got {:?}",
             array.shape()
-        )));
+        ));
     }
     Ok(match array.as_slice() {
         Ok(flat) => flat.chunks_exact(3).map(|r| [r[0], r[1], r[2]]).collect(),
@@ -374,6 +385,116 @@ fn write_mesh(
     })
 }
 
+/// A loop as Python passes it back: boundary point indices, corner
+/// positions, edges (closed, points).
+type LoopIn<'py> = (
+    PyReadonlyArray1<'py, i64>,
+    PyReadonlyArray2<'py, f64>,
+    Vec<(bool, PyReadonlyArray2<'py, f64>)>,
+);
+
+/// Writes loops to an edges file as `meshtrim edges -o` does (format by
+/// extension, atomically). `boundary` marks the SVG's boundary points.
+#[pyfunction]
+#[pyo3(name = "write_edges", signature = (path, points, boundary, loops, units, dxf_splines))]
+fn write_edges_py(
+    py: Python<'_>,
+    path: PathBuf,
+    points: PyReadonlyArray2<'_, f64>,
+    boundary: PyReadonlyArray1<'_, bool>,
+    loops: Vec<LoopIn<'_>>,
+    units: &str,
+    dxf_splines: bool,
+) -> PyResult<()> {
+    let points = rows(&points, "points")?;
+    let boundary = boundary.as_array().to_vec();
+    if boundary.len() != points.len() {
+        return Err(MeshtrimError::new_err(format!(
+            "boundary: {} labels for {} points",
+            boundary.len(),
+            points.len()
+        )));
+    }
+    let units = match units {
+        "mm" => LengthUnit::Mm,
+        "m" => LengthUnit::M,
+        "in" => LengthUnit::In,
+        other => {
+            return Err(MeshtrimError::new_err(format!(
+                "units: {other:?} is not a length unit: mm, m or in"
+            )))
+        }
+    };
+    if dxf_splines && EdgesFormat::from_path(&path) != Some(EdgesFormat::Dxf) {
+        return Err(MeshtrimError::new_err(format!(
+            "{}: dxf_splines writes splines into a .dxf file, and this is not one",
+            path.display()
+        )));
+    }
+    let edges = Edges {
+        loops: loops
+            .iter()
+            .enumerate()
+            .map(|(i, l)| loop_of(&points, l).map_err(|e| format!("edges[{i}].{e}")))
+            .collect::<Result<_, _>>()
+            .map_err(MeshtrimError::new_err)?,
+        dropped_clusters: 0,
+        thinned_points: 0,
+    };
+    let data = EdgeData {
+        points: &points,
+        boundary: &boundary,
+        edges: &edges,
+        options: EdgeFileOptions { units, dxf_splines },
+    };
+    without_gil(py, || edges_out::write_file(&path, data))
+}
+
+/// A library loop from its Python parts: the indices checked against the
+/// cloud, each corner found among the loop's boundary points (in order),
+/// the edge points finite. Errors name the part.
+fn loop_of(points: &[Point3], (indices, corners, edges): &LoopIn<'_>) -> Result<Loop, String> {
+    let mut boundary_points = Vec::with_capacity(indices.len());
+    for (j, &i) in indices.as_array().iter().enumerate() {
+        match u32::try_from(i) {
+            Ok(index) if (index as usize) < points.len() => boundary_points.push(index),
+            _ => {
+                return Err(format!(
+                    "boundary_points[{j}]: {i} is not a point of the cloud ({} points)",
+                    points.len()
+                ))
+            }
+        }
+    }
+    let corner_points = rows_or_message(corners, "corners")?;
+    let mut positions = Vec::with_capacity(corner_points.len());
+    let mut from = 0;
+    for (c, corner) in corner_points.iter().enumerate() {
+        let at = (from..boundary_points.len())
+            .find(|&j| points[boundary_points[j] as usize] == *corner)
+            .ok_or_else(|| format!("corners[{c}]: not one of the loop's boundary points (after the previous corner)"))?;
+        positions.push(at);
+        from = at + 1;
+    }
+    let mut pieces = Vec::with_capacity(edges.len());
+    for (e, (closed, array)) in edges.iter().enumerate() {
+        let points = rows_or_message(array, "points").map_err(|err| format!("edges[{e}].{err}"))?;
+        if points.iter().flatten().any(|c| !c.is_finite()) {
+            return Err(format!("edges[{e}].points: a coordinate is not finite"));
+        }
+        pieces.push(Edge {
+            closed: *closed,
+            points,
+        });
+    }
+    Ok(Loop {
+        boundary_points,
+        corners: positions,
+        edges: pieces,
+        sides: Vec::new(),
+    })
+}
+
 #[pymodule]
 fn _meshtrim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MeshtrimError", m.py().get_type::<MeshtrimError>())?;
@@ -385,5 +506,6 @@ fn _meshtrim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read_cloud, m)?)?;
     m.add_function(wrap_pyfunction!(read_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(write_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(write_edges_py, m)?)?;
     Ok(())
 }

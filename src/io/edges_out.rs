@@ -50,6 +50,13 @@ pub struct EdgeFileOptions {
     pub dxf_splines: bool,
 }
 
+/// Writes `data` to `path` (atomically), in the format its extension
+/// names: what `meshtrim edges -o` writes.
+pub fn write_file(path: &std::path::Path, data: EdgeData) -> anyhow::Result<()> {
+    let format = edges_format(path)?;
+    crate::io::atomic::write_atomic(path, |w| format.write(w, data))
+}
+
 /// Output formats of `edges`, chosen by the output's extension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum EdgesFormat {

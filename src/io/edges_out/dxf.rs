@@ -69,7 +69,7 @@ pub fn write_dxf(w: &mut dyn Write, data: EdgeData) -> std::io::Result<()> {
     if data.options.dxf_splines {
         for e in data.edges.loops.iter().flat_map(|l| &l.edges) {
             if let Some(curve) = trim::interpolate_bspline(&e.points, e.closed) {
-                file.spline(&curve.with_double_knots(), e.closed);
+                file.spline(&curve.with_double_knots());
             }
         }
     }
@@ -222,12 +222,16 @@ impl Dxf {
     }
 
     /// A B-spline curve on `SPLINES` (R2000 only): degree, the full knot
-    /// vector, the control points; `closed` when it ends where it starts.
-    fn spline(&mut self, curve: &trim::BSpline, closed: bool) {
+    /// vector, the control points. A closed loop's curve is clamped, its
+    /// first and last control points the same point, and is written
+    /// without the closed flag (70 = 0): to some readers that flag means a
+    /// periodic curve whose control polygon wraps round, which would be
+    /// another curve; the knots and points alone say this one.
+    fn spline(&mut self, curve: &trim::BSpline) {
         self.entity("SPLINE", SPLINE_LAYER.0, None, &["AcDbSpline"]);
         let knots = curve.knot_vector();
         let out = &mut self.entities;
-        group(out, 70, if closed { "1" } else { "0" });
+        group(out, 70, "0");
         group(out, 71, &curve.degree.to_string());
         group(out, 72, &knots.len().to_string());
         group(out, 73, &curve.control_points.len().to_string());

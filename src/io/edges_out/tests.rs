@@ -293,7 +293,11 @@ fn dxf_splines_interpolate_the_edge_points() {
         assert_eq!(values(72), [knots.len() as f64]);
         assert_eq!(values(73), [x.len() as f64]);
         assert_eq!(knots.len(), x.len() + 4, "a cubic's knot count");
-        assert_eq!(values(70), [if edge.closed { 1.0 } else { 0.0 }]);
+        assert_eq!(
+            values(70),
+            [0.0],
+            "clamped, never flagged periodic or closed"
+        );
         // The curve the file holds is the one STEP and IGES write.
         let curve = trim::interpolate_bspline(&edge.points, edge.closed)
             .unwrap()
@@ -301,8 +305,12 @@ fn dxf_splines_interpolate_the_edge_points() {
         assert_eq!(knots, curve.knot_vector());
         let control: Vec<Point3> = (0..x.len()).map(|i| [x[i], y[i], z[i]]).collect();
         assert_eq!(control, curve.control_points);
-        // It starts at the edge's first point and passes through each.
+        // It starts at the edge's first point (and a closed edge's ends
+        // there too) and passes through each.
         assert_eq!(control[0], edge.points[0]);
+        if edge.closed {
+            assert_eq!(control.last(), Some(&edge.points[0]));
+        }
         for (p, &k) in edge.points.iter().zip(&curve.knots) {
             let on = curve.point_at(k);
             assert!((0..3).all(|c| (on[c] - p[c]).abs() < 1e-12), "{on:?} {p:?}");
