@@ -351,6 +351,7 @@ def write_edges(
         indices = np.asarray(loop.boundary_points)
         if indices.ndim != 1 or (indices.size and indices.dtype.kind not in "iu"):
             raise MeshtrimError(f"edges[{i}].boundary_points: expected a 1-D array of point indices")
+        indices = np.ascontiguousarray(indices, dtype=np.int64)
         corners = loop.corners if np.size(loop.corners) else np.empty((0, 3))
         pieces = [
             (bool(e.closed), _float_rows(e.points, f"edges[{i}].edges[{j}].points"))
@@ -360,7 +361,7 @@ def write_edges(
             boundary[indices[(indices >= 0) & (indices < len(pts))]] = True
         loops.append(
             (
-                np.ascontiguousarray(indices, dtype=np.int64),
+                indices,
                 _float_rows(corners, f"edges[{i}].corners"),
                 pieces,
             )

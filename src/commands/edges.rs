@@ -25,8 +25,9 @@ pub struct Args {
     /// Write the loops and edges: OUT.json (everything), OUT.obj (the
     /// smoothed edges as polylines), OUT.svg (a picture), OUT.dxf (3-D
     /// polylines on layers OUTER and HOLES, corners on CORNERS, for CAD and
-    /// CAM; with --dxf-splines also curves), OUT.step (cubic B-spline curves, in --units) or OUT.igs (the
-    /// same curves as IGES). Missing parent directories are created.
+    /// CAM; with --dxf-splines also curves), OUT.step (cubic B-spline
+    /// curves, in --units) or OUT.igs (the same curves as IGES). Missing
+    /// parent directories are created.
     #[arg(short, long, value_name = "OUT")]
     pub output: PathBuf,
     /// Detection and edge options.

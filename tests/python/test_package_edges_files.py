@@ -85,3 +85,14 @@ def test_loops_that_do_not_fit_are_refused(tmp_path, found):
             meshtrim.write_edges(tmp_path / name, selection, points, **options)
         assert message in str(raised.value), (message, str(raised.value))
         assert not (tmp_path / name).exists()
+
+
+def test_a_loop_without_points_draws_nothing(tmp_path, found):
+    points, loops = found
+    empty = meshtrim.Loop(True, [], [], [])
+    meshtrim.write_edges(tmp_path / "e.json", [loops[0], empty], points)
+    written = json.loads((tmp_path / "e.json").read_text())["loops"]
+    assert len(written) == 2 and written[1] == {"closed": True, "boundary_points": [], "corners": [], "edges": []}
+    meshtrim.write_edges(tmp_path / "e.dxf", [loops[0], empty], points, dxf_splines=True)
+    doc = ezdxf.readfile(tmp_path / "e.dxf")
+    assert len(doc.modelspace().query("POLYLINE")) == 1 and not doc.audit().has_errors

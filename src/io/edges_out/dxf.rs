@@ -56,6 +56,11 @@ pub fn write_dxf(w: &mut dyn Write, data: EdgeData) -> std::io::Result<()> {
     };
     let outer = outer_loops(&polylines, &PicturePlane::of(data.points));
     for (polyline, is_outer) in polylines.iter().zip(outer) {
+        // A loop of fewer than two points (only a caller's own loops can
+        // be) has no polyline: CAD systems refuse an empty one.
+        if polyline.len() < 2 {
+            continue;
+        }
         let layer = if is_outer { "OUTER" } else { "HOLES" };
         file.polyline(polyline, layer);
     }
