@@ -64,7 +64,7 @@ pub struct CleanOutcome {
 /// (docs/clean.md): one-sided range scans 0.94 and more (bun090, whose
 /// faces at its silhouette turn past 90°), meshes round whole objects
 /// 0.76 and less (Laurana50k, open at its base; bun_zipper 0.54).
-pub const WRAPS_BELOW: f64 = 0.85;
+pub const WRAPS_BELOW: f64 = trim::SEEN_FROM_ONE_SIDE;
 
 /// What `clean` prints and `--report` writes.
 #[derive(Debug, Clone, Serialize)]

@@ -433,8 +433,8 @@ def median_turning(v, loop):
     """Median angle (degrees) between consecutive segments of a loop: a
     sawtooth border turns by tens of degrees at every vertex, a smooth one
     by a few. Measured on the outer borders, in -> out: face000 33.9 -> 9.5,
-    lato000 36.7 -> 8.7, Laurana50k 16.5 -> 4.2, bun000 55.6 -> 13.6,
-    bun045 50.1 -> 13.0, bun090 51.8 -> 15.7, chin 48.8 -> 12.5."""
+    lato000 36.7 -> 8.7, Laurana50k 16.5 -> 4.2, bun000 55.6 -> 10.5,
+    bun045 50.1 -> 10.1, bun090 51.8 -> 11.7, chin 48.8 -> 10.1."""
     p = v[loop]
     a = np.roll(p, -1, axis=0) - p
     b = np.roll(a, -1, axis=0)
@@ -522,8 +522,8 @@ def test_scan_new_faces_are_rarely_thin(scan):
     The bunny's silhouettes, a known weakness recorded as measured: the
     strip meets the range grid's own thin faces there (1.5-4.2 % of the
     input's faces are below 10 degrees, far more along the silhouette):
-    bun000 104 / 295 of 2338, bun045 163 / 342 of 2188, bun090 118 / 290
-    of 2083, chin 179 / 371 of 2286. Bounds: 10 % below 5, 20 % below 10."""
+    bun000 96 / 289 of 2341, bun045 168 / 332 of 2180, bun090 118 / 291
+    of 2080, chin 180 / 351 of 2277. Bounds: 10 % below 5, 20 % below 10."""
     angles = new_face_angles(scan)
     rep = scan["report"]
     # The report's smallest angle covers every new face.
@@ -578,7 +578,7 @@ def test_wrapped_cylinder_border_on_the_truth(seed, tmp_path):
     the jagged outer border is no height field over any plane. Both loops
     are replaced, the border lies within 0.25 spacings of the analytic rim
     on average (measured 0.120-0.137, from 0.297-0.378), the output is
-    valid and its new faces are not thin (measured: smallest 17-26
+    valid and its new faces are not thin (measured: smallest 16-26
     degrees)."""
     cloud = synthetic.wrapped_cylinder(1.5, seed)
     v, f, _ = jagged.jagged_mesh(cloud)

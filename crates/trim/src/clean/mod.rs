@@ -124,6 +124,11 @@ const MAX_FAR_REMOVED: usize = 3;
 const FIRST_DEPTH: u32 = 3;
 /// … and the most it grows to.
 const MAX_DEPTH: u32 = 30;
+/// Share of a mesh's area facing one direction ([`Mesh::area_facing_one_way`])
+/// from which it is taken for a scan seen from one side: measured 0.944–1.0
+/// on the range scans, 0.758 on a bust open at its base, 0.545 on the
+/// zippered bunny.
+pub const SEEN_FROM_ONE_SIDE: f64 = 0.85;
 
 /// Options of the cleanup.
 #[derive(Debug, Clone, PartialEq)]
@@ -302,7 +307,11 @@ pub fn clean_mesh(
         area_facing_one_way: mesh.area_facing_one_way(),
         ..Default::default()
     };
-    let mut outcomes = replace_bands(mesh, beta, &borders, &rings);
+    // A scan seen from one side was seen along its faces' mean normal.
+    let view = (report.area_facing_one_way >= SEEN_FROM_ONE_SIDE)
+        .then(|| mesh.mean_normal())
+        .flatten();
+    let mut outcomes = replace_bands(mesh, beta, &borders, &rings, view);
     let out = assemble_manifold(mesh, &mut outcomes);
     let (out, mut report) = finish(out, &outcomes, report)?;
     // Small loops a strip absorbed count as replaced.
@@ -362,6 +371,7 @@ fn replace_bands(
     beta: &[f64],
     borders: &[Vec<u32>],
     rings: &[Option<Ring>],
+    view: Option<Point3>,
 ) -> Vec<Outcome> {
     let topology = Topology::new(mesh);
     let context = Context {
@@ -371,6 +381,7 @@ fn replace_bands(
         rings,
         topology: &topology,
         beta_median: median(beta),
+        view,
     };
     let mut outcomes = replace_all(&context);
     replace_left_by_strips(&context, &mut outcomes);
@@ -625,6 +636,9 @@ struct Context<'a> {
     rings: &'a [Option<Ring>],
     topology: &'a Topology,
     beta_median: f64,
+    /// The direction a scan seen from one side was seen along; `None` for
+    /// a surface that wraps round an object.
+    view: Option<Point3>,
 }
 
 /// The new faces of one band.

@@ -3,6 +3,16 @@
 //! the loops whose band is no height field over one plane: outer borders
 //! that wrap round the object, borders on steep or folded surface).
 //!
+//! 0. **The depth of a silhouette.** On a scan seen from one side, the
+//!    smoothed loop's depth (its component along the direction the scan
+//!    was seen from) is smoothed again, by a local quadratic fit with
+//!    Gaussian weights of [`DEPTH_SIGMA`]·β over arc length
+//!    ([`smooth_depth`]): where the
+//!    surface turns away from the scanner, consecutive border samples jump
+//!    between front and back by up to 20 spacings (grazing incidence: the
+//!    depth is measured worst there), and the low-pass filter, whose
+//!    cut-off follows β, passes those jumps of a few samples' width on.
+//!    The outline across the view keeps the filter's result.
 //! 1. **Which side is the surface.** Every segment of the smoothed loop
 //!    gets the direction into the surface there: the mean direction from
 //!    the border vertices it was smoothed from to the faces around them,
@@ -34,6 +44,21 @@
 use super::*;
 use crate::geom::{scale, segment_param, unit};
 use crate::spatial::PointTree;
+
+/// Width (σ, in median β) of the Gaussian weights of the fit that smooths
+/// a one-sided scan's silhouette depth ([`smooth_depth`]). Measured on the
+/// bunny's range scans (bun000, bun045, bun090, chin), the median turning
+/// angle of the output's outer border in degrees: without, 13.6 / 13.0 /
+/// 15.7 / 12.5; with σ = 2 β 11.7 / 11.3 / 13.0 / 11.3; 3 β 10.5 / 10.1 /
+/// 11.7 / 10.1; 4 β 9.5 / 9.2 / 10.3 / 9.3. A weighted mean instead of the
+/// quadratic smooths more for its width (2 β: 10.2 / 9.9 / 11.1 / 10.2)
+/// but pulls a rim that curves in depth towards its chords: on the
+/// wrapped cylinder of the tests (radius 40, 1.5 spacing) its border moved
+/// from 0.120 / 0.124 to 0.135 / 0.137 spacings from the truth; the
+/// quadratic's stays at 0.120 / 0.125.
+const DEPTH_SIGMA: f64 = 3.0;
+/// The Gaussian's window, in σ on either side.
+const DEPTH_WINDOW: f64 = 2.0;
 
 /// Segments of the smoothed loop searched, ahead of the last wall vertex's
 /// nearest one, for the next wall vertex's nearest point …
@@ -110,6 +135,9 @@ impl Guide {
         let m = points.len();
         if m < 3 {
             return None;
+        }
+        if let Some(view) = cx.view {
+            smooth_depth(&mut points, view, DEPTH_SIGMA * cx.beta_median);
         }
         // The direction into the surface at each smoothed vertex, from the
         // border vertex nearest it.
@@ -830,4 +858,248 @@ fn footprint(cx: &Context, removed: &[u32]) -> Vec<u32> {
         .flat_map(|v| cx.topology.faces_of(v).iter().copied())
         .collect();
     faces.into_iter().collect()
+}
+
+/// Smooths the closed loop `points`' depth along `view` (a unit vector):
+/// each point's depth becomes the value at the point of the quadratic (in
+/// arc length) fitted by least squares to the depths around it, weighted
+/// by a Gaussian of width `sigma` cut at [`DEPTH_WINDOW`]·σ on either
+/// side. A quadratic, not a weighted mean, so that a rim curving in depth
+/// keeps its curve while jumps a few samples wide go. Each point moves
+/// along `view` only,
+/// so the loop's outline across the view is kept. A loop of no length, or
+/// a `sigma` that is not positive, is left as it is.
+fn smooth_depth(points: &mut [Point3], view: Point3, sigma: f64) {
+    let m = points.len();
+    let depth: Vec<f64> = points.iter().map(|&p| dot(p, view)).collect();
+    // Arc length along the loop itself, not along its outline: where the
+    // surface really turns away (past a silhouette) the outline folds
+    // back, and a window over its length would span far along the
+    // surface.
+    let mut arc = Vec::with_capacity(m + 1);
+    arc.push(0.0);
+    for j in 0..m {
+        arc.push(arc[j] + dist2(points[j], points[(j + 1) % m]).sqrt());
+    }
+    let total = arc[m];
+    let reach = DEPTH_WINDOW * sigma;
+    if !(total > 0.0 && total.is_finite() && sigma > 0.0) {
+        return;
+    }
+    let weight = |along: f64| (-0.5 * (along / sigma).powi(2)).exp();
+    let smoothed: Vec<f64> = (0..m)
+        .map(|i| {
+            let mut fit = LocalFit::default();
+            fit.take(0.0, 1.0, depth[i]);
+            // Each neighbour within reach counts once, the short way round:
+            // walking ahead, those no farther ahead than behind …
+            for step in 1..m {
+                let j = (i + step) % m;
+                let ahead = forward(&arc, i, j, total);
+                if ahead > reach {
+                    break;
+                }
+                if ahead <= total - ahead {
+                    fit.take(ahead / sigma, weight(ahead), depth[j]);
+                }
+            }
+            // … and walking behind, the others.
+            for step in 1..m {
+                let j = (i + m - step) % m;
+                let behind = forward(&arc, j, i, total);
+                if behind > reach {
+                    break;
+                }
+                if behind < total - behind {
+                    fit.take(-behind / sigma, weight(behind), depth[j]);
+                }
+            }
+            fit.quadratic_at_zero()
+        })
+        .collect();
+    for ((p, d), s) in points.iter_mut().zip(&depth).zip(&smoothed) {
+        *p = add(*p, scale(view, s - d));
+    }
+}
+
+/// Weighted moments of depth against a signed offset t along the loop.
+#[derive(Default)]
+struct LocalFit {
+    /// Σ w tᵏ for k = 0..4.
+    t: [f64; 5],
+    /// Σ w tᵏ d for k = 0..2.
+    d: [f64; 3],
+}
+
+impl LocalFit {
+    fn take(&mut self, t: f64, w: f64, d: f64) {
+        let mut power = w;
+        for k in 0..5 {
+            self.t[k] += power;
+            if k < 3 {
+                self.d[k] += power * d;
+            }
+            power *= t;
+        }
+    }
+
+    fn mean(&self) -> f64 {
+        self.d[0] / self.t[0]
+    }
+
+    /// The weighted least-squares quadratic's value at t = 0; the mean
+    /// where the offsets cannot fix a quadratic.
+    fn quadratic_at_zero(&self) -> f64 {
+        let [s0, s1, s2, s3, s4] = self.t;
+        let [d0, d1, d2] = self.d;
+        // Cramer's rule on the 3×3 normal equations, for the constant.
+        let det = s0 * (s2 * s4 - s3 * s3) - s1 * (s1 * s4 - s3 * s2) + s2 * (s1 * s3 - s2 * s2);
+        let scale = s0 * s2 * s4;
+        if det.is_nan() || det <= 1e-9 * scale {
+            return self.mean();
+        }
+        (d0 * (s2 * s4 - s3 * s3) - s1 * (d1 * s4 - s3 * d2) + s2 * (d1 * s3 - s2 * d2)) / det
+    }
+}
+
+/// Arc length from loop vertex `from` forwards to vertex `to`.
+fn forward(arc: &[f64], from: usize, to: usize, total: f64) -> f64 {
+    if to >= from {
+        arc[to] - arc[from]
+    } else {
+        total - arc[from] + arc[to]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{RngExt, SeedableRng};
+
+    /// A circle of `n` points round the z axis, of radius 10, its depth
+    /// (z) `depth(i)`.
+    fn circle(n: usize, depth: impl FnMut(usize) -> f64) -> Vec<Point3> {
+        let turns: Vec<f64> = (0..n).map(|i| i as f64 / n as f64).collect();
+        circle_at(&turns, depth)
+    }
+
+    /// Points on the same circle at the given fractions of a turn.
+    fn circle_at(turns: &[f64], mut depth: impl FnMut(usize) -> f64) -> Vec<Point3> {
+        turns
+            .iter()
+            .enumerate()
+            .map(|(i, t)| {
+                let a = std::f64::consts::TAU * t;
+                [10.0 * a.cos(), 10.0 * a.sin(), depth(i)]
+            })
+            .collect()
+    }
+
+    /// The plain fit: every point of the loop, its signed offset the short
+    /// way round, the weighted quadratic solved by nalgebra (the weighted
+    /// mean where the window cannot fix a quadratic): the reference for
+    /// the windowed walk and its closed-form solve.
+    fn smooth_depth_reference(points: &[Point3], view: Point3, sigma: f64) -> Vec<f64> {
+        let m = points.len();
+        let mut arc = vec![0.0];
+        for j in 0..m {
+            arc.push(arc[j] + dist2(points[j], points[(j + 1) % m]).sqrt());
+        }
+        let total = arc[m];
+        (0..m)
+            .map(|i| {
+                let mut rows = Vec::new();
+                for j in 0..m {
+                    let ahead = (arc[j] - arc[i]).rem_euclid(total);
+                    let t = if ahead <= total - ahead {
+                        ahead
+                    } else {
+                        ahead - total
+                    };
+                    if t.abs() <= DEPTH_WINDOW * sigma {
+                        let w = (-0.5 * (t / sigma).powi(2)).exp();
+                        rows.push((t / sigma, w, dot(points[j], view)));
+                    }
+                }
+                let a = nalgebra::DMatrix::from_fn(rows.len(), 3, |r, k| {
+                    rows[r].1.sqrt() * rows[r].0.powi(k as i32)
+                });
+                let b = nalgebra::DVector::from_fn(rows.len(), |r, _| rows[r].1.sqrt() * rows[r].2);
+                let normal = a.transpose() * &a;
+                let mean = rows.iter().map(|r| r.1 * r.2).sum::<f64>()
+                    / rows.iter().map(|r| r.1).sum::<f64>();
+                if normal.determinant() <= 1e-9 * normal[(0, 0)] * normal[(1, 1)] * normal[(2, 2)] {
+                    return mean;
+                }
+                normal
+                    .lu()
+                    .solve(&(a.transpose() * b))
+                    .map_or(mean, |x| x[0])
+            })
+            .collect()
+    }
+
+    #[test]
+    fn depth_is_smoothed_along_the_view_only() {
+        // A zig-zag in depth of ±0.2 at every other point (0.63 apart
+        // round the circle).
+        let zigzag = circle(100, |i| if i % 2 == 0 { 0.2 } else { -0.2 });
+        let mut smoothed = zigzag.clone();
+        smooth_depth(&mut smoothed, [0.0, 0.0, 1.0], 1.5);
+        for (a, b) in zigzag.iter().zip(&smoothed) {
+            assert_eq!((a[0], a[1]), (b[0], b[1]), "the outline is kept");
+            assert!(b[2].abs() < 0.02, "{b:?}");
+        }
+        // A constant depth stays where it is.
+        let flat = circle(60, |_| 3.25);
+        let mut same = flat.clone();
+        smooth_depth(&mut same, [0.0, 0.0, 1.0], 1.5);
+        for (a, b) in flat.iter().zip(&same) {
+            assert!((a[2] - b[2]).abs() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn windowed_smoothing_matches_the_plain_sum() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        for n in [3, 4, 7, 50, 201] {
+            // Unevenly spaced: bunched points make the short way round
+            // differ from the walk's direction.
+            let mut turns: Vec<f64> = (0..n).map(|_| rng.random::<f64>().powi(3)).collect();
+            turns.sort_unstable_by(f64::total_cmp);
+            let points = circle_at(&turns, |_| rng.random_range(-1.0..1.0));
+            for sigma in [0.05, 0.7, 3.0, 100.0] {
+                let view = unit([0.1, -0.2, 1.0]);
+                let mut fast = points.clone();
+                smooth_depth(&mut fast, view, sigma);
+                let plain = smooth_depth_reference(&points, view, sigma);
+                for (p, d) in fast.iter().zip(&plain) {
+                    assert!((dot(*p, view) - d).abs() < 1e-9, "n {n} sigma {sigma}");
+                }
+            }
+        }
+    }
+
+    /// A rim that curves in depth keeps its curve: a circle in a tilted
+    /// plane, whose depth is a sinusoid along it (a weighted mean would
+    /// pull it in by σ²/2 times its curvature, 0.034 here).
+    #[test]
+    fn depth_that_curves_smoothly_is_kept() {
+        let tilted = circle(200, |_| 0.0)
+            .into_iter()
+            .map(|[x, y, _]| [x, y, 0.3 * x])
+            .collect::<Vec<_>>();
+        let mut smoothed = tilted.clone();
+        smooth_depth(&mut smoothed, [0.0, 0.0, 1.0], 1.5);
+        for (a, b) in tilted.iter().zip(&smoothed) {
+            assert!((a[2] - b[2]).abs() < 1e-3, "{a:?} {b:?}");
+        }
+    }
+
+    #[test]
+    fn a_loop_of_no_length_is_left_alone() {
+        let mut one = vec![[1.0, 2.0, 3.0]; 5];
+        smooth_depth(&mut one, [0.0, 0.0, 1.0], 1.0);
+        assert_eq!(one, vec![[1.0, 2.0, 3.0]; 5]);
+    }
 }

@@ -82,6 +82,20 @@ impl Mesh {
         (0..self.faces.len()).map(|f| self.face_area(f)).sum()
     }
 
+    /// The area-weighted mean of the faces' normals, as a unit vector:
+    /// for a scan seen from one side, the direction it was seen from
+    /// (towards the scanner, the faces' orientation). `None` when the
+    /// normals cancel (a closed surface) or there is no area.
+    pub fn mean_normal(&self) -> Option<Point3> {
+        let mut sum = [0.0; 3];
+        for f in &self.faces {
+            let [a, b, c] = f.map(|i| self.vertices[i as usize]);
+            sum = add(sum, cross(sub(b, a), sub(c, a)));
+        }
+        let length = norm2(sum).sqrt();
+        (length > 0.0 && length.is_finite()).then(|| sum.map(|x| x / length))
+    }
+
     /// The largest share of the area that faces one direction (whose
     /// normals make less than 90° with it), over all directions: 1 for a
     /// surface seen from one side (every face of a single range scan faces
