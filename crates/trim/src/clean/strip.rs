@@ -866,9 +866,8 @@ fn footprint(cx: &Context, removed: &[u32]) -> Vec<u32> {
 /// by a Gaussian of width `sigma` cut at [`DEPTH_WINDOW`]·σ on either
 /// side. A quadratic, not a weighted mean, so that a rim curving in depth
 /// keeps its curve while jumps a few samples wide go. Each point moves
-/// along `view` only,
-/// so the loop's outline across the view is kept. A loop of no length, or
-/// a `sigma` that is not positive, is left as it is.
+/// along `view` only, so the loop's outline across the view is kept. A
+/// loop of no length, or a `sigma` that is not positive, is left as it is.
 fn smooth_depth(points: &mut [Point3], view: Point3, sigma: f64) {
     let m = points.len();
     let depth: Vec<f64> = points.iter().map(|&p| dot(p, view)).collect();
@@ -889,8 +888,10 @@ fn smooth_depth(points: &mut [Point3], view: Point3, sigma: f64) {
     let weight = |along: f64| (-0.5 * (along / sigma).powi(2)).exp();
     let smoothed: Vec<f64> = (0..m)
         .map(|i| {
+            // Depths relative to the point's own, so that a loop far from
+            // the origin keeps its digits in the sums.
             let mut fit = LocalFit::default();
-            fit.take(0.0, 1.0, depth[i]);
+            fit.take(0.0, 1.0, 0.0);
             // Each neighbour within reach counts once, the short way round:
             // walking ahead, those no farther ahead than behind …
             for step in 1..m {
@@ -900,7 +901,7 @@ fn smooth_depth(points: &mut [Point3], view: Point3, sigma: f64) {
                     break;
                 }
                 if ahead <= total - ahead {
-                    fit.take(ahead / sigma, weight(ahead), depth[j]);
+                    fit.take(ahead / sigma, weight(ahead), depth[j] - depth[i]);
                 }
             }
             // … and walking behind, the others.
@@ -911,10 +912,10 @@ fn smooth_depth(points: &mut [Point3], view: Point3, sigma: f64) {
                     break;
                 }
                 if behind < total - behind {
-                    fit.take(-behind / sigma, weight(behind), depth[j]);
+                    fit.take(-behind / sigma, weight(behind), depth[j] - depth[i]);
                 }
             }
-            fit.quadratic_at_zero()
+            depth[i] + fit.quadratic_at_zero()
         })
         .collect();
     for ((p, d), s) in points.iter_mut().zip(&depth).zip(&smoothed) {
