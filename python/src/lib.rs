@@ -415,16 +415,11 @@ fn write_edges_py(
             points.len()
         )));
     }
-    let units = match units {
-        "mm" => LengthUnit::Mm,
-        "m" => LengthUnit::M,
-        "in" => LengthUnit::In,
-        other => {
-            return Err(MeshtrimError::new_err(format!(
-                "units: {other:?} is not a length unit: mm, m or in"
-            )))
-        }
-    };
+    let units = LengthUnit::from_name(units).ok_or_else(|| {
+        MeshtrimError::new_err(format!(
+            "units: {units:?} is not a length unit: mm, m or in"
+        ))
+    })?;
     if dxf_splines && EdgesFormat::from_path(&path) != Some(EdgesFormat::Dxf) {
         return Err(MeshtrimError::new_err(format!(
             "{}: dxf_splines writes splines into a .dxf file, and this is not one",

@@ -38,6 +38,14 @@ pub enum LengthUnit {
     In,
 }
 
+impl LengthUnit {
+    /// The unit `--units` names (`mm`, `m`, `in`), for callers without
+    /// the command line's parser.
+    pub fn from_name(name: &str) -> Option<Self> {
+        <Self as clap::ValueEnum>::from_str(name, false).ok()
+    }
+}
+
 /// Writes the edges as STEP (see the module doc).
 pub fn write_step(w: &mut dyn Write, data: EdgeData) -> std::io::Result<()> {
     let mut file = StepFile::default();

@@ -272,16 +272,13 @@ impl Projection {
         // range scan faces its scanner everywhere, so every face projects
         // the right way up along the mean normal even where a band that
         // curves round a silhouette has a best-fit plane at a steep angle.
-        let sum = faces
-            .iter()
-            .fold([0.0; 3], |acc, &f| add(acc, face_normal(mesh, f)));
-        let length = norm2(sum).sqrt();
-        let normal = if length > 0.0 {
-            sum.map(|c| c / length)
-        } else {
-            let members: Vec<u32> = faces.iter().flat_map(|&f| mesh.faces[f as usize]).collect();
-            fit_plane(&mesh.vertices, &members).normal
-        };
+        let normal = mesh
+            .mean_normal_of(faces.iter().map(|&f| f as usize))
+            .unwrap_or_else(|| {
+                let members: Vec<u32> =
+                    faces.iter().flat_map(|&f| mesh.faces[f as usize]).collect();
+                fit_plane(&mesh.vertices, &members).normal
+            });
         // Any tangent axis: the coordinate axis least aligned with n.
         let axis = (0..3)
             .min_by(|&a, &b| normal[a].abs().total_cmp(&normal[b].abs()))
@@ -306,11 +303,6 @@ impl Projection {
     pub(super) fn vertex_to2(&self, mesh: &Mesh, v: u32) -> [f64; 2] {
         self.to2(mesh.vertices[v as usize])
     }
-}
-
-pub(super) fn face_normal(mesh: &Mesh, f: u32) -> Point3 {
-    let [a, b, c] = mesh.faces[f as usize].map(|i| mesh.vertices[i as usize]);
-    cross(sub(b, a), sub(c, a))
 }
 
 /// The group's smoothed loops in the band's projection, with the vertices

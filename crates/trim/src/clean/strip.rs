@@ -42,6 +42,7 @@
 //!    beside them.
 
 use super::*;
+use crate::edges::smooth::arc_lengths;
 use crate::geom::{scale, segment_param, unit};
 use crate::spatial::PointTree;
 
@@ -158,12 +159,7 @@ impl Guide {
                 unit(sub(d, scale(t, dot(d, t))))
             })
             .collect();
-        let mut arc = Vec::with_capacity(m + 1);
-        arc.push(0.0);
-        for j in 0..m {
-            let step = dist2(points[j], points[(j + 1) % m]).sqrt();
-            arc.push(arc[j] + step);
-        }
+        let arc = arc_lengths(&points, true);
         // A loop of one point (or of non-finite length) has no direction
         // along it.
         if !arc[m].is_finite() || arc[m] <= 0.0 {
@@ -870,16 +866,15 @@ fn footprint(cx: &Context, removed: &[u32]) -> Vec<u32> {
 /// loop of no length, or a `sigma` that is not positive, is left as it is.
 fn smooth_depth(points: &mut [Point3], view: Point3, sigma: f64) {
     let m = points.len();
+    if m < 2 {
+        return;
+    }
     let depth: Vec<f64> = points.iter().map(|&p| dot(p, view)).collect();
     // Arc length along the loop itself, not along its outline: where the
     // surface really turns away (past a silhouette) the outline folds
     // back, and a window over its length would span far along the
     // surface.
-    let mut arc = Vec::with_capacity(m + 1);
-    arc.push(0.0);
-    for j in 0..m {
-        arc.push(arc[j] + dist2(points[j], points[(j + 1) % m]).sqrt());
-    }
+    let arc = arc_lengths(points, true);
     let total = arc[m];
     let reach = DEPTH_WINDOW * sigma;
     if !(total > 0.0 && total.is_finite() && sigma > 0.0) {
@@ -1002,10 +997,7 @@ mod tests {
     /// the windowed walk and its closed-form solve.
     fn smooth_depth_reference(points: &[Point3], view: Point3, sigma: f64) -> Vec<f64> {
         let m = points.len();
-        let mut arc = vec![0.0];
-        for j in 0..m {
-            arc.push(arc[j] + dist2(points[j], points[(j + 1) % m]).sqrt());
-        }
+        let arc = arc_lengths(points, true);
         let total = arc[m];
         (0..m)
             .map(|i| {

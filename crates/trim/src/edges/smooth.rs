@@ -182,7 +182,7 @@ fn valid_input(points: &[Point3], beta: &[f64]) -> bool {
 
 /// Cumulative arc length at each point (and, closed, at the first point
 /// again after the closing segment: n + 1 values).
-fn arc_lengths(points: &[Point3], closed: bool) -> Vec<f64> {
+pub(crate) fn arc_lengths(points: &[Point3], closed: bool) -> Vec<f64> {
     let mut s = Vec::with_capacity(points.len() + 1);
     let mut acc = 0.0;
     s.push(0.0);

@@ -73,8 +73,14 @@ impl Mesh {
 
     /// Area of face `f`.
     pub fn face_area(&self, f: usize) -> f64 {
+        0.5 * norm2(self.face_area_vector(f)).sqrt()
+    }
+
+    /// Face `f`'s normal times twice its area (the cross product of two
+    /// of its sides, in its vertices' order).
+    pub(crate) fn face_area_vector(&self, f: usize) -> Point3 {
         let [a, b, c] = self.faces[f].map(|i| self.vertices[i as usize]);
-        0.5 * norm2(cross(sub(b, a), sub(c, a))).sqrt()
+        cross(sub(b, a), sub(c, a))
     }
 
     /// Total area.
@@ -87,11 +93,14 @@ impl Mesh {
     /// (towards the scanner, the faces' orientation). `None` when the
     /// normals cancel (a closed surface) or there is no area.
     pub fn mean_normal(&self) -> Option<Point3> {
-        let mut sum = [0.0; 3];
-        for f in &self.faces {
-            let [a, b, c] = f.map(|i| self.vertices[i as usize]);
-            sum = add(sum, cross(sub(b, a), sub(c, a)));
-        }
+        self.mean_normal_of(0..self.faces.len())
+    }
+
+    /// [`Mesh::mean_normal`] of the faces `faces` alone.
+    pub(crate) fn mean_normal_of(&self, faces: impl IntoIterator<Item = usize>) -> Option<Point3> {
+        let sum = faces
+            .into_iter()
+            .fold([0.0; 3], |sum, f| add(sum, self.face_area_vector(f)));
         let length = norm2(sum).sqrt();
         (length > 0.0 && length.is_finite()).then(|| sum.map(|x| x / length))
     }
