@@ -519,11 +519,15 @@ def test_scan_new_faces_are_rarely_thin(scan):
     thin whatever the triangulation); the synthetic cases have none below
     10.
 
-    The bunny's silhouettes, a known weakness recorded as measured: the
-    strip meets the range grid's own thin faces there (1.5-4.2 % of the
-    input's faces are below 10 degrees, far more along the silhouette):
-    bun000 96 / 289 of 2341, bun045 168 / 332 of 2180, bun090 116 / 291
-    of 2080, chin 180 / 351 of 2277. Bounds: 10 % below 5, 20 % below 10."""
+    The bunny's silhouettes: the strip meets the range grid's own thin
+    faces there (1.5-4.2 % of the input's faces are below 10 degrees, far
+    more along the silhouette), where the kept mesh's new border lies
+    several spacings behind the smoothed loop; the strip is refined in its
+    unfolded plane, and what stays thin lies against the kept border's own
+    sharp turns or where the strip folds: bun000 15 / 48 of 2547, bun045
+    59 / 83 of 2479, bun090 36 / 88 of 2330, chin 70 / 130 of 2451 (96 /
+    289, 168 / 332, 116 / 291, 180 / 351 unrefined). Bounds: 4 % below 5,
+    8 % below 10."""
     angles = new_face_angles(scan)
     rep = scan["report"]
     # The report's smallest angle covers every new face.
@@ -531,7 +535,7 @@ def test_scan_new_faces_are_rarely_thin(scan):
     assert len(angles) > 0, scan["name"]
     thin, very_thin = (angles < 10.0).sum(), (angles < 5.0).sum()
     if scan["name"] in SILHOUETTE_STRIPS:
-        most_very_thin, most_thin = 0.10 * len(angles), 0.20 * len(angles)
+        most_very_thin, most_thin = 0.04 * len(angles), 0.08 * len(angles)
     else:
         most_very_thin, most_thin = max(2, 0.005 * len(angles)), max(4, 0.02 * len(angles))
     assert very_thin <= most_very_thin and thin <= most_thin, (scan["name"], very_thin, thin, len(angles))
@@ -546,18 +550,17 @@ SHORT_OF_THE_FLOOR = {
     # borders, or a border and the range grid's own slivers along a
     # silhouette, run within a fraction of a spacing, the strip or patch
     # between them has a needle.
-    "face000": 0.03,
-    "bun000": 0.44,
-    "bun045": 0.10,
-    "bun090": 0.17,
-    "chin": 0.12,
+    "face000": 0.29,
+    "bun045": 0.43,
+    "bun090": 0.30,
+    "chin": 0.36,
 }
 
 
 @pytest.mark.parametrize("name", sorted(REAL))
 def test_scan_new_faces_have_a_floor(name, tmp_path_factory, request):
     """No new face below MIN_NEW_ANGLE. The product falls short of it on
-    five scans: those are strict expected failures, so the suite says so,
+    four scans: those are strict expected failures, so the suite says so,
     and turns red the day one of them passes (then the entry goes)."""
     if name in SHORT_OF_THE_FLOOR:
         request.applymarker(

@@ -62,11 +62,13 @@ mod assemble;
 mod band;
 mod gap;
 mod strip;
+mod unfold;
 
 use assemble::*;
 use band::*;
 use gap::*;
 use strip::*;
+use unfold::refine_strip;
 
 use std::borrow::Cow;
 use std::collections::BTreeSet;

@@ -40,6 +40,9 @@
 //!    a mesh vertex or a smoothed loop vertex, so the strip follows the
 //!    surface without any lifting, and its faces turn as the kept faces
 //!    beside them.
+//! 5. **The slivers.** Where the wall lies several spacings behind the
+//!    smoothed loop, runs of the strip that hold slivers are unfolded
+//!    into the plane and refined there ([`refine_strip`]).
 
 use super::*;
 use crate::edges::smooth::arc_lengths;
@@ -354,6 +357,27 @@ pub(super) fn replace_by_strip(
     };
     let (removed, wall) = closed_wall(cx, removed)?;
     let faces = zip(cx, &guide, &wall)?;
+    let n = cx.mesh.vertices.len() as u32;
+    let m = guide.len() as u32;
+    let position = |id: u32| {
+        if id < n {
+            cx.mesh.vertices[id as usize]
+        } else {
+            guide.points[(id - n) as usize]
+        }
+    };
+    let joined = |a: u32, b: u32| {
+        a < n
+            && b < n
+            && cx
+                .topology
+                .faces_of(a)
+                .iter()
+                .any(|&f| cx.mesh.faces[f as usize].contains(&b))
+    };
+    let (faces, added) = refine_strip(&faces, &position, &joined, n + m, cx.beta_median);
+    let mut vertices = guide.points.clone();
+    vertices.extend(added);
     let footprint = footprint(cx, &removed);
     let mut loops = vec![l];
     loops.extend(cut.absorbed.iter().copied());
@@ -361,7 +385,7 @@ pub(super) fn replace_by_strip(
         patch: Patch {
             loops,
             removed,
-            vertices: guide.points.clone(),
+            vertices,
             faces,
             reaches_far: false,
         },
