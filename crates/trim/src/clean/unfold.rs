@@ -63,98 +63,170 @@ pub(super) fn refine_strip(
         .iter()
         .map(|run| smallest_angle_of(&faces[run.clone()], position, &[]) < REFINE_ANGLE)
         .collect();
-    let mut added = Vec::new();
-    let candidates = split_rungs(faces, &runs, &thin, position, first_id, scale, &mut added);
-    let at = |id: u32| match id {
-        id if id >= first_id => added[(id - first_id) as usize],
-        _ => position(id),
+    let mut rung_points = Vec::new();
+    let candidates = split_rungs(
+        faces,
+        &runs,
+        &thin,
+        position,
+        first_id,
+        scale,
+        &mut rung_points,
+    );
+    let strip = Strip {
+        faces,
+        position,
+        joined,
+        first_id,
+        scale,
+        rung_points,
     };
-    let attempt = |run: &Range<usize>, splits: &Splits| {
-        let original = &faces[run.clone()];
-        let smallest = smallest_angle_of(original, &at, &[]);
-        refine_run(original, &at, splits, scale)
-            .filter(|(f, _)| !joins_anew(original, f, joined))
-            .filter(|(f, v)| smallest_angle_of(f, &at, v) > smallest)
-    };
-    // A rung stays split only while both runs beside it refine with the
-    // rungs split so far; dropping one can only fail runs, so this ends.
-    let mut splits = candidates;
-    let mut refined;
-    loop {
-        refined = runs
-            .iter()
-            .zip(&thin)
-            .map(|(run, &thin)| thin.then(|| attempt(run, &splits)).flatten())
-            .collect::<Vec<_>>();
-        let before = splits.len();
-        let count = runs.len();
-        splits.retain(|_, rung| {
-            refined[(rung.after + count - 1) % count].is_some() && refined[rung.after].is_some()
-        });
-        if splits.len() == before {
-            break;
-        }
-    }
-    let mut out = Vec::with_capacity(faces.len());
-    let mut steiner = Vec::new();
-    let mut take = |run_faces: &[[u32; 3]], run_vertices: Vec<Point3>, out: &mut Vec<[u32; 3]>| {
-        let base = STEINER_BASE + steiner.len() as u32;
-        out.extend(run_faces.iter().map(|f| {
-            f.map(|id| {
-                if id >= STEINER_BASE {
-                    base + (id - STEINER_BASE)
-                } else {
-                    id
-                }
-            })
-        }));
-        steiner.extend(run_vertices);
-    };
+    let (splits, mut refined) = strip.settle(&runs, &thin, candidates);
+    let mut out = Assembled::default();
     for (k, run) in runs.iter().enumerate() {
         match refined[k].take() {
-            Some((run_faces, run_vertices)) => take(&run_faces, run_vertices, &mut out),
-            None if thin[k] => {
-                // Its rungs are whole: the run folds over itself in the
-                // plane, or its refinement would join kept vertices. Its
-                // halves may not.
-                let mut pending = vec![run.clone()];
-                while let Some(part) = pending.pop() {
-                    match attempt(&part, &splits) {
-                        Some((run_faces, run_vertices)) => take(&run_faces, run_vertices, &mut out),
-                        None if part.len() >= 2 * MIN_RUN => {
-                            let middle = part.start + part.len() / 4..=part.end - part.len() / 4;
-                            let split = shortest_rung(faces, position, middle);
-                            pending.push(split..part.end);
-                            pending.push(part.start..split);
-                        }
-                        None => out.extend_from_slice(&faces[part]),
-                    }
-                }
-            }
-            None => out.extend_from_slice(&faces[run.clone()]),
+            Some(run_refined) => out.take(run_refined),
+            // Both its rungs are whole (see `settle`).
+            None if thin[k] => strip.refine_in_halves(run.clone(), &splits, &mut out),
+            None => out.keep(&faces[run.clone()]),
         }
     }
-    numbered(out, added, steiner, &splits, first_id)
+    numbered(out.faces, strip.rung_points, out.steiner, first_id)
 }
 
-/// The faces with the split rungs' points kept (those of `rung_points`
-/// that `splits` still holds) and the runs' added points after them,
-/// numbered from `first_id`, in that order.
+/// A run's faces refined (ids from [`STEINER_BASE`] for its added
+/// points) and its added points.
+type Refined = (Vec<[u32; 3]>, Vec<Point3>);
+
+/// What refining one strip reads.
+struct Strip<'a, P, J> {
+    faces: &'a [[u32; 3]],
+    position: &'a P,
+    joined: &'a J,
+    first_id: u32,
+    scale: f64,
+    /// The points of the split rungs (ids from `first_id`).
+    rung_points: Vec<Point3>,
+}
+
+impl<P: Fn(u32) -> Point3, J: Fn(u32, u32) -> bool> Strip<'_, P, J> {
+    fn at(&self, id: u32) -> Point3 {
+        if id >= self.first_id {
+            self.rung_points[(id - self.first_id) as usize]
+        } else {
+            (self.position)(id)
+        }
+    }
+
+    /// The run refined with the rungs `splits` split, if that raises its
+    /// smallest angle and draws no edge of the kept mesh again.
+    fn attempt(&self, run: &Range<usize>, splits: &Splits) -> Option<Refined> {
+        let at = |id: u32| self.at(id);
+        let original = &self.faces[run.clone()];
+        let smallest = smallest_angle_of(original, &at, &[]);
+        refine_run(original, &at, splits, self.scale)
+            .filter(|(f, _)| !joins_anew(original, f, self.joined))
+            .filter(|(f, v)| smallest_angle_of(f, &at, v) > smallest)
+    }
+
+    /// The rungs that stay split, and each thin run refined with them. A
+    /// rung stays split only while both runs beside it refine with the
+    /// rungs split so far; leaving one whole can only make runs fail, so
+    /// this ends, and a run that fails has both its rungs whole.
+    fn settle(
+        &self,
+        runs: &[Range<usize>],
+        thin: &[bool],
+        mut splits: Splits,
+    ) -> (Splits, Vec<Option<Refined>>) {
+        let count = runs.len();
+        loop {
+            let refined: Vec<Option<Refined>> = runs
+                .iter()
+                .zip(thin)
+                .map(|(run, &thin)| thin.then(|| self.attempt(run, &splits)).flatten())
+                .collect();
+            let before = splits.len();
+            splits.retain(|_, rung| {
+                refined[(rung.after + count - 1) % count].is_some() && refined[rung.after].is_some()
+            });
+            if splits.len() == before {
+                return (splits, refined);
+            }
+        }
+    }
+
+    /// A run that cannot be refined whole (it folds over itself in the
+    /// plane, or its refinement would join kept vertices), refined in
+    /// halves, split at their shortest rung, down to [`MIN_RUN`] faces;
+    /// what is left keeps its faces.
+    fn refine_in_halves(&self, run: Range<usize>, splits: &Splits, out: &mut Assembled) {
+        let mut pending = vec![run];
+        while let Some(part) = pending.pop() {
+            match self.attempt(&part, splits) {
+                Some(refined) => out.take(refined),
+                None if part.len() >= 2 * MIN_RUN => {
+                    let middle = part.start + part.len() / 4..=part.end - part.len() / 4;
+                    let split = shortest_rung(self.faces, self.position, middle);
+                    pending.push(split..part.end);
+                    pending.push(part.start..split);
+                }
+                None => out.keep(&self.faces[part]),
+            }
+        }
+    }
+}
+
+/// The strip's faces as they are made, run after run.
+#[derive(Default)]
+struct Assembled {
+    /// Faces; ids from [`STEINER_BASE`] index `steiner`.
+    faces: Vec<[u32; 3]>,
+    steiner: Vec<Point3>,
+}
+
+impl Assembled {
+    fn take(&mut self, (faces, added): Refined) {
+        let base = STEINER_BASE + self.steiner.len() as u32;
+        let renumber = |id: u32| match id {
+            STEINER_BASE.. => base + (id - STEINER_BASE),
+            _ => id,
+        };
+        self.faces.extend(faces.iter().map(|f| f.map(renumber)));
+        self.steiner.extend(added);
+    }
+
+    fn keep(&mut self, faces: &[[u32; 3]]) {
+        self.faces.extend_from_slice(faces);
+    }
+}
+
+/// The faces with their vertices numbered from `first_id`: the points of
+/// `rung_points` (ids from `first_id`) that the faces use, in order, then
+/// the runs' added points (ids from [`STEINER_BASE`]). Rung points whose
+/// rung was left whole again are dropped.
 fn numbered(
     faces: Vec<[u32; 3]>,
     rung_points: Vec<Point3>,
     steiner: Vec<Point3>,
-    splits: &Splits,
     first_id: u32,
 ) -> (Vec<[u32; 3]>, Vec<Point3>) {
-    let mut new_id: BTreeMap<u32, u32> = BTreeMap::new();
-    let mut vertices = Vec::with_capacity(steiner.len());
-    for rung in splits.values() {
-        for &id in &rung.points {
-            new_id.insert(id, first_id + vertices.len() as u32);
-            vertices.push(rung_points[(id - first_id) as usize]);
-        }
-    }
+    let is_rung_point = |id: u32| (first_id..STEINER_BASE).contains(&id);
+    let used: BTreeSet<u32> = faces
+        .iter()
+        .flatten()
+        .copied()
+        .filter(|&id| is_rung_point(id))
+        .collect();
+    let new_id: BTreeMap<u32, u32> = used
+        .iter()
+        .enumerate()
+        .map(|(k, &id)| (id, first_id + k as u32))
+        .collect();
+    let mut vertices: Vec<Point3> = used
+        .iter()
+        .map(|&id| rung_points[(id - first_id) as usize])
+        .collect();
     let steiner_first = first_id + vertices.len() as u32;
     vertices.extend(steiner);
     let faces = faces
@@ -162,8 +234,7 @@ fn numbered(
         .map(|f| {
             f.map(|id| match id {
                 STEINER_BASE.. => steiner_first + (id - STEINER_BASE),
-                id if id >= first_id => new_id[&id],
-                id => id,
+                id => new_id.get(&id).copied().unwrap_or(id),
             })
         })
         .collect();
@@ -186,8 +257,8 @@ type Splits = BTreeMap<(u32, u32), SplitRung>;
 /// [`MAX_RUNG_POINTS`] points): a run's outline is never split by its
 /// refinement (the wall is shared with the kept faces), and a long
 /// unsplit rung keeps refinement out of the half of the run round it.
-/// Both runs take the same points. The points are pushed onto `added`
-/// (ids from `first_id`).
+/// Both runs take the same points. The points are pushed onto
+/// `rung_points` (ids from `first_id`).
 fn split_rungs(
     faces: &[[u32; 3]],
     runs: &[Range<usize>],
@@ -195,7 +266,7 @@ fn split_rungs(
     position: &impl Fn(u32) -> Point3,
     first_id: u32,
     scale: f64,
-    added: &mut Vec<Point3>,
+    rung_points: &mut Vec<Point3>,
 ) -> Splits {
     let mut splits = Splits::new();
     if runs.len() < 2 {
@@ -220,8 +291,8 @@ fn split_rungs(
         let points = (1..pieces)
             .map(|i| {
                 let t = i as f64 / pieces as f64;
-                added.push(std::array::from_fn(|c| p[c] + t * (q[c] - p[c])));
-                first_id + added.len() as u32 - 1
+                rung_points.push(std::array::from_fn(|c| p[c] + t * (q[c] - p[c])));
+                first_id + rung_points.len() as u32 - 1
             })
             .collect();
         splits.insert((low, high), SplitRung { after: k, points });
@@ -264,14 +335,15 @@ fn runs(
     runs
 }
 
-/// The face `t` among `among` (each above 0) whose rung with face t − 1
-/// is the shortest; the first of equals.
+/// The face `t` among `among` whose rung with the face before it (the
+/// last face, before face 0) is the shortest; the first of equals.
 fn shortest_rung(
     faces: &[[u32; 3]],
     position: &impl Fn(u32) -> Point3,
     among: RangeInclusive<usize>,
 ) -> usize {
-    let rung_length = |t: usize| match shared_edge(&faces[t - 1], &faces[t]) {
+    let before = |t: usize| (t + faces.len() - 1) % faces.len();
+    let rung_length = |t: usize| match shared_edge(&faces[before(t)], &faces[t]) {
         Some((a, b)) => dist2(position(a), position(b)),
         None => 0.0,
     };
