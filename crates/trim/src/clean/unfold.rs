@@ -58,7 +58,7 @@ pub(super) fn refine_strip(
     first_id: u32,
     scale: f64,
 ) -> (Vec<[u32; 3]>, Vec<Point3>) {
-    let runs = runs(faces, position, RUN);
+    let runs = runs(faces, position);
     let thin: Vec<bool> = runs
         .iter()
         .map(|run| smallest_angle_of(&faces[run.clone()], position, &[]) < REFINE_ANGLE)
@@ -315,19 +315,15 @@ const STEINER_BASE: u32 = STEINER - (1 << 30);
 
 /// The runs of faces, each about [`RUN`] long and ended at the shortest
 /// rung near that length.
-fn runs(
-    faces: &[[u32; 3]],
-    position: &impl Fn(u32) -> Point3,
-    run_len: usize,
-) -> Vec<Range<usize>> {
+fn runs(faces: &[[u32; 3]], position: &impl Fn(u32) -> Point3) -> Vec<Range<usize>> {
     let mut runs = Vec::new();
     let mut start = 0;
     while start < faces.len() {
-        let end = if faces.len() - start <= run_len + RUN_SLACK {
+        let end = if faces.len() - start <= RUN + RUN_SLACK {
             faces.len()
         } else {
-            let last = (start + run_len + RUN_SLACK).min(faces.len() - 2);
-            shortest_rung(faces, position, start + run_len - RUN_SLACK..=last)
+            let last = (start + RUN + RUN_SLACK).min(faces.len() - 2);
+            shortest_rung(faces, position, start + RUN - RUN_SLACK..=last)
         };
         runs.push(start..end);
         start = end;
