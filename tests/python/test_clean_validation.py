@@ -523,8 +523,8 @@ def test_scan_new_faces_are_rarely_thin(scan):
     faces there (1.5-4.2 % of the input's faces are below 10 degrees, far
     more along the silhouette), where the kept mesh's new border lies
     several spacings behind the smoothed loop; the strip is refined in its
-    unfolded plane, and what stays thin lies against the kept border's own
-    sharp turns or where the strip folds: bun000 15 / 48 of 2547, bun045
+    unfolded plane, and about a third of what stays thin lies where the
+    strip folds and cannot be refined: bun000 15 / 48 of 2547, bun045
     59 / 83 of 2479, bun090 36 / 88 of 2330, chin 70 / 130 of 2451 (96 /
     289, 168 / 332, 116 / 291, 180 / 351 unrefined). Bounds: 4 % below 5,
     8 % below 10."""
