@@ -241,13 +241,7 @@ pub(super) fn coincide(ring: Option<usize>) -> Retry {
 pub(super) fn refine_gap(cdt: &mut Cdt, mesh: &Mesh, patch: &mut Patch, scale: f64) {
     let n = mesh.vertices.len() as u32;
     let before = cdt.clone();
-    let parameters = RefinementParameters::<f64>::new()
-        .exclude_outer_faces(true)
-        .keep_constraint_edges()
-        .with_angle_limit(AngleLimit::from_deg(REFINE_ANGLE))
-        .with_min_required_area(REFINE_MIN_AREA * scale * scale)
-        .with_max_additional_vertices(4 * before.num_vertices() + 16);
-    cdt.refine(parameters);
+    cdt.refine(refinement(before.num_vertices(), scale));
     let position = |id: u32| {
         if id < n {
             mesh.vertices[id as usize]
@@ -264,6 +258,19 @@ pub(super) fn refine_gap(cdt: &mut Cdt, mesh: &Mesh, patch: &mut Patch, scale: f
         cdt.vertex_data_mut(h).id = n + patch.vertices.len() as u32;
         patch.vertices.push(p);
     }
+}
+
+/// Delaunay refinement of the faces between constraints to
+/// [`REFINE_ANGLE`], the constraints never split, faces below
+/// [`REFINE_MIN_AREA`]·`scale`² left alone, and at most about four points
+/// added per vertex of the `vertices` triangulated.
+pub(super) fn refinement(vertices: usize, scale: f64) -> RefinementParameters<f64> {
+    RefinementParameters::<f64>::new()
+        .exclude_outer_faces(true)
+        .keep_constraint_edges()
+        .with_angle_limit(AngleLimit::from_deg(REFINE_ANGLE))
+        .with_min_required_area(REFINE_MIN_AREA * scale * scale)
+        .with_max_additional_vertices(4 * vertices + 16)
 }
 
 /// The 3D point of the surface at `p` of the unrefined triangulation: the

@@ -181,6 +181,17 @@ impl Guide {
         self.points.len()
     }
 
+    /// The place of a strip vertex: a mesh vertex, or (ids from the mesh's
+    /// vertex count on) a vertex of the smoothed loop.
+    fn position(&self, cx: &Context, id: u32) -> Point3 {
+        let n = cx.mesh.vertices.len() as u32;
+        if id < n {
+            cx.mesh.vertices[id as usize]
+        } else {
+            self.points[(id - n) as usize]
+        }
+    }
+
     fn length(&self) -> f64 {
         self.arc[self.len()]
     }
@@ -359,21 +370,9 @@ pub(super) fn replace_by_strip(
     let faces = zip(cx, &guide, &wall)?;
     let n = cx.mesh.vertices.len() as u32;
     let m = guide.len() as u32;
-    let position = |id: u32| {
-        if id < n {
-            cx.mesh.vertices[id as usize]
-        } else {
-            guide.points[(id - n) as usize]
-        }
-    };
+    let position = |id: u32| guide.position(cx, id);
     let joined = |a: u32, b: u32| {
-        a < n
-            && b < n
-            && cx
-                .topology
-                .faces_of(a)
-                .iter()
-                .any(|&f| cx.mesh.faces[f as usize].contains(&b))
+        a < n && b < n && (face_running(cx, a, b).is_some() || face_running(cx, b, a).is_some())
     };
     let (faces, added) = refine_strip(&faces, &position, &joined, n + m, cx.beta_median);
     let mut vertices = guide.points.clone();
@@ -856,14 +855,7 @@ fn zip(cx: &Context, guide: &Guide, wall: &[u32]) -> Result<Vec<[u32; 3]>, Strip
 /// Whether a strip face turns against the surface at the nearest segment
 /// of the smoothed loop.
 fn turns_against(cx: &Context, guide: &Guide, face: &[u32; 3]) -> bool {
-    let n = cx.mesh.vertices.len() as u32;
-    let p = face.map(|id| {
-        if id < n {
-            cx.mesh.vertices[id as usize]
-        } else {
-            guide.points[(id - n) as usize]
-        }
-    });
+    let p = face.map(|id| guide.position(cx, id));
     let normal = cross(sub(p[1], p[0]), sub(p[2], p[0]));
     let centre = scale(add(add(p[0], p[1]), p[2]), 1.0 / 3.0);
     let near = guide.nearest(centre);

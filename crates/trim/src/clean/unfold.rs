@@ -140,18 +140,28 @@ impl<P: Fn(u32) -> Point3, J: Fn(u32, u32) -> bool> Strip<'_, P, J> {
         mut splits: Splits,
     ) -> (Splits, Vec<Option<Refined>>) {
         let count = runs.len();
+        let mut refined: Vec<Option<Refined>> = runs
+            .iter()
+            .zip(thin)
+            .map(|(run, &thin)| thin.then(|| self.attempt(run, &splits)).flatten())
+            .collect();
         loop {
-            let refined: Vec<Option<Refined>> = runs
-                .iter()
-                .zip(thin)
-                .map(|(run, &thin)| thin.then(|| self.attempt(run, &splits)).flatten())
-                .collect();
-            let before = splits.len();
+            // The runs beside a rung left whole again are tried again;
+            // the others saw the same rungs.
+            let mut again = BTreeSet::new();
             splits.retain(|_, rung| {
-                refined[(rung.after + count - 1) % count].is_some() && refined[rung.after].is_some()
+                let before = (rung.after + count - 1) % count;
+                let stays = refined[before].is_some() && refined[rung.after].is_some();
+                if !stays {
+                    again.extend([before, rung.after]);
+                }
+                stays
             });
-            if splits.len() == before {
+            if again.is_empty() {
                 return (splits, refined);
+            }
+            for k in again.into_iter().filter(|&k| thin[k]) {
+                refined[k] = self.attempt(&runs[k], &splits);
             }
         }
     }
@@ -577,13 +587,7 @@ fn refine_run(
         }
         cdt.add_constraint(handles[a], handles[b]);
     }
-    let parameters = RefinementParameters::<f64>::new()
-        .exclude_outer_faces(true)
-        .keep_constraint_edges()
-        .with_angle_limit(AngleLimit::from_deg(REFINE_ANGLE))
-        .with_min_required_area(REFINE_MIN_AREA * scale * scale)
-        .with_max_additional_vertices(4 * run.ids.len() + 16);
-    cdt.refine(parameters);
+    cdt.refine(refinement(run.ids.len(), scale));
     let mut added = Vec::new();
     let mut index_of = vec![0u32; cdt.num_vertices()];
     for h in cdt.fixed_vertices() {
