@@ -28,7 +28,7 @@ use crate::anisotropy::{
 use crate::cloud::{check_finite, check_not_degenerate, merge_duplicates, Sites, PASS_PIECE};
 use crate::error::CloudError;
 use crate::frame::{fit_plane_normal, project_sheared, ray_shear, spread, Frame, Point2};
-use crate::geom::{sub, Point3};
+use crate::geom::{dist2, sub, Point3};
 use crate::resolution::{beta_of, nearest_distances, Columns};
 use crate::spatial::morton::{octree_runs, spatial_order, split_by_runs, MortonCells, MortonGrid};
 use crate::spatial::neighbours::{NeighbourIndex, RunScratch};
@@ -143,6 +143,14 @@ pub struct Detection {
     /// boundary, the edges of the α-shape with α = β. A duplicate point is represented by
     /// its first copy. Edge reconstruction clusters and orders with them.
     pub links: Vec<[u32; 2]>,
+    /// The scanner's view the neighbourhoods were projected along, when
+    /// given.
+    pub view: Option<View>,
+    /// With a view, each point's neighbourhood radius (the distance to the
+    /// farthest of its k nearest points), in input order; empty without
+    /// one. Edge reconstruction tells from it the neighbours a point's
+    /// test saw from points across a jump in depth.
+    pub reach: Vec<f64>,
 }
 
 impl Detection {
@@ -221,7 +229,41 @@ fn run(
     } else {
         analyse_all::<Vec<u32>>(&hoods, &site_of, how, tests)
     };
-    Ok(detection)
+    let reach = match options.view {
+        Some(_) => neighbourhood_reach(&hoods, &site_of),
+        None => Vec::new(),
+    };
+    Ok(Detection {
+        view: options.view,
+        reach,
+        ..detection
+    })
+}
+
+/// The distance from each input point to the farthest member of its
+/// neighbourhood.
+fn neighbourhood_reach(hoods: &Neighbourhoods, site_of: &[u32]) -> Vec<f64> {
+    let radius: Vec<f64> = (0..hoods.points.len())
+        .into_par_iter()
+        .with_min_len(PASS_PIECE)
+        .map(|p| {
+            let at = hoods.points[p];
+            hoods
+                .at(p)
+                .iter()
+                .map(|&m| dist2(at, hoods.points[m as usize]))
+                .fold(0.0, f64::max)
+                .sqrt()
+        })
+        .collect();
+    let mut position_of = vec![0u32; hoods.order.len()];
+    for (position, &site) in hoods.order.iter().enumerate() {
+        position_of[site as usize] = position as u32;
+    }
+    site_of
+        .iter()
+        .map(|&site| radius[position_of[site as usize] as usize])
+        .collect()
 }
 
 /// Neighbourhoods sampled to judge whether the cloud has a second
@@ -677,6 +719,8 @@ fn spread_to_input<T: Sync>(
         decision,
         duplicates: site_of.len() - verdicts.len(),
         links: Vec::new(),
+        view: None,
+        reach: Vec::new(),
     }
 }
 
@@ -1134,7 +1178,15 @@ mod tests {
             view: Some(View::Along([0.0, 0.0, -2.0])),
             ..BpdOptions::default()
         };
-        assert_eq!(paper, detect_boundary(&flat, &along_z).unwrap());
+        let viewed = detect_boundary(&flat, &along_z).unwrap();
+        assert_eq!(viewed.view, along_z.view);
+        assert_eq!(viewed.reach.len(), flat.len());
+        let without_view = Detection {
+            view: None,
+            reach: Vec::new(),
+            ..viewed
+        };
+        assert_eq!(paper, without_view);
     }
 
     #[test]

@@ -5,7 +5,9 @@
 //!    links BPD found between them and thins spurs away;
 //! 2. [`order`] turns each group into a closed tour; [`split`] cuts a tour
 //!    that jumps across the surface (two borders in one group) into loops
-//!    that follow the links;
+//!    that follow the links. For a range scan whose line of sight is known,
+//!    [`trace`] takes the place of both steps: the loops are the border of
+//!    the cloud's region in the scan's image plane;
 //! 3. [`corners`] finds the corners of each loop (section 3.1), which split
 //!    it into edges;
 //! 4. each edge is smoothed by a spatial low-pass filter (section 3.3);
@@ -18,6 +20,7 @@ pub mod offset;
 pub mod order;
 pub mod smooth;
 pub mod split;
+pub mod trace;
 
 use rayon::prelude::*;
 
@@ -113,6 +116,9 @@ pub struct Edges {
 /// Reconstructs the boundary edges of a cloud from its BPD result: loops,
 /// corners and smoothed edges (see the module doc for the steps).
 pub fn reconstruct_edges(points: &[Point3], detection: &Detection, options: &EdgeOptions) -> Edges {
+    if let Some(traced) = trace::traced_loops(points, detection) {
+        return edges_of_traced_loops(points, detection, options, traced);
+    }
     let canon = CanonicalBoundary::new(points, detection);
     let clusters = cluster::cluster_boundary(&canon.boundary, &canon.links);
     let tours: Vec<Vec<u32>> = clusters
@@ -150,6 +156,73 @@ pub fn reconstruct_edges(points: &[Point3], detection: &Detection, options: &Edg
     }
 }
 
+/// Corners and smoothed edges of the loops traced in a scan's image plane
+/// ([`trace`]). As with tours, a loop needs [`cluster::MIN_LOOP_POINTS`]
+/// points that BPD labelled boundary; the loops are numbered, started and
+/// oriented by their points' geometry (see [`CanonicalBoundary`]).
+fn edges_of_traced_loops(
+    points: &[Point3],
+    detection: &Detection,
+    options: &EdgeOptions,
+    traced: Vec<Vec<u32>>,
+) -> Edges {
+    let before = traced.len();
+    let mut traced: Vec<Vec<u32>> = traced
+        .into_iter()
+        .filter(|tour| {
+            let found = tour
+                .iter()
+                .filter(|&&i| detection.boundary[i as usize])
+                .count();
+            found >= cluster::MIN_LOOP_POINTS
+        })
+        .collect();
+    let dropped = before - traced.len();
+    let mut on_loops: Vec<u32> = traced.iter().flatten().copied().collect();
+    on_loops.sort_unstable();
+    on_loops.dedup();
+    let by_number = geometric_order(points, on_loops);
+    let mut number = std::collections::HashMap::with_capacity(by_number.len());
+    for (c, &i) in by_number.iter().enumerate() {
+        number.insert(i, c as u32);
+    }
+    for tour in &mut traced {
+        let numbered = tour.iter().map(|i| number[i]).collect();
+        *tour = order::canonical(numbered)
+            .into_iter()
+            .map(|c| by_number[c as usize])
+            .collect();
+    }
+    traced.sort_by_cached_key(|tour| tour.iter().map(|i| number[i]).min());
+    let index = options.offset.then(|| NeighbourIndex::new(points));
+    let thinned = (0..points.len() as u32)
+        .filter(|i| detection.boundary[*i as usize] && !number.contains_key(i))
+        .count();
+    let loops = traced
+        .into_par_iter()
+        .map(|tour| loop_from_tour(points, &detection.beta, tour, index.as_ref()))
+        .collect();
+    Edges {
+        loops,
+        dropped_clusters: dropped,
+        thinned_points: thinned,
+    }
+}
+
+/// `members` (input indices) in the order of their geometry: by squared
+/// distance from their centroid in [`tie_key`] bins, then by input index.
+fn geometric_order(points: &[Point3], mut members: Vec<u32>) -> Vec<u32> {
+    let n = members.len().max(1) as f64;
+    let mut centre = [0.0; 3];
+    for &i in &members {
+        for (c, x) in centre.iter_mut().zip(points[i as usize]) {
+            *c += x / n;
+        }
+    }
+    members.sort_by_cached_key(|&i| (tie_key(dist2(points[i as usize], centre)), i));
+    members
+}
+
 /// The boundary points renumbered 0, 1, … in an order of their own
 /// geometry, in which edge reconstruction works: so every tie-break, each
 /// tour's start and direction and the order of the loops follow the points,
@@ -175,17 +248,12 @@ struct CanonicalBoundary {
 impl CanonicalBoundary {
     fn new(points: &[Point3], detection: &Detection) -> Self {
         let fillers = gap_fillers(detection);
-        let mut input: Vec<u32> = (0..points.len() as u32)
-            .filter(|&i| detection.boundary[i as usize] || fillers[i as usize])
-            .collect();
-        let n = input.len().max(1) as f64;
-        let mut centre = [0.0; 3];
-        for &i in &input {
-            for (c, x) in centre.iter_mut().zip(points[i as usize]) {
-                *c += x / n;
-            }
-        }
-        input.sort_by_cached_key(|&i| (tie_key(dist2(points[i as usize], centre)), i));
+        let input = geometric_order(
+            points,
+            (0..points.len() as u32)
+                .filter(|&i| detection.boundary[i as usize] || fillers[i as usize])
+                .collect(),
+        );
         let mut renumbered = vec![u32::MAX; points.len()];
         for (c, &i) in input.iter().enumerate() {
             renumbered[i as usize] = c as u32;
@@ -412,6 +480,8 @@ mod tests {
             beta: vec![3.0; n],
             duplicates: 0,
             links,
+            view: None,
+            reach: Vec::new(),
         };
         (points, detection)
     }

@@ -1,0 +1,453 @@
+//! Loops of a range scan traced in its image plane (meshtrim's extension
+//! of the clustering and ordering that section 3 leaves to "existing
+//! algorithms").
+//!
+//! A scan taken from one view is a height field over its image plane: each
+//! line of sight meets the surface once. There the cloud's region is the
+//! union of the Delaunay triangles of the projected points whose empty
+//! circumcircle is smaller than β, the very circles BPD tests (a point is
+//! a boundary point when an empty circle of radius ≥ β passes through it,
+//! and the largest empty circles through a point are the circumcircles of
+//! its Delaunay triangles). The region's border, traced edge by edge, is a
+//! set of closed, single-row, planar loops: no tour to find, nothing to
+//! jump across, however ragged or thick the band of boundary points is.
+//!
+//! A triangle is part of the region when its circumcircle's radius, in the
+//! cloud's units, is below the largest β of its corners, and each of its
+//! sides joins points that lie within one another's neighbourhood: a side
+//! across a jump in depth (an occluding silhouette) joins points that saw
+//! each other in the image but not in space, and the region ends there.
+
+use std::collections::HashMap;
+
+use spade::handles::FixedDirectedEdgeHandle;
+use spade::{DelaunayTriangulation, HierarchyHintGenerator, Point2, Triangulation};
+
+use crate::bpd::{Detection, View};
+use crate::frame::Frame;
+use crate::geom::{dist2, dot, sub, unit, Point3};
+
+type Image = DelaunayTriangulation<Point2<f64>, (), (), (), HierarchyHintGenerator<f64>>;
+
+/// Where the cloud lies in its image plane.
+struct Projection {
+    /// Each input point's image coordinates.
+    image: Vec<[f64; 2]>,
+    /// Each input point's image scale: the cloud's units per image unit at
+    /// its depth (1 along parallel lines of sight).
+    scale: Vec<f64>,
+}
+
+/// Smallest cosine between a point's line of sight from the scanner's
+/// position and the view's axis: a camera's field of view is well inside
+/// ±84°; farther off the axis the image plane no longer holds the cloud.
+const MIN_AXIS_COSINE: f64 = 0.1;
+
+impl Projection {
+    /// The image of the cloud as the scanner saw it, or `None` when no
+    /// single image plane holds it (points beside or behind a scanner's
+    /// position).
+    fn new(points: &[Point3], view: View) -> Option<Self> {
+        match view {
+            View::Along(direction) => {
+                let frame = Frame::of_normal(unit(direction));
+                Some(Projection {
+                    image: points
+                        .iter()
+                        .map(|&p| [dot(p, frame.u), dot(p, frame.v)])
+                        .collect(),
+                    scale: vec![1.0; points.len()],
+                })
+            }
+            View::From(origin) => {
+                let rays: Vec<Point3> = points.iter().map(|&p| sub(p, origin)).collect();
+                let axis = unit(rays.iter().fold([0.0; 3], |s, r| {
+                    let r = unit(*r);
+                    [s[0] + r[0], s[1] + r[1], s[2] + r[2]]
+                }));
+                let frame = Frame::of_normal(axis);
+                let mut image = Vec::with_capacity(points.len());
+                let mut scale = Vec::with_capacity(points.len());
+                for ray in rays {
+                    let depth = dot(ray, axis);
+                    if !(depth > MIN_AXIS_COSINE * dot(ray, ray).sqrt()) {
+                        return None;
+                    }
+                    image.push([dot(ray, frame.u) / depth, dot(ray, frame.v) / depth]);
+                    scale.push(depth);
+                }
+                Some(Projection { image, scale })
+            }
+        }
+    }
+}
+
+/// The region's border loops (input indices, each loop a simple cycle,
+/// the region on its left in the image plane), or `None` when the
+/// detection has no view or no image plane holds the cloud.
+pub(crate) fn traced_loops(points: &[Point3], detection: &Detection) -> Option<Vec<Vec<u32>>> {
+    let view = detection.view?;
+    if detection.reach.len() != points.len() {
+        return None;
+    }
+    let projection = Projection::new(points, view)?;
+    let (image, owner) = triangulate(&projection.image)?;
+    let covered = covered_faces(&image, &owner, points, detection, &projection.scale);
+    let cycles = trace_borders(&image, &covered);
+    Some(
+        cycles
+            .into_iter()
+            .map(|cycle| cycle.into_iter().map(|v| owner[v]).collect())
+            .flat_map(simple_cycles)
+            .collect(),
+    )
+}
+
+/// The Delaunay triangulation of the image, and the input point that owns
+/// each of its vertices (the first of points that share an image
+/// position). Points are inserted sorted by their image coordinates, so
+/// the triangulation does not depend on the order the cloud was written
+/// in. `None` if spade refuses a coordinate.
+fn triangulate(image: &[[f64; 2]]) -> Option<(Image, Vec<u32>)> {
+    let mut order: Vec<u32> = (0..image.len() as u32).collect();
+    order.sort_by(|&a, &b| {
+        let (p, q) = (image[a as usize], image[b as usize]);
+        p[0].total_cmp(&q[0])
+            .then(p[1].total_cmp(&q[1]))
+            .then(a.cmp(&b))
+    });
+    let mut triangulation = Image::new();
+    let mut owner = Vec::with_capacity(image.len());
+    for i in order {
+        let [x, y] = image[i as usize];
+        let before = triangulation.num_vertices();
+        triangulation.insert(crate::planar::point([x, y])).ok()?;
+        if triangulation.num_vertices() > before {
+            owner.push(i);
+        }
+    }
+    Some((triangulation, owner))
+}
+
+/// Which inner faces belong to the cloud's region (by face index).
+fn covered_faces(
+    image: &Image,
+    owner: &[u32],
+    points: &[Point3],
+    detection: &Detection,
+    scale: &[f64],
+) -> Vec<bool> {
+    let mut covered = vec![false; image.num_all_faces()];
+    for face in image.inner_faces() {
+        let corners = face.vertices().map(|v| owner[v.fix().index()] as usize);
+        let [a, b, c] = face.positions().map(|p| [p.x, p.y]);
+        let image_scale = corners.iter().map(|&i| scale[i]).sum::<f64>() / 3.0;
+        let radius = circumradius(a, b, c) * image_scale;
+        let beta = corners
+            .iter()
+            .map(|&i| detection.beta[i])
+            .fold(0.0, f64::max);
+        let sees = |i: usize, j: usize| {
+            let reach = detection.reach[i].max(detection.reach[j]);
+            dist2(points[i], points[j]) <= reach * reach
+        };
+        let [i, j, k] = corners;
+        covered[face.fix().index()] = radius < beta && sees(i, j) && sees(j, k) && sees(k, i);
+    }
+    covered
+}
+
+/// The radius of the circle through three image points (infinite for a
+/// degenerate triangle).
+fn circumradius(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
+    let side = |p: [f64; 2], q: [f64; 2]| ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)).sqrt();
+    let twice_area = ((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])).abs();
+    if twice_area == 0.0 {
+        return f64::INFINITY;
+    }
+    side(a, b) * side(b, c) * side(c, a) / (2.0 * twice_area)
+}
+
+/// Whether the face on the left of `edge` is a covered inner face.
+fn covers(image: &Image, covered: &[bool], edge: FixedDirectedEdgeHandle) -> bool {
+    image
+        .directed_edge(edge)
+        .face()
+        .as_inner()
+        .is_some_and(|f| covered[f.fix().index()])
+}
+
+/// The border of the covered region as cycles of vertex indices, the
+/// region on their left. At a vertex the walk turns through the covered
+/// faces round it to the next border edge, so two parts of the region
+/// that touch only at a vertex are traced apart there.
+fn trace_borders(image: &Image, covered: &[bool]) -> Vec<Vec<usize>> {
+    let is_border =
+        |e: FixedDirectedEdgeHandle| covers(image, covered, e) && !covers(image, covered, e.rev());
+    let mut visited = vec![false; image.num_directed_edges()];
+    let mut cycles = Vec::new();
+    for start in image.directed_edges().map(|e| e.fix()) {
+        if visited[start.index()] || !is_border(start) {
+            continue;
+        }
+        let mut cycle = Vec::new();
+        let mut edge = start;
+        while !visited[edge.index()] {
+            visited[edge.index()] = true;
+            cycle.push(image.directed_edge(edge).from().fix().index());
+            edge = next_border_edge(image, covered, edge);
+        }
+        cycles.push(cycle);
+    }
+    cycles
+}
+
+/// The border edge that follows `edge` (a border edge, covered on its
+/// left) at its end vertex: the first side, turning from `edge` through
+/// the covered faces round that vertex, with no covered face beyond it.
+fn next_border_edge(
+    image: &Image,
+    covered: &[bool],
+    edge: FixedDirectedEdgeHandle,
+) -> FixedDirectedEdgeHandle {
+    let mut next = image.directed_edge(edge).next();
+    while covers(image, covered, next.rev().fix()) {
+        next = next.rev().next();
+    }
+    next.fix()
+}
+
+/// A closed walk split into simple cycles where it passes a vertex twice
+/// (a region pinched at a vertex between two of its stretches).
+fn simple_cycles(walk: Vec<u32>) -> Vec<Vec<u32>> {
+    let mut cycles = Vec::new();
+    let mut path: Vec<u32> = Vec::with_capacity(walk.len());
+    let mut at: HashMap<u32, usize> = HashMap::new();
+    for v in walk {
+        if let Some(&first) = at.get(&v) {
+            let cycle = path.split_off(first + 1);
+            for w in &cycle {
+                at.remove(w);
+            }
+            let mut closed = vec![v];
+            closed.extend(cycle);
+            cycles.push(closed);
+        } else {
+            at.insert(v, path.len());
+            path.push(v);
+        }
+    }
+    cycles.push(path);
+    cycles
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bpd::{detect_boundary, BpdOptions};
+    use crate::edges::{reconstruct_edges, EdgeOptions};
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+    use std::collections::BTreeMap;
+
+    /// A jittered grid, `z = height(x, y)`, keeping the points `keep`
+    /// accepts: a range scan seen along z.
+    fn scan(
+        seed: u64,
+        side: usize,
+        keep: impl Fn(f64, f64, &mut ChaCha8Rng) -> bool,
+        height: impl Fn(f64, f64) -> f64,
+    ) -> Vec<Point3> {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let mut points = Vec::new();
+        for i in 0..side {
+            for j in 0..side {
+                let x = i as f64 + rng.random_range(-0.3..0.3);
+                let y = j as f64 + rng.random_range(-0.3..0.3);
+                if keep(x, y, &mut rng) {
+                    points.push([x, y, height(x, y)]);
+                }
+            }
+        }
+        points
+    }
+
+    /// A square with a hole whose border is ragged several rows deep:
+    /// points within 3 of the edge are dropped at random.
+    fn ragged(seed: u64) -> Vec<Point3> {
+        let side = 40;
+        scan(
+            seed,
+            side,
+            |x, y, rng| {
+                let edge = x
+                    .min(y)
+                    .min(side as f64 - 1.0 - x)
+                    .min(side as f64 - 1.0 - y);
+                let hole = (x - 20.0).hypot(y - 20.0) < 5.0;
+                !hole && (edge > 3.0 || rng.random_range(0.0..1.0) < 0.6)
+            },
+            |x, y| 0.3 * (0.2 * x).sin() + 0.1 * y,
+        )
+    }
+
+    fn along_z() -> BpdOptions {
+        BpdOptions {
+            view: Some(View::Along([0.0, 0.0, 1.0])),
+            ..BpdOptions::default()
+        }
+    }
+
+    fn loops_of(points: &[Point3]) -> Vec<Vec<u32>> {
+        let detection = detect_boundary(points, &along_z()).unwrap();
+        traced_loops(points, &detection).unwrap()
+    }
+
+    /// The traced loops' sides are exactly the triangulation's sides that
+    /// one covered face has and the other side's face has not (counted
+    /// plainly over the faces), and each loop is a simple cycle.
+    #[test]
+    fn loops_are_the_covered_regions_border() {
+        for seed in 1..=6 {
+            let points = ragged(seed);
+            let detection = detect_boundary(&points, &along_z()).unwrap();
+            let projection = Projection::new(&points, detection.view.unwrap()).unwrap();
+            let (image, owner) = triangulate(&projection.image).unwrap();
+            let covered = covered_faces(&image, &owner, &points, &detection, &projection.scale);
+            let mut sides: BTreeMap<(u32, u32), usize> = BTreeMap::new();
+            for face in image.inner_faces().filter(|f| covered[f.fix().index()]) {
+                let [a, b, c] = face.vertices().map(|v| owner[v.fix().index()]);
+                for (p, q) in [(a, b), (b, c), (c, a)] {
+                    *sides.entry((p.min(q), p.max(q))).or_default() += 1;
+                }
+            }
+            let mut expected: Vec<(u32, u32)> = sides
+                .into_iter()
+                .filter(|&(_, n)| n == 1)
+                .map(|(s, _)| s)
+                .collect();
+            let loops = traced_loops(&points, &detection).unwrap();
+            let mut traced = Vec::new();
+            for cycle in &loops {
+                let mut seen = cycle.clone();
+                seen.sort_unstable();
+                seen.dedup();
+                assert_eq!(
+                    seen.len(),
+                    cycle.len(),
+                    "seed {seed}: a loop repeats a point"
+                );
+                for (k, &a) in cycle.iter().enumerate() {
+                    let b = cycle[(k + 1) % cycle.len()];
+                    traced.push((a.min(b), a.max(b)));
+                }
+            }
+            traced.sort_unstable();
+            expected.sort_unstable();
+            assert_eq!(traced, expected, "seed {seed}");
+        }
+    }
+
+    /// However ragged the square's border, its outer loop goes all round
+    /// it, and the hole is a loop of its own.
+    #[test]
+    fn a_ragged_border_closes_into_one_loop() {
+        for seed in 1..=6 {
+            let points = ragged(seed);
+            let loops: Vec<Vec<u32>> = loops_of(&points)
+                .into_iter()
+                .filter(|l| l.len() >= 8)
+                .collect();
+            let longest = loops.iter().max_by_key(|l| l.len()).unwrap();
+            let (lo, hi) = longest.iter().fold((f64::MAX, f64::MIN), |(lo, hi), &i| {
+                let p = points[i as usize];
+                (lo.min(p[0]).min(p[1]), hi.max(p[0]).max(p[1]))
+            });
+            assert!(
+                lo < 1.0 && hi > 38.0,
+                "seed {seed}: outer loop spans {lo}..{hi}"
+            );
+            let round_hole = loops.iter().any(|l| {
+                l.iter().all(|&i| {
+                    let p = points[i as usize];
+                    (p[0] - 20.0).hypot(p[1] - 20.0) < 7.0
+                })
+            });
+            assert!(round_hole, "seed {seed}: no loop round the hole");
+        }
+    }
+
+    /// Two sheets side by side in the image but 20 spacings apart in depth
+    /// are two regions: the step is a border of both.
+    #[test]
+    fn a_jump_in_depth_ends_the_region() {
+        let points = scan(
+            7,
+            30,
+            |_, _, _| true,
+            |x, _| if x < 15.0 { 0.0 } else { 20.0 },
+        );
+        let loops = loops_of(&points);
+        let spans: Vec<(f64, f64)> = loops
+            .iter()
+            .filter(|l| l.len() >= 8)
+            .map(|l| {
+                l.iter().fold((f64::MAX, f64::MIN), |(lo, hi), &i| {
+                    (lo.min(points[i as usize][0]), hi.max(points[i as usize][0]))
+                })
+            })
+            .collect();
+        assert_eq!(spans.len(), 2, "{spans:?}");
+        assert!(
+            spans.iter().all(|&(lo, hi)| hi < 15.5 || lo > 14.0),
+            "{spans:?}"
+        );
+    }
+
+    /// The view in either sense, and the cloud in any order, give the same
+    /// edges.
+    #[test]
+    fn edges_do_not_depend_on_the_views_sense_nor_the_order() {
+        let points = ragged(3);
+        let edges_with = |points: &[Point3], direction: Point3| {
+            let options = BpdOptions {
+                view: Some(View::Along(direction)),
+                ..BpdOptions::default()
+            };
+            let detection = detect_boundary(points, &options).unwrap();
+            reconstruct_edges(points, &detection, &EdgeOptions::default())
+        };
+        let up = edges_with(&points, [0.0, 0.0, 1.0]);
+        assert_eq!(up, edges_with(&points, [0.0, 0.0, -3.0]));
+        let mut rng = ChaCha8Rng::seed_from_u64(11);
+        let mut order: Vec<usize> = (0..points.len()).collect();
+        for i in (1..order.len()).rev() {
+            order.swap(i, rng.random_range(0..=i));
+        }
+        let shuffled: Vec<Point3> = order.iter().map(|&i| points[i]).collect();
+        let again = edges_with(&shuffled, [0.0, 0.0, 1.0]);
+        let polylines = |e: &crate::edges::Edges| -> Vec<Vec<Point3>> {
+            e.loops
+                .iter()
+                .flat_map(|l| l.edges.iter().map(|e| e.points.clone()))
+                .collect()
+        };
+        assert_eq!(polylines(&up), polylines(&again));
+    }
+
+    /// A walk through a pinch vertex comes apart into simple cycles.
+    #[test]
+    fn a_pinched_walk_splits_into_simple_cycles() {
+        let cycles = simple_cycles(vec![1, 2, 3, 9, 4, 5, 9, 6]);
+        assert_eq!(cycles, vec![vec![9, 4, 5], vec![1, 2, 3, 9, 6]]);
+    }
+
+    /// With the scanner's position behind part of the cloud, no image
+    /// plane holds it, and edge reconstruction goes by BPD's links.
+    #[test]
+    fn no_image_plane_for_points_behind_the_scanner() {
+        let points = ragged(2);
+        assert!(Projection::new(&points, View::From([20.0, 20.0, 0.5])).is_none());
+        assert!(Projection::new(&points, View::From([20.0, 20.0, -50.0])).is_some());
+    }
+}
