@@ -70,7 +70,9 @@ impl Projection {
                 let mut scale = Vec::with_capacity(points.len());
                 for ray in rays {
                     let depth = dot(ray, axis);
-                    if !(depth > MIN_AXIS_COSINE * dot(ray, ray).sqrt()) {
+                    // Also refuses a NaN depth (a point at the scanner).
+                    let in_view = depth > MIN_AXIS_COSINE * dot(ray, ray).sqrt();
+                    if !in_view {
                         return None;
                     }
                     image.push([dot(ray, frame.u) / depth, dot(ray, frame.v) / depth]);
