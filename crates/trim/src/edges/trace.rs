@@ -94,7 +94,8 @@ pub(crate) fn traced_loops(points: &[Point3], detection: &Detection) -> Option<V
     }
     let projection = Projection::new(points, view)?;
     let (image, owner) = triangulate(&projection.image)?;
-    let covered = covered_faces(&image, &owner, points, detection, &projection.scale);
+    let mut covered = covered_faces(&image, &owner, points, detection, &projection.scale);
+    drop_regions_without_inside(&image, &mut covered);
     let cycles = trace_borders(&image, &covered);
     Some(
         cycles
@@ -148,7 +149,7 @@ fn covered_faces(
         let beta = corners
             .iter()
             .map(|&i| detection.beta[i])
-            .fold(0.0, f64::max);
+            .fold(f64::INFINITY, f64::min);
         let sees = |i: usize, j: usize| {
             let reach = detection.reach[i].max(detection.reach[j]);
             dist2(points[i], points[j]) <= reach * reach
@@ -157,6 +158,55 @@ fn covered_faces(
         covered[face.fix().index()] = radius < beta && sees(i, j) && sees(j, k) && sees(k, i);
     }
     covered
+}
+
+/// Uncovers each connected part of the region (faces joined by a side)
+/// that has no vertex off its border: points that are all on the border
+/// (a few strays far from the scan, whose β is as large as the gap round
+/// them) enclose no surface.
+fn drop_regions_without_inside(image: &Image, covered: &mut [bool]) {
+    let mut on_border = vec![false; image.num_vertices()];
+    for face in image.inner_faces().filter(|f| covered[f.fix().index()]) {
+        for edge in face.adjacent_edges() {
+            if !covers(image, covered, edge.rev().fix()) {
+                on_border[edge.from().fix().index()] = true;
+            }
+        }
+    }
+    let mut seen = vec![false; covered.len()];
+    for start in image.inner_faces() {
+        let start = start.fix();
+        if !covered[start.index()] || seen[start.index()] {
+            continue;
+        }
+        seen[start.index()] = true;
+        let mut part = vec![start];
+        let mut next = 0;
+        while next < part.len() {
+            for edge in image.face(part[next]).adjacent_edges() {
+                if let Some(beyond) = edge.rev().face().as_inner() {
+                    let f = beyond.fix();
+                    if covered[f.index()] && !seen[f.index()] {
+                        seen[f.index()] = true;
+                        part.push(f);
+                    }
+                }
+            }
+            next += 1;
+        }
+        let has_inside = part.iter().any(|&f| {
+            image
+                .face(f)
+                .vertices()
+                .iter()
+                .any(|v| !on_border[v.fix().index()])
+        });
+        if !has_inside {
+            for f in part {
+                covered[f.index()] = false;
+            }
+        }
+    }
 }
 
 /// The radius of the circle through three image points (infinite for a
@@ -307,7 +357,8 @@ mod tests {
 
     /// The traced loops' sides are exactly the triangulation's sides that
     /// one covered face has and the other side's face has not (counted
-    /// plainly over the faces), and each loop is a simple cycle.
+    /// plainly over the faces, after the parts without inside are left
+    /// out), and each loop is a simple cycle.
     #[test]
     fn loops_are_the_covered_regions_border() {
         for seed in 1..=6 {
@@ -315,7 +366,8 @@ mod tests {
             let detection = detect_boundary(&points, &along_z()).unwrap();
             let projection = Projection::new(&points, detection.view.unwrap()).unwrap();
             let (image, owner) = triangulate(&projection.image).unwrap();
-            let covered = covered_faces(&image, &owner, &points, &detection, &projection.scale);
+            let mut covered = covered_faces(&image, &owner, &points, &detection, &projection.scale);
+            drop_regions_without_inside(&image, &mut covered);
             let mut sides: BTreeMap<(u32, u32), usize> = BTreeMap::new();
             for face in image.inner_faces().filter(|f| covered[f.fix().index()]) {
                 let [a, b, c] = face.vertices().map(|v| owner[v.fix().index()]);
