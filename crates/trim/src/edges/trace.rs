@@ -21,13 +21,13 @@
 use std::collections::HashMap;
 
 use spade::handles::FixedDirectedEdgeHandle;
-use spade::{DelaunayTriangulation, HierarchyHintGenerator, Point2, Triangulation};
+use spade::{DelaunayTriangulation, Point2, Triangulation};
 
 use crate::bpd::{Detection, View};
 use crate::frame::Frame;
 use crate::geom::{dist2, dot, sub, unit, Point3};
 
-type Image = DelaunayTriangulation<Point2<f64>, (), (), (), HierarchyHintGenerator<f64>>;
+type Image = DelaunayTriangulation<Point2<f64>>;
 
 /// Where the cloud lies in its image plane.
 struct Projection {
@@ -108,28 +108,23 @@ pub(crate) fn traced_loops(points: &[Point3], detection: &Detection) -> Option<V
 
 /// The Delaunay triangulation of the image, and the input point that owns
 /// each of its vertices (the first of points that share an image
-/// position). Points are inserted sorted by their image coordinates, so
+/// position). The points are loaded sorted by their image coordinates, so
 /// the triangulation does not depend on the order the cloud was written
 /// in. `None` if spade refuses a coordinate.
 fn triangulate(image: &[[f64; 2]]) -> Option<(Image, Vec<u32>)> {
     let mut order: Vec<u32> = (0..image.len() as u32).collect();
+    let at = |i: u32| crate::planar::point(image[i as usize]);
     order.sort_by(|&a, &b| {
-        let (p, q) = (image[a as usize], image[b as usize]);
-        p[0].total_cmp(&q[0])
-            .then(p[1].total_cmp(&q[1]))
+        let (p, q) = (at(a), at(b));
+        p.x.total_cmp(&q.x)
+            .then(p.y.total_cmp(&q.y))
             .then(a.cmp(&b))
     });
-    let mut triangulation = Image::new();
-    let mut owner = Vec::with_capacity(image.len());
-    for i in order {
-        let [x, y] = image[i as usize];
-        let before = triangulation.num_vertices();
-        triangulation.insert(crate::planar::point([x, y])).ok()?;
-        if triangulation.num_vertices() > before {
-            owner.push(i);
-        }
-    }
-    Some((triangulation, owner))
+    order.dedup_by(|later, first| at(*later) == at(*first));
+    let triangulation = Image::bulk_load_stable(order.iter().map(|&i| at(i)).collect()).ok()?;
+    // Each vertex is the owner at its place in `order`, unless spade still
+    // merged two of them.
+    (triangulation.num_vertices() == order.len()).then_some((triangulation, order))
 }
 
 /// Which inner faces belong to the cloud's region (by face index).
