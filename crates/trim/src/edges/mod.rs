@@ -137,7 +137,7 @@ pub fn reconstruct_edges(points: &[Point3], detection: &Detection, options: &Edg
         .collect();
     let dropped_pieces: usize = split.iter().map(|t| t.1).sum();
     let mut tours: Vec<Vec<u32>> = split.into_iter().flat_map(|t| t.0).collect();
-    let filled_only = drop_tours_made_by_fillers(&mut tours, &canon.detected);
+    let filled_only = drop_tours_made_by_fillers(&mut tours, |c| canon.detected[c as usize]);
     tours.sort_unstable();
     let index = options.offset.then(|| NeighbourIndex::new(points));
     let on_loops: std::collections::BTreeSet<u32> = tours.iter().flatten().copied().collect();
@@ -166,37 +166,14 @@ fn edges_of_traced_loops(
     options: &EdgeOptions,
     traced: Vec<Vec<u32>>,
 ) -> Edges {
-    let before = traced.len();
-    let mut traced: Vec<Vec<u32>> = traced
-        .into_iter()
-        .filter(|tour| {
-            let found = tour
-                .iter()
-                .filter(|&&i| detection.boundary[i as usize])
-                .count();
-            found >= cluster::MIN_LOOP_POINTS
-        })
-        .collect();
-    let dropped = before - traced.len();
-    let mut on_loops: Vec<u32> = traced.iter().flatten().copied().collect();
-    on_loops.sort_unstable();
-    on_loops.dedup();
-    let by_number = geometric_order(points, on_loops);
-    let mut number = std::collections::HashMap::with_capacity(by_number.len());
-    for (c, &i) in by_number.iter().enumerate() {
-        number.insert(i, c as u32);
-    }
-    for tour in &mut traced {
-        let numbered = tour.iter().map(|i| number[i]).collect();
-        *tour = order::canonical(numbered)
-            .into_iter()
-            .map(|c| by_number[c as usize])
-            .collect();
-    }
-    traced.sort_by_cached_key(|tour| tour.iter().map(|i| number[i]).min());
+    let mut traced = traced;
+    // Points on a traced loop that BPD labelled interior close it as gap
+    // fillers close a tour.
+    let dropped = drop_tours_made_by_fillers(&mut traced, |i| detection.boundary[i as usize]);
+    let (traced, on_loops) = in_geometric_order(points, traced);
     let index = options.offset.then(|| NeighbourIndex::new(points));
     let thinned = (0..points.len() as u32)
-        .filter(|i| detection.boundary[*i as usize] && !number.contains_key(i))
+        .filter(|i| detection.boundary[*i as usize] && on_loops.binary_search(i).is_err())
         .count();
     let loops = traced
         .into_par_iter()
@@ -207,6 +184,34 @@ fn edges_of_traced_loops(
         dropped_clusters: dropped,
         thinned_points: thinned,
     }
+}
+
+/// The loops (input indices) each started and oriented by the geometric
+/// numbering of their points ([`geometric_order`], as tours are by
+/// [`order::canonical`]), listed by their smallest number; and the points
+/// on them, sorted by index.
+fn in_geometric_order(points: &[Point3], loops: Vec<Vec<u32>>) -> (Vec<Vec<u32>>, Vec<u32>) {
+    let mut on_loops: Vec<u32> = loops.iter().flatten().copied().collect();
+    on_loops.sort_unstable();
+    on_loops.dedup();
+    let by_number = geometric_order(points, on_loops.clone());
+    let mut number = vec![0u32; on_loops.len()];
+    for (c, i) in by_number.iter().enumerate() {
+        if let Ok(at) = on_loops.binary_search(i) {
+            number[at] = c as u32;
+        }
+    }
+    let number_of = |i: &u32| on_loops.binary_search(i).map_or(u32::MAX, |at| number[at]);
+    let mut numbered: Vec<Vec<u32>> = loops
+        .into_iter()
+        .map(|tour| order::canonical(tour.iter().map(number_of).collect()))
+        .collect();
+    numbered.sort_unstable();
+    let loops = numbered
+        .into_iter()
+        .map(|tour| tour.into_iter().map(|c| by_number[c as usize]).collect())
+        .collect();
+    (loops, on_loops)
 }
 
 /// `members` (input indices) in the order of their geometry: by squared
@@ -322,7 +327,8 @@ fn gap_fillers(detection: &Detection) -> Vec<bool> {
 }
 
 /// Drops the tours with fewer than [`cluster::MIN_LOOP_POINTS`] points that
-/// BPD labelled boundary (`detected`, by canonical index); returns how many.
+/// BPD labelled boundary (`detected`, asked of each point as the tours
+/// number it); returns how many.
 ///
 /// Gap fillers close a border that BPD found; they do not make one. In a
 /// jittered cloud a gap of the sampling at the resolution limit sometimes
@@ -332,10 +338,10 @@ fn gap_fillers(detection: &Detection) -> Vec<bool> {
 /// meshing would cut it out (the 100k benchmark sheet has one, the 1M
 /// sheet five). The paper's smallest hole is found by four points, so a
 /// loop needs four detected ones.
-fn drop_tours_made_by_fillers(tours: &mut Vec<Vec<u32>>, detected: &[bool]) -> usize {
+fn drop_tours_made_by_fillers(tours: &mut Vec<Vec<u32>>, detected: impl Fn(u32) -> bool) -> usize {
     let before = tours.len();
     tours.retain(|tour| {
-        let found = tour.iter().filter(|&&c| detected[c as usize]).count();
+        let found = tour.iter().filter(|&&c| detected(c)).count();
         found >= cluster::MIN_LOOP_POINTS
     });
     before - tours.len()
