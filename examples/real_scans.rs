@@ -37,6 +37,13 @@ const SCANS: &[(&str, &str, View, Option<Scanner>)] = &[
         None,
     ),
     (
+        "bunny_bun000_view",
+        "stanford_bunny/bun000.ply",
+        View::Axis(2, false),
+        // A range scan in the scanner's frame, seen along its z.
+        Some(Scanner::Along([0.0, 0.0, 1.0])),
+    ),
+    (
         "blade_scan1",
         "blade_scan_kinect/BladeScan1.csv",
         View::Plane,
@@ -54,6 +61,12 @@ const SCANS: &[(&str, &str, View, Option<Scanner>)] = &[
         "blade_scan_kinect/BladeScan2.csv",
         View::Plane,
         None,
+    ),
+    (
+        "blade_scan2_view",
+        "blade_scan_kinect/BladeScan2.csv",
+        View::Plane,
+        Some(Scanner::Along([0.0, 0.0, 1.0])),
     ),
     ("milk", "pcl_test/milk.pcd", View::Plane, None),
     (
