@@ -20,14 +20,19 @@
 
 use std::collections::HashMap;
 
+use rayon::slice::ParallelSliceMut;
 use spade::handles::FixedDirectedEdgeHandle;
 use spade::{DelaunayTriangulation, Point2, Triangulation};
+
+use crate::planar::Node;
 
 use crate::bpd::{Detection, View};
 use crate::frame::Frame;
 use crate::geom::{dist2, dot, sub, unit, Point3};
 
-type Image = DelaunayTriangulation<Point2<f64>>;
+/// The image's Delaunay triangulation; each vertex's id is the input point
+/// at that image position.
+type Image = DelaunayTriangulation<Node>;
 
 /// Where the cloud lies in its image plane.
 struct Projection {
@@ -93,51 +98,47 @@ pub(crate) fn traced_loops(points: &[Point3], detection: &Detection) -> Option<V
         return None;
     }
     let projection = Projection::new(points, view)?;
-    let (image, owner) = triangulate(&projection.image)?;
-    let mut covered = covered_faces(&image, &owner, points, detection, &projection.scale);
+    let image = triangulate(&projection.image)?;
+    let mut covered = covered_faces(&image, points, detection, &projection.scale);
     drop_regions_without_inside(&image, &mut covered);
     let cycles = trace_borders(&image, &covered);
-    Some(
-        cycles
-            .into_iter()
-            .map(|cycle| cycle.into_iter().map(|v| owner[v]).collect())
-            .flat_map(simple_cycles)
-            .collect(),
-    )
+    Some(cycles.into_iter().flat_map(simple_cycles).collect())
 }
 
-/// The Delaunay triangulation of the image, and the input point that owns
-/// each of its vertices (the first of points that share an image
-/// position). The points are loaded sorted by their image coordinates, so
-/// the triangulation does not depend on the order the cloud was written
-/// in. `None` if spade refuses a coordinate.
-fn triangulate(image: &[[f64; 2]]) -> Option<(Image, Vec<u32>)> {
+/// The Delaunay triangulation of the image; each vertex's id is the first
+/// input point at its position. The points are loaded sorted by their
+/// image coordinates, so the triangulation does not depend on the order
+/// the cloud was written in. `None` if spade refuses a coordinate.
+fn triangulate(image: &[[f64; 2]]) -> Option<Image> {
+    let at: Vec<Point2<f64>> = image.iter().map(|&p| crate::planar::point(p)).collect();
     let mut order: Vec<u32> = (0..image.len() as u32).collect();
-    let at = |i: u32| crate::planar::point(image[i as usize]);
-    order.sort_by(|&a, &b| {
-        let (p, q) = (at(a), at(b));
+    order.par_sort_unstable_by(|&a, &b| {
+        let (p, q) = (at[a as usize], at[b as usize]);
         p.x.total_cmp(&q.x)
             .then(p.y.total_cmp(&q.y))
             .then(a.cmp(&b))
     });
-    order.dedup_by(|later, first| at(*later) == at(*first));
-    let triangulation = Image::bulk_load_stable(order.iter().map(|&i| at(i)).collect()).ok()?;
-    // Each vertex is the owner at its place in `order`, unless spade still
-    // merged two of them.
-    (triangulation.num_vertices() == order.len()).then_some((triangulation, order))
+    order.dedup_by(|later, first| at[*later as usize] == at[*first as usize]);
+    let nodes = order
+        .into_iter()
+        .map(|id| Node {
+            position: at[id as usize],
+            id,
+        })
+        .collect();
+    Image::bulk_load(nodes).ok()
 }
 
 /// Which inner faces belong to the cloud's region (by face index).
 fn covered_faces(
     image: &Image,
-    owner: &[u32],
     points: &[Point3],
     detection: &Detection,
     scale: &[f64],
 ) -> Vec<bool> {
     let mut covered = vec![false; image.num_all_faces()];
     for face in image.inner_faces() {
-        let corners = face.vertices().map(|v| owner[v.fix().index()] as usize);
+        let corners = face.vertices().map(|v| v.data().id as usize);
         let [a, b, c] = face.positions().map(|p| [p.x, p.y]);
         let image_scale = corners.iter().map(|&i| scale[i]).sum::<f64>() / 3.0;
         let radius = circumradius(a, b, c) * image_scale;
@@ -224,11 +225,11 @@ fn covers(image: &Image, covered: &[bool], edge: FixedDirectedEdgeHandle) -> boo
         .is_some_and(|f| covered[f.fix().index()])
 }
 
-/// The border of the covered region as cycles of vertex indices, the
+/// The border of the covered region as cycles of input indices, the
 /// region on their left. At a vertex the walk turns through the covered
 /// faces round it to the next border edge, so two parts of the region
 /// that touch only at a vertex are traced apart there.
-fn trace_borders(image: &Image, covered: &[bool]) -> Vec<Vec<usize>> {
+fn trace_borders(image: &Image, covered: &[bool]) -> Vec<Vec<u32>> {
     let is_border =
         |e: FixedDirectedEdgeHandle| covers(image, covered, e) && !covers(image, covered, e.rev());
     let mut visited = vec![false; image.num_directed_edges()];
@@ -241,7 +242,7 @@ fn trace_borders(image: &Image, covered: &[bool]) -> Vec<Vec<usize>> {
         let mut edge = start;
         while !visited[edge.index()] {
             visited[edge.index()] = true;
-            cycle.push(image.directed_edge(edge).from().fix().index());
+            cycle.push(image.directed_edge(edge).from().data().id);
             edge = next_border_edge(image, covered, edge);
         }
         cycles.push(cycle);
@@ -360,12 +361,12 @@ mod tests {
             let points = ragged(seed);
             let detection = detect_boundary(&points, &along_z()).unwrap();
             let projection = Projection::new(&points, detection.view.unwrap()).unwrap();
-            let (image, owner) = triangulate(&projection.image).unwrap();
-            let mut covered = covered_faces(&image, &owner, &points, &detection, &projection.scale);
+            let image = triangulate(&projection.image).unwrap();
+            let mut covered = covered_faces(&image, &points, &detection, &projection.scale);
             drop_regions_without_inside(&image, &mut covered);
             let mut sides: BTreeMap<(u32, u32), usize> = BTreeMap::new();
             for face in image.inner_faces().filter(|f| covered[f.fix().index()]) {
-                let [a, b, c] = face.vertices().map(|v| owner[v.fix().index()]);
+                let [a, b, c] = face.vertices().map(|v| v.data().id);
                 for (p, q) in [(a, b), (b, c), (c, a)] {
                     *sides.entry((p.min(q), p.max(q))).or_default() += 1;
                 }
