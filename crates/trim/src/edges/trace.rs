@@ -13,7 +13,7 @@
 //! jump across, however ragged or thick the band of boundary points is.
 //!
 //! A triangle is part of the region when its circumcircle's radius, in the
-//! cloud's units, is below the largest β of its corners, and each of its
+//! cloud's units, is below the β of each of its corners, and each of its
 //! sides joins points that lie within one another's neighbourhood: a side
 //! across a jump in depth (an occluding silhouette) joins points that saw
 //! each other in the image but not in space, and the region ends there.
@@ -21,14 +21,13 @@
 use std::collections::HashMap;
 
 use rayon::slice::ParallelSliceMut;
-use spade::handles::FixedDirectedEdgeHandle;
+use spade::handles::{FixedDirectedEdgeHandle, FixedFaceHandle, InnerTag};
 use spade::{DelaunayTriangulation, Point2, Triangulation};
-
-use crate::planar::Node;
 
 use crate::bpd::{Detection, View};
 use crate::frame::Frame;
-use crate::geom::{dist2, dot, sub, unit, Point3};
+use crate::geom::{add, dist2, dot, sub, unit, Point3};
+use crate::planar::Node;
 
 /// The image's Delaunay triangulation; each vertex's id is the input point
 /// at that image position.
@@ -66,10 +65,7 @@ impl Projection {
             }
             View::From(origin) => {
                 let rays: Vec<Point3> = points.iter().map(|&p| sub(p, origin)).collect();
-                let axis = unit(rays.iter().fold([0.0; 3], |s, r| {
-                    let r = unit(*r);
-                    [s[0] + r[0], s[1] + r[1], s[2] + r[2]]
-                }));
+                let axis = unit(rays.iter().fold([0.0; 3], |sum, &r| add(sum, unit(r))));
                 let frame = Frame::of_normal(axis);
                 let mut image = Vec::with_capacity(points.len());
                 let mut scale = Vec::with_capacity(points.len());
@@ -161,35 +157,8 @@ fn covered_faces(
 /// (a few strays far from the scan, whose β is as large as the gap round
 /// them) enclose no surface.
 fn drop_regions_without_inside(image: &Image, covered: &mut [bool]) {
-    let mut on_border = vec![false; image.num_vertices()];
-    for face in image.inner_faces().filter(|f| covered[f.fix().index()]) {
-        for edge in face.adjacent_edges() {
-            if !covers(image, covered, edge.rev().fix()) {
-                on_border[edge.from().fix().index()] = true;
-            }
-        }
-    }
-    let mut seen = vec![false; covered.len()];
-    for start in image.inner_faces() {
-        let start = start.fix();
-        if !covered[start.index()] || seen[start.index()] {
-            continue;
-        }
-        seen[start.index()] = true;
-        let mut part = vec![start];
-        let mut next = 0;
-        while next < part.len() {
-            for edge in image.face(part[next]).adjacent_edges() {
-                if let Some(beyond) = edge.rev().face().as_inner() {
-                    let f = beyond.fix();
-                    if covered[f.index()] && !seen[f.index()] {
-                        seen[f.index()] = true;
-                        part.push(f);
-                    }
-                }
-            }
-            next += 1;
-        }
+    let on_border = border_vertices(image, covered);
+    for part in connected_parts(image, covered) {
         let has_inside = part.iter().any(|&f| {
             image
                 .face(f)
@@ -203,6 +172,47 @@ fn drop_regions_without_inside(image: &Image, covered: &mut [bool]) {
             }
         }
     }
+}
+
+/// Whether each vertex lies on the border of the covered region.
+fn border_vertices(image: &Image, covered: &[bool]) -> Vec<bool> {
+    let mut on_border = vec![false; image.num_vertices()];
+    for face in image.inner_faces().filter(|f| covered[f.fix().index()]) {
+        for edge in face.adjacent_edges() {
+            if !covers(image, covered, edge.rev().fix()) {
+                on_border[edge.from().fix().index()] = true;
+            }
+        }
+    }
+    on_border
+}
+
+/// The covered faces in connected parts (faces joined by a side).
+fn connected_parts(image: &Image, covered: &[bool]) -> Vec<Vec<FixedFaceHandle<InnerTag>>> {
+    let mut seen = vec![false; covered.len()];
+    let mut parts = Vec::new();
+    for start in image.inner_faces().map(|f| f.fix()) {
+        if !covered[start.index()] || seen[start.index()] {
+            continue;
+        }
+        seen[start.index()] = true;
+        let mut part = vec![start];
+        let mut next = 0;
+        while next < part.len() {
+            for edge in image.face(part[next]).adjacent_edges() {
+                if covers(image, covered, edge.rev().fix()) {
+                    let beyond = edge.rev().face().fix();
+                    if !seen[beyond.index()] {
+                        seen[beyond.index()] = true;
+                        part.extend(beyond.as_inner());
+                    }
+                }
+            }
+            next += 1;
+        }
+        parts.push(part);
+    }
+    parts
 }
 
 /// The radius of the circle through three image points (infinite for a
