@@ -20,7 +20,7 @@
 
 use std::collections::HashMap;
 
-use rayon::slice::ParallelSliceMut;
+use rayon::prelude::*;
 use spade::handles::{FixedDirectedEdgeHandle, FixedFaceHandle, InnerTag};
 use spade::{DelaunayTriangulation, Point2, Triangulation};
 
@@ -132,22 +132,31 @@ fn covered_faces(
     detection: &Detection,
     scale: &[f64],
 ) -> Vec<bool> {
+    let faces: Vec<FixedFaceHandle<InnerTag>> = image.inner_faces().map(|f| f.fix()).collect();
+    let in_region: Vec<bool> = faces
+        .par_iter()
+        .with_min_len(4096)
+        .map(|&f| {
+            let face = image.face(f);
+            let corners = face.vertices().map(|v| v.data().id as usize);
+            let [a, b, c] = face.positions().map(|p| [p.x, p.y]);
+            let image_scale = corners.iter().map(|&i| scale[i]).sum::<f64>() / 3.0;
+            let radius = circumradius(a, b, c) * image_scale;
+            let beta = corners
+                .iter()
+                .map(|&i| detection.beta[i])
+                .fold(f64::INFINITY, f64::min);
+            let sees = |i: usize, j: usize| {
+                let reach = detection.reach[i].max(detection.reach[j]);
+                dist2(points[i], points[j]) <= reach * reach
+            };
+            let [i, j, k] = corners;
+            radius < beta && sees(i, j) && sees(j, k) && sees(k, i)
+        })
+        .collect();
     let mut covered = vec![false; image.num_all_faces()];
-    for face in image.inner_faces() {
-        let corners = face.vertices().map(|v| v.data().id as usize);
-        let [a, b, c] = face.positions().map(|p| [p.x, p.y]);
-        let image_scale = corners.iter().map(|&i| scale[i]).sum::<f64>() / 3.0;
-        let radius = circumradius(a, b, c) * image_scale;
-        let beta = corners
-            .iter()
-            .map(|&i| detection.beta[i])
-            .fold(f64::INFINITY, f64::min);
-        let sees = |i: usize, j: usize| {
-            let reach = detection.reach[i].max(detection.reach[j]);
-            dist2(points[i], points[j]) <= reach * reach
-        };
-        let [i, j, k] = corners;
-        covered[face.fix().index()] = radius < beta && sees(i, j) && sees(j, k) && sees(k, i);
+    for (f, inside) in faces.into_iter().zip(in_region) {
+        covered[f.index()] = inside;
     }
     covered
 }
