@@ -5,7 +5,9 @@ use testkit::{
     edge_metrics::{match_corners, polyline_to_truth_in_spacings, true_corners},
     synthetic::{self, SyntheticCloud},
 };
-use trim::{detect_boundary, reconstruct_edges, BpdOptions, EdgeOptions, Edges, Point3};
+use trim::{
+    detect_boundary, fit_plane, reconstruct_edges, BpdOptions, EdgeOptions, Edges, Point3, View,
+};
 
 /// Mean and largest distance of all smoothed edges to the true boundary,
 /// in local spacings.
@@ -22,15 +24,30 @@ fn distance_to_truth(cloud: &SyntheticCloud, edges: &Edges) -> (f64, f64) {
 }
 
 fn edges_of(cloud: &SyntheticCloud, offset: bool) -> Edges {
-    let detection = detect_boundary(&cloud.points, &BpdOptions::default()).unwrap();
+    edges_seen(cloud, offset, None)
+}
+
+/// The edges with the scanner's line of sight `view` (then traced in the
+/// image plane), or without one.
+fn edges_seen(cloud: &SyntheticCloud, offset: bool, view: Option<View>) -> Edges {
+    let options = BpdOptions {
+        view,
+        ..BpdOptions::default()
+    };
+    let detection = detect_boundary(&cloud.points, &options).unwrap();
     reconstruct_edges(&cloud.points, &detection, &EdgeOptions { offset })
 }
 
 /// Checks loops, corners, distances and chaining; returns failures.
 fn check(cloud: &SyntheticCloud) -> Vec<String> {
+    check_seen(cloud, None)
+}
+
+/// [`check`] with the scanner's line of sight `view`.
+fn check_seen(cloud: &SyntheticCloud, view: Option<View>) -> Vec<String> {
     let mut failures = Vec::new();
-    let edges = edges_of(cloud, true);
-    let raw = edges_of(cloud, false);
+    let edges = edges_seen(cloud, true, view);
+    let raw = edges_seen(cloud, false, view);
     let name = &cloud.name;
     if edges.loops.len() != cloud.boundary.len() {
         failures.push(format!(
@@ -114,6 +131,29 @@ fn a_gap_of_the_sampling_is_no_hole() {
     let cloud = synthetic::blade_with_jitter(1.0, 0.3, 1007);
     let edges = edges_of(&cloud, true);
     assert_eq!(edges.loops.len(), cloud.boundary.len());
+}
+
+/// Seen along the normal of their best-fit plane, over which each is a
+/// height field, the clouds' loops are traced in the image plane: the same
+/// loop counts and corners, and the same bounds on the distance to the
+/// truth.
+#[test]
+fn seen_along_their_plane_s_normal_the_traced_edges_hold_the_same_bounds() {
+    let failures: Vec<String> = [
+        synthetic::blade(4.0, 10),
+        synthetic::blade(8.0, 11),
+        synthetic::blade(16.0, 12),
+        synthetic::notched_plate(1.0, 2),
+        synthetic::curved_disc_with_hole(1.5, 3),
+    ]
+    .iter()
+    .flat_map(|cloud| {
+        let all: Vec<u32> = (0..cloud.points.len() as u32).collect();
+        let normal = fit_plane(&cloud.points, &all).normal;
+        check_seen(cloud, Some(View::Along(normal)))
+    })
+    .collect();
+    assert!(failures.is_empty(), "{failures:#?}");
 }
 
 #[test]
