@@ -87,7 +87,8 @@ impl Projection {
 
 /// The region's border loops (input indices, each loop a simple cycle,
 /// the region on its left in the image plane), or `None` when the
-/// detection has no view or no image plane holds the cloud.
+/// detection has no view, no image plane holds the cloud, or the region
+/// holds less than half of it.
 pub(crate) fn traced_loops(points: &[Point3], detection: &Detection) -> Option<Vec<Vec<u32>>> {
     let view = detection.view?;
     if detection.reach.len() != points.len() {
@@ -97,6 +98,9 @@ pub(crate) fn traced_loops(points: &[Point3], detection: &Detection) -> Option<V
     let image = triangulate(&projection.image)?;
     let mut covered = covered_faces(&image, points, detection, &projection.scale);
     drop_regions_without_inside(&image, &mut covered);
+    if !holds_most_points(&image, &covered) {
+        return None;
+    }
     let cycles = trace_borders(&image, &covered);
     Some(cycles.into_iter().flat_map(simple_cycles).collect())
 }
@@ -159,6 +163,20 @@ fn covered_faces(
         covered[f.index()] = inside;
     }
     covered
+}
+
+/// Whether the region's faces touch at least half of the image's points.
+/// Fewer, and the view does not see the cloud as a surface (a wall seen
+/// edge on, whose image is a strip of slivers): the loops are then found
+/// from BPD's links.
+fn holds_most_points(image: &Image, covered: &[bool]) -> bool {
+    let mut touched = vec![false; image.num_vertices()];
+    for face in image.inner_faces().filter(|f| covered[f.fix().index()]) {
+        for v in face.vertices() {
+            touched[v.fix().index()] = true;
+        }
+    }
+    2 * touched.iter().filter(|&&t| t).count() >= image.num_vertices()
 }
 
 /// Uncovers each connected part of the region (faces joined by a side)
@@ -502,6 +520,21 @@ mod tests {
                 .collect()
         };
         assert_eq!(polylines(&up), polylines(&again));
+    }
+
+    /// A sheet seen edge on has no region in the image: its loops come
+    /// from BPD's links, as without a view.
+    #[test]
+    fn a_sheet_seen_edge_on_goes_by_the_links() {
+        let points = scan(5, 30, |_, _, _| true, |_, _| 0.0);
+        let options = BpdOptions {
+            view: Some(View::Along([1.0, 0.0, 0.0])),
+            ..BpdOptions::default()
+        };
+        let detection = detect_boundary(&points, &options).unwrap();
+        assert!(traced_loops(&points, &detection).is_none());
+        let edges = reconstruct_edges(&points, &detection, &EdgeOptions::default());
+        assert_eq!(edges.loops.len(), 1);
     }
 
     /// A walk through a pinch vertex comes apart into simple cycles.
