@@ -256,14 +256,20 @@ fn neighbourhood_reach(hoods: &Neighbourhoods, site_of: &[u32]) -> Vec<f64> {
                 .sqrt()
         })
         .collect();
-    let mut position_of = vec![0u32; hoods.order.len()];
-    for (position, &site) in hoods.order.iter().enumerate() {
-        position_of[site as usize] = position as u32;
-    }
+    let position_of = positions_of_sites(&hoods.order);
     site_of
         .iter()
         .map(|&site| radius[position_of[site as usize] as usize])
         .collect()
+}
+
+/// Site → position, from `order` (each position's site).
+fn positions_of_sites(order: &[u32]) -> Vec<u32> {
+    let mut position_of = vec![0u32; order.len()];
+    for (position, &site) in order.iter().enumerate() {
+        position_of[site as usize] = position as u32;
+    }
+    position_of
 }
 
 /// Neighbourhoods sampled to judge whether the cloud has a second
@@ -700,10 +706,7 @@ fn spread_to_input<T: Sync>(
     // Site → position, so that each input point reads its verdict in one
     // gather (one pass: at 12k points the verdicts no longer sit in the
     // cache, and each pass over them cost some 30 µs).
-    let mut position_of = vec![0u32; order.len()];
-    for (position, &site) in order.iter().enumerate() {
-        position_of[site as usize] = position as u32;
-    }
+    let position_of = positions_of_sites(order);
     let (decision, beta): (Vec<Decision>, Vec<f64>) = site_of
         .par_iter()
         .with_min_len(PASS_PIECE)

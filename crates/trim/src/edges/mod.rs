@@ -139,16 +139,13 @@ pub fn reconstruct_edges(points: &[Point3], detection: &Detection, options: &Edg
     let mut tours: Vec<Vec<u32>> = split.into_iter().flat_map(|t| t.0).collect();
     let filled_only = drop_tours_made_by_fillers(&mut tours, |c| canon.detected[c as usize]);
     tours.sort_unstable();
-    let index = options.offset.then(|| NeighbourIndex::new(points));
     let on_loops: std::collections::BTreeSet<u32> = tours.iter().flatten().copied().collect();
     let clustered: usize = clusters.clusters.iter().map(Vec::len).sum();
-    let loops = tours
-        .into_par_iter()
-        .map(|tour| {
-            let tour = tour.iter().map(|&c| canon.input[c as usize]).collect();
-            loop_from_tour(points, &detection.beta, tour, index.as_ref())
-        })
+    let tours = tours
+        .into_iter()
+        .map(|tour| tour.iter().map(|&c| canon.input[c as usize]).collect())
         .collect();
+    let loops = loops_of_tours(points, &detection.beta, tours, options);
     Edges {
         loops,
         dropped_clusters: clusters.dropped_clusters + dropped_pieces + filled_only,
@@ -164,23 +161,17 @@ fn edges_of_traced_loops(
     points: &[Point3],
     detection: &Detection,
     options: &EdgeOptions,
-    traced: Vec<Vec<u32>>,
+    mut traced: Vec<Vec<u32>>,
 ) -> Edges {
-    let mut traced = traced;
     // Points on a traced loop that BPD labelled interior close it as gap
     // fillers close a tour.
     let dropped = drop_tours_made_by_fillers(&mut traced, |i| detection.boundary[i as usize]);
     let (traced, on_loops) = in_geometric_order(points, traced);
-    let index = options.offset.then(|| NeighbourIndex::new(points));
     let thinned = (0..points.len() as u32)
         .filter(|i| detection.boundary[*i as usize] && on_loops.binary_search(i).is_err())
         .count();
-    let loops = traced
-        .into_par_iter()
-        .map(|tour| loop_from_tour(points, &detection.beta, tour, index.as_ref()))
-        .collect();
     Edges {
-        loops,
+        loops: loops_of_tours(points, &detection.beta, traced, options),
         dropped_clusters: dropped,
         thinned_points: thinned,
     }
@@ -212,6 +203,21 @@ fn in_geometric_order(points: &[Point3], loops: Vec<Vec<u32>>) -> (Vec<Vec<u32>>
         .map(|tour| tour.into_iter().map(|c| by_number[c as usize]).collect())
         .collect();
     (loops, on_loops)
+}
+
+/// Each closed tour (input indices, in loop order) made a loop by
+/// [`loop_from_tour`], with the outward offset when `options` asks for it.
+fn loops_of_tours(
+    points: &[Point3],
+    beta: &[f64],
+    tours: Vec<Vec<u32>>,
+    options: &EdgeOptions,
+) -> Vec<Loop> {
+    let index = options.offset.then(|| NeighbourIndex::new(points));
+    tours
+        .into_par_iter()
+        .map(|tour| loop_from_tour(points, beta, tour, index.as_ref()))
+        .collect()
 }
 
 /// `members` (input indices) in the order of their geometry: by squared
