@@ -51,14 +51,7 @@ fn pcl_test() {
 /// The sizes of a scan's edge loops seen from `view`, largest first, and
 /// the cloud.
 fn loop_sizes(rel: &str, view: trim::View) -> (Vec<usize>, Vec<trim::Point3>) {
-    use trim::{reconstruct_edges, EdgeOptions};
-    let cloud = read_cloud(&data(rel)).unwrap_or_else(|e| panic!("{e:#}"));
-    let options = trim::BpdOptions {
-        view: Some(view),
-        ..trim::BpdOptions::default()
-    };
-    let found = trim::detect_boundary(&cloud.points, &options).unwrap();
-    let edges = reconstruct_edges(&cloud.points, &found, &EdgeOptions::default());
+    let (cloud, _, edges) = edges_of(rel, Some(view));
     let mut sizes: Vec<usize> = edges
         .loops
         .iter()
@@ -66,6 +59,70 @@ fn loop_sizes(rel: &str, view: trim::View) -> (Vec<usize>, Vec<trim::Point3>) {
         .collect();
     sizes.sort_unstable_by(|a, b| b.cmp(a));
     (sizes, cloud.points)
+}
+
+/// A scan's cloud, its detection and its edges (default options).
+fn edges_of(
+    rel: &str,
+    view: Option<trim::View>,
+) -> (meshtrim::io::Cloud, trim::Detection, trim::Edges) {
+    use trim::{reconstruct_edges, EdgeOptions};
+    let cloud = read_cloud(&data(rel)).unwrap_or_else(|e| panic!("{e:#}"));
+    let options = trim::BpdOptions {
+        view,
+        ..trim::BpdOptions::default()
+    };
+    let found = trim::detect_boundary(&cloud.points, &options).unwrap();
+    let edges = reconstruct_edges(&cloud.points, &found, &EdgeOptions::default());
+    (cloud, found, edges)
+}
+
+/// Without a view, single-view scans whose ragged borders BPD's links
+/// leave open (10-48 % of their boundary points off every loop) are traced
+/// in their own best-fit plane, which sees each as a height field: the
+/// outer border closes as one loop, and every step of every loop joins
+/// points within one another's neighbourhood. Measured: the Kinect panels
+/// 992 and 1,088 points, the next loop 39 and 53; milk.pcd 509 (next 20);
+/// lato000 986 (127); face000 1,834 (229). By the links the largest loops
+/// had 644, 210, 50, 914 and 917 points.
+#[test]
+fn ragged_scans_without_a_view_close_in_their_own_plane() {
+    for (rel, least, most_of_the_next) in [
+        ("blade_scan_kinect/BladeScan1.csv", 900, 10),
+        ("blade_scan_kinect/BladeScan2.csv", 900, 10),
+        ("pcl_test/milk.pcd", 450, 10),
+        ("meshlab_scans/lato000.ply", 900, 5),
+        ("meshlab_scans/face000.ply", 1500, 5),
+    ] {
+        let (cloud, found, edges) = edges_of(rel, None);
+        let mut sizes: Vec<usize> = edges
+            .loops
+            .iter()
+            .map(|l| l.boundary_points.len())
+            .collect();
+        sizes.sort_unstable_by(|a, b| b.cmp(a));
+        assert!(
+            sizes.first().is_some_and(|&n| n >= least),
+            "{rel}: {sizes:?}"
+        );
+        assert!(
+            sizes[1..].iter().all(|&n| n * most_of_the_next < sizes[0]),
+            "{rel}: {sizes:?}"
+        );
+        for l in &edges.loops {
+            let ring = &l.boundary_points;
+            for (k, &i) in ring.iter().enumerate() {
+                let j = ring[(k + 1) % ring.len()];
+                let (i, j) = (i as usize, j as usize);
+                let reach = found.reach[i].max(found.reach[j]);
+                let d = (0..3)
+                    .map(|c| (cloud.points[i][c] - cloud.points[j][c]).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                assert!(d <= reach, "{rel}: step {i}-{j} of {d} beyond {reach}");
+            }
+        }
+    }
 }
 
 /// milk.pcd is a Kinect cloud in its camera's frame. Seen from the camera
@@ -186,14 +243,18 @@ mod shared_data {
     /// tour step longer than 3β that no BPD link supports. Tours not cut at
     /// their jumps (`crates/trim/src/edges/split.rs`) have 16 such steps on
     /// bun000 (longest 57.4 β) and 40 on face000 (longest 169.5 β); cut, none.
-
+    /// (face000's loops, ragged without a view, are now traced in its own
+    /// plane: there every step is a side of a region triangle, joining
+    /// points within one another's neighbourhood, which
+    /// `ragged_scans_without_a_view_close_in_their_own_plane` checks.)
     #[test]
     fn edge_tours_on_range_scans_do_not_jump() {
         use testkit::edge_metrics::tour_jumps;
         use trim::{reconstruct_edges, EdgeOptions};
         for (rel, max_jumps) in [
             ("stanford_bunny/bun000.ply", 0),
-            ("meshlab_scans/face000.ply", 0),
+            ("stanford_bunny/bun045.ply", 0),
+            ("stanford_bunny/chin.ply", 0),
         ] {
             let cloud = read_cloud(&data(rel)).unwrap_or_else(|e| panic!("{e:#}"));
             let found = trim::detect_boundary(&cloud.points, &trim::BpdOptions::default()).unwrap();
@@ -206,6 +267,7 @@ mod shared_data {
                     tour_jumps(&cloud.points, &found.beta, &found.links, &l.boundary_points).count
                 })
                 .sum();
+            eprintln!("{rel}: {jumps} jumps");
             assert!(jumps <= max_jumps, "{rel}: {jumps} jumps");
         }
     }

@@ -146,10 +146,10 @@ pub struct Detection {
     /// The scanner's view the neighbourhoods were projected along, when
     /// given.
     pub view: Option<View>,
-    /// With a view, each point's neighbourhood radius (the distance to the
-    /// farthest of its k nearest points), in input order; empty without
-    /// one. Edge reconstruction tells from it the neighbours a point's
-    /// test saw from points across a jump in depth.
+    /// Each point's neighbourhood radius (the distance to the farthest of
+    /// its k nearest points), in input order. Edge reconstruction tells
+    /// from it the neighbours in an image plane that lie across a jump in
+    /// depth.
     pub reach: Vec<f64>,
 }
 
@@ -229,10 +229,7 @@ fn run(
     } else {
         analyse_all::<Vec<u32>>(&hoods, &site_of, how, tests)
     };
-    let reach = match options.view {
-        Some(_) => neighbourhood_reach(&hoods, &site_of),
-        None => Vec::new(),
-    };
+    let reach = neighbourhood_reach(&hoods, &site_of);
     Ok(Detection {
         view: options.view,
         reach,
@@ -258,7 +255,8 @@ fn neighbourhood_reach(hoods: &Neighbourhoods, site_of: &[u32]) -> Vec<f64> {
         .collect();
     let position_of = positions_of_sites(&hoods.order);
     site_of
-        .iter()
+        .par_iter()
+        .with_min_len(PASS_PIECE)
         .map(|&site| radius[position_of[site as usize] as usize])
         .collect()
 }
@@ -1186,7 +1184,6 @@ mod tests {
         assert_eq!(viewed.reach.len(), flat.len());
         let without_view = Detection {
             view: None,
-            reach: Vec::new(),
             ..viewed
         };
         assert_eq!(paper, without_view);
