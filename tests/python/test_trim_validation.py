@@ -232,32 +232,44 @@ def test_range_scan_trimmed_along_the_line_of_sight(tmp_path):
     """milk.pcd is a Kinect cloud in its camera's frame. Its Poisson mesh
     trimmed with the camera's view (--view-from 0,0,0) keeps the carton's
     scanned faces and nothing beyond the cloud's reach (measured: largest
-    distance 2.11 β, 0.01 % of the vertices beyond 2 β; the default trim
-    keeps a flap of envelope 22 spacings off). With the view its border is
-    traced in the camera's image plane (docs/edges.md)."""
+    distance 2.11 β, 0.01 % of the vertices beyond 2 β). With the view its
+    border is traced in the camera's image plane (docs/edges.md); by
+    default, in its own best-fit plane, where it closes as well (largest
+    distance 2.08 β, no point uncovered)."""
     milk = shared_data("pcl_test/milk.pcd")
     pts, beta, envelope, out_v, of = trimmed_scan(milk, tmp_path, ["--view-from", "0,0,0"])
     assert_within_reach_and_covering(pts, beta, envelope, out_v)
     assert poisson.is_edge_manifold(of)
 
 
+def test_single_view_scan_trimmed_in_its_own_plane(tmp_path):
+    """milk.pcd without a view: its ragged border, which BPD's links leave
+    open, is traced in its own best-fit plane and closes, so the default
+    trim keeps the carton's faces within the cloud's reach as the camera's
+    view does (measured: largest distance 2.08 β, farthest vertex 2.0 local
+    spacings, no point uncovered, 6 border loops)."""
+    milk = shared_data("pcl_test/milk.pcd")
+    pts, beta, envelope, out_v, of = trimmed_scan(milk, tmp_path, [])
+    assert_within_reach_and_covering(pts, beta, envelope, out_v)
+    assert poisson.is_edge_manifold(of)
+    assert len(poisson.fan_boundary_loops(of)) <= 10
+
+
 @pytest.mark.parametrize("scan", ["BladeScan1.csv", "BladeScan2.csv"])
 @pytest.mark.parametrize("view", [[], ["--view-along", "0,0,1"]], ids=["default", "view"])
 def test_kinect_blade_trim_stays_within_the_clouds_reach(tmp_path, scan, view):
-    """The real Kinect scans of the blade-shaped panel. In the paper's
-    projection their ragged borders do not close into loops, and no wall
-    cuts the Poisson envelope off there; without the cut along the cloud's
-    reach (2 β) slabs of it would stay, up to 85 local spacings from the
-    cloud (BladeScan2). With it (measured): largest distance 2.9-3.8 β,
-    0.00-0.08 % of the vertices beyond 2.5 β; the depth camera's terraces
-    make about 300 loops, stripes across the panel, and which pieces
-    between them stay moves with single labels: 0.05 % and 0.13 % of the
-    points uncovered, held to 0.15 %. Seen along z the borders are traced
-    in the image plane and close: the cut follows the smoothed outer loop,
-    largest distance 2.3 and 3.1 β, and the smoothed border passes inside
-    the ragged band's farthest points: 0.10 % and 0.01 % of the points
-    uncovered (42 and 5, border points 3.2 spacings apart or more), held
-    to 0.15 % as well."""
+    """The real Kinect scans of the blade-shaped panel, whose ragged
+    borders BPD's links do not close. Traced in the image plane, their
+    own best-fit plane's by default and the camera's along z, the borders
+    close and the cut follows the smoothed outer loop (measured by default:
+    largest distance 2.7 and 3.1 β, 0.004 % and 0.010 % of the vertices
+    beyond 2.5 β; along z 2.3 and 3.1 β). Without the cut along the
+    cloud's reach (2 β), the envelope beyond a border that stays open would
+    stay, as it did by the links, up to 85 local spacings from the cloud
+    (BladeScan2). The smoothed border passes inside the ragged band's
+    farthest points: 0.10 % and 0.03 % of the points uncovered by default
+    (42 and 13), 0.10 % and 0.01 % along z (42 and 5, border points 3.2
+    spacings apart or more), held to 0.15 %."""
     cloud = shared_data(f"blade_scan_kinect/{scan}")
     pts, beta, envelope, out_v, of = trimmed_scan(cloud, tmp_path, view)
     assert_within_reach_and_covering(pts, beta, envelope, out_v, uncovered=0.0015)
