@@ -10,8 +10,8 @@
 use std::path::Path;
 
 use trim::{
-    detect_boundary, reconstruct_edges, trim_mesh, BpdOptions, EdgeOptions, NeighbourIndex,
-    Point3, TrimOptions,
+    detect_boundary, reconstruct_edges, trim_mesh, BpdOptions, EdgeOptions, NeighbourIndex, Point3,
+    TrimOptions,
 };
 
 fn main() -> anyhow::Result<()> {
@@ -58,7 +58,11 @@ fn local_spacing(cloud: &[Point3]) -> Vec<f64> {
     (0..cloud.len())
         .map(|i| {
             index.nearest(i, 7, &mut near);
-            near[1..].iter().map(|&j| distance(cloud[i], cloud[j as usize])).sum::<f64>() / 6.0
+            near[1..]
+                .iter()
+                .map(|&j| distance(cloud[i], cloud[j as usize]))
+                .sum::<f64>()
+                / 6.0
         })
         .collect()
 }
