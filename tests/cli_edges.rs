@@ -236,6 +236,7 @@ fn json_summary_has_the_documented_keys() {
         "corners",
         "dropped_clusters",
         "thinned_points",
+        "loops_from",
         "read_ms",
         "detect_ms",
         "edges_ms",
@@ -248,6 +249,7 @@ fn json_summary_has_the_documented_keys() {
     assert_eq!(v["file"], FIXTURE);
     assert_eq!(v["points"], FIXTURE_POINTS);
     assert_eq!(v["loops"], 4);
+    assert_eq!(v["loops_from"], "links");
     assert_eq!(v["offset"], true);
     let n = |k: &str| v[k].as_f64().unwrap();
     assert!(n("boundary_points") > 0.0 && n("boundary_points") < n("points"));

@@ -433,8 +433,7 @@ fn write_edges_py(
             .map(|(i, l)| loop_of(&points, l).map_err(|e| format!("edges[{i}].{e}")))
             .collect::<Result<_, _>>()
             .map_err(MeshtrimError::new_err)?,
-        dropped_clusters: 0,
-        thinned_points: 0,
+        ..Edges::default()
     };
     let data = EdgeData {
         points: &points,

@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{bail, Result};
 use serde::Serialize;
-use trim::{Detection, Edges};
+use trim::{Detection, Edges, LoopSource};
 
 use crate::commands::args::{EdgeFileArgs, StageArgs};
 use crate::console;
@@ -65,6 +65,14 @@ pub struct Summary {
     pub dropped_clusters: usize,
     /// Boundary points removed as spurs, strays or isolated points.
     pub thinned_points: usize,
+    /// How the loops were found: `links` (BPD's links), `scanner_image`
+    /// (traced in the view's image plane) or `own_plane` (traced in the
+    /// cloud's own best-fit plane).
+    pub loops_from: &'static str,
+    /// The direction the own plane's image was seen along, when the loops
+    /// were traced there (shown in the table, not in the JSON).
+    #[serde(skip)]
+    pub own_plane_normal: Option<Point3>,
     /// Time to read the file, in milliseconds.
     pub read_ms: f64,
     /// Time of boundary detection, in milliseconds.
@@ -150,6 +158,11 @@ impl Summary {
             corners: edges.loops.iter().map(|l| l.corners.len()).sum(),
             dropped_clusters: edges.dropped_clusters,
             thinned_points: edges.thinned_points,
+            loops_from: loop_source_name(edges.loops_from),
+            own_plane_normal: match edges.loops_from {
+                LoopSource::OwnPlane { normal } => Some(normal),
+                _ => None,
+            },
             read_ms: 0.0,
             detect_ms: millis(detect),
             edges_ms: millis(reconstruct),
@@ -174,6 +187,7 @@ impl Summary {
             ("corners", self.corners.to_string()),
             ("dropped clusters", self.dropped_clusters.to_string()),
             ("thinned points", self.thinned_points.to_string()),
+            ("loops from", self.loops_from_shown()),
             ("offset", on_off.to_string()),
             ("read time", format!("{:.1} ms", self.read_ms)),
             ("detect time", format!("{:.1} ms", self.detect_ms)),
@@ -183,6 +197,28 @@ impl Summary {
         rows.iter()
             .map(|(label, value)| format!("{label:<20} {value}\n"))
             .collect()
+    }
+}
+
+impl Summary {
+    /// How the loops were found, in words.
+    fn loops_from_shown(&self) -> String {
+        match (self.loops_from, self.own_plane_normal) {
+            ("scanner_image", _) => "the scanner's image plane".to_string(),
+            ("own_plane", Some([x, y, z])) => {
+                format!("the cloud's own plane, seen along {x:.3},{y:.3},{z:.3}")
+            }
+            _ => "BPD's links".to_string(),
+        }
+    }
+}
+
+/// The JSON name of a way of finding the loops.
+fn loop_source_name(source: LoopSource) -> &'static str {
+    match source {
+        LoopSource::Links => "links",
+        LoopSource::ScannerImage => "scanner_image",
+        LoopSource::OwnPlane { .. } => "own_plane",
     }
 }
 
@@ -221,6 +257,8 @@ mod tests {
             corners: 4,
             dropped_clusters: 1,
             thinned_points: 3,
+            loops_from: "own_plane",
+            own_plane_normal: Some([0.0, 0.6, 0.8]),
             read_ms: 1.0,
             detect_ms: 2.5,
             edges_ms: 0.25,
@@ -231,6 +269,12 @@ mod tests {
         assert!(t.contains("boundary points      20 (10.0%)\n"), "{t}");
         assert!(t.contains("offset               off\n"), "{t}");
         assert!(t.contains("write time           0.5 ms\n"), "{t}");
-        assert_eq!(t.lines().count(), 13);
+        assert!(
+            t.contains(
+                "loops from           the cloud's own plane, seen along 0.000,0.600,0.800\n"
+            ),
+            "{t}"
+        );
+        assert_eq!(t.lines().count(), 14);
     }
 }

@@ -81,7 +81,7 @@ pub use bspline::{interpolate as interpolate_bspline, BSpline};
 pub use clean::{clean_mesh, CleanOptions, CleanReport, LeftLoops, LeftReason, SEEN_FROM_ONE_SIDE};
 pub use cloud::Point3;
 pub use delaunay::{delaunay_mesh, delaunay_mesh_with_report, DelaunayOptions, DelaunayReport};
-pub use edges::{reconstruct_edges, Edge, EdgeOptions, Edges, Loop};
+pub use edges::{reconstruct_edges, Edge, EdgeOptions, Edges, Loop, LoopSource};
 pub use error::{CleanError, CloudError, DelaunayError, MeshError, TrimError};
 pub use frame::{fit_plane, Frame};
 pub use geom::rotation_from_quaternion;

@@ -45,6 +45,7 @@ fn sample() -> (Vec<Point3>, Vec<bool>, Edges) {
         loops: vec![square, hole],
         dropped_clusters: 1,
         thinned_points: 2,
+        ..Edges::default()
     };
     (points, boundary, edges)
 }

@@ -111,24 +111,45 @@ pub struct Edges {
     /// Boundary points removed as spurs, strays or isolated points, or
     /// left on no loop when a jumping tour was split.
     pub thinned_points: usize,
+    /// How the loops were found.
+    pub loops_from: LoopSource,
+}
+
+/// How edge reconstruction found the loops.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum LoopSource {
+    /// From BPD's links: clustered, toured and split where a tour jumps.
+    #[default]
+    Links,
+    /// Traced in the image plane of the detection's view, the scanner's.
+    ScannerImage,
+    /// Traced in the image plane of the cloud's own best-fit plane, seen
+    /// along its unit `normal` (a cloud without a view whose links leave a
+    /// ragged border open).
+    OwnPlane {
+        /// The plane's normal, the direction the image was seen along.
+        normal: Point3,
+    },
 }
 
 /// Reconstructs the boundary edges of a cloud from its BPD result: loops,
 /// corners and smoothed edges (see the module doc for the steps).
 pub fn reconstruct_edges(points: &[Point3], detection: &Detection, options: &EdgeOptions) -> Edges {
     if let Some(traced) = trace::traced_loops(points, detection) {
-        return edges_of_traced_loops(points, detection, options, traced);
+        return edges_of_traced_loops(points, detection, options, traced, LoopSource::ScannerImage);
     }
     let linked = LinkedTours::new(points, detection);
     if detection.view.is_none() && linked.leave_a_ragged_border() {
-        if let Some(traced) = trace::traced_loops_in_own_plane(points, detection) {
-            return edges_of_traced_loops(points, detection, options, traced);
+        if let Some((normal, traced)) = trace::traced_loops_in_own_plane(points, detection) {
+            let source = LoopSource::OwnPlane { normal };
+            return edges_of_traced_loops(points, detection, options, traced, source);
         }
     }
     Edges {
         loops: loops_of_tours(points, &detection.beta, linked.tours, options),
         dropped_clusters: linked.dropped_clusters,
         thinned_points: linked.thinned_points,
+        loops_from: LoopSource::Links,
     }
 }
 
@@ -210,6 +231,7 @@ fn edges_of_traced_loops(
     detection: &Detection,
     options: &EdgeOptions,
     mut traced: Vec<Vec<u32>>,
+    loops_from: LoopSource,
 ) -> Edges {
     // Points on a traced loop that BPD labelled interior close it as gap
     // fillers close a tour.
@@ -222,6 +244,7 @@ fn edges_of_traced_loops(
         loops: loops_of_tours(points, &detection.beta, traced, options),
         dropped_clusters: dropped,
         thinned_points: thinned,
+        loops_from,
     }
 }
 
