@@ -5,10 +5,45 @@ use std::path::Path;
 
 use anyhow::Result;
 use serde::Serialize;
+use trim::LoopSource;
 
 use crate::console;
 use crate::io::atomic::write_atomic;
 use crate::io::edges_out::EdgeFileOptions;
+
+/// How edge reconstruction found the loops, as the reports give it: in
+/// JSON by its name (`links`, `scanner_image`, `own_plane`), in the
+/// tables in words.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct LoopsFrom(pub LoopSource);
+
+impl LoopsFrom {
+    /// The JSON name.
+    pub fn name(self) -> &'static str {
+        match self.0 {
+            LoopSource::Links => "links",
+            LoopSource::ScannerImage => "scanner_image",
+            LoopSource::OwnPlane { .. } => "own_plane",
+        }
+    }
+
+    /// The tables' words, with the direction the own plane was seen along.
+    pub fn shown(self) -> String {
+        match self.0 {
+            LoopSource::Links => "BPD's links".to_string(),
+            LoopSource::ScannerImage => "the scanner's image plane".to_string(),
+            LoopSource::OwnPlane { normal: [x, y, z] } => {
+                format!("the cloud's own plane, seen along {x:.3},{y:.3},{z:.3}")
+            }
+        }
+    }
+}
+
+impl Serialize for LoopsFrom {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(self.name())
+    }
+}
 
 /// A command's report that can print itself as a two-column table.
 pub trait Table {

@@ -388,3 +388,34 @@ fn usage_errors_exit_2() {
         Some(2)
     );
 }
+
+/// The summary says how the loops were found: milk.pcd's ragged border,
+/// which BPD's links leave open, traced in the cloud's own best-fit plane
+/// by default and in the camera's image plane with its view; the fixture's
+/// clean borders by the links (see `json_summary_keys`).
+#[test]
+fn the_summary_says_how_the_loops_were_found() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("e.json");
+    let milk = "fixtures/scans/pcl_test/milk.pcd";
+    for (view, expected, words) in [
+        (&[][..], "own_plane", "the cloud's own plane, seen along "),
+        (
+            &["--view-from", "0,0,0"][..],
+            "scanner_image",
+            "the scanner's image plane",
+        ),
+    ] {
+        let mut args = vec!["edges", milk, "-o", path_str(&out)];
+        args.extend_from_slice(view);
+        let run = meshtrim(&[args.clone(), vec!["--json"]].concat());
+        assert!(run.status.success(), "{}", stderr(&run));
+        let v: Value = serde_json::from_slice(&run.stdout).unwrap();
+        assert_eq!(v["loops_from"], expected, "{v}");
+        let table = String::from_utf8(meshtrim(&args).stdout).unwrap();
+        assert!(
+            table.contains(&format!("loops from           {words}")),
+            "{table}"
+        );
+    }
+}

@@ -7,13 +7,13 @@ use std::time::{Duration, Instant};
 
 use anyhow::{bail, Result};
 use serde::Serialize;
-use trim::{Detection, Edges, LoopSource};
+use trim::{Detection, Edges};
 
 use crate::commands::args::{EdgeFileArgs, StageArgs};
 use crate::console;
 use crate::io::edges_out::{edges_format, EdgesFormat};
 use crate::io::{read_cloud_with, CloudOptions, Point3};
-use crate::report::{same_file, shown, write_edges};
+use crate::report::{same_file, shown, write_edges, LoopsFrom};
 use crate::stages::{detect_and_reconstruct, millis, Stages};
 
 /// Arguments of `meshtrim edges`.
@@ -68,11 +68,7 @@ pub struct Summary {
     /// How the loops were found: `links` (BPD's links), `scanner_image`
     /// (traced in the view's image plane) or `own_plane` (traced in the
     /// cloud's own best-fit plane).
-    pub loops_from: &'static str,
-    /// The direction the own plane's image was seen along, when the loops
-    /// were traced there (shown in the table, not in the JSON).
-    #[serde(skip)]
-    pub own_plane_normal: Option<Point3>,
+    pub loops_from: LoopsFrom,
     /// Time to read the file, in milliseconds.
     pub read_ms: f64,
     /// Time of boundary detection, in milliseconds.
@@ -158,11 +154,7 @@ impl Summary {
             corners: edges.loops.iter().map(|l| l.corners.len()).sum(),
             dropped_clusters: edges.dropped_clusters,
             thinned_points: edges.thinned_points,
-            loops_from: loop_source_name(edges.loops_from),
-            own_plane_normal: match edges.loops_from {
-                LoopSource::OwnPlane { normal } => Some(normal),
-                _ => None,
-            },
+            loops_from: LoopsFrom(edges.loops_from),
             read_ms: 0.0,
             detect_ms: millis(detect),
             edges_ms: millis(reconstruct),
@@ -187,7 +179,7 @@ impl Summary {
             ("corners", self.corners.to_string()),
             ("dropped clusters", self.dropped_clusters.to_string()),
             ("thinned points", self.thinned_points.to_string()),
-            ("loops from", self.loops_from_shown()),
+            ("loops from", self.loops_from.shown()),
             ("offset", on_off.to_string()),
             ("read time", format!("{:.1} ms", self.read_ms)),
             ("detect time", format!("{:.1} ms", self.detect_ms)),
@@ -200,31 +192,10 @@ impl Summary {
     }
 }
 
-impl Summary {
-    /// How the loops were found, in words.
-    fn loops_from_shown(&self) -> String {
-        match (self.loops_from, self.own_plane_normal) {
-            ("scanner_image", _) => "the scanner's image plane".to_string(),
-            ("own_plane", Some([x, y, z])) => {
-                format!("the cloud's own plane, seen along {x:.3},{y:.3},{z:.3}")
-            }
-            _ => "BPD's links".to_string(),
-        }
-    }
-}
-
-/// The JSON name of a way of finding the loops.
-fn loop_source_name(source: LoopSource) -> &'static str {
-    match source {
-        LoopSource::Links => "links",
-        LoopSource::ScannerImage => "scanner_image",
-        LoopSource::OwnPlane { .. } => "own_plane",
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use trim::LoopSource;
 
     #[test]
     fn output_checks() {
@@ -257,8 +228,9 @@ mod tests {
             corners: 4,
             dropped_clusters: 1,
             thinned_points: 3,
-            loops_from: "own_plane",
-            own_plane_normal: Some([0.0, 0.6, 0.8]),
+            loops_from: LoopsFrom(LoopSource::OwnPlane {
+                normal: [0.0, 0.6, 0.8],
+            }),
             read_ms: 1.0,
             detect_ms: 2.5,
             edges_ms: 0.25,

@@ -12,7 +12,7 @@ use trim::{delaunay_mesh_with_report, DelaunayOptions, DelaunayReport, Detection
 use crate::commands::args::{EdgeFileArgs, StageArgs};
 use crate::io::mesh_out::write_mesh;
 use crate::io::{read_cloud_with, CloudOptions, Point3};
-use crate::report::{shown, write_edges};
+use crate::report::{shown, write_edges, LoopsFrom};
 use crate::stages::{detect_and_reconstruct, millis, Stages};
 
 /// Arguments of `meshtrim mesh`.
@@ -64,6 +64,8 @@ pub struct Report {
     pub points_near_loop: usize,
     /// Smoothed loops used as constraints.
     pub loops: usize,
+    /// How the loops were found (see `meshtrim edges`).
+    pub loops_from: LoopsFrom,
     /// Loop vertices dropped to untwist self-crossing loops.
     pub loop_vertices_dropped: usize,
     /// Diagonals of co-circular quads (quantised clouds) flipped to the
@@ -148,7 +150,8 @@ pub fn mesh_in_memory(
         delaunay_mesh_with_report(points, &detection, &edges, &DelaunayOptions::default())
             .with_context(|| name.to_string())?;
     let times = [detect_time, edges_time, started.elapsed()];
-    let report = Report::new(points.len(), mesh.faces.len(), &made, times);
+    let loops_from = LoopsFrom(edges.loops_from);
+    let report = Report::new(points.len(), mesh.faces.len(), &made, loops_from, times);
     Ok(Meshed {
         mesh,
         report,
@@ -162,6 +165,7 @@ impl Report {
         points: usize,
         faces: usize,
         made: &DelaunayReport,
+        loops_from: LoopsFrom,
         [detect, edges, mesh]: [Duration; 3],
     ) -> Self {
         Report {
@@ -172,6 +176,7 @@ impl Report {
             points_outside: made.points_outside,
             points_near_loop: made.points_near_loop,
             loops: made.loops.len(),
+            loops_from,
             loop_vertices_dropped: made.loop_vertices_dropped,
             diagonals_flipped: made.diagonals_flipped,
             faces,
@@ -196,6 +201,7 @@ impl crate::report::Table for Report {
             ("points outside", self.points_outside.to_string()),
             ("points on a loop", self.points_near_loop.to_string()),
             ("loops", self.loops.to_string()),
+            ("loops from", self.loops_from.shown()),
             ("faces", self.faces.to_string()),
             ("diagonals flipped", self.diagonals_flipped.to_string()),
             ("area", format!("{:.6}", self.area)),

@@ -19,7 +19,7 @@ use crate::io::edges_out::step::LengthUnit;
 use crate::io::edges_out::EdgeFileOptions;
 use crate::io::mesh_out::write_mesh;
 use crate::io::{read_cloud_with, read_mesh_with_faces, CloudOptions, Point3};
-use crate::report::{shown, significant, write_edges};
+use crate::report::{shown, significant, write_edges, LoopsFrom};
 use crate::stages::{detect_and_reconstruct, millis, Stages};
 
 /// Arguments of the trimming (`meshtrim MESH CLOUD OUT`).
@@ -118,6 +118,8 @@ pub struct Report {
     pub boundary_points: usize,
     /// Smoothed boundary loops the mesh was cut along.
     pub loops: usize,
+    /// How the loops were found (see `meshtrim edges`).
+    pub loops_from: LoopsFrom,
     /// Input faces.
     pub faces_in: usize,
     /// Output faces.
@@ -284,6 +286,7 @@ pub fn trim_in_memory(
         points.len(),
         detection.boundary_count(),
         &trimmed,
+        LoopsFrom(edges.loops_from),
         [detect_time, edges_time, trim_time],
     );
     Ok(Trimmed {
@@ -310,6 +313,7 @@ impl Report {
         points: usize,
         boundary_points: usize,
         r: &TrimReport,
+        loops_from: LoopsFrom,
         [detect, edges, trim]: [Duration; 3],
     ) -> Self {
         let fit = |l: &LoopFit| BorderFit {
@@ -324,6 +328,7 @@ impl Report {
             points,
             boundary_points,
             loops: r.loops.len(),
+            loops_from,
             faces_in: r.faces_in,
             faces_out: r.faces_out,
             faces_split: r.faces_split,
@@ -365,6 +370,7 @@ impl crate::report::Table for Report {
                 ),
             ),
             ("loops", self.loops.to_string()),
+            ("loops from", self.loops_from.shown()),
             (
                 "faces in / out",
                 format!("{} / {}", self.faces_in, self.faces_out),
