@@ -1,13 +1,16 @@
 //! Times BPD and edge reconstruction on one seeded synthetic cloud and
 //! prints one JSON line.
 //!
-//! `cargo run --release --example bench_bpd -- N [sheet|linescan|viewed] [OUT.ply]`
+//! `cargo run --release --example bench_bpd -- N [sheet|linescan|viewed|ragged] [OUT.ply]`
 //!
 //! The cloud is a jittered, twisted sheet of about N points with three holes;
 //! `linescan` samples it in lines four times farther apart than the points
 //! along each line; `viewed` is the sheet detected with its line of sight
 //! given (along z, over which the sheet is a height field), so that its
-//! edges are traced in the image plane. With OUT.ply the cloud is also written (binary PLY) so
+//! edges are traced in the image plane; `ragged` is the sheet whose points
+//! within 4 spacings of its outer edge are kept at random (three in five),
+//! so that BPD's links leave that border open and the edges are traced in
+//! the sheet's own best-fit plane. With OUT.ply the cloud is also written (binary PLY) so
 //! that `bench/bpd.sh` can time Open3D on the very same points.
 //!
 //! Detection runs `BENCH_REPEAT` times (default: 3 up to 1.5M points, 1
@@ -28,8 +31,9 @@ fn main() -> anyhow::Result<()> {
     let n: usize = args.get(1).and_then(|a| a.parse().ok()).unwrap_or(100_000);
     let kind = args.get(2).map(String::as_str).unwrap_or("sheet");
     let cloud = match kind {
-        "linescan" => twisted_sheet(n, 4.0, 7),
-        _ => twisted_sheet(n, 1.0, 7),
+        "linescan" => twisted_sheet(n, 4.0, 7, false),
+        "ragged" => twisted_sheet(n, 1.0, 7, true),
+        _ => twisted_sheet(n, 1.0, 7, false),
     };
     let options = BpdOptions {
         view: (kind == "viewed").then_some(View::Along([0.0, 0.0, 1.0])),
@@ -68,11 +72,17 @@ fn main() -> anyhow::Result<()> {
         .filter(|&&d| d == trim::Decision::OpenPath)
         .count();
     println!(
-        "{{\"kind\":\"{kind}\",\"points\":{},\"boundary\":{},\"by_path_test\":{by_path},\"detect_ms\":{ms:.1},\"first_ms\":{:.1},\"loops\":{},\"edges_ms\":{edges_ms:.1},\"peak_rss_mb\":{:.1}}}",
+        "{{\"kind\":\"{kind}\",\"points\":{},\"boundary\":{},\"by_path_test\":{by_path},\"detect_ms\":{ms:.1},\"first_ms\":{:.1},\"loops\":{},\"largest_loop\":{},\"loops_from\":\"{}\",\"edges_ms\":{edges_ms:.1},\"peak_rss_mb\":{:.1}}}",
         cloud.len(),
         found.boundary_count(),
         first_ms.unwrap_or(f64::NAN),
         edges.loops.len(),
+        edges.loops.iter().map(|l| l.boundary_points.len()).max().unwrap_or(0),
+        match edges.loops_from {
+            trim::LoopSource::Links => "links",
+            trim::LoopSource::ScannerImage => "scanner_image",
+            trim::LoopSource::OwnPlane { .. } => "own_plane",
+        },
         peak_mb.unwrap_or(f64::NAN)
     );
     Ok(())
@@ -80,8 +90,9 @@ fn main() -> anyhow::Result<()> {
 
 /// A twisted, cambered sheet (about 600 × 200 units) with three round holes,
 /// jittered-grid sampled with about `n` points; rows are `ratio` times
-/// farther apart than points within a row.
-fn twisted_sheet(n: usize, ratio: f64, seed: u64) -> Vec<Point3> {
+/// farther apart than points within a row. When `ragged`, the points within
+/// 4 spacings of the outer edge are kept at random, three in five.
+fn twisted_sheet(n: usize, ratio: f64, seed: u64, ragged: bool) -> Vec<Point3> {
     let (w, h) = (600.0, 200.0);
     let s = (w * h / (n as f64 * ratio)).sqrt();
     let mut rng = SplitMix(seed);
@@ -97,6 +108,10 @@ fn twisted_sheet(n: usize, ratio: f64, seed: u64) -> Vec<Point3> {
             let u = (i as f64 + 0.5 + 0.6 * (rng.unit() - 0.5)) * s;
             let v = (j as f64 + 0.5 + 0.6 * (rng.unit() - 0.5) / ratio) * s * ratio;
             if holes.iter().any(|&(x, y, r)| (u - x).hypot(v - y) < r) {
+                continue;
+            }
+            let edge = u.min(v).min(w - u).min(h - v);
+            if ragged && edge < 4.0 * s && rng.unit() < 0.4 {
                 continue;
             }
             let twist = 0.5 * u / w;
