@@ -52,13 +52,18 @@ fn pcl_test() {
 /// the cloud.
 fn loop_sizes(rel: &str, view: trim::View) -> (Vec<usize>, Vec<trim::Point3>) {
     let (cloud, _, edges) = edges_of(rel, Some(view));
+    (sizes_of(&edges), cloud.points)
+}
+
+/// The sizes of the edges' loops, largest first.
+fn sizes_of(edges: &trim::Edges) -> Vec<usize> {
     let mut sizes: Vec<usize> = edges
         .loops
         .iter()
         .map(|l| l.boundary_points.len())
         .collect();
     sizes.sort_unstable_by(|a, b| b.cmp(a));
-    (sizes, cloud.points)
+    sizes
 }
 
 /// A scan's cloud, its detection and its edges (default options).
@@ -120,12 +125,7 @@ fn ragged_scans_without_a_view_close_in_their_own_plane() {
             matches!(edges.loops_from, trim::LoopSource::OwnPlane { .. }),
             "{rel}"
         );
-        let mut sizes: Vec<usize> = edges
-            .loops
-            .iter()
-            .map(|l| l.boundary_points.len())
-            .collect();
-        sizes.sort_unstable_by(|a, b| b.cmp(a));
+        let sizes = sizes_of(&edges);
         assert!(
             sizes.first().is_some_and(|&n| n >= least),
             "{rel}: {sizes:?}"
