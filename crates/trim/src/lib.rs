@@ -92,11 +92,14 @@ pub use trimming::{trim_mesh, LoopFit, TrimOptions, TrimReport};
 
 /// Steps of detection and edge reconstruction the test kit looks into
 /// (which mechanism flips a label under noise; which steps of a tour jump
-/// across the surface, by the rule that cuts tours). Not part of the API:
+/// across the surface, by the rule that cuts tours; the measures that
+/// decide whether a cloud is traced in its own plane). Not part of the API:
 /// they change with the algorithm.
 #[doc(hidden)]
 pub mod internals {
     pub use crate::anisotropy::own_sampling_vectors;
+    pub use crate::edges::share_left_by_tours;
     pub use crate::edges::split::supported as step_is_supported;
+    pub use crate::edges::trace::own_plane_layered_share;
     pub use crate::frame::project;
 }

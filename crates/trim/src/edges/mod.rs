@@ -157,12 +157,21 @@ pub fn reconstruct_edges(points: &[Point3], detection: &Detection, options: &Edg
 /// every loop before a cloud without a view is traced in its own plane.
 /// A tour is cut where it jumps across the surface, and the pieces that
 /// close no loop are dropped: a ragged band of boundary points, no single
-/// cycle of links, loses a large share. Measured: the synthetic clouds and
+/// cycle of links, loses a large share. Measured (`cargo run --release
+/// --example own_plane`, and `bench_bpd`'s clouds): the synthetic clouds and
 /// the benchmark's sheets and line scans (12k to 1M points) 0–3.1 %;
 /// lato000 9.7 %, the Kinect blades 16 % and 26 %, face000 26 %, milk.pcd
 /// 27 %. (Small clusters dropped whole, round gaps of the sampling inside
 /// a surface, do not count: their number grows with the surface's area.)
 const MAX_SHARE_LEFT_BY_TOURS: f64 = 0.05;
+
+/// The share of the linked clusters' points that the tours of BPD's links
+/// leave on no loop (the limit is [`MAX_SHARE_LEFT_BY_TOURS`]). For the
+/// test kit's measurements.
+pub fn share_left_by_tours(points: &[Point3], detection: &Detection) -> f64 {
+    let linked = LinkedTours::new(points, detection);
+    linked.off_loops as f64 / linked.clustered.max(1) as f64
+}
 
 /// The loops found from BPD's links (input indices, in canonical order),
 /// with what was left off them.
