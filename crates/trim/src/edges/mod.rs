@@ -166,7 +166,7 @@ pub fn reconstruct_edges(points: &[Point3], detection: &Detection, options: &Edg
 const MAX_SHARE_LEFT_BY_TOURS: f64 = 0.05;
 
 /// The share of the linked clusters' points that the tours of BPD's links
-/// leave on no loop (the limit is [`MAX_SHARE_LEFT_BY_TOURS`]). For the
+/// leave on no loop (the limit is 5 %). For the
 /// test kit's measurements.
 pub fn share_left_by_tours(points: &[Point3], detection: &Detection) -> f64 {
     let linked = LinkedTours::new(points, detection);

@@ -119,7 +119,7 @@ pub(crate) fn traced_loops_in_own_plane(
 }
 
 /// The share of the points in two layers of the image of the cloud's own
-/// best-fit plane (the limit is [`MAX_LAYERED_SHARE`]), or `None` when no
+/// best-fit plane (the limit is 0.5 %), or `None` when no
 /// region of half of the points is seen there. For the test kit's
 /// measurements.
 pub fn own_plane_layered_share(points: &[Point3], detection: &Detection) -> Option<f64> {
