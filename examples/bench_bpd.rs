@@ -78,11 +78,7 @@ fn main() -> anyhow::Result<()> {
         first_ms.unwrap_or(f64::NAN),
         edges.loops.len(),
         edges.loops.iter().map(|l| l.boundary_points.len()).max().unwrap_or(0),
-        match edges.loops_from {
-            trim::LoopSource::Links => "links",
-            trim::LoopSource::ScannerImage => "scanner_image",
-            trim::LoopSource::OwnPlane { .. } => "own_plane",
-        },
+        edges.loops_from.name(),
         peak_mb.unwrap_or(f64::NAN)
     );
     Ok(())

@@ -11,7 +11,7 @@ use std::path::Path;
 
 use testkit::synthetic;
 use trim::internals::{own_plane_layered_share, share_left_by_tours};
-use trim::{detect_boundary, reconstruct_edges, BpdOptions, EdgeOptions, LoopSource, Point3};
+use trim::{detect_boundary, reconstruct_edges, BpdOptions, EdgeOptions, Point3};
 
 const SCANS: &[&str] = &[
     "blade_scan_kinect/BladeScan1.csv",
@@ -63,11 +63,7 @@ fn row(name: &str, points: &[Point3]) -> anyhow::Result<()> {
             format!("{:.2} %", 100.0 * s)
         });
     let edges = reconstruct_edges(points, &detection, &EdgeOptions::default());
-    let from = match edges.loops_from {
-        LoopSource::Links => "links",
-        LoopSource::ScannerImage => "scanner's image",
-        LoopSource::OwnPlane { .. } => "own plane",
-    };
+    let from = edges.loops_from.name();
     println!(
         "| {name} | {} | {:.1} % | {layered} | {from} |",
         points.len(),

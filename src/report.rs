@@ -20,11 +20,7 @@ pub struct LoopsFrom(pub LoopSource);
 impl LoopsFrom {
     /// The JSON name.
     pub fn name(self) -> &'static str {
-        match self.0 {
-            LoopSource::Links => "links",
-            LoopSource::ScannerImage => "scanner_image",
-            LoopSource::OwnPlane { .. } => "own_plane",
-        }
+        self.0.name()
     }
 
     /// The tables' words, with the direction the own plane was seen along.

@@ -132,6 +132,17 @@ pub enum LoopSource {
     },
 }
 
+impl LoopSource {
+    /// A short name: `links`, `scanner_image` or `own_plane`.
+    pub fn name(self) -> &'static str {
+        match self {
+            LoopSource::Links => "links",
+            LoopSource::ScannerImage => "scanner_image",
+            LoopSource::OwnPlane { .. } => "own_plane",
+        }
+    }
+}
+
 /// Reconstructs the boundary edges of a cloud from its BPD result: loops,
 /// corners and smoothed edges (see the module doc for the steps).
 pub fn reconstruct_edges(points: &[Point3], detection: &Detection, options: &EdgeOptions) -> Edges {
@@ -169,8 +180,7 @@ const MAX_SHARE_LEFT_BY_TOURS: f64 = 0.05;
 /// leave on no loop (the limit is 5 %). For the
 /// test kit's measurements.
 pub fn share_left_by_tours(points: &[Point3], detection: &Detection) -> f64 {
-    let linked = LinkedTours::new(points, detection);
-    linked.off_loops as f64 / linked.clustered.max(1) as f64
+    LinkedTours::new(points, detection).share_left()
 }
 
 /// The loops found from BPD's links (input indices, in canonical order),
@@ -211,6 +221,7 @@ impl LinkedTours {
         tours.sort_unstable();
         let on_loops: std::collections::BTreeSet<u32> = tours.iter().flatten().copied().collect();
         let clustered: usize = clusters.clusters.iter().map(Vec::len).sum();
+        let off_loops = clustered - on_loops.len();
         let tours = tours
             .into_iter()
             .map(|tour| tour.iter().map(|&c| canon.input[c as usize]).collect())
@@ -218,16 +229,21 @@ impl LinkedTours {
         LinkedTours {
             tours,
             dropped_clusters: clusters.dropped_clusters + dropped_pieces + filled_only,
-            thinned_points: clusters.thinned_points + (clustered - on_loops.len()),
+            thinned_points: clusters.thinned_points + off_loops,
             clustered,
-            off_loops: clustered - on_loops.len(),
+            off_loops,
         }
+    }
+
+    /// The share of the clustered points on no loop.
+    fn share_left(&self) -> f64 {
+        self.off_loops as f64 / self.clustered.max(1) as f64
     }
 
     /// Whether the tours leave more than [`MAX_SHARE_LEFT_BY_TOURS`] of
     /// the clustered points off every loop.
     fn leave_a_ragged_border(&self) -> bool {
-        self.off_loops as f64 > MAX_SHARE_LEFT_BY_TOURS * self.clustered as f64
+        self.share_left() > MAX_SHARE_LEFT_BY_TOURS
     }
 }
 
