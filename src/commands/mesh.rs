@@ -68,6 +68,12 @@ pub struct Report {
     pub loops_from: LoopsFrom,
     /// Loop vertices dropped to untwist self-crossing loops.
     pub loop_vertices_dropped: usize,
+    /// Crossings of smoothed loops split, the surface then taken by
+    /// winding.
+    pub loop_crossings: usize,
+    /// Faces dropped where crossing loops pinched the surface or enclosed
+    /// no cloud point.
+    pub crossing_faces_dropped: usize,
     /// Diagonals of co-circular quads (quantised clouds) flipped to the
     /// canonical side.
     pub diagonals_flipped: usize,
@@ -178,6 +184,8 @@ impl Report {
             loops: made.loops.len(),
             loops_from,
             loop_vertices_dropped: made.loop_vertices_dropped,
+            loop_crossings: made.loop_crossings,
+            crossing_faces_dropped: made.crossing_faces_dropped,
             diagonals_flipped: made.diagonals_flipped,
             faces,
             area: made.area,
@@ -202,6 +210,7 @@ impl crate::report::Table for Report {
             ("points on a loop", self.points_near_loop.to_string()),
             ("loops", self.loops.to_string()),
             ("loops from", self.loops_from.shown()),
+            ("loop crossings", self.loop_crossings.to_string()),
             ("faces", self.faces.to_string()),
             ("diagonals flipped", self.diagonals_flipped.to_string()),
             ("area", format!("{:.6}", self.area)),

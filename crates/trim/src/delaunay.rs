@@ -21,15 +21,22 @@
 //!    must not touch one another: a loop that crosses itself is repaired
 //!    by dropping the vertices of the shorter side of the crossing (a
 //!    twist, or a spike that turns straight back), as long as that takes at
-//!    most [`DelaunayOptions::max_repair`] of its vertices (and at least 4 may always go);
-//!    otherwise [`DelaunayError::LoopNotSimple`]. Two loops that cross or touch
-//!    give [`DelaunayError::LoopsCross`]. spade's exact predicates check every
-//!    constraint again before it is added (spade panics on crossing
-//!    constraints): what the floating-point repair missed is an error,
-//!    never a panic.
+//!    most [`DelaunayOptions::max_repair`] of its vertices (and at least 4 may always go).
+//!    Where that leaves loops crossing (a twist too long to drop, a small
+//!    hole across the outer border, two holes across each other: ragged
+//!    real scans have them), every proper crossing is split into a vertex
+//!    the loops share, and each loop gets its surface side from the cloud
+//!    points near it (`planar/tangle.rs`): the surface is then where the
+//!    winding is at least 1, the outer border's inside less every hole.
+//!    Loops that touch without crossing, or run along each other, give
+//!    [`DelaunayError::LoopsCross`] (or [`DelaunayError::LoopNotSimple`]
+//!    for one loop). spade's exact predicates check every constraint
+//!    again before it is added (spade panics on crossing constraints):
+//!    what the floating-point repair missed is an error, never a panic.
 //! 4. **Which points go in.** A cloud point is inserted when it lies inside
 //!    the loops by parity (inside the outer border, outside the holes; with
-//!    several outer loops, each patch) and farther than [`DelaunayOptions::exclude`]·βᵢ from
+//!    several outer loops, each patch), or by winding where loops crossed,
+//!    and farther than [`DelaunayOptions::exclude`]·βᵢ from
 //!    every loop. Points closer to a loop are left out: the loop vertices
 //!    stand for the border there, and a point next to a constraint would
 //!    only make a sliver (or, on it, split the constraint and change the
@@ -40,7 +47,11 @@
 //!    its segments added as constraint edges.
 //! 6. **Kept faces.** The faces are classified exactly by a flood fill from
 //!    the outside that flips parity across every constraint edge: odd faces
-//!    (inside the outer border and outside the holes) are kept. Co-circular
+//!    (inside the outer border and outside the holes) are kept. Where loops
+//!    crossed, the fill adds each constraint's turn of the winding instead
+//!    and keeps the faces of winding at least 1; where two holes touch at a
+//!    crossing the faces of the smaller fan round it go (a pinch would be a
+//!    non-manifold vertex), and so do patches without a cloud point. Co-circular
 //!    quads (the lattice rectangles of quantised clouds), where either
 //!    diagonal is Delaunay, take the one through their lowest id
 //!    ([`canonical_diagonals`]), and the faces are listed in the order of their ids,
@@ -82,8 +93,8 @@ use crate::spatial::neighbours::{NeighbourIndex, RunScratch};
 
 use crate::geom::median;
 use crate::planar::{
-    canonical_diagonals, cocircular, inside_faces, obstacle, point, untwist, Cdt, Node, Ring,
-    SegmentGrid, Tangle,
+    canonical_diagonals, cocircular, inside_faces, obstacle, pinches_opened, point, surface_sides,
+    untangle, untwist, winding_faces, Cdt, Node, Ring, SegmentGrid, Tangle, Turns, VOTE_REACH,
 };
 
 /// Neighbourhood size of the local normals of the height-field check.
@@ -146,6 +157,12 @@ pub struct DelaunayReport {
     pub loop_vertices_merged: usize,
     /// Loop vertices dropped to untwist self-crossing loops.
     pub loop_vertices_dropped: usize,
+    /// Crossings of smoothed loops (with one another or themselves) that
+    /// were split, the surface then taken by winding (step 3).
+    pub loop_crossings: usize,
+    /// Faces dropped where loops crossed: round a vertex where the surface
+    /// pinched, or in a patch without a cloud point (step 6).
+    pub crossing_faces_dropped: usize,
     /// Share of local normals standing on edge (|nᵢ·n| < 0.1), %.
     pub steep_normals_percent: f64,
     /// Share of kept triangles not following the surface, %.
@@ -156,6 +173,8 @@ pub struct DelaunayReport {
     /// one through the quad's lowest id).
     pub diagonals_flipped: usize,
     /// For each smoothed loop, its vertices in the output, in loop order.
+    /// Loops that cross are split at their crossings first (step 3), each
+    /// lobe a loop, and list only the vertices the output uses.
     pub loops: Vec<Vec<u32>>,
     /// Unit normal of the best-fit plane; faces are counter-clockwise seen
     /// from its side.
@@ -197,9 +216,17 @@ pub fn delaunay_mesh_with_report(
     if edges.loops.is_empty() {
         return Err(MeshError::NoFaces.into());
     }
-    let (rings, grid) = valid_rings(edges, beta, beta_median, &plane, options, &mut report)?;
-    let nodes = points_inside(cloud, beta, &plane, &grid, options.exclude, &mut report);
-    let triangulation = LoopCdt::build(nodes, &rings, n, &mut report)?;
+    let bounds = valid_rings(
+        edges,
+        cloud,
+        beta,
+        beta_median,
+        &plane,
+        options,
+        &mut report,
+    )?;
+    let nodes = points_inside(cloud, beta, &plane, &bounds, options.exclude, &mut report);
+    let triangulation = LoopCdt::build(nodes, &bounds, n, &mut report)?;
     let (mesh, reference) = triangulation.lift(cloud, &mut report)?;
     check_triangles(
         &mesh,
@@ -330,18 +357,41 @@ fn check_steep_normals(
     Ok(())
 }
 
+/// The loops that bound the mesh, valid in the projection.
+struct Bounds {
+    rings: Vec<Ring>,
+    grid: SegmentGrid,
+    /// Where loops crossed: each ring's surface side ([`surface_sides`]),
+    /// the surface then being where the winding is at least 1. `None`
+    /// where no loop crosses: parity says the same without sides.
+    sides: Option<Vec<i32>>,
+}
+
+impl Bounds {
+    /// Is `p` (away from the loops) on the surface?
+    fn inside(&self, p: [f64; 2]) -> bool {
+        match &self.sides {
+            None => self.grid.parity(p),
+            Some(sides) => self.grid.winding(p, sides) >= 1,
+        }
+    }
+}
+
 /// Step 3, **loops made valid**: each smoothed loop as a ring projected
-/// onto the plane, coincident vertices merged, self-crossings untwisted
-/// ([`untwist`]); returns the rings and the grid of their segments. Fills
-/// `loop_vertices_merged` and `loop_vertices_dropped`.
+/// onto the plane, coincident vertices merged, small self-crossings
+/// untwisted ([`untwist`]); where that leaves loops crossing, they are
+/// split at their crossings instead ([`untangle`]) and each gets its
+/// surface side. Fills `loop_vertices_merged`, `loop_vertices_dropped`
+/// and `loop_crossings`.
 fn valid_rings(
     edges: &Edges,
+    cloud: &[Point3],
     beta: &[f64],
     beta_median: f64,
     plane: &Projection,
     options: &DelaunayOptions,
     report: &mut DelaunayReport,
-) -> Result<(Vec<Ring>, SegmentGrid), DelaunayError> {
+) -> Result<Bounds, DelaunayError> {
     let mut rings: Vec<Ring> = edges
         .loops
         .iter()
@@ -351,12 +401,50 @@ fn valid_rings(
         ring.p2 = ring.p3.iter().map(|&p| plane.to2(p)).collect();
         report.loop_vertices_merged += ring.merge_coincident();
     }
-    let (grid, dropped) = untwist(
-        &mut rings,
-        options.exclude * beta_median,
-        options.max_repair,
-    )
-    .map_err(|tangle| match tangle {
+    let min_cell = options.exclude * beta_median;
+    let merged = rings.clone();
+    match untwist(&mut rings, min_cell, options.max_repair) {
+        Ok((grid, dropped)) => {
+            report.loop_vertices_dropped += dropped;
+            Ok(Bounds {
+                rings,
+                grid,
+                sides: None,
+            })
+        }
+        Err(tangle) => untangled(&merged, cloud, beta, plane, min_cell, report)
+            .ok_or_else(|| tangle_error(tangle)),
+    }
+}
+
+/// The loops split at their crossings ([`untangle`]), each with the
+/// surface side the cloud points near it vote for; `None` where loops
+/// touch or run along each other, which no split resolves.
+fn untangled(
+    rings: &[Ring],
+    cloud: &[Point3],
+    beta: &[f64],
+    plane: &Projection,
+    min_cell: f64,
+    report: &mut DelaunayReport,
+) -> Option<Bounds> {
+    let split = untangle(rings, &SegmentGrid::new(rings, min_cell)).ok()?;
+    let grid = SegmentGrid::new(&split.rings, min_cell);
+    let votes: Vec<Option<(u32, f64)>> = (0..cloud.len())
+        .into_par_iter()
+        .map(|i| grid.nearest(plane.to2(cloud[i]), VOTE_REACH * beta[i]))
+        .collect();
+    let sides = surface_sides(&split.rings, &grid, votes.into_iter().flatten());
+    report.loop_crossings = split.crossings;
+    Some(Bounds {
+        rings: split.rings,
+        grid,
+        sides: Some(sides),
+    })
+}
+
+fn tangle_error(tangle: Tangle) -> DelaunayError {
+    match tangle {
         Tangle::SelfCrossing {
             index,
             vertices,
@@ -367,9 +455,7 @@ fn valid_rings(
             dropped,
         },
         Tangle::Crossing { a, b } => DelaunayError::LoopsCross { a, b },
-    })?;
-    report.loop_vertices_dropped += dropped;
-    Ok((rings, grid))
+    }
 }
 
 /// Where a cloud point lies relative to the loops (step 4).
@@ -393,7 +479,7 @@ fn points_inside(
     cloud: &[Point3],
     beta: &[f64],
     plane: &Projection,
-    grid: &SegmentGrid,
+    bounds: &Bounds,
     exclude: f64,
     report: &mut DelaunayReport,
 ) -> Vec<Node> {
@@ -401,9 +487,9 @@ fn points_inside(
         .into_par_iter()
         .map(|i| {
             let p = plane.to2(cloud[i]);
-            if grid.near(p, exclude * beta[i]) {
+            if bounds.grid.near(p, exclude * beta[i]) {
                 PointClass::NearLoop
-            } else if grid.parity(p) {
+            } else if bounds.inside(p) {
                 PointClass::Inside
             } else {
                 PointClass::Outside
@@ -435,20 +521,25 @@ struct LoopCdt {
     loop_of: Vec<u32>,
     /// Each ring's vertex handles, in ring order.
     ring_handles: Vec<Vec<FixedVertexHandle>>,
+    /// Where loops crossed, the constraint edges' turns of the winding
+    /// ([`winding_faces`]); `None` for parity.
+    turns: Option<Turns>,
 }
 
 impl LoopCdt {
     /// Bulk-loads the `nodes`, then inserts every ring's vertices and adds
     /// its segments as constraint edges, outer borders first. A ring vertex
     /// or segment that meets another ring's (or its own) is an error, never
-    /// a panic in spade. Fills `points_merged` (nodes spade found
-    /// coincident, the first kept).
+    /// a panic in spade; where loops were split at their crossings, those
+    /// crossing vertices and the segments between them are shared. Fills
+    /// `points_merged` (nodes spade found coincident, the first kept).
     fn build(
         nodes: Vec<Node>,
-        rings: &[Ring],
+        bounds: &Bounds,
         n: usize,
         report: &mut DelaunayReport,
     ) -> Result<Self, DelaunayError> {
+        let rings = &bounds.rings;
         let inserted = nodes.len();
         let cdt: Cdt = if nodes.is_empty() {
             Cdt::new()
@@ -463,10 +554,12 @@ impl LoopCdt {
             loop_ref: Vec::new(),
             loop_of: Vec::new(),
             ring_handles: vec![Vec::new(); rings.len()],
+            turns: bounds.sides.as_ref().map(|_| Turns::default()),
         };
         for l in largest_first(rings) {
             let handles = t.insert_ring_vertices(l, &rings[l])?;
-            t.constrain_ring(l, rings[l].len(), &handles)?;
+            let side = bounds.sides.as_ref().map_or(1, |sides| sides[l]);
+            t.constrain_ring(l, rings[l].len(), &handles, side)?;
             t.ring_handles[l] = handles;
         }
         Ok(t)
@@ -484,6 +577,10 @@ impl LoopCdt {
             let id = (self.n + self.loop_p3.len()) as u32;
             let position = point(ring.p2[j]);
             match self.cdt.locate(position) {
+                PositionInTriangulation::OnVertex(h) if self.is_shared_crossing(h, position) => {
+                    handles.push(h);
+                    continue;
+                }
                 PositionInTriangulation::OnVertex(h) => {
                     let other = self.cdt.vertex(h).data().id;
                     return Err(self.crossing(l, ring.len(), other));
@@ -508,18 +605,45 @@ impl LoopCdt {
         Ok(handles)
     }
 
+    /// Where loops were split at their crossings, is `h` a loop vertex at
+    /// exactly `position`: a crossing another loop inserted first?
+    fn is_shared_crossing(&self, h: FixedVertexHandle, position: spade::Point2<f64>) -> bool {
+        let v = self.cdt.vertex(h);
+        self.turns.is_some() && v.data().id as usize >= self.n && v.position() == position
+    }
+
     /// Adds the closed polyline through `handles` (ring `l`, of `vertices`
-    /// vertices) as constraint edges, checking each first with exact
-    /// predicates: spade panics on crossing constraints.
+    /// vertices, its surface on the side `side`) as constraint edges,
+    /// checking each first with exact predicates: spade panics on crossing
+    /// constraints. Where loops were split at their crossings, a segment
+    /// two loops share is added once and each turn of the winding noted.
     fn constrain_ring(
         &mut self,
         l: usize,
         vertices: usize,
         handles: &[FixedVertexHandle],
+        side: i32,
     ) -> Result<(), DelaunayError> {
         let m = handles.len();
         for j in 0..m {
             let (a, b) = (handles[j], handles[(j + 1) % m]);
+            if let Some(turns) = self.turns.as_mut() {
+                // Crossing a → b from its right to its left, the winding
+                // gains the ring's side.
+                let (key, turn) = if a < b {
+                    ((a, b), side)
+                } else {
+                    ((b, a), -side)
+                };
+                *turns.entry(key).or_default() += turn;
+                let shared = self
+                    .cdt
+                    .get_edge_from_neighbors(a, b)
+                    .is_some_and(|e| e.is_constraint_edge());
+                if shared {
+                    continue;
+                }
+            }
             if let Some(other) = obstacle(&self.cdt, a, b) {
                 return Err(self.crossing(l, vertices, other));
             }
@@ -555,8 +679,16 @@ impl LoopCdt {
         let KeptFaces {
             mut faces,
             positions,
-            used,
+            mut used,
         } = self.kept_faces(flips_possible);
+        if self.turns.is_some() {
+            report.crossing_faces_dropped = pinches_opened(&mut faces, used.len(), self.n);
+            used.fill(false);
+            faces
+                .iter()
+                .flatten()
+                .for_each(|&id| used[id as usize] = true);
+        }
         report.diagonals_flipped = if flips_possible {
             canonical_diagonals(&positions, &mut faces, &self.constraint_pairs())
         } else {
@@ -580,21 +712,29 @@ impl LoopCdt {
         Ok((mesh, reference))
     }
 
-    /// Each ring's vertices as output numbers, in ring order.
+    /// Each ring's vertices as output numbers, in ring order; those the
+    /// output does not use (where loops crossed) are left out, and rings
+    /// with none.
     fn ring_vertices(&self, out_index: &[u32]) -> Vec<Vec<u32>> {
         self.ring_handles
             .iter()
             .map(|hs| {
                 hs.iter()
                     .map(|&h| out_index[self.cdt.vertex(h).data().id as usize])
-                    .collect()
+                    .filter(|&v| v != u32::MAX)
+                    .collect::<Vec<u32>>()
             })
+            .filter(|vertices| !vertices.is_empty())
             .collect()
     }
 
-    /// The odd faces, counter-clockwise.
+    /// The faces on the surface, counter-clockwise: odd by parity, or of
+    /// winding at least 1 where loops crossed.
     fn kept_faces(&self, with_positions: bool) -> KeptFaces {
-        let kept = inside_faces(&self.cdt);
+        let kept = match &self.turns {
+            None => inside_faces(&self.cdt),
+            Some(turns) => winding_faces(&self.cdt, turns),
+        };
         let mut faces: Vec<[u32; 3]> = Vec::with_capacity(kept.len());
         let mut positions = HashMap::default();
         let mut used = vec![false; self.n + self.loop_p3.len()];
@@ -842,6 +982,98 @@ mod tests {
                 local_normals(&cloud, up),
                 local_normals_reference(&cloud, up),
                 "case {case}"
+            );
+        }
+    }
+
+    /// A circle of `m` vertices round `c` of radius `r`, counter-clockwise
+    /// or not, as a smoothed loop of the cloud (each vertex smoothed from
+    /// the nearest cloud point).
+    fn circle(cloud: &[Point3], c: [f64; 2], r: f64, m: usize, ccw: bool) -> crate::edges::Loop {
+        let sense = if ccw { 1.0 } else { -1.0 };
+        let points: Vec<Point3> = (0..m)
+            .map(|j| {
+                let t = sense * std::f64::consts::TAU * j as f64 / m as f64;
+                [c[0] + r * t.cos(), c[1] + r * t.sin(), 0.0]
+            })
+            .collect();
+        let nearest = |p: Point3| {
+            (0..cloud.len())
+                .min_by(|&a, &b| norm2(sub(cloud[a], p)).total_cmp(&norm2(sub(cloud[b], p))))
+                .unwrap_or(0) as u32
+        };
+        crate::edges::Loop {
+            boundary_points: points.iter().map(|&p| nearest(p)).collect(),
+            corners: Vec::new(),
+            edges: vec![crate::edges::Edge {
+                closed: true,
+                points,
+            }],
+            sides: Vec::new(),
+        }
+    }
+
+    /// A disc of radius 9 with three holes where no point was sampled:
+    /// one across the border, two overlapping each other. The smoothed
+    /// loops cross four times; the mesh is the disc less the holes, one
+    /// manifold piece with two borders, whichever way each loop runs.
+    #[test]
+    fn loops_that_cross_bound_the_surface_by_winding() {
+        let holes = [([18.0, 10.0], 2.0), ([8.0, 10.0], 1.6), ([10.0, 10.0], 1.6)];
+        let in_hole = |p: [f64; 2], slack: f64| {
+            holes
+                .iter()
+                .any(|(c, r)| (p[0] - c[0]).hypot(p[1] - c[1]) < r - slack)
+        };
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        let mut cloud = Vec::new();
+        for i in 0..=48 {
+            for j in 0..=48 {
+                let p = [
+                    i as f64 * 0.42 + rng.random_range(-0.05..0.05),
+                    j as f64 * 0.42 + rng.random_range(-0.05..0.05),
+                ];
+                if (p[0] - 10.0).hypot(p[1] - 10.0) < 8.9 && !in_hole(p, -0.1) {
+                    cloud.push([p[0], p[1], 0.0]);
+                }
+            }
+        }
+        let detection =
+            crate::bpd::detect_boundary(&cloud, &crate::bpd::BpdOptions::default()).unwrap();
+        for senses in [[false, true, false, true], [true, false, true, false]] {
+            let mut loops = vec![circle(&cloud, [10.0, 10.0], 9.0, 120, senses[0])];
+            for ((c, r), ccw) in holes.iter().zip(&senses[1..]) {
+                loops.push(circle(&cloud, *c, *r, 40, *ccw));
+            }
+            let edges = Edges {
+                loops,
+                ..Default::default()
+            };
+            let (mesh, report) =
+                delaunay_mesh_with_report(&cloud, &detection, &edges, &DelaunayOptions::default())
+                    .unwrap();
+            assert_eq!(report.loop_crossings, 4, "{senses:?}");
+            mesh.check_manifold().unwrap();
+            for f in 0..mesh.faces.len() {
+                let [a, b, c] = mesh.faces[f].map(|v| mesh.vertices[v as usize]);
+                let centre = [(a[0] + b[0] + c[0]) / 3.0, (a[1] + b[1] + c[1]) / 3.0];
+                assert!(!in_hole(centre, 0.0), "{senses:?}: face {f} in a hole");
+                assert!((centre[0] - 10.0).hypot(centre[1] - 10.0) < 9.0);
+            }
+            assert_eq!(mesh.boundary_loops().len(), 2, "{senses:?}");
+            // The disc less the holes, by the midpoint rule.
+            let step = 0.02;
+            let cells = (0..1000 * 1000)
+                .filter(|k| {
+                    let p = [(k % 1000) as f64 + 0.5, (k / 1000) as f64 + 0.5].map(|c| c * step);
+                    (p[0] - 10.0).hypot(p[1] - 10.0) < 9.0 && !in_hole(p, 0.0)
+                })
+                .count();
+            let expected = cells as f64 * step * step;
+            assert!(
+                (mesh.area() - expected).abs() < 0.01 * expected,
+                "{} {expected}",
+                mesh.area()
             );
         }
     }

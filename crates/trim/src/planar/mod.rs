@@ -8,8 +8,11 @@
 mod diagonals;
 mod ring;
 mod segment_grid;
+mod tangle;
 
 use spade::handles::{FixedFaceHandle, FixedVertexHandle, InnerTag};
+
+use crate::hash::HashMap;
 use spade::{
     ConstrainedDelaunayTriangulation, HasPosition, Intersection, LineIntersectionIterator, Point2,
     Triangulation,
@@ -18,6 +21,7 @@ use spade::{
 pub(crate) use diagonals::{canonical_diagonals, cocircular};
 pub(crate) use ring::{untwist, Ring, Tangle};
 pub(crate) use segment_grid::SegmentGrid;
+pub(crate) use tangle::{pinches_opened, surface_sides, untangle, VOTE_REACH};
 
 /// The constrained Delaunay triangulation of a projection.
 pub(crate) type Cdt = ConstrainedDelaunayTriangulation<Node>;
@@ -122,5 +126,54 @@ pub(crate) fn inside_faces(cdt: &Cdt) -> Vec<FixedFaceHandle<InnerTag>> {
     }
     cdt.fixed_inner_faces()
         .filter(|f| parity[f.index()] == Some(true))
+        .collect()
+}
+
+/// Turns of constraint edges: for the edge between two vertices (smaller
+/// handle first), what the winding gains crossing it from the right of
+/// smaller → larger to its left.
+pub(crate) type Turns = HashMap<(FixedVertexHandle, FixedVertexHandle), i32>;
+
+/// The inner faces whose winding is at least 1: a flood fill from the
+/// outside (winding 0) that adds each constraint edge's turn as it crosses.
+pub(crate) fn winding_faces(cdt: &Cdt, turns: &Turns) -> Vec<FixedFaceHandle<InnerTag>> {
+    // What the winding gains crossing edge from → to from its right to
+    // its left.
+    let gain = |from: FixedVertexHandle, to: FixedVertexHandle| {
+        if from < to {
+            turns.get(&(from, to)).copied().unwrap_or(0)
+        } else {
+            -turns.get(&(to, from)).copied().unwrap_or(0)
+        }
+    };
+    let mut winding: Vec<Option<i32>> = vec![None; cdt.num_all_faces()];
+    let mut stack = Vec::new();
+    for e in cdt.convex_hull() {
+        for side in [e, e.rev()] {
+            // The face on the side's left, entered from the outside on its
+            // right.
+            if let Some(inner) = side.face().as_inner() {
+                if winding[inner.fix().index()].is_none() {
+                    let w = gain(side.from().fix(), side.to().fix());
+                    winding[inner.fix().index()] = Some(w);
+                    stack.push((inner.fix(), w));
+                }
+            }
+        }
+    }
+    while let Some((f, w)) = stack.pop() {
+        for e in cdt.face(f).adjacent_edges() {
+            // f is on e's left; the next face on its right.
+            if let Some(next) = e.rev().face().as_inner() {
+                if winding[next.fix().index()].is_none() {
+                    let v = w - gain(e.from().fix(), e.to().fix());
+                    winding[next.fix().index()] = Some(v);
+                    stack.push((next.fix(), v));
+                }
+            }
+        }
+    }
+    cdt.fixed_inner_faces()
+        .filter(|f| winding[f.index()].is_some_and(|w| w >= 1))
         .collect()
 }

@@ -122,6 +122,116 @@ impl SegmentGrid {
         odd
     }
 
+    /// The winding number of the loops round `p`, each loop's turn weighed
+    /// by `sign[loop]` (ray to +x: a segment crossing it upwards counts
+    /// +sign, downwards −sign). With every sign +1 this is the plain
+    /// winding number; its parity is [`SegmentGrid::parity`].
+    pub(crate) fn winding(&self, p: [f64; 2], sign: &[i32]) -> i32 {
+        if self.a.is_empty()
+            || p[1] < self.y0
+            || p[1] > self.y0 + self.cell * self.ny as f64
+            || p[0] > self.x0 + self.cell * self.nx as f64
+        {
+            return 0;
+        }
+        let r = self.row(p[1]);
+        let mut winding = 0;
+        for c in self.col(p[0])..self.nx {
+            for &s in &self.cells[r * self.nx + c] {
+                let (a, b) = (self.a[s as usize], self.b[s as usize]);
+                if (a[1] > p[1]) != (b[1] > p[1]) {
+                    let t = (p[1] - a[1]) / (b[1] - a[1]);
+                    let x = (a[0] + t * (b[0] - a[0])).clamp(a[0].min(b[0]), a[0].max(b[0]));
+                    if x > p[0] && self.col(x) == c {
+                        let upwards = if b[1] > a[1] { 1 } else { -1 };
+                        winding += upwards * sign[self.owner[s as usize].0 as usize];
+                    }
+                }
+            }
+        }
+        winding
+    }
+
+    /// The segment nearest to `p` among those within `radius` of it, with
+    /// the exact side `p` lies on (1 left of it as it runs, −1 right, 0 on
+    /// its line).
+    pub(crate) fn nearest(&self, p: [f64; 2], radius: f64) -> Option<(u32, f64)> {
+        if self.a.is_empty() {
+            return None;
+        }
+        let (c0, c1) = (self.col(p[0] - radius), self.col(p[0] + radius));
+        let (r0, r1) = (self.row(p[1] - radius), self.row(p[1] + radius));
+        let mut best: Option<(f64, u32)> = None;
+        for r in r0..=r1 {
+            for c in c0..=c1 {
+                for &s in &self.cells[r * self.nx + c] {
+                    let d = dist2d(p, closest_on(self.a[s as usize], self.b[s as usize], p));
+                    let better = best.is_none_or(|(bd, bs)| d < bd || (d == bd && s < bs));
+                    if d < radius && better {
+                        best = Some((d, s));
+                    }
+                }
+            }
+        }
+        best.map(|(_, s)| (s, orientation(self.a[s as usize], self.b[s as usize], p)))
+    }
+
+    /// Every pair of segments that cross properly (each passes strictly
+    /// between the other's ends), smaller index first, in order; or the
+    /// first pair that meets any other way (touching at a vertex, along a
+    /// line, or a spike turning straight back), which no split can resolve.
+    pub(crate) fn crossings(&self) -> Result<Vec<(u32, u32)>, (u32, u32)> {
+        let mut found = Vec::new();
+        for cell in &self.cells {
+            for (x, &s) in cell.iter().enumerate() {
+                for &t in &cell[x + 1..] {
+                    let (s, t) = (s.min(t), s.max(t));
+                    if self.adjacent(s, t) {
+                        if self.turns_back(s, t) {
+                            return Err((s, t));
+                        }
+                        continue;
+                    }
+                    let (sa, sb) = (self.a[s as usize], self.b[s as usize]);
+                    let (ta, tb) = (self.a[t as usize], self.b[t as usize]);
+                    if !segments_meet(sa, sb, ta, tb) {
+                        continue;
+                    }
+                    let strictly = |p, q, r, u| orientation(p, q, r) * orientation(p, q, u) < 0.0;
+                    if strictly(sa, sb, ta, tb) && strictly(ta, tb, sa, sb) {
+                        found.push((s, t));
+                    } else {
+                        return Err((s, t));
+                    }
+                }
+            }
+        }
+        found.sort_unstable();
+        found.dedup();
+        Ok(found)
+    }
+
+    /// Consecutive segments of one loop.
+    fn adjacent(&self, s: u32, t: u32) -> bool {
+        let ((ls, is), (lt, it)) = (self.owner[s as usize], self.owner[t as usize]);
+        let m = self.sizes[ls as usize];
+        ls == lt && ((is + 1) % m == it || (it + 1) % m == is)
+    }
+
+    /// Consecutive segments `s`, `t` that run straight back over each other.
+    fn turns_back(&self, s: u32, t: u32) -> bool {
+        let ((ls, is), (_, it)) = (self.owner[s as usize], self.owner[t as usize]);
+        let m = self.sizes[ls as usize];
+        let (first, second) = if (is + 1) % m == it { (s, t) } else { (t, s) };
+        let (p, q, r) = (
+            self.a[first as usize],
+            self.b[first as usize],
+            self.b[second as usize],
+        );
+        let back = (q[0] - p[0]) * (r[0] - q[0]) + (q[1] - p[1]) * (r[1] - q[1]);
+        m > 3 && orientation(p, q, r) == 0.0 && back < 0.0
+    }
+
     /// True if a segment passes within `radius` of `p`.
     pub(crate) fn near(&self, p: [f64; 2], radius: f64) -> bool {
         if self.a.is_empty() {
@@ -132,15 +242,7 @@ impl SegmentGrid {
         for r in r0..=r1 {
             for c in c0..=c1 {
                 for &s in &self.cells[r * self.nx + c] {
-                    let (a, b) = (self.a[s as usize], self.b[s as usize]);
-                    let ab = [b[0] - a[0], b[1] - a[1]];
-                    let len2 = ab[0] * ab[0] + ab[1] * ab[1];
-                    let t = if len2 > 0.0 {
-                        (((p[0] - a[0]) * ab[0] + (p[1] - a[1]) * ab[1]) / len2).clamp(0.0, 1.0)
-                    } else {
-                        0.0
-                    };
-                    let q = [a[0] + t * ab[0], a[1] + t * ab[1]];
+                    let q = closest_on(self.a[s as usize], self.b[s as usize], p);
                     if dist2d(p, q) < radius {
                         return true;
                     }
@@ -172,31 +274,13 @@ impl SegmentGrid {
         for cell in &self.cells {
             for (x, &s) in cell.iter().enumerate() {
                 for &t in &cell[x + 1..] {
-                    let (ls, is) = self.owner[s as usize];
-                    let (lt, it) = self.owner[t as usize];
-                    let (sa, sb) = (self.a[s as usize], self.b[s as usize]);
-                    let (ta, tb) = (self.a[t as usize], self.b[t as usize]);
-                    if ls == lt {
-                        let m = self.sizes[ls as usize];
-                        let (first, second) = if (is + 1) % m == it {
-                            ((sa, sb), (ta, tb))
-                        } else if (it + 1) % m == is {
-                            ((ta, tb), (sa, sb))
-                        } else {
-                            if segments_meet(sa, sb, ta, tb) {
-                                return Some((s, t));
-                            }
-                            continue;
-                        };
-                        // Adjacent: a spike turns straight back.
-                        let (p, q, r) = (first.0, first.1, second.1);
-                        let back = (q[0] - p[0]) * (r[0] - q[0]) + (q[1] - p[1]) * (r[1] - q[1]);
-                        if m > 3 && orientation(p, q, r) == 0.0 && back < 0.0 {
-                            return Some((s, t));
-                        }
-                        continue;
-                    }
-                    if segments_meet(sa, sb, ta, tb) {
+                    let meet = if self.adjacent(s, t) {
+                        self.turns_back(s, t)
+                    } else {
+                        let (sa, sb) = (self.a[s as usize], self.b[s as usize]);
+                        segments_meet(sa, sb, self.a[t as usize], self.b[t as usize])
+                    };
+                    if meet {
                         return Some((s, t));
                     }
                 }
@@ -204,4 +288,16 @@ impl SegmentGrid {
         }
         None
     }
+}
+
+/// The point of segment ab nearest to `p`.
+fn closest_on(a: [f64; 2], b: [f64; 2], p: [f64; 2]) -> [f64; 2] {
+    let ab = [b[0] - a[0], b[1] - a[1]];
+    let len2 = ab[0] * ab[0] + ab[1] * ab[1];
+    let t = if len2 > 0.0 {
+        (((p[0] - a[0]) * ab[0] + (p[1] - a[1]) * ab[1]) / len2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    [a[0] + t * ab[0], a[1] + t * ab[1]]
 }
