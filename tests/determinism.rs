@@ -59,6 +59,18 @@ fn a_ragged_cloud_traced_in_its_own_plane_gives_the_same_bytes_on_1_2_and_4_thre
     same_bytes_on_1_2_and_4_threads(dir.path(), cloud);
 }
 
+#[test]
+fn a_range_map_whose_loops_cross_gives_the_same_bytes_on_1_2_and_4_threads() {
+    let dir = tempfile::tempdir().unwrap();
+    let cloud = common::shared_data("meshlab_scans/lato000.ply");
+    let cloud = path_str(&cloud);
+    let out = dir.path().join("mesh.ply");
+    let run = common::meshtrim(&["mesh", cloud, path_str(&out), "--json"], None);
+    let summary: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+    assert!(summary["loop_crossings"].as_u64() > Some(0), "{summary}");
+    same_bytes_on_1_2_and_4_threads(dir.path(), cloud);
+}
+
 /// Detection, edges and the Delaunay mesh of `cloud` give the same bytes
 /// on 1, 2 and 4 threads.
 fn same_bytes_on_1_2_and_4_threads(dir: &Path, cloud: &str) {
