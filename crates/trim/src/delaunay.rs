@@ -79,7 +79,7 @@
 use crate::hash::{HashMap, HashSet};
 
 use rayon::prelude::*;
-use spade::handles::FixedVertexHandle;
+use spade::handles::{FixedFaceHandle, FixedVertexHandle, InnerTag};
 use spade::{PositionInTriangulation, Triangulation};
 
 use crate::bpd::Detection;
@@ -728,13 +728,19 @@ impl LoopCdt {
             .collect()
     }
 
-    /// The faces on the surface, counter-clockwise: odd by parity, or of
-    /// winding at least 1 where loops crossed.
-    fn kept_faces(&self, with_positions: bool) -> KeptFaces {
-        let kept = match &self.turns {
+    /// The faces on the surface: odd by parity, or of winding at least 1
+    /// where loops crossed.
+    fn surface_faces(&self) -> Vec<FixedFaceHandle<InnerTag>> {
+        match &self.turns {
             None => inside_faces(&self.cdt),
             Some(turns) => winding_faces(&self.cdt, turns),
-        };
+        }
+    }
+
+    /// The faces on the surface ([`LoopCdt::surface_faces`]),
+    /// counter-clockwise.
+    fn kept_faces(&self, with_positions: bool) -> KeptFaces {
+        let kept = self.surface_faces();
         let mut faces: Vec<[u32; 3]> = Vec::with_capacity(kept.len());
         let mut positions = HashMap::default();
         let mut used = vec![false; self.n + self.loop_p3.len()];
@@ -1076,5 +1082,85 @@ mod tests {
                 mesh.area()
             );
         }
+    }
+
+    /// The flood fill's faces (parity where no loop crosses, winding where
+    /// loops cross) are those a ray cast over the loops keeps at the
+    /// face's centroid, the straightforward reference: on random circles
+    /// that cross one another and themselves, each run either way, over a
+    /// jittered grid.
+    #[test]
+    fn the_filled_faces_match_a_ray_cast_at_every_centroid() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        let mut cloud = Vec::new();
+        for i in 0..30 {
+            for j in 0..30 {
+                let jitter = [0, 1].map(|_| rng.random_range(-0.1..0.1));
+                cloud.push([i as f64 * 0.5 + jitter[0], j as f64 * 0.5 + jitter[1], 0.0]);
+            }
+        }
+        let detection =
+            crate::bpd::detect_boundary(&cloud, &crate::bpd::BpdOptions::default()).unwrap();
+        let beta_median = median(&detection.beta);
+        let plane = Projection::fit(&cloud);
+        let (mut crossed, mut compared) = (0, 0);
+        for case in 0..60 {
+            let loops = (0..rng.random_range(1..6))
+                .map(|_| {
+                    let c = [rng.random_range(3.0..12.0), rng.random_range(3.0..12.0)];
+                    let m = rng.random_range(5..40);
+                    circle(
+                        &cloud,
+                        c,
+                        rng.random_range(1.0..6.0),
+                        m,
+                        rng.random_bool(0.5),
+                    )
+                })
+                .collect();
+            let edges = Edges {
+                loops,
+                ..Default::default()
+            };
+            let options = DelaunayOptions::default();
+            let mut report = DelaunayReport::default();
+            let Ok(bounds) = valid_rings(
+                &edges,
+                &cloud,
+                &detection.beta,
+                beta_median,
+                &plane,
+                &options,
+                &mut report,
+            ) else {
+                continue;
+            };
+            let nodes = points_inside(
+                &cloud,
+                &detection.beta,
+                &plane,
+                &bounds,
+                options.exclude,
+                &mut report,
+            );
+            let Ok(t) = LoopCdt::build(nodes, &bounds, cloud.len(), &mut report) else {
+                continue;
+            };
+            crossed += usize::from(bounds.sides.is_some());
+            let kept: HashSet<_> = t.surface_faces().into_iter().collect();
+            for f in t.cdt.fixed_inner_faces() {
+                let p = t.cdt.face(f).vertices().map(|v| v.position());
+                let centre = [
+                    (p[0].x + p[1].x + p[2].x) / 3.0,
+                    (p[0].y + p[1].y + p[2].y) / 3.0,
+                ];
+                if bounds.grid.near(centre, 1e-9 * beta_median) {
+                    continue;
+                }
+                compared += 1;
+                assert_eq!(kept.contains(&f), bounds.inside(centre), "case {case}");
+            }
+        }
+        assert!(crossed >= 20 && compared > 10_000, "{crossed} {compared}");
     }
 }
