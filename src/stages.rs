@@ -90,10 +90,13 @@ fn detect_with_progress(points: &[Point3], options: &BpdOptions) -> Result<Detec
 /// command line they are the flag `--k` and the command
 /// `meshtrim MESH CLOUD OUT`. Applied where the CLI prints an error.
 pub fn in_cli_words(message: &str) -> String {
-    message.replace("lower k or", "lower --k or").replace(
-        "trim that mesh instead",
-        "use `meshtrim MESH CLOUD OUT` instead",
-    )
+    message
+        .replace("lower k or", "lower --k or")
+        .replace(
+            "trim that mesh instead",
+            "use `meshtrim MESH CLOUD OUT` instead",
+        )
+        .replace("check the view's position", "check --view-from")
 }
 
 #[cfg(test)]
@@ -111,18 +114,26 @@ mod tests {
             k: 30,
         };
         assert!(in_cli_words(&few.to_string()).ends_with("; lower --k or use a denser cloud"));
+        let behind = DelaunayError::NotInView { index: 3 };
+        assert!(in_cli_words(&behind.to_string()).ends_with("; check --view-from"));
         let folds = [
             DelaunayError::NotAHeightField {
+                onto: "the best-fit plane",
                 percent: 2.0,
                 what: "triangles",
                 limit: 1.0,
             },
             DelaunayError::LoopNotSimple {
+                onto: "the best-fit plane",
                 index: 0,
                 vertices: 10,
                 dropped: 4,
             },
-            DelaunayError::LoopsCross { a: 0, b: 1 },
+            DelaunayError::LoopsCross {
+                onto: "the scanner's image",
+                a: 0,
+                b: 1,
+            },
         ];
         for error in folds {
             let words = in_cli_words(&error.to_string());

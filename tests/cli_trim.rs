@@ -245,6 +245,20 @@ fn the_delaunay_path_meshes_the_cloud_and_refuses_a_folded_surface() {
         "folded.xyz",
     );
     assert!(!out.exists());
+    // The scanner placed inside the cloud: no camera image holds it.
+    let run = meshtrim(
+        &[
+            "mesh",
+            CLOUD,
+            out.to_str().unwrap(),
+            "--view-from",
+            "277,0,9",
+        ],
+        None,
+    );
+    assert_clean_failure(&run, "beside or behind the scanner's position");
+    assert!(String::from_utf8_lossy(&run.stderr).contains("check --view-from"));
+    assert!(!out.exists());
 }
 
 /// The main job takes the stage options without a subcommand.

@@ -119,7 +119,7 @@ macro_rules! view_from_help {
 }
 macro_rules! view_why {
     () => {
-        "Range scanners (depth cameras, laser line and structured-light scanners) err along their line of sight. Given it, detection projects each neighbourhood along it instead of along the neighbourhood's normal, so that depth noise and the terraces of a quantised depth do not open gaps where the surface is inclined to the scanner (docs/bpd.md, \"Scanner's line of sight\"), and the edges' loops are traced as the border of the cloud in the scanner's image plane, so ragged borders close (docs/edges.md). Without it, the paper's projection along each neighbourhood's normal; ragged borders are then traced in the cloud's own best-fit plane when that plane sees the cloud as a height field."
+        "Range scanners (depth cameras, laser line and structured-light scanners) err along their line of sight. Given it, detection projects each neighbourhood along it instead of along the neighbourhood's normal, so that depth noise and the terraces of a quantised depth do not open gaps where the surface is inclined to the scanner (docs/bpd.md, \"Scanner's line of sight\"), and the edges' loops are traced as the border of the cloud in the scanner's image plane, so ragged borders close (docs/edges.md); `mesh` triangulates the cloud in that image, where a single-view scan is a height field whatever the object's shape (docs/trimming.md). Without it, the paper's projection along each neighbourhood's normal; ragged borders are then traced in the cloud's own best-fit plane when that plane sees the cloud as a height field."
     };
 }
 /// `--view-along`'s one-line help.

@@ -8,11 +8,24 @@
 //!    relative to the first point, which keeps precision for clouds far
 //!    from the origin. Since u × v = n, counter-clockwise in (u, v) is
 //!    counter-clockwise seen from the side the plane normal n points to.
+//!    *With a view* (the detection's [`View`]) the projection is the
+//!    scanner's image instead: a range scan seen from one place is a
+//!    height field over it whatever the object's shape, since the scanner
+//!    saw each point along its own line of sight, while over the best-fit
+//!    plane a real object's scan folds (the bunny's scans: 1.1–1.7 % of the
+//!    local normals on edge). Along a direction, the image is the plane
+//!    square to it; from a position, the camera's: each point divided by
+//!    its depth along the mean line of sight, scaled by the mean depth so
+//!    that image lengths at the cloud stay about the cloud's own (the
+//!    β-scaled distances below hold), with n towards the scanner, so the
+//!    faces face it. A point more than 84° off that axis is
+//!    [`DelaunayError::NotInView`].
 //! 2. **Height-field check, on the points.** Each point's local normal is
 //!    fitted to its 30 nearest neighbours. Where the surface
 //!    stands on edge or folds over its plane, local normals turn
-//!    perpendicular to n; if more than [`DelaunayOptions::max_steep_share`] of the points have
-//!    |nᵢ·n| < 0.1, the cloud is rejected with
+//!    perpendicular to the line of sight (n, or from the scanner's
+//!    position); if more than [`DelaunayOptions::max_steep_share`] of the
+//!    points have |nᵢ·sᵢ| < 0.1, the cloud is rejected with
 //!    [`DelaunayError::NotAHeightField`].
 //! 3. **Loops made valid.** Each smoothed loop becomes one closed polyline
 //!    (each open edge without its last point, the next edge's corner), with
@@ -82,11 +95,11 @@ use rayon::prelude::*;
 use spade::handles::{FixedFaceHandle, FixedVertexHandle, InnerTag};
 use spade::{PositionInTriangulation, Triangulation};
 
-use crate::bpd::Detection;
+use crate::bpd::{Detection, View, MIN_AXIS_COSINE};
 use crate::edges::Edges;
 use crate::error::{DelaunayError, MeshError};
 use crate::frame::{fit_plane, Frame};
-use crate::geom::{cross, dot, norm2, sub, Point3};
+use crate::geom::{cross, dot, norm2, sub, unit, Point3};
 use crate::mesh::{lowest_first, Mesh};
 use crate::spatial::morton::{octree_runs, spatial_order, split_by_runs, MortonCells, MortonGrid};
 use crate::spatial::neighbours::{NeighbourIndex, RunScratch};
@@ -209,10 +222,10 @@ pub fn delaunay_mesh_with_report(
         points_in: n,
         ..Default::default()
     };
-    let plane = Projection::fit(cloud);
+    let plane = Projection::new(cloud, detection.view)?;
     report.plane_normal = plane.frame.normal;
     let normals = local_normals(cloud, plane.frame.normal);
-    check_steep_normals(&normals, plane.frame.normal, options, &mut report)?;
+    check_steep_normals(cloud, &normals, &plane, options, &mut report)?;
     if edges.loops.is_empty() {
         return Err(MeshError::NoFaces.into());
     }
@@ -233,6 +246,7 @@ pub fn delaunay_mesh_with_report(
         &reference,
         &normals,
         beta_median,
+        plane.onto,
         options,
         &mut report,
     )?;
@@ -255,28 +269,91 @@ fn check_input(cloud: &[Point3], detection: &Detection) -> Result<(), DelaunayEr
     Ok(())
 }
 
-/// Step 1, **projection**: the cloud's best-fit plane, with (u, v)
-/// coordinates relative to the first point, which keeps precision for
-/// clouds far from the origin.
+/// Step 1, **projection**: the cloud's best-fit plane, or with a view the
+/// scanner's image, with (u, v) coordinates relative to the first point
+/// (or the scanner), which keeps precision for clouds far from the origin.
 struct Projection {
     frame: Frame,
     origin: Point3,
+    /// For a view from a position: the image is the camera's, each point
+    /// divided by its depth along the axis (−`frame.normal`) and scaled by
+    /// this, the points' mean depth, so that image lengths at the cloud are
+    /// about the cloud's own (the β-scaled distances of steps 3 and 4 hold).
+    perspective: Option<f64>,
+    /// What the errors call the plane.
+    onto: &'static str,
 }
 
+const BEST_FIT_PLANE: &str = "the best-fit plane";
+const SCANNER_IMAGE: &str = "the scanner's image";
+
 impl Projection {
-    /// The plane of all the points (PCA, [`fit_plane`]).
-    fn fit(cloud: &[Point3]) -> Self {
-        let all: Vec<u32> = (0..cloud.len() as u32).collect();
-        Projection {
-            frame: fit_plane(cloud, &all),
-            origin: cloud[0],
+    /// The plane of all the points (PCA, [`fit_plane`]), or the image of
+    /// the detection's view: along a direction, the plane square to it;
+    /// from a position, the camera's image about the mean line of sight
+    /// to the points, its normal towards the scanner (faces then face
+    /// it). Refuses a point beside or behind the scanner's position,
+    /// which no camera image holds.
+    fn new(cloud: &[Point3], view: Option<View>) -> Result<Self, DelaunayError> {
+        match view {
+            None => {
+                let all: Vec<u32> = (0..cloud.len() as u32).collect();
+                Ok(Projection {
+                    frame: fit_plane(cloud, &all),
+                    origin: cloud[0],
+                    perspective: None,
+                    onto: BEST_FIT_PLANE,
+                })
+            }
+            Some(View::Along(direction)) => Ok(Projection {
+                frame: Frame::of_normal(unit(direction)),
+                origin: cloud[0],
+                perspective: None,
+                onto: SCANNER_IMAGE,
+            }),
+            Some(View::From(eye)) => {
+                let axis = View::camera_axis(eye, cloud);
+                let mut depths = 0.0;
+                for (index, &p) in cloud.iter().enumerate() {
+                    let ray = sub(p, eye);
+                    let depth = dot(ray, axis);
+                    // Also refuses a NaN depth (a point at the scanner).
+                    let in_view = depth > MIN_AXIS_COSINE * norm2(ray).sqrt();
+                    if !in_view {
+                        return Err(DelaunayError::NotInView { index });
+                    }
+                    depths += depth;
+                }
+                Ok(Projection {
+                    frame: Frame::of_normal(axis.map(|c| -c)),
+                    origin: eye,
+                    perspective: Some(depths / cloud.len() as f64),
+                    onto: SCANNER_IMAGE,
+                })
+            }
         }
     }
 
-    /// `p` in the plane's (u, v) coordinates.
+    /// `p` in the image's (u, v) coordinates.
     fn to2(&self, p: Point3) -> [f64; 2] {
         let d = sub(p, self.origin);
-        [dot(d, self.frame.u), dot(d, self.frame.v)]
+        let (u, v) = (dot(d, self.frame.u), dot(d, self.frame.v));
+        match self.perspective {
+            None => [u, v],
+            Some(scale) => {
+                let depth = -dot(d, self.frame.normal);
+                [scale * u / depth, scale * v / depth]
+            }
+        }
+    }
+
+    /// The line of sight through `p` (unit): the plane's normal, or from
+    /// the scanner's position.
+    fn sight(&self, p: Point3) -> Point3 {
+        match self.perspective {
+            None => self.frame.normal,
+            Some(_) => unit(sub(p, self.origin)),
+        }
     }
 }
 
@@ -336,19 +413,22 @@ fn oriented_normal(cloud: &[Point3], members: &[u32], plane_normal: Point3) -> P
 /// 0.1 is [`DelaunayError::NotAHeightField`]. Fills
 /// `steep_normals_percent`.
 fn check_steep_normals(
+    cloud: &[Point3],
     normals: &[Point3],
-    plane_normal: Point3,
+    plane: &Projection,
     options: &DelaunayOptions,
     report: &mut DelaunayReport,
 ) -> Result<(), DelaunayError> {
     let n = normals.len();
     let steep = normals
         .iter()
-        .filter(|m| dot(**m, plane_normal) < STEEP_COS)
+        .zip(cloud)
+        .filter(|&(m, &p)| dot(*m, plane.sight(p)).abs() < STEEP_COS)
         .count();
     report.steep_normals_percent = 100.0 * steep as f64 / n as f64;
     if steep as f64 > options.max_steep_share * n as f64 {
         return Err(DelaunayError::NotAHeightField {
+            onto: plane.onto,
             percent: report.steep_normals_percent,
             what: "local normals",
             limit: 100.0 * options.max_steep_share,
@@ -365,6 +445,8 @@ struct Bounds {
     /// the surface then being where the winding is at least 1. `None`
     /// where no loop crosses: parity says the same without sides.
     sides: Option<Vec<i32>>,
+    /// What the errors call the plane.
+    onto: &'static str,
 }
 
 impl Bounds {
@@ -410,10 +492,11 @@ fn valid_rings(
                 rings,
                 grid,
                 sides: None,
+                onto: plane.onto,
             })
         }
         Err(tangle) => untangled(&merged, cloud, beta, plane, min_cell, report)
-            .ok_or_else(|| tangle_error(tangle)),
+            .ok_or_else(|| tangle_error(tangle, plane.onto)),
     }
 }
 
@@ -440,21 +523,23 @@ fn untangled(
         rings: split.rings,
         grid,
         sides: Some(sides),
+        onto: plane.onto,
     })
 }
 
-fn tangle_error(tangle: Tangle) -> DelaunayError {
+fn tangle_error(tangle: Tangle, onto: &'static str) -> DelaunayError {
     match tangle {
         Tangle::SelfCrossing {
             index,
             vertices,
             dropped,
         } => DelaunayError::LoopNotSimple {
+            onto,
             index,
             vertices,
             dropped,
         },
-        Tangle::Crossing { a, b } => DelaunayError::LoopsCross { a, b },
+        Tangle::Crossing { a, b } => DelaunayError::LoopsCross { onto, a, b },
     }
 }
 
@@ -524,6 +609,8 @@ struct LoopCdt {
     /// Where loops crossed, the constraint edges' turns of the winding
     /// ([`winding_faces`]); `None` for parity.
     turns: Option<Turns>,
+    /// What the errors call the plane.
+    onto: &'static str,
 }
 
 impl LoopCdt {
@@ -555,6 +642,7 @@ impl LoopCdt {
             loop_of: Vec::new(),
             ring_handles: vec![Vec::new(); rings.len()],
             turns: bounds.sides.as_ref().map(|_| Turns::default()),
+            onto: bounds.onto,
         };
         for l in largest_first(rings) {
             let handles = t.insert_ring_vertices(l, &rings[l])?;
@@ -654,7 +742,7 @@ impl LoopCdt {
 
     /// The error for ring `l` meeting the vertex `other` ([`crossing`]).
     fn crossing(&self, l: usize, vertices: usize, other: u32) -> DelaunayError {
-        crossing(l, vertices, other, self.n, &self.loop_of)
+        crossing(l, vertices, other, self.n, &self.loop_of, self.onto)
     }
 
     /// Step 6, **kept faces, lifted**: the odd faces ([`inside_faces`]),
@@ -878,6 +966,7 @@ fn check_triangles(
     reference: &[u32],
     normals: &[Point3],
     beta_median: f64,
+    onto: &'static str,
     options: &DelaunayOptions,
     report: &mut DelaunayReport,
 ) -> Result<(), DelaunayError> {
@@ -898,6 +987,7 @@ fn check_triangles(
     report.misfit_triangles_percent = 100.0 * misfits as f64 / mesh.faces.len() as f64;
     if misfits as f64 > options.max_misfit_share * mesh.faces.len() as f64 {
         return Err(DelaunayError::NotAHeightField {
+            onto,
             percent: report.misfit_triangles_percent,
             what: "triangles",
             limit: 100.0 * options.max_misfit_share,
@@ -922,19 +1012,28 @@ fn is_misfit(nt: Point3, len: f64, vertex_normals: [Point3; 3]) -> bool {
 }
 
 /// The error for loop `l` meeting the vertex `other` (a vertex id).
-fn crossing(l: usize, vertices: usize, other: u32, n: usize, loop_of: &[u32]) -> DelaunayError {
+fn crossing(
+    l: usize,
+    vertices: usize,
+    other: u32,
+    n: usize,
+    loop_of: &[u32],
+    onto: &'static str,
+) -> DelaunayError {
     let b = (other as usize)
         .checked_sub(n)
         .and_then(|j| loop_of.get(j))
         .map_or(l, |&b| b as usize);
     if b == l {
         DelaunayError::LoopNotSimple {
+            onto,
             index: l,
             vertices,
             dropped: 0,
         }
     } else {
         DelaunayError::LoopsCross {
+            onto,
             a: b.min(l),
             b: b.max(l),
         }
@@ -1102,7 +1201,7 @@ mod tests {
         let detection =
             crate::bpd::detect_boundary(&cloud, &crate::bpd::BpdOptions::default()).unwrap();
         let beta_median = median(&detection.beta);
-        let plane = Projection::fit(&cloud);
+        let plane = Projection::new(&cloud, None).unwrap();
         let (mut crossed, mut compared) = (0, 0);
         for case in 0..60 {
             let loops = (0..rng.random_range(1..6))

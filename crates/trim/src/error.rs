@@ -165,10 +165,13 @@ pub enum DelaunayError {
     /// The cloud's coordinates, or too few points to triangulate.
     #[error(transparent)]
     Input(#[from] MeshError),
-    /// The cloud is not a height field over its best-fit plane: the
-    /// Delaunay path, which triangulates in that projection, cannot mesh it.
-    #[error("the surface folds over its best-fit plane ({percent:.1}% of the {what} stand on edge or face away from it, at most {limit}% allowed), so a mesh built in that projection would be broken; mesh it with screened Poisson and trim that mesh instead")]
+    /// The cloud is not a height field over the plane it is projected
+    /// onto: the Delaunay path, which triangulates in that projection,
+    /// cannot mesh it.
+    #[error("the surface folds over {onto} ({percent:.1}% of the {what} stand on edge or face away from it, at most {limit}% allowed), so a mesh built in that projection would be broken; mesh it with screened Poisson and trim that mesh instead")]
     NotAHeightField {
+        /// The plane: "its best-fit plane" or "the scanner's image".
+        onto: &'static str,
         /// Share of the offending elements, in percent.
         percent: f64,
         /// What was counted: "local normals" or "triangles".
@@ -176,10 +179,20 @@ pub enum DelaunayError {
         /// Largest accepted share, in percent.
         limit: f64,
     },
-    /// A smoothed loop crosses itself in the projection onto the cloud's
-    /// best-fit plane, and removing the twisted stretch would take too much.
-    #[error("smoothed loop {index} crosses itself in the projection onto the best-fit plane (repairing it would drop {dropped} of its {vertices} vertices); the surface may fold over its plane there: mesh it with screened Poisson and trim that mesh instead")]
+    /// With a view from a position, a point lies beside or behind the
+    /// scanner: no camera image holds it.
+    #[error("point {index} lies beside or behind the scanner's position (more than 84° off the camera's axis), so no camera image holds the cloud; check the view's position")]
+    NotInView {
+        /// Its index in the cloud.
+        index: usize,
+    },
+    /// A smoothed loop crosses itself in the projection, and neither
+    /// removing the twisted stretch nor splitting it at the crossing
+    /// resolves it.
+    #[error("smoothed loop {index} crosses itself in the projection onto {onto} (repairing it would drop {dropped} of its {vertices} vertices); the surface may fold over its plane there: mesh it with screened Poisson and trim that mesh instead")]
     LoopNotSimple {
+        /// The plane: "the best-fit plane" or "the scanner's image".
+        onto: &'static str,
         /// Index of the loop in the edges.
         index: usize,
         /// Its vertices.
@@ -187,10 +200,12 @@ pub enum DelaunayError {
         /// Vertices a repair would have dropped.
         dropped: usize,
     },
-    /// Two smoothed loops cross or touch in the projection onto the cloud's
-    /// best-fit plane.
-    #[error("smoothed loops {a} and {b} cross or touch in the projection onto the best-fit plane; the surface may fold over its plane there: mesh it with screened Poisson and trim that mesh instead")]
+    /// Two smoothed loops touch (or run along each other) in the
+    /// projection, where no split at a crossing resolves them.
+    #[error("smoothed loops {a} and {b} cross or touch in the projection onto {onto}; the surface may fold over its plane there: mesh it with screened Poisson and trim that mesh instead")]
     LoopsCross {
+        /// The plane: "the best-fit plane" or "the scanner's image".
+        onto: &'static str,
         /// Index of one loop in the edges.
         a: usize,
         /// Index of the other.

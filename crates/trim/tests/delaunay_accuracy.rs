@@ -228,3 +228,86 @@ fn a_folded_surface_is_not_a_height_field() {
         other => panic!("expected NotAHeightField, got {other:?}"),
     }
 }
+
+/// A channel seen from inside: a floor 2 wide and 4 long between two
+/// walls 2 high, the camera 3 above the floor's middle. The walls stand on
+/// edge over the cloud's best-fit plane, so without a view the cloud is
+/// refused; from the camera every point lies on its own line of sight,
+/// and the mesh is built in the camera's image: one piece, the channel's
+/// area, every face facing the camera.
+#[test]
+fn a_channel_seen_from_inside_is_meshed_in_the_camera_image() {
+    let h = 0.05;
+    let wobble = |i: usize, j: usize| ((i * 7 + j * 13) % 11) as f64 / 11.0 - 0.5;
+    let mut points = Vec::new();
+    // The floor across x, then each wall up z, all along y.
+    for (across, width) in [(0, 2.0), (1, 2.0), (2, 2.0)] {
+        let (na, ny) = ((width / h) as usize, (4.0 / h) as usize);
+        for i in 0..=na {
+            for j in 0..=ny {
+                let a = (i as f64 + 0.2 * wobble(i, j)).clamp(0.0, na as f64) * h;
+                let y = (j as f64 + 0.2 * wobble(j, i)).clamp(0.0, ny as f64) * h - 2.0;
+                // Rows on the creases belong to the floor only.
+                let p = match across {
+                    0 => [a - 1.0, y, 0.0],
+                    1 if i > 0 => [-1.0, y, a],
+                    2 if i > 0 => [1.0, y, a],
+                    _ => continue,
+                };
+                points.push(p);
+            }
+        }
+    }
+    let eye = [0.0, 0.0, 3.0];
+    let detection = detect_boundary(&points, &BpdOptions::default()).unwrap();
+    let edges = reconstruct_edges(&points, &detection, &EdgeOptions::default());
+    let refused = delaunay_mesh(&points, &detection, &edges, &DelaunayOptions::default());
+    assert!(
+        matches!(refused, Err(DelaunayError::NotAHeightField { onto, .. }) if onto == "the best-fit plane"),
+        "{refused:?}"
+    );
+    let options = BpdOptions {
+        view: Some(trim::View::From(eye)),
+        ..Default::default()
+    };
+    let detection = detect_boundary(&points, &options).unwrap();
+    let edges = reconstruct_edges(&points, &detection, &EdgeOptions::default());
+    assert_eq!(edges.loops_from, trim::LoopSource::ScannerImage);
+    let (mesh, report) =
+        delaunay_mesh_with_report(&points, &detection, &edges, &DelaunayOptions::default())
+            .unwrap();
+    eprintln!(
+        "channel from inside: {} faces, area {:.3} (true 24), steep {:.2} %, misfits {:.2} %",
+        mesh.faces.len(),
+        mesh.area(),
+        report.steep_normals_percent,
+        report.misfit_triangles_percent
+    );
+    mesh.check_manifold().unwrap();
+    assert_eq!(mesh.boundary_loops().len(), 1);
+    assert!((mesh.area() - 24.0).abs() < 0.02 * 24.0, "{}", mesh.area());
+    for face in &mesh.faces {
+        let [a, b, c] = face.map(|v| mesh.vertices[v as usize]);
+        let n = cross3(sub3(b, a), sub3(c, a));
+        assert!(
+            dot3(n, sub3(eye, a)) > 0.0,
+            "a face turns away from the camera"
+        );
+    }
+}
+
+fn sub3(a: Point3, b: Point3) -> Point3 {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn cross3(a: Point3, b: Point3) -> Point3 {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn dot3(a: Point3, b: Point3) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}

@@ -28,7 +28,7 @@ use crate::anisotropy::{
 use crate::cloud::{check_finite, check_not_degenerate, merge_duplicates, Sites, PASS_PIECE};
 use crate::error::CloudError;
 use crate::frame::{fit_plane_normal, project_sheared, ray_shear, spread, Frame, Point2};
-use crate::geom::{dist2, sub, Point3};
+use crate::geom::{add, dist2, sub, unit, Point3};
 use crate::resolution::{beta_of, nearest_distances, Columns};
 use crate::spatial::morton::{octree_runs, spatial_order, split_by_runs, MortonCells, MortonGrid};
 use crate::spatial::neighbours::{NeighbourIndex, RunScratch};
@@ -88,6 +88,11 @@ pub enum View {
     From(Point3),
 }
 
+/// Smallest cosine between a point's line of sight from the scanner's
+/// position and the camera's axis: a camera's field of view is well inside
+/// ±84°; farther off the axis the image plane no longer holds the cloud.
+pub(crate) const MIN_AXIS_COSINE: f64 = 0.1;
+
 impl View {
     /// The line of sight to `p` (not normalised; zero for `p` at the
     /// scanner, which then gets the paper's projection).
@@ -96,6 +101,16 @@ impl View {
             View::Along(direction) => direction,
             View::From(origin) => sub(p, origin),
         }
+    }
+
+    /// The axis of a camera at `eye` that sees `points`: the mean of the
+    /// unit lines of sight to them.
+    pub(crate) fn camera_axis(eye: Point3, points: &[Point3]) -> Point3 {
+        unit(
+            points
+                .iter()
+                .fold([0.0; 3], |sum, &p| add(sum, unit(sub(p, eye)))),
+        )
     }
 
     /// Rejects a zero or non-finite direction and a non-finite position.

@@ -31,9 +31,9 @@ use rayon::prelude::*;
 use spade::handles::{FixedDirectedEdgeHandle, FixedFaceHandle, InnerTag};
 use spade::{DelaunayTriangulation, Point2, Triangulation};
 
-use crate::bpd::{Detection, View};
+use crate::bpd::{Detection, View, MIN_AXIS_COSINE};
 use crate::frame::Frame;
-use crate::geom::{add, dist2, dot, sub, unit, Point3};
+use crate::geom::{dist2, dot, sub, unit, Point3};
 use crate::planar::Node;
 
 /// The image's Delaunay triangulation; each vertex's id is the input point
@@ -48,11 +48,6 @@ struct Projection {
     /// its depth (1 along parallel lines of sight).
     scale: Vec<f64>,
 }
-
-/// Smallest cosine between a point's line of sight from the scanner's
-/// position and the view's axis: a camera's field of view is well inside
-/// ±84°; farther off the axis the image plane no longer holds the cloud.
-const MIN_AXIS_COSINE: f64 = 0.1;
 
 impl Projection {
     /// The image of the cloud as the scanner saw it, or `None` when no
@@ -72,7 +67,7 @@ impl Projection {
             }
             View::From(origin) => {
                 let rays: Vec<Point3> = points.iter().map(|&p| sub(p, origin)).collect();
-                let axis = unit(rays.iter().fold([0.0; 3], |sum, &r| add(sum, unit(r))));
+                let axis = View::camera_axis(origin, points);
                 let frame = Frame::of_normal(axis);
                 let mut image = Vec::with_capacity(points.len());
                 let mut scale = Vec::with_capacity(points.len());
