@@ -1043,6 +1043,7 @@ fn crossing(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::planar::pinched_faces;
     use rand::{RngExt, SeedableRng};
 
     /// The straightforward local normals: one query a point, each on its
@@ -1261,5 +1262,56 @@ mod tests {
             }
         }
         assert!(crossed >= 20 && compared > 10_000, "{crossed} {compared}");
+    }
+
+    /// Whatever random circles bound it (crossing one another and
+    /// themselves, touching, nested), the Delaunay path gives a clear
+    /// error or a mesh that is manifold at every edge and vertex, whose
+    /// every vertex is a cloud point or on a loop.
+    #[test]
+    fn random_loops_give_an_error_or_a_manifold_mesh() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(17);
+        let mut cloud = Vec::new();
+        for i in 0..30 {
+            for j in 0..30 {
+                let jitter = [0, 1].map(|_| rng.random_range(-0.1..0.1));
+                let (x, y) = (i as f64 * 0.5 + jitter[0], j as f64 * 0.5 + jitter[1]);
+                cloud.push([x, y, 0.05 * (x * 0.7).sin()]);
+            }
+        }
+        let detection =
+            crate::bpd::detect_boundary(&cloud, &crate::bpd::BpdOptions::default()).unwrap();
+        let (mut meshed, mut crossed) = (0, 0);
+        for case in 0..80 {
+            let loops = (0..rng.random_range(1..7))
+                .map(|_| {
+                    let c = [rng.random_range(2.0..13.0), rng.random_range(2.0..13.0)];
+                    let m = rng.random_range(4..40);
+                    circle(
+                        &cloud,
+                        c,
+                        rng.random_range(0.3..7.0),
+                        m,
+                        rng.random_bool(0.5),
+                    )
+                })
+                .collect();
+            let edges = Edges {
+                loops,
+                ..Default::default()
+            };
+            let options = DelaunayOptions::default();
+            let Ok((mesh, report)) =
+                delaunay_mesh_with_report(&cloud, &detection, &edges, &options)
+            else {
+                continue;
+            };
+            meshed += 1;
+            crossed += usize::from(report.loop_crossings > 0);
+            mesh.check_manifold().unwrap();
+            let pinched = pinched_faces(&mesh.faces, mesh.vertices.len(), 0);
+            assert!(pinched.is_empty(), "case {case}: a pinched vertex");
+        }
+        assert!(meshed >= 40 && crossed >= 20, "{meshed} {crossed}");
     }
 }

@@ -21,6 +21,8 @@ use spade::{
 pub(crate) use diagonals::{canonical_diagonals, cocircular};
 pub(crate) use ring::{untwist, Ring, Tangle};
 pub(crate) use segment_grid::SegmentGrid;
+#[cfg(test)]
+pub(crate) use tangle::pinched_faces;
 pub(crate) use tangle::{pinches_opened, surface_sides, untangle, VOTE_REACH};
 
 /// The constrained Delaunay triangulation of a projection.

@@ -273,7 +273,7 @@ pub(crate) fn pinches_opened(faces: &mut Vec<[u32; 3]>, ids: usize, points: usiz
 /// loop vertex (id `points` on) whose faces make more than one fan (faces
 /// round a vertex are one fan when they connect through edges at it).
 /// Cloud points lie off the loops, so their stars are whole.
-fn pinched_faces(faces: &[[u32; 3]], ids: usize, points: usize) -> Vec<usize> {
+pub(crate) fn pinched_faces(faces: &[[u32; 3]], ids: usize, points: usize) -> Vec<usize> {
     let mut round: Vec<Vec<u32>> = vec![Vec::new(); ids - points];
     for (k, f) in faces.iter().enumerate() {
         for &v in f.iter().filter(|&&v| v as usize >= points) {
