@@ -18,6 +18,6 @@ pub mod baseline;
 pub mod edge_metrics;
 pub mod evaluate;
 pub mod synthetic;
-mod vec3;
+pub mod vec3;
 
 pub use synthetic::SplitMix64;

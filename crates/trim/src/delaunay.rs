@@ -1119,6 +1119,37 @@ mod tests {
         }
     }
 
+    /// A 30 × 30 grid of spacing 0.5, jittered by up to 0.1, on the wave
+    /// z = `bump`·sin(0.7x).
+    fn jittered_sheet(rng: &mut rand_chacha::ChaCha8Rng, bump: f64) -> Vec<Point3> {
+        let mut cloud = Vec::new();
+        for i in 0..30 {
+            for j in 0..30 {
+                let jitter = [0, 1].map(|_| rng.random_range(-0.1..0.1));
+                let (x, y) = (i as f64 * 0.5 + jitter[0], j as f64 * 0.5 + jitter[1]);
+                cloud.push([x, y, bump * (x * 0.7).sin()]);
+            }
+        }
+        cloud
+    }
+
+    /// A random number of circles over the sheet, of random centres,
+    /// radii, vertex counts and senses.
+    fn random_circles(
+        rng: &mut rand_chacha::ChaCha8Rng,
+        cloud: &[Point3],
+        count: std::ops::Range<usize>,
+        radius: std::ops::Range<f64>,
+    ) -> Vec<crate::edges::Loop> {
+        (0..rng.random_range(count))
+            .map(|_| {
+                let c = [rng.random_range(2.0..13.0), rng.random_range(2.0..13.0)];
+                let (r, m) = (rng.random_range(radius.clone()), rng.random_range(4..40));
+                circle(cloud, c, r, m, rng.random_bool(0.5))
+            })
+            .collect()
+    }
+
     /// A disc of radius 9 with three holes where no point was sampled:
     /// one across the border, two overlapping each other. The smoothed
     /// loops cross four times; the mesh is the disc less the holes, one
@@ -1192,32 +1223,14 @@ mod tests {
     #[test]
     fn the_filled_faces_match_a_ray_cast_at_every_centroid() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
-        let mut cloud = Vec::new();
-        for i in 0..30 {
-            for j in 0..30 {
-                let jitter = [0, 1].map(|_| rng.random_range(-0.1..0.1));
-                cloud.push([i as f64 * 0.5 + jitter[0], j as f64 * 0.5 + jitter[1], 0.0]);
-            }
-        }
+        let cloud = jittered_sheet(&mut rng, 0.0);
         let detection =
             crate::bpd::detect_boundary(&cloud, &crate::bpd::BpdOptions::default()).unwrap();
         let beta_median = median(&detection.beta);
         let plane = Projection::new(&cloud, None).unwrap();
         let (mut crossed, mut compared) = (0, 0);
         for case in 0..60 {
-            let loops = (0..rng.random_range(1..6))
-                .map(|_| {
-                    let c = [rng.random_range(3.0..12.0), rng.random_range(3.0..12.0)];
-                    let m = rng.random_range(5..40);
-                    circle(
-                        &cloud,
-                        c,
-                        rng.random_range(1.0..6.0),
-                        m,
-                        rng.random_bool(0.5),
-                    )
-                })
-                .collect();
+            let loops = random_circles(&mut rng, &cloud, 1..6, 1.0..6.0);
             let edges = Edges {
                 loops,
                 ..Default::default()
@@ -1271,31 +1284,12 @@ mod tests {
     #[test]
     fn random_loops_give_an_error_or_a_manifold_mesh() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(17);
-        let mut cloud = Vec::new();
-        for i in 0..30 {
-            for j in 0..30 {
-                let jitter = [0, 1].map(|_| rng.random_range(-0.1..0.1));
-                let (x, y) = (i as f64 * 0.5 + jitter[0], j as f64 * 0.5 + jitter[1]);
-                cloud.push([x, y, 0.05 * (x * 0.7).sin()]);
-            }
-        }
+        let cloud = jittered_sheet(&mut rng, 0.05);
         let detection =
             crate::bpd::detect_boundary(&cloud, &crate::bpd::BpdOptions::default()).unwrap();
         let (mut meshed, mut crossed) = (0, 0);
         for case in 0..80 {
-            let loops = (0..rng.random_range(1..7))
-                .map(|_| {
-                    let c = [rng.random_range(2.0..13.0), rng.random_range(2.0..13.0)];
-                    let m = rng.random_range(4..40);
-                    circle(
-                        &cloud,
-                        c,
-                        rng.random_range(0.3..7.0),
-                        m,
-                        rng.random_bool(0.5),
-                    )
-                })
-                .collect();
+            let loops = random_circles(&mut rng, &cloud, 1..7, 0.3..7.0);
             let edges = Edges {
                 loops,
                 ..Default::default()

@@ -7,6 +7,7 @@ use std::collections::HashSet;
 use testkit::{
     synthetic::BoundaryIndex,
     synthetic::{self, SyntheticCloud},
+    vec3::{cross, dot, sub},
 };
 use trim::{
     delaunay_mesh, delaunay_mesh_with_report, detect_boundary, reconstruct_edges, BpdOptions,
@@ -288,26 +289,10 @@ fn a_channel_seen_from_inside_is_meshed_in_the_camera_image() {
     assert!((mesh.area() - 24.0).abs() < 0.02 * 24.0, "{}", mesh.area());
     for face in &mesh.faces {
         let [a, b, c] = face.map(|v| mesh.vertices[v as usize]);
-        let n = cross3(sub3(b, a), sub3(c, a));
+        let n = cross(sub(b, a), sub(c, a));
         assert!(
-            dot3(n, sub3(eye, a)) > 0.0,
+            dot(n, sub(eye, a)) > 0.0,
             "a face turns away from the camera"
         );
     }
-}
-
-fn sub3(a: Point3, b: Point3) -> Point3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn cross3(a: Point3, b: Point3) -> Point3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-fn dot3(a: Point3, b: Point3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }

@@ -102,33 +102,56 @@ pub(crate) fn obstacle(cdt: &Cdt, a: FixedVertexHandle, b: FixedVertexHandle) ->
 /// The inner faces with odd parity: a flood fill from the outside that
 /// flips parity across each constraint edge.
 pub(crate) fn inside_faces(cdt: &Cdt) -> Vec<FixedFaceHandle<InnerTag>> {
-    let mut parity: Vec<Option<bool>> = vec![None; cdt.num_all_faces()];
-    let mut stack = Vec::new();
-    for e in cdt.convex_hull() {
-        for side in [e, e.rev()] {
-            if let Some(inner) = side.face().as_inner() {
-                if parity[inner.fix().index()].is_none() {
-                    let odd = side.is_constraint_edge();
-                    parity[inner.fix().index()] = Some(odd);
-                    stack.push((inner.fix(), odd));
-                }
-            }
-        }
-    }
-    while let Some((f, odd)) = stack.pop() {
-        for e in cdt.face(f).adjacent_edges() {
-            if let Some(next) = e.rev().face().as_inner() {
-                if parity[next.fix().index()].is_none() {
-                    let p = odd ^ e.is_constraint_edge();
-                    parity[next.fix().index()] = Some(p);
-                    stack.push((next.fix(), p));
-                }
-            }
-        }
-    }
+    let parity = flood(cdt, false, |odd, edge| odd ^ edge.constraint);
     cdt.fixed_inner_faces()
         .filter(|f| parity[f.index()] == Some(true))
         .collect()
+}
+
+/// An edge crossed by [`flood`], from its right to its left.
+struct Crossing {
+    from: FixedVertexHandle,
+    to: FixedVertexHandle,
+    constraint: bool,
+}
+
+/// A value for every face reached from the outside (which holds
+/// `outside`), flooding across edges: a face's value is `enter` of its
+/// neighbour's and the edge crossed into it. Indexed by face.
+fn flood<T: Copy>(cdt: &Cdt, outside: T, enter: impl Fn(T, Crossing) -> T) -> Vec<Option<T>> {
+    let crossing = |e: spade::handles::DirectedEdgeHandle<Node, (), _, ()>| Crossing {
+        from: e.from().fix(),
+        to: e.to().fix(),
+        constraint: e.is_constraint_edge(),
+    };
+    let mut value: Vec<Option<T>> = vec![None; cdt.num_all_faces()];
+    let mut stack = Vec::new();
+    for e in cdt.convex_hull() {
+        for side in [e, e.rev()] {
+            // The face on the side's left, entered from the outside.
+            if let Some(inner) = side.face().as_inner() {
+                if value[inner.fix().index()].is_none() {
+                    let v = enter(outside, crossing(side));
+                    value[inner.fix().index()] = Some(v);
+                    stack.push((inner.fix(), v));
+                }
+            }
+        }
+    }
+    while let Some((f, v)) = stack.pop() {
+        for e in cdt.face(f).adjacent_edges() {
+            // f is on e's left: the next face, on its right, is entered
+            // across e's reverse from that one's right to its left.
+            if let Some(next) = e.rev().face().as_inner() {
+                if value[next.fix().index()].is_none() {
+                    let w = enter(v, crossing(e.rev()));
+                    value[next.fix().index()] = Some(w);
+                    stack.push((next.fix(), w));
+                }
+            }
+        }
+    }
+    value
 }
 
 /// Turns of constraint edges: for the edge between two vertices (smaller
@@ -139,42 +162,15 @@ pub(crate) type Turns = HashMap<(FixedVertexHandle, FixedVertexHandle), i32>;
 /// The inner faces whose winding is at least 1: a flood fill from the
 /// outside (winding 0) that adds each constraint edge's turn as it crosses.
 pub(crate) fn winding_faces(cdt: &Cdt, turns: &Turns) -> Vec<FixedFaceHandle<InnerTag>> {
-    // What the winding gains crossing edge from → to from its right to
-    // its left.
-    let gain = |from: FixedVertexHandle, to: FixedVertexHandle| {
-        if from < to {
-            turns.get(&(from, to)).copied().unwrap_or(0)
+    let winding = flood(cdt, 0, |w, edge| {
+        // What the winding gains crossing edge from → to from its right
+        // to its left.
+        w + if edge.from < edge.to {
+            turns.get(&(edge.from, edge.to)).copied().unwrap_or(0)
         } else {
-            -turns.get(&(to, from)).copied().unwrap_or(0)
+            -turns.get(&(edge.to, edge.from)).copied().unwrap_or(0)
         }
-    };
-    let mut winding: Vec<Option<i32>> = vec![None; cdt.num_all_faces()];
-    let mut stack = Vec::new();
-    for e in cdt.convex_hull() {
-        for side in [e, e.rev()] {
-            // The face on the side's left, entered from the outside on its
-            // right.
-            if let Some(inner) = side.face().as_inner() {
-                if winding[inner.fix().index()].is_none() {
-                    let w = gain(side.from().fix(), side.to().fix());
-                    winding[inner.fix().index()] = Some(w);
-                    stack.push((inner.fix(), w));
-                }
-            }
-        }
-    }
-    while let Some((f, w)) = stack.pop() {
-        for e in cdt.face(f).adjacent_edges() {
-            // f is on e's left; the next face on its right.
-            if let Some(next) = e.rev().face().as_inner() {
-                if winding[next.fix().index()].is_none() {
-                    let v = w - gain(e.from().fix(), e.to().fix());
-                    winding[next.fix().index()] = Some(v);
-                    stack.push((next.fix(), v));
-                }
-            }
-        }
-    }
+    });
     cdt.fixed_inner_faces()
         .filter(|f| winding[f.index()].is_some_and(|w| w >= 1))
         .collect()

@@ -165,18 +165,21 @@ pub(crate) fn untwist(
     }
 }
 
+/// A ring through `p2` in the plane z = 0, β 1 (for tests).
+#[cfg(test)]
+pub(crate) fn flat_ring(p2: Vec<[f64; 2]>) -> Ring {
+    Ring {
+        p3: p2.iter().map(|p| [p[0], p[1], 0.0]).collect(),
+        reference: vec![0; p2.len()],
+        beta: vec![1.0; p2.len()],
+        p2,
+    }
+}
+
 #[cfg(test)]
 mod tests {
+    use super::flat_ring as ring;
     use super::*;
-
-    fn ring(p2: Vec<[f64; 2]>) -> Ring {
-        Ring {
-            p3: p2.iter().map(|p| [p[0], p[1], 0.0]).collect(),
-            reference: vec![0; p2.len()],
-            beta: vec![1.0; p2.len()],
-            p2,
-        }
-    }
 
     /// A square of side `s` at `o`, 4·k vertices counter-clockwise.
     fn square(o: [f64; 2], s: f64, k: usize) -> Vec<[f64; 2]> {

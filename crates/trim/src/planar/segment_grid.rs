@@ -98,27 +98,8 @@ impl SegmentGrid {
 
     /// True if `p` is inside an odd number of loops (ray to +x).
     pub(crate) fn parity(&self, p: [f64; 2]) -> bool {
-        if self.a.is_empty()
-            || p[1] < self.y0
-            || p[1] > self.y0 + self.cell * self.ny as f64
-            || p[0] > self.x0 + self.cell * self.nx as f64
-        {
-            return false;
-        }
-        let r = self.row(p[1]);
         let mut odd = false;
-        for c in self.col(p[0])..self.nx {
-            for &s in &self.cells[r * self.nx + c] {
-                let (a, b) = (self.a[s as usize], self.b[s as usize]);
-                if (a[1] > p[1]) != (b[1] > p[1]) {
-                    let t = (p[1] - a[1]) / (b[1] - a[1]);
-                    let x = (a[0] + t * (b[0] - a[0])).clamp(a[0].min(b[0]), a[0].max(b[0]));
-                    if x > p[0] && self.col(x) == c {
-                        odd = !odd;
-                    }
-                }
-            }
-        }
+        self.ray_crossings(p, |_, _| odd = !odd);
         odd
     }
 
@@ -127,15 +108,26 @@ impl SegmentGrid {
     /// +sign, downwards −sign). With every sign +1 this is the plain
     /// winding number; its parity is [`SegmentGrid::parity`].
     pub(crate) fn winding(&self, p: [f64; 2], sign: &[i32]) -> i32 {
+        let mut winding = 0;
+        self.ray_crossings(p, |s, upwards| {
+            let turn = sign[self.owner[s as usize].0 as usize];
+            winding += if upwards { turn } else { -turn };
+        });
+        winding
+    }
+
+    /// Calls `visit` with every segment the ray from `p` to +x crosses,
+    /// and whether it crosses upwards. Each crossing is counted in the
+    /// cell it lies in, once.
+    fn ray_crossings(&self, p: [f64; 2], mut visit: impl FnMut(u32, bool)) {
         if self.a.is_empty()
             || p[1] < self.y0
             || p[1] > self.y0 + self.cell * self.ny as f64
             || p[0] > self.x0 + self.cell * self.nx as f64
         {
-            return 0;
+            return;
         }
         let r = self.row(p[1]);
-        let mut winding = 0;
         for c in self.col(p[0])..self.nx {
             for &s in &self.cells[r * self.nx + c] {
                 let (a, b) = (self.a[s as usize], self.b[s as usize]);
@@ -143,13 +135,11 @@ impl SegmentGrid {
                     let t = (p[1] - a[1]) / (b[1] - a[1]);
                     let x = (a[0] + t * (b[0] - a[0])).clamp(a[0].min(b[0]), a[0].max(b[0]));
                     if x > p[0] && self.col(x) == c {
-                        let upwards = if b[1] > a[1] { 1 } else { -1 };
-                        winding += upwards * sign[self.owner[s as usize].0 as usize];
+                        visit(s, b[1] > a[1]);
                     }
                 }
             }
         }
-        winding
     }
 
     /// The segment nearest to `p` among those within `radius` of it, with

@@ -343,16 +343,8 @@ fn on_segment(a: Vertex, b: Vertex, t: f64) -> (crate::geom::Point3, f64, u32) {
 
 #[cfg(test)]
 mod tests {
+    use super::super::ring::flat_ring as ring;
     use super::*;
-
-    fn ring(p2: Vec<[f64; 2]>) -> Ring {
-        Ring {
-            p3: p2.iter().map(|p| [p[0], p[1], 0.0]).collect(),
-            reference: vec![0; p2.len()],
-            beta: vec![1.0; p2.len()],
-            p2,
-        }
-    }
 
     fn square(o: [f64; 2], s: f64) -> Vec<[f64; 2]> {
         vec![o, [o[0] + s, o[1]], [o[0] + s, o[1] + s], [o[0], o[1] + s]]
