@@ -18,7 +18,8 @@
 //!    area) at that spot. The two may lie at different depths (a loop
 //!    round a few strays in front of the surface crosses its border); the
 //!    larger loop is the main surface's border, and a mean would be on
-//!    neither (on the statue's range map, 21 β from the nearest point). A loop that meets another any other way (touching at a vertex,
+//!    neither (on the statue's range map, 21 β from the nearest point).
+//!    A loop that meets another any other way (touching at a vertex,
 //!    running along it) is left an error: no split resolves it.
 //! 2. **Lobes.** A loop that crossed itself now visits a vertex twice; it
 //!    is cut there into two closed loops, so that each lobe of a twist
@@ -73,15 +74,16 @@ pub(crate) fn untangle(rings: &[Ring], grid: &SegmentGrid) -> Result<Untangled, 
         let (lt, it) = grid.owner[t as usize];
         let (a, b) = segment(&rings[ls as usize], is as usize);
         let (c, d) = segment(&rings[lt as usize], it as usize);
-        // Parameters along each segment from the orientation areas: exact
-        // signs were checked, so both denominators are non-zero.
+        // Parameters along each segment from the orientation areas (their
+        // exact signs are opposite; the plain values may underflow).
         let (oa, ob) = (orient(c.p2, d.p2, a.p2), orient(c.p2, d.p2, b.p2));
         let (oc, od) = (orient(a.p2, b.p2, c.p2), orient(a.p2, b.p2, d.p2));
         let ts = (oa / (oa - ob)).clamp(0.0, 1.0);
         let tt = (oc / (oc - od)).clamp(0.0, 1.0);
         let p2 = lerp2(a.p2, b.p2, ts);
-        if p2 == a.p2 || p2 == b.p2 || p2 == c.p2 || p2 == d.p2 {
-            // The crossing rounds onto a vertex: a touch, not a split.
+        let rounds_onto_a_vertex = [a.p2, b.p2, c.p2, d.p2].contains(&p2);
+        if !(ts.is_finite() && tt.is_finite()) || rounds_onto_a_vertex {
+            // No point to split at: left as a touch.
             return Err((s, t));
         }
         let (p3, beta, reference) = if area[lt as usize] > area[ls as usize] {
