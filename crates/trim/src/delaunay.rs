@@ -41,9 +41,9 @@
 //!    the loops share, and each loop gets its surface side from the cloud
 //!    points near it (`planar/tangle.rs`): the surface is then where the
 //!    winding is at least 1, the outer border's inside less every hole.
-//!    Loops that touch without crossing, or run along each other, give
-//!    [`DelaunayError::LoopsCross`] (or [`DelaunayError::LoopNotSimple`]
-//!    for one loop). spade's exact predicates check every constraint
+//!    A loop through another's vertex shares it the same way. Loops that
+//!    run along one line and meet give [`DelaunayError::LoopsCross`] (or
+//!    [`DelaunayError::LoopNotSimple`] for one loop). spade's exact predicates check every constraint
 //!    again before it is added (spade panics on crossing constraints):
 //!    what the floating-point repair missed is an error, never a panic.
 //! 4. **Which points go in.** A cloud point is inserted when it lies inside
@@ -170,8 +170,9 @@ pub struct DelaunayReport {
     pub loop_vertices_merged: usize,
     /// Loop vertices dropped to untwist self-crossing loops.
     pub loop_vertices_dropped: usize,
-    /// Crossings of smoothed loops (with one another or themselves) that
-    /// were split, the surface then taken by winding (step 3).
+    /// Places where smoothed loops cross or touch (one another or
+    /// themselves) that were split, the surface then taken by winding
+    /// (step 3).
     pub loop_crossings: usize,
     /// Faces dropped where loops crossed: round a vertex where the surface
     /// pinched, or in a patch without a cloud point (step 6).

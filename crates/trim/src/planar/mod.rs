@@ -20,7 +20,7 @@ use spade::{
 
 pub(crate) use diagonals::{canonical_diagonals, cocircular};
 pub(crate) use ring::{untwist, Ring, Tangle};
-pub(crate) use segment_grid::SegmentGrid;
+pub(crate) use segment_grid::{Contact, SegmentGrid};
 #[cfg(test)]
 pub(crate) use tangle::pinched_faces;
 pub(crate) use tangle::{pinches_opened, surface_sides, untangle, VOTE_REACH};

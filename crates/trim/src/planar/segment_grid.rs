@@ -3,6 +3,20 @@
 use super::ring::{dist2d, Ring};
 use crate::geom::{orientation, segments_meet};
 
+/// Where two loop segments meet ([`SegmentGrid::contacts`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub(crate) enum Contact {
+    /// The two segments cross properly.
+    Cross(u32, u32),
+    /// `segment` passes through an end of `other` (its start when
+    /// `start`, else its end), between its own ends.
+    Touch {
+        segment: u32,
+        other: u32,
+        start: bool,
+    },
+}
+
 /// The loops' segments in a uniform grid, for parity, proximity and
 /// crossing queries in 2D.
 pub(crate) struct SegmentGrid {
@@ -166,11 +180,13 @@ impl SegmentGrid {
         best.map(|(_, s)| (s, orientation(self.a[s as usize], self.b[s as usize], p)))
     }
 
-    /// Every pair of segments that cross properly (each passes strictly
-    /// between the other's ends), smaller index first, in order; or the
-    /// first pair that meets any other way (touching at a vertex, along a
-    /// line, or a spike turning straight back), which no split can resolve.
-    pub(crate) fn crossings(&self) -> Result<Vec<(u32, u32)>, (u32, u32)> {
+    /// Every place where two segments meet other than at the vertex two
+    /// consecutive segments share, in order: proper crossings (each passes
+    /// strictly between the other's ends) and touches (a segment passes
+    /// through an end of another); segments that only share an end are
+    /// left out. Or the first pair that no split resolves: segments along
+    /// one line that meet, or a spike turning straight back.
+    pub(crate) fn contacts(&self) -> Result<Vec<Contact>, (u32, u32)> {
         let mut found = Vec::new();
         for cell in &self.cells {
             for (x, &s) in cell.iter().enumerate() {
@@ -187,11 +203,34 @@ impl SegmentGrid {
                     if !segments_meet(sa, sb, ta, tb) {
                         continue;
                     }
-                    let strictly = |p, q, r, u| orientation(p, q, r) * orientation(p, q, u) < 0.0;
-                    if strictly(sa, sb, ta, tb) && strictly(ta, tb, sa, sb) {
-                        found.push((s, t));
-                    } else {
+                    let side = [
+                        orientation(sa, sb, ta),
+                        orientation(sa, sb, tb),
+                        orientation(ta, tb, sa),
+                        orientation(ta, tb, sb),
+                    ];
+                    if side.iter().all(|&o| o == 0.0) {
                         return Err((s, t));
+                    }
+                    if side[0] * side[1] < 0.0 && side[2] * side[3] < 0.0 {
+                        found.push(Contact::Cross(s, t));
+                    } else if [sa, sb].iter().any(|p| [ta, tb].contains(p)) {
+                        // Meeting at a shared end, and only there.
+                    } else {
+                        // Not along one line, so they meet at one point:
+                        // an end of one, inside the other.
+                        let touch = [(s, t, ta, true), (s, t, tb, false)]
+                            .into_iter()
+                            .chain([(t, s, sa, true), (t, s, sb, false)])
+                            .find(|&(segment, _, p, _)| self.passes_through(segment, p));
+                        match touch {
+                            Some((segment, other, _, start)) => found.push(Contact::Touch {
+                                segment,
+                                other,
+                                start,
+                            }),
+                            None => return Err((s, t)),
+                        }
                     }
                 }
             }
@@ -199,6 +238,16 @@ impl SegmentGrid {
         found.sort_unstable();
         found.dedup();
         Ok(found)
+    }
+
+    /// Does segment `s` pass through `p` between its ends (exactly)?
+    fn passes_through(&self, s: u32, p: [f64; 2]) -> bool {
+        let (a, b) = (self.a[s as usize], self.b[s as usize]);
+        let within = p[0] >= a[0].min(b[0])
+            && p[0] <= a[0].max(b[0])
+            && p[1] >= a[1].min(b[1])
+            && p[1] <= a[1].max(b[1]);
+        orientation(a, b, p) == 0.0 && within && p != a && p != b
     }
 
     /// Consecutive segments of one loop.

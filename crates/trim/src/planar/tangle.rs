@@ -19,8 +19,11 @@
 //!    round a few strays in front of the surface crosses its border); the
 //!    larger loop is the main surface's border, and a mean would be on
 //!    neither (on the statue's range map, 21 β from the nearest point).
-//!    A loop that meets another any other way (touching at a vertex,
-//!    running along it) is left an error: no split resolves it.
+//!    Where a loop passes exactly through another's vertex (a touch, as
+//!    loops through the border points themselves make), that vertex is
+//!    put into the segment it lies on; loops that share a vertex need no
+//!    split. Loops that run along one line and meet are left an error: no
+//!    split resolves them.
 //! 2. **Lobes.** A loop that crossed itself now visits a vertex twice; it
 //!    is cut there into two closed loops, so that each lobe of a twist
 //!    gets its own side. Lobes of fewer than 3 vertices or no area go.
@@ -37,9 +40,9 @@
 //!    goes too.
 
 use super::ring::Ring;
-use super::SegmentGrid;
+use super::{Contact, SegmentGrid};
 use crate::geom::{orient, UnionFind};
-use crate::hash::HashMap;
+use crate::hash::{HashMap, HashSet};
 
 /// Cloud points within this many β of a loop vote for its surface side.
 pub(crate) const VOTE_REACH: f64 = 2.0;
@@ -49,7 +52,7 @@ pub(crate) const VOTE_REACH: f64 = 2.0;
 #[derive(Debug, Clone)]
 pub(crate) struct Untangled {
     pub(crate) rings: Vec<Ring>,
-    /// Proper crossings split.
+    /// Places where loops crossed or touched, split.
     pub(crate) crossings: usize,
 }
 
@@ -66,48 +69,105 @@ struct Insert {
 /// Steps 1 and 2 of the module doc. Returns the pair of segments (indices
 /// into `grid`'s owners) that meet in a way no split resolves.
 pub(crate) fn untangle(rings: &[Ring], grid: &SegmentGrid) -> Result<Untangled, (u32, u32)> {
-    let pairs = grid.crossings()?;
+    let contacts = grid.contacts()?;
     let area: Vec<f64> = rings.iter().map(|r| r.area().abs()).collect();
-    let mut inserts = Vec::with_capacity(2 * pairs.len());
-    for &(s, t) in &pairs {
-        let (ls, is) = grid.owner[s as usize];
-        let (lt, it) = grid.owner[t as usize];
-        let (a, b) = segment(&rings[ls as usize], is as usize);
-        let (c, d) = segment(&rings[lt as usize], it as usize);
-        // Parameters along each segment from the orientation areas (their
-        // exact signs are opposite; the plain values may underflow).
-        let (oa, ob) = (orient(c.p2, d.p2, a.p2), orient(c.p2, d.p2, b.p2));
-        let (oc, od) = (orient(a.p2, b.p2, c.p2), orient(a.p2, b.p2, d.p2));
-        let ts = (oa / (oa - ob)).clamp(0.0, 1.0);
-        let tt = (oc / (oc - od)).clamp(0.0, 1.0);
-        let p2 = lerp2(a.p2, b.p2, ts);
-        let rounds_onto_a_vertex = [a.p2, b.p2, c.p2, d.p2].contains(&p2);
-        if !(ts.is_finite() && tt.is_finite()) || rounds_onto_a_vertex {
-            // No point to split at: left as a touch.
-            return Err((s, t));
-        }
-        let (p3, beta, reference) = if area[lt as usize] > area[ls as usize] {
-            on_segment(c, d, tt)
+    let end_of = |segment: u32, start: bool| {
+        let (l, i) = grid.owner[segment as usize];
+        let (a, b) = self::segment(&rings[l as usize], i as usize);
+        if start {
+            a
         } else {
-            on_segment(a, b, ts)
-        };
-        for (segment, t) in [(s, ts), (t, tt)] {
-            inserts.push(Insert {
+            b
+        }
+    };
+    let mut inserts = Vec::with_capacity(2 * contacts.len());
+    for &contact in &contacts {
+        match contact {
+            Contact::Cross(s, t) => inserts.extend(crossing(rings, grid, &area, s, t)?),
+            Contact::Touch {
                 segment,
-                t,
-                p2,
-                p3,
-                beta,
-                reference,
-            });
+                other,
+                start,
+            } => {
+                // The touching end, put into the segment it lies on.
+                let v = end_of(other, start);
+                let (l, i) = grid.owner[segment as usize];
+                let (a, b) = self::segment(&rings[l as usize], i as usize);
+                inserts.push(Insert {
+                    segment,
+                    t: along(a.p2, b.p2, v.p2),
+                    p2: v.p2,
+                    p3: v.p3,
+                    beta: v.beta,
+                    reference: v.reference,
+                });
+            }
         }
     }
+    // A touching end shared by two segments of its loop is found twice.
+    inserts.sort_by(|x, y| {
+        (x.segment, x.p2[0], x.p2[1])
+            .partial_cmp(&(y.segment, y.p2[0], y.p2[1]))
+            .unwrap_or(std::cmp::Ordering::Equal)
+    });
+    inserts.dedup_by(|x, y| x.segment == y.segment && x.p2 == y.p2);
+    let places: HashSet<(u64, u64)> = inserts
+        .iter()
+        .map(|x| (x.p2[0].to_bits(), x.p2[1].to_bits()))
+        .collect();
     let split = insert_crossings(rings, grid, inserts);
     let rings = split.iter().flat_map(lobes).collect();
     Ok(Untangled {
         rings,
-        crossings: pairs.len(),
+        crossings: places.len(),
     })
+}
+
+/// The crossing vertex of segments `s` and `t`, for both of them.
+fn crossing(
+    rings: &[Ring],
+    grid: &SegmentGrid,
+    area: &[f64],
+    s: u32,
+    t: u32,
+) -> Result<[Insert; 2], (u32, u32)> {
+    let (ls, is) = grid.owner[s as usize];
+    let (lt, it) = grid.owner[t as usize];
+    let (a, b) = segment(&rings[ls as usize], is as usize);
+    let (c, d) = segment(&rings[lt as usize], it as usize);
+    // Parameters along each segment from the orientation areas (their
+    // exact signs are opposite; the plain values may underflow).
+    let (oa, ob) = (orient(c.p2, d.p2, a.p2), orient(c.p2, d.p2, b.p2));
+    let (oc, od) = (orient(a.p2, b.p2, c.p2), orient(a.p2, b.p2, d.p2));
+    let ts = (oa / (oa - ob)).clamp(0.0, 1.0);
+    let tt = (oc / (oc - od)).clamp(0.0, 1.0);
+    let p2 = lerp2(a.p2, b.p2, ts);
+    let rounds_onto_a_vertex = [a.p2, b.p2, c.p2, d.p2].contains(&p2);
+    if !(ts.is_finite() && tt.is_finite()) || rounds_onto_a_vertex {
+        // No point to split at: left as a touch.
+        return Err((s, t));
+    }
+    let (p3, beta, reference) = if area[lt as usize] > area[ls as usize] {
+        on_segment(c, d, tt)
+    } else {
+        on_segment(a, b, ts)
+    };
+    let insert = |segment, t| Insert {
+        segment,
+        t,
+        p2,
+        p3,
+        beta,
+        reference,
+    };
+    Ok([insert(s, ts), insert(t, tt)])
+}
+
+/// Where `p` (on segment ab) lies along it, 0 at a and 1 at b.
+fn along(a: [f64; 2], b: [f64; 2], p: [f64; 2]) -> f64 {
+    let ab = [b[0] - a[0], b[1] - a[1]];
+    let len2 = ab[0] * ab[0] + ab[1] * ab[1];
+    ((p[0] - a[0]) * ab[0] + (p[1] - a[1]) * ab[1]) / len2
 }
 
 /// One vertex of a ring, by value.
@@ -380,7 +440,20 @@ mod tests {
     }
 
     #[test]
-    fn loops_that_touch_are_not_split() {
+    fn a_loop_through_another_s_vertex_shares_it() {
+        let rings = vec![
+            ring(square([0.0, 0.0], 10.0)),
+            ring(vec![[10.0, 5.0], [12.0, 3.0], [12.0, 7.0]]),
+        ];
+        let grid = SegmentGrid::new(&rings, 0.1);
+        let u = untangle(&rings, &grid).unwrap();
+        assert_eq!(u.crossings, 1);
+        assert_eq!(u.rings[0].len(), 5);
+        assert!(u.rings[0].p2.contains(&[10.0, 5.0]));
+    }
+
+    #[test]
+    fn loops_along_one_line_are_not_split() {
         let rings = vec![
             ring(square([0.0, 0.0], 10.0)),
             ring(square([10.0, 2.0], 4.0)),
