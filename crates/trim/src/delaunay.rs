@@ -95,7 +95,7 @@ use rayon::prelude::*;
 use spade::handles::{FixedFaceHandle, FixedVertexHandle, InnerTag};
 use spade::{PositionInTriangulation, Triangulation};
 
-use crate::bpd::{Detection, View, MIN_AXIS_COSINE};
+use crate::bpd::{Detection, View};
 use crate::edges::Edges;
 use crate::error::{DelaunayError, MeshError};
 use crate::frame::{fit_plane, Frame};
@@ -316,14 +316,8 @@ impl Projection {
                 let axis = View::camera_axis(eye, cloud);
                 let mut depths = 0.0;
                 for (index, &p) in cloud.iter().enumerate() {
-                    let ray = sub(p, eye);
-                    let depth = dot(ray, axis);
-                    // Also refuses a NaN depth (a point at the scanner).
-                    let in_view = depth > MIN_AXIS_COSINE * norm2(ray).sqrt();
-                    if !in_view {
-                        return Err(DelaunayError::NotInView { index });
-                    }
-                    depths += depth;
+                    depths += View::camera_depth(sub(p, eye), axis)
+                        .ok_or(DelaunayError::NotInView { index })?;
                 }
                 Ok(Projection {
                     frame: Frame::of_normal(axis.map(|c| -c)),

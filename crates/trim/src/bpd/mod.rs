@@ -113,6 +113,15 @@ impl View {
         )
     }
 
+    /// The depth of `ray` (from the camera) along the camera's `axis`, or
+    /// `None` when it runs more than [`MIN_AXIS_COSINE`] off the axis, or
+    /// is NaN (a point at the camera): no camera image holds it.
+    pub(crate) fn camera_depth(ray: Point3, axis: Point3) -> Option<f64> {
+        let depth = ray[0] * axis[0] + ray[1] * axis[1] + ray[2] * axis[2];
+        let length = (ray[0] * ray[0] + ray[1] * ray[1] + ray[2] * ray[2]).sqrt();
+        (depth > MIN_AXIS_COSINE * length).then_some(depth)
+    }
+
     /// Rejects a zero or non-finite direction and a non-finite position.
     fn check(&self) -> Result<(), CloudError> {
         let (what, [x, y, z]) = match *self {

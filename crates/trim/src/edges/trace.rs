@@ -31,7 +31,7 @@ use rayon::prelude::*;
 use spade::handles::{FixedDirectedEdgeHandle, FixedFaceHandle, InnerTag};
 use spade::{DelaunayTriangulation, Point2, Triangulation};
 
-use crate::bpd::{Detection, View, MIN_AXIS_COSINE};
+use crate::bpd::{Detection, View};
 use crate::frame::Frame;
 use crate::geom::{dist2, dot, sub, unit, Point3};
 use crate::planar::Node;
@@ -72,12 +72,7 @@ impl Projection {
                 let mut image = Vec::with_capacity(points.len());
                 let mut scale = Vec::with_capacity(points.len());
                 for ray in rays {
-                    let depth = dot(ray, axis);
-                    // Also refuses a NaN depth (a point at the scanner).
-                    let in_view = depth > MIN_AXIS_COSINE * dot(ray, ray).sqrt();
-                    if !in_view {
-                        return None;
-                    }
+                    let depth = View::camera_depth(ray, axis)?;
                     image.push([dot(ray, frame.u) / depth, dot(ray, frame.v) / depth]);
                     scale.push(depth);
                 }

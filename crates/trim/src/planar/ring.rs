@@ -24,7 +24,7 @@ pub(crate) enum Tangle {
 }
 
 /// One smoothed loop as a closed polyline.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub(crate) struct Ring {
     pub(crate) p3: Vec<Point3>,
     pub(crate) p2: Vec<[f64; 2]>,

@@ -199,15 +199,6 @@ fn push(ring: &mut Ring, v: Vertex) {
     ring.reference.push(v.reference);
 }
 
-fn empty() -> Ring {
-    Ring {
-        p3: Vec::new(),
-        p2: Vec::new(),
-        reference: Vec::new(),
-        beta: Vec::new(),
-    }
-}
-
 /// The rings with each crossing inserted into its segments, in order
 /// along them.
 fn insert_crossings(rings: &[Ring], grid: &SegmentGrid, mut inserts: Vec<Insert>) -> Vec<Ring> {
@@ -222,7 +213,7 @@ fn insert_crossings(rings: &[Ring], grid: &SegmentGrid, mut inserts: Vec<Insert>
         .iter()
         .enumerate()
         .map(|(l, ring)| {
-            let mut out = empty();
+            let mut out = Ring::default();
             for j in 0..ring.len() {
                 push(&mut out, vertex(ring, j));
                 for &k in at.get(&(l as u32, j as u32)).map_or(&[][..], Vec::as_slice) {
@@ -259,7 +250,7 @@ fn lobes(ring: &Ring) -> Vec<Ring> {
             for w in &tail {
                 seen.remove(&key(w.p2));
             }
-            let mut lobe = empty();
+            let mut lobe = Ring::default();
             push(&mut lobe, path[i]);
             tail.into_iter().for_each(|w| push(&mut lobe, w));
             out.push(lobe);
@@ -268,7 +259,7 @@ fn lobes(ring: &Ring) -> Vec<Ring> {
             path.push(v);
         }
     }
-    let mut rest = empty();
+    let mut rest = Ring::default();
     path.into_iter().for_each(|w| push(&mut rest, w));
     out.push(rest);
     out.retain(|r| r.len() >= 3 && r.area() != 0.0);
