@@ -74,6 +74,9 @@ pub struct Report {
     /// Faces dropped where crossing loops pinched the surface or enclosed
     /// no cloud point.
     pub crossing_faces_dropped: usize,
+    /// Faces dropped for spanning a depth jump where a nearer surface
+    /// occludes a farther one.
+    pub occlusion_faces_dropped: usize,
     /// Diagonals of co-circular quads (quantised clouds) flipped to the
     /// canonical side.
     pub diagonals_flipped: usize,
@@ -186,6 +189,7 @@ impl Report {
             loop_vertices_dropped: made.loop_vertices_dropped,
             loop_crossings: made.loop_crossings,
             crossing_faces_dropped: made.crossing_faces_dropped,
+            occlusion_faces_dropped: made.occlusion_faces_dropped,
             diagonals_flipped: made.diagonals_flipped,
             faces,
             area: made.area,
@@ -212,6 +216,10 @@ impl crate::report::Table for Report {
             ("loops from", self.loops_from.shown()),
             ("loop crossings", self.loop_crossings.to_string()),
             ("faces", self.faces.to_string()),
+            (
+                "occlusion faces dropped",
+                self.occlusion_faces_dropped.to_string(),
+            ),
             ("diagonals flipped", self.diagonals_flipped.to_string()),
             ("area", format!("{:.6}", self.area)),
             ("read time", format!("{:.1} ms", self.read_ms)),

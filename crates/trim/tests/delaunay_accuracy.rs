@@ -296,3 +296,80 @@ fn a_channel_seen_from_inside_is_meshed_in_the_camera_image() {
         );
     }
 }
+
+/// A plate 10 units in front of a wall, seen along z: in the scanner's
+/// image the two meet without a gap (the wall's samples stop where the
+/// plate hides it), so the image's triangulation joins them with faces
+/// standing edge-on to the scanner, a skirt no surface is under. Those
+/// faces go: the plate and the wall come out apart, each face on one of
+/// them, with the plate's area and the wall's visible area. Keeping every
+/// face (`occlusion_reach` infinite) gives the skirt back.
+#[test]
+fn a_plate_in_front_of_a_wall_is_meshed_without_the_skirt_between() {
+    let h = 0.1;
+    let wobble = |i: i64, j: i64| ((i * 7 + j * 13).rem_euclid(11)) as f64 / 11.0 - 0.5;
+    let plate = |x: f64, y: f64| (0.0..=4.0).contains(&x) && (0.0..=4.0).contains(&y);
+    let mut points = Vec::new();
+    for i in -40..=80 {
+        for j in -40..=80 {
+            let x = (i as f64 + 0.2 * wobble(i, j)) * h;
+            let y = (j as f64 + 0.2 * wobble(j, i)) * h;
+            if plate(x, y) {
+                points.push([x, y, 10.0]);
+            } else {
+                points.push([x, y, 0.0]);
+            }
+        }
+    }
+    let options = BpdOptions {
+        view: Some(trim::View::Along([0.0, 0.0, 1.0])),
+        ..Default::default()
+    };
+    let detection = detect_boundary(&points, &options).unwrap();
+    let edges = reconstruct_edges(&points, &detection, &EdgeOptions::default());
+    let (mesh, report) =
+        delaunay_mesh_with_report(&points, &detection, &edges, &DelaunayOptions::default())
+            .unwrap();
+    let depth_span = |mesh: &Mesh, face: &[u32; 3]| {
+        let z = face.map(|v| mesh.vertices[v as usize][2]);
+        z.iter().fold(f64::MIN, |a, &b| a.max(b)) - z.iter().fold(f64::MAX, |a, &b| a.min(b))
+    };
+    let area_at = |mesh: &Mesh, depth: f64| -> f64 {
+        mesh.faces
+            .iter()
+            .filter(|f| f.iter().all(|&v| mesh.vertices[v as usize][2] == depth))
+            .map(|f| {
+                let [a, b, c] = f.map(|v| mesh.vertices[v as usize]);
+                let n = cross(sub(b, a), sub(c, a));
+                0.5 * dot(n, n).sqrt()
+            })
+            .sum()
+    };
+    let (plate_area, wall_area) = (area_at(&mesh, 10.0), area_at(&mesh, 0.0));
+    eprintln!(
+        "plate before a wall: {} faces, {} dropped as a skirt, plate {plate_area:.2} (16), \
+         wall {wall_area:.2} (128)",
+        mesh.faces.len(),
+        report.occlusion_faces_dropped
+    );
+    mesh.check_manifold().unwrap();
+    assert!(report.occlusion_faces_dropped > 0);
+    assert!(
+        mesh.faces.iter().all(|f| depth_span(&mesh, f) < 1.0),
+        "a face joins the plate to the wall"
+    );
+    // The plate's border and the wall's hole run through the outermost
+    // samples: within a spacing of the true outline.
+    assert!((plate_area - 16.0).abs() < 4.0 * 4.0 * h, "{plate_area}");
+    assert!(
+        (wall_area - 128.0).abs() < 2.0 * 4.0 * 4.0 * h,
+        "{wall_area}"
+    );
+    let kept = DelaunayOptions {
+        occlusion_reach: f64::INFINITY,
+        ..Default::default()
+    };
+    let (skirted, report) = delaunay_mesh_with_report(&points, &detection, &edges, &kept).unwrap();
+    assert_eq!(report.occlusion_faces_dropped, 0);
+    assert!(skirted.faces.iter().any(|f| depth_span(&skirted, f) > 9.0));
+}

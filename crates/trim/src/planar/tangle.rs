@@ -292,12 +292,18 @@ pub(crate) fn surface_sides(
 
 /// Step 4: drops the faces (id triples; ids below `points` are cloud
 /// points, the others loop vertices) of every fan but the largest round
-/// each vertex where the surface pinches, then every patch of faces
-/// without a cloud point. Returns how many faces went.
-pub(crate) fn pinches_opened(faces: &mut Vec<[u32; 3]>, ids: usize, points: usize) -> usize {
+/// each vertex from id `pinch_from` on where the surface pinches, then
+/// every patch of faces without a cloud point. Returns how many faces
+/// went.
+pub(crate) fn pinches_opened(
+    faces: &mut Vec<[u32; 3]>,
+    ids: usize,
+    points: usize,
+    pinch_from: usize,
+) -> usize {
     let before = faces.len();
     loop {
-        let pinched = pinched_faces(faces, ids, points);
+        let pinched = pinched_faces(faces, ids, pinch_from);
         if pinched.is_empty() {
             break;
         }
