@@ -845,34 +845,11 @@ fn without_empty_faces(mesh: &Mesh) -> (Cow<'_, Mesh>, DroppedFaces) {
     (Cow::Owned(kept), dropped)
 }
 
-/// Drops each smoothed loop vertex closer than [`MIN_GAP`]·β to the last
-/// one kept (and, at the end, to the first), so that the new border's
-/// segments are not much shorter than the mesh's edges.
+/// Drops each smoothed loop vertex closer than [`MIN_GAP`]·β (in 3D) to
+/// the last one kept (and, at the end, to the first), so that the new
+/// border's segments are not much shorter than the mesh's edges.
 fn even_out(mut ring: Ring) -> Ring {
-    let m = ring.p3.len();
-    if m < 2 * MIN_LOOP_POINTS {
-        return ring;
-    }
-    let mut keep = vec![true; m];
-    let mut last = 0;
-    for (j, kept) in keep.iter_mut().enumerate().skip(1) {
-        let gap = MIN_GAP * ring.beta[j];
-        let close = dist2(ring.p3[j], ring.p3[last]).sqrt() < gap;
-        let closing = dist2(ring.p3[j], ring.p3[0]).sqrt() < gap;
-        if close || closing {
-            *kept = false;
-        } else {
-            last = j;
-        }
-    }
-    if keep.iter().filter(|&&k| k).count() >= MIN_LOOP_POINTS {
-        let mut k = keep.iter();
-        ring.p3.retain(|_| *k.next().unwrap_or(&true));
-        let mut k = keep.iter();
-        ring.reference.retain(|_| *k.next().unwrap_or(&true));
-        let mut k = keep.iter();
-        ring.beta.retain(|_| *k.next().unwrap_or(&true));
-    }
+    ring.even_out(MIN_GAP, |r, i, j| dist2(r.p3[i], r.p3[j]).sqrt());
     ring
 }
 

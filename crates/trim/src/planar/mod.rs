@@ -19,6 +19,8 @@ use spade::{
 };
 
 pub(crate) use diagonals::{canonical_diagonals, cocircular};
+#[cfg(test)]
+pub(crate) use ring::flat_ring;
 pub(crate) use ring::{untwist, Ring, Tangle};
 pub(crate) use segment_grid::{Contact, SegmentGrid};
 #[cfg(test)]

@@ -2,6 +2,7 @@
 //! themselves in a projection.
 
 use super::SegmentGrid;
+use crate::edges::cluster::MIN_LOOP_POINTS;
 use crate::edges::Loop;
 use crate::geom::Point3;
 
@@ -63,6 +64,45 @@ impl Ring {
         self.reference.retain(|_| *k.next().unwrap_or(&true));
         let mut k = keep.iter();
         self.beta.retain(|_| *k.next().unwrap_or(&true));
+    }
+
+    /// Drops each vertex closer than `gap`·β (its own β) to the last one
+    /// kept, or at the end to the first, by `distance` between two
+    /// vertices: where a zig-zag border is smoothed its vertices bunch up,
+    /// and a very short segment opposite a vertex a spacing away makes a
+    /// sliver. A ring of fewer than twice [`MIN_LOOP_POINTS`] vertices, or
+    /// that would keep fewer than [`MIN_LOOP_POINTS`], stays as it is.
+    /// Returns how many went.
+    pub(crate) fn even_out(
+        &mut self,
+        gap: f64,
+        distance: impl Fn(&Ring, usize, usize) -> f64,
+    ) -> usize {
+        let m = self.p3.len();
+        if m < 2 * MIN_LOOP_POINTS {
+            return 0;
+        }
+        let mut keep = vec![true; m];
+        let mut last = 0;
+        for (j, kept) in keep.iter_mut().enumerate().skip(1) {
+            let reach = gap * self.beta[j];
+            if distance(self, j, last) < reach || distance(self, j, 0) < reach {
+                *kept = false;
+            } else {
+                last = j;
+            }
+        }
+        let dropped = keep.iter().filter(|&&k| !k).count();
+        if m - dropped < MIN_LOOP_POINTS {
+            return 0;
+        }
+        self.retain(&keep);
+        dropped
+    }
+
+    /// [`Ring::even_out`] by the distance in the projection.
+    pub(crate) fn even_out_in_projection(&mut self, gap: f64) -> usize {
+        self.even_out(gap, |r, i, j| dist2d(r.p2[i], r.p2[j]))
     }
 
     /// Merges each vertex into its predecessor when they coincide in 2D
@@ -190,6 +230,23 @@ mod tests {
         p.extend((0..k).map(|i| [o[0] + s - t(i), o[1] + s]));
         p.extend((0..k).map(|i| [o[0], o[1] + s - t(i)]));
         p
+    }
+
+    /// Vertices closer than the gap to the last one kept go; the ring's
+    /// first vertex and a small ring stay.
+    #[test]
+    fn evening_out_drops_bunched_vertices() {
+        let mut p = square([0.0, 0.0], 4.0, 4);
+        // Two vertices bunched after the first corner, one before the first.
+        p.insert(1, [0.1, 0.0]);
+        p.insert(2, [0.3, 0.0]);
+        p.push([0.0, 0.2]);
+        let mut r = ring(p);
+        assert_eq!(r.even_out_in_projection(0.4), 3);
+        assert_eq!(r.p2, square([0.0, 0.0], 4.0, 4));
+        let mut small = ring(vec![[0.0, 0.0], [0.1, 0.0], [1.0, 0.0], [0.0, 1.0]]);
+        assert_eq!(small.even_out_in_projection(0.4), 0);
+        assert_eq!(small.len(), 4);
     }
 
     #[test]

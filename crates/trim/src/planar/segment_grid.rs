@@ -273,6 +273,17 @@ impl SegmentGrid {
 
     /// True if a segment passes within `radius` of `p`.
     pub(crate) fn near(&self, p: [f64; 2], radius: f64) -> bool {
+        self.near_where(p, radius, |_| true)
+    }
+
+    /// True if a segment `s` for which `accept(s)` holds passes within
+    /// `radius` of `p`.
+    pub(crate) fn near_where(
+        &self,
+        p: [f64; 2],
+        radius: f64,
+        accept: impl Fn(u32) -> bool,
+    ) -> bool {
         if self.a.is_empty() {
             return false;
         }
@@ -282,7 +293,7 @@ impl SegmentGrid {
             for c in c0..=c1 {
                 for &s in &self.cells[r * self.nx + c] {
                     let q = closest_on(self.a[s as usize], self.b[s as usize], p);
-                    if dist2d(p, q) < radius {
+                    if dist2d(p, q) < radius && accept(s) {
                         return true;
                     }
                 }
