@@ -343,12 +343,12 @@ def test_delaunay_path_on_real_range_scans(tmp_path, scan):
     surface occludes a farther one are dropped.
     PyMeshLab finds each mesh valid (no non-manifold edge or vertex, no
     null, duplicate or misoriented face); every vertex lies within reach
-    of the cloud (measured at most 3.03, 1.62, 1.63, 1.88, 1.25, 1.68 β for
+    of the cloud (measured at most 1.79, 1.32, 1.45, 1.91, 1.25, 1.68 β for
     face000, lato000, bun000, bun045, bun090, chin: loop vertices half a
     row beyond the border points); and the mesh covers the cloud but for
-    points beyond the loops (measured 0.21, 0.16, 0.19, 0.02, 0.33, 0.22 %
+    points beyond the loops (measured 0.21, 0.17, 0.19, 0.05, 0.39, 0.22 %
     farther than two spacings from every vertex; without the offset 4 and
-    3 contacts, the same bounds). All eight were refused before the loops
+    2 contacts, the same bounds). All eight were refused before the loops
     could cross, and bun090 until the faces across its occlusions went
     (1.1 % of its triangles stood on edge)."""
     rel, view = REAL_DELAUNAY[scan]
