@@ -60,7 +60,8 @@ pub struct Report {
     pub points_used: usize,
     /// Cloud points outside the loops (beyond the border or in holes).
     pub points_outside: usize,
-    /// Cloud points left out for lying right on a loop.
+    /// Cloud points left out for lying next to a loop (within 0.3 β),
+    /// which stands for the border there.
     pub points_near_loop: usize,
     /// Smoothed loops used as constraints.
     pub loops: usize,

@@ -65,10 +65,10 @@
 //!    `test_delaunay_path_on_real_range_scans`): 0.1 β in the projection
 //!    and no evening out of the loops left the synthetic meshes' smallest
 //!    angles at 4.4–5.7° and 32–146 faces under 5° on each real scan;
-//!    with both, 9.9–11.4° and 6–60. 0.4 β gives 12.2–16.2°, but on
+//!    with both, 9.9–11.4° and 6–57. 0.4 β gives 12.2–16.2°, but on
 //!    bun090 the points it leaves out along its occlusions go with the
 //!    faces there (0.50 % of the points then lie farther than two
-//!    spacings from the mesh, against 0.40 %). Points that coincide in 2D
+//!    spacings from the mesh, against 0.39 %). Points that coincide in 2D
 //!    are merged by spade (the first kept).
 //! 5. **Constrained Delaunay triangulation** (spade, exact predicates): the
 //!    points are bulk-loaded, then every loop's vertices are inserted and
@@ -102,9 +102,9 @@
 //!    their image: faces with an edge over 10 times the median held 4.6,
 //!    5.3 and 6.7 % of bun000's, bun045's and chin's area, every one of
 //!    those faces within 11.5° of edge-on, with an edge of 3.9 β or more;
-//!    after the drop 0.00–0.03 %. A real surface the scanner saw at a grazing angle keeps
-//!    its faces: its samples lie far apart, but so does β there (face000's
-//!    longest faces: 1.2–4.4 β). The new border along an occlusion runs
+//!    after the drop 0.00–0.03 %. A real surface the scanner saw at a
+//!    grazing angle keeps its faces: its samples lie far apart, but so
+//!    does β there (face000's longest faces: 1.2–4.4 β). The new border along an occlusion runs
 //!    through the outermost samples of each surface; it is not smoothed.
 //! 7. **Height-field check, on the triangles.** A lifted counter-clockwise
 //!    triangle can never be flipped relative to n (its normal's component
@@ -215,7 +215,8 @@ pub struct DelaunayReport {
     pub points_near_loop: usize,
     /// Cloud points merged with another that projects to the same spot.
     pub points_merged: usize,
-    /// Loop vertices merged with their predecessor (2D coincidence).
+    /// Loop vertices merged with their predecessor: closer than 0.4 β to
+    /// it in the projection (step 3).
     pub loop_vertices_merged: usize,
     /// Loop vertices dropped to untwist self-crossing loops.
     pub loop_vertices_dropped: usize,
@@ -507,11 +508,10 @@ impl Bounds {
     /// Is the point `p3`, at `p` in the projection, within `reach` of a
     /// loop in 3D, or within [`IN_PROJECTION`]·`reach` of one in the
     /// projection, where it could lie on the constraint? Measured in 3D
-    /// because that is
-    /// where the faces are: where the surface turns steeply away from the
-    /// projection near its border, a point close to the loop in the
-    /// projection lies far from it on the surface, and its faces are
-    /// well shaped.
+    /// because that is where the faces are: where the surface turns
+    /// steeply away from the projection near its border, a point close to
+    /// the loop in the projection lies far from it on the surface, and its
+    /// faces are well shaped.
     fn near_loop(&self, p3: Point3, p: [f64; 2], reach: f64) -> bool {
         self.grid.near(p, IN_PROJECTION * reach)
             || self.grid.near_where(p, reach, |s| {
@@ -535,7 +535,7 @@ impl Bounds {
 }
 
 /// Step 3, **loops made valid**: each smoothed loop as a ring projected
-/// onto the plane, coincident vertices merged, small self-crossings
+/// onto the plane, vertices closer than 0.4 β merged, small self-crossings
 /// untwisted ([`untwist`]); where that leaves loops crossing, they are
 /// split at their crossings instead ([`untangle`]) and each gets its
 /// surface side. Fills `loop_vertices_merged`, `loop_vertices_dropped`
@@ -1294,10 +1294,6 @@ mod tests {
             .collect()
     }
 
-    /// A disc of radius 9 with three holes where no point was sampled:
-    /// one across the border, two overlapping each other. The smoothed
-    /// loops cross four times; the mesh is the disc less the holes, one
-    /// manifold piece with two borders, whichever way each loop runs.
     /// A point near a loop in the projection but far from it in 3D, where
     /// the surface turns steeply away near its border, goes in; one near
     /// it in 3D, or on it in the projection, stays out.
@@ -1322,6 +1318,10 @@ mod tests {
         assert!(!bounds.near_loop([2.0, 1.0, 0.0], [2.0, 1.0], reach));
     }
 
+    /// A disc of radius 9 with three holes where no point was sampled:
+    /// one across the border, two overlapping each other. The smoothed
+    /// loops cross four times; the mesh is the disc less the holes, one
+    /// manifold piece with two borders, whichever way each loop runs.
     #[test]
     fn loops_that_cross_bound_the_surface_by_winding() {
         let holes = [([18.0, 10.0], 2.0), ([8.0, 10.0], 1.6), ([10.0, 10.0], 1.6)];
