@@ -337,16 +337,17 @@ def test_delaunay_path_on_real_range_scans(tmp_path, scan):
     maps in their own best-fit plane, the bunny's scans in their scanner's
     image (along z; over their best-fit plane they fold). Some of their
     smoothed loops cross (small holes across the outer border, holes
-    across each other), or with `--no-offset` touch where they pass
-    through the same border point: split there, the surface is kept by
-    winding. In the image, faces that span a depth jump where a nearer
-    surface occludes a farther one are dropped.
+    across each other; not on bun045 and bun090), or with `--no-offset`
+    touch where they pass through the same border point: split there, the
+    surface is kept by winding. In the image, the loops run along the
+    occlusions without the half-row offset, and the faces that still span
+    a depth jump where a nearer surface occludes a farther one are dropped.
     PyMeshLab finds each mesh valid (no non-manifold edge or vertex, no
     null, duplicate or misoriented face); every vertex lies within reach
-    of the cloud (measured at most 1.79, 1.32, 1.45, 1.91, 1.25, 1.68 β for
+    of the cloud (measured at most 1.46, 1.32, 1.33, 1.19, 1.14, 1.29 β for
     face000, lato000, bun000, bun045, bun090, chin: loop vertices half a
     row beyond the border points); and the mesh covers the cloud but for
-    points beyond the loops (measured 0.21, 0.17, 0.19, 0.05, 0.39, 0.22 %
+    points beyond the loops (measured 0.21, 0.17, 0.21, 0.00, 0.37, 0.22 %
     farther than two spacings from every vertex; without the offset 4 and
     2 contacts, the same bounds). All eight were refused before the loops
     could cross, and bun090 until the faces across its occlusions went
@@ -360,7 +361,8 @@ def test_delaunay_path_on_real_range_scans(tmp_path, scan):
     beta = np.asarray(verts["beta"], dtype=float)
     run_meshtrim("mesh", cloud, out_path, "--report", report_path, *view)
     report = json.loads(report_path.read_text())
-    assert report["loop_crossings"] > 0, report
+    if scan not in ("bun045", "bun090"):
+        assert report["loop_crossings"] > 0, report
     assert report["loops_from"] == ("scanner_image" if "--view-along" in view else "own_plane"), report
     v, f = poisson.load_mesh(out_path)
     pm = poisson.pymeshlab_validity(v, f)
@@ -373,9 +375,9 @@ def test_delaunay_path_on_real_range_scans(tmp_path, scan):
     spacing = tree.query(pts, k=7)[0][:, 1:].mean(axis=1)
     uncovered = (cKDTree(v).query(pts)[0] > 2.0 * spacing).mean()
     assert uncovered <= 0.005, uncovered
-    # Few slivers: faces under 5° are at most 0.073 % of the faces (0.04 to
+    # Few slivers: faces under 5° are at most 0.046 % of the faces (0.04 to
     # 0.19 % before the loops were evened out and points kept 0.3 β from
-    # them); those under 1° lie where loops cross.
+    # them); the one under 1° (chin) lies where loops cross.
     assert (smallest_angles(v, f) < 5.0).mean() <= 0.001, (smallest_angles(v, f) < 5.0).mean()
     if "--view-along" in view:
         # Where a nearer surface occludes a farther one, no face spans the

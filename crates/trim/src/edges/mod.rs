@@ -255,9 +255,13 @@ fn edges_of_traced_loops(
     points: &[Point3],
     detection: &Detection,
     options: &EdgeOptions,
-    mut traced: Vec<Vec<u32>>,
+    traced: trace::Traced,
     loops_from: LoopSource,
 ) -> Edges {
+    let trace::Traced {
+        loops: mut traced,
+        occluding,
+    } = traced;
     // Points on a traced loop that BPD labelled interior close it as gap
     // fillers close a tour.
     let dropped = drop_tours_made_by_fillers(&mut traced, |i| detection.boundary[i as usize]);
@@ -265,8 +269,16 @@ fn edges_of_traced_loops(
     let thinned = (0..points.len() as u32)
         .filter(|i| detection.boundary[*i as usize] && on_loops.binary_search(i).is_err())
         .count();
+    let index = options.offset.then(|| NeighbourIndex::new(points));
+    let loops = traced
+        .into_par_iter()
+        .map(|tour| {
+            let held = tour.iter().map(|&i| occluding[i as usize]).collect();
+            loop_held_at_occlusions(points, &detection.beta, tour, index.as_ref(), held)
+        })
+        .collect();
     Edges {
-        loops: loops_of_tours(points, &detection.beta, traced, options),
+        loops,
         dropped_clusters: dropped,
         thinned_points: thinned,
         loops_from,
@@ -459,11 +471,27 @@ pub fn loop_from_tour(
     tour: Vec<u32>,
     index: Option<&NeighbourIndex>,
 ) -> Loop {
+    loop_held_at_occlusions(points, beta, tour, index, Vec::new())
+}
+
+/// [`loop_from_tour`], the offset held back where `occluding` (per tour
+/// point; empty for none) says the loop runs along an occlusion
+/// ([`offset::hold_at_occlusions`]).
+fn loop_held_at_occlusions(
+    points: &[Point3],
+    beta: &[f64],
+    tour: Vec<u32>,
+    index: Option<&NeighbourIndex>,
+    occluding: Vec<bool>,
+) -> Loop {
     let loop_points: Vec<Point3> = tour.iter().map(|&i| points[i as usize]).collect();
     let loop_beta: Vec<f64> = tour.iter().map(|&i| beta[i as usize]).collect();
     let corners = corners::find_corners(&loop_points, &loop_beta);
     let mut edges = smoothed_edges(&loop_points, &loop_beta, &corners);
-    let sides = index.map_or_else(Vec::new, |index| offset::edge_sides(index, &tour));
+    let mut sides = index.map_or_else(Vec::new, |index| offset::edge_sides(index, &tour));
+    if !occluding.is_empty() {
+        offset::hold_at_occlusions(&mut sides, &occluding);
+    }
     if !sides.is_empty() {
         move_edges_outward(&mut edges, &corners, &sides);
     }

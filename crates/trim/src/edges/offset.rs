@@ -79,6 +79,31 @@ pub fn edge_sides(index: &NeighbourIndex, loop_points: &[u32]) -> Vec<EdgeSide> 
         .collect()
 }
 
+/// Scales each side's offset by the share of the loop points within
+/// ±[`WINDOW`] of it that do not lie along an occlusion (`occluding`, per
+/// loop point): where a nearer surface hides a farther one the region ends
+/// at the occlusion, not where the samples end, so no row lies beyond the
+/// outermost one and the edge is the samples' own. The ramp over the
+/// window keeps the moved loop from stepping where an occlusion begins.
+pub fn hold_at_occlusions(sides: &mut [EdgeSide], occluding: &[bool]) {
+    let n = sides.len();
+    if n == 0 || occluding.len() != n || !occluding.contains(&true) {
+        return;
+    }
+    let window = 2 * WINDOW + 1;
+    let share: Vec<f64> = (0..n)
+        .map(|i| {
+            let open = (0..window)
+                .filter(|k| !occluding[(i + n * (WINDOW + 1) + k - WINDOW) % n])
+                .count();
+            open as f64 / window as f64
+        })
+        .collect();
+    for (side, s) in sides.iter_mut().zip(share) {
+        side.offset *= s;
+    }
+}
+
 /// Area per sample, plane normal and centroid of a neighbourhood.
 fn local_surface(points: &[Point3], members: &[u32]) -> (f64, Point3, Point3) {
     let mut centroid = [0.0; 3];
@@ -222,6 +247,26 @@ pub fn corner_shift(offset: f64, n_in: Point3, n_out: Point3) -> Point3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Along an occlusion the offset is held back to nothing, ramping over
+    /// the window where it begins and ends; elsewhere it stays.
+    #[test]
+    fn the_offset_is_held_back_along_an_occlusion() {
+        let side = EdgeSide {
+            offset: 1.0,
+            normal: [0.0, 0.0, 1.0],
+            inside: [0.0; 3],
+        };
+        let mut sides = vec![side; 40];
+        let occluding: Vec<bool> = (0..40).map(|i| (10..25).contains(&i)).collect();
+        hold_at_occlusions(&mut sides, &occluding);
+        let window = (2 * WINDOW + 1) as f64;
+        assert_eq!(sides[0].offset, 1.0);
+        assert_eq!(sides[17].offset, 0.0);
+        assert_eq!(sides[10].offset, (WINDOW as f64) / window);
+        assert_eq!(sides[24].offset, (WINDOW as f64) / window);
+        assert_eq!(sides[30].offset, 1.0);
+    }
 
     #[test]
     fn pick_area_of_a_square_lattice_patch_is_one_cell() {

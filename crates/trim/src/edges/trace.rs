@@ -86,9 +86,27 @@ impl Projection {
 /// the region on its left in the image plane), or `None` when the
 /// detection has no view, no image plane holds the cloud, or the region
 /// holds less than half of it.
-pub(crate) fn traced_loops(points: &[Point3], detection: &Detection) -> Option<Vec<Vec<u32>>> {
+pub(crate) fn traced_loops(points: &[Point3], detection: &Detection) -> Option<Traced> {
     let region = Region::seen(points, detection, detection.view?)?;
-    Some(region.border_loops())
+    Some(Traced {
+        loops: region.border_loops(),
+        occluding: region.layered(points, detection),
+    })
+}
+
+/// The loops of a region traced in an image plane, and where they run
+/// along an occlusion.
+pub(crate) struct Traced {
+    /// Each loop's points (input indices), a simple cycle, the region on
+    /// its left in the image plane.
+    pub(crate) loops: Vec<Vec<u32>>,
+    /// Per input point, whether it lies next to another layer of the
+    /// image: a point of another surface beside it in the image, out of
+    /// its reach in space. The region ends there at an occlusion (a nearer
+    /// surface's silhouette, or the farther one's edge where the nearer
+    /// one hides it), not where the samples end, so its edge is there and
+    /// not half a row beyond.
+    pub(crate) occluding: Vec<bool>,
 }
 
 /// The loops of a cloud without a view, traced in the image plane of its
@@ -99,13 +117,15 @@ pub(crate) fn traced_loops(points: &[Point3], detection: &Detection) -> Option<V
 pub(crate) fn traced_loops_in_own_plane(
     points: &[Point3],
     detection: &Detection,
-) -> Option<(Point3, Vec<Vec<u32>>)> {
+) -> Option<(Point3, Traced)> {
     let normal = own_normal(points);
     let region = Region::seen(points, detection, View::Along(normal))?;
-    if region.layered_share(points, detection) > MAX_LAYERED_SHARE {
+    let occluding = region.layered(points, detection);
+    if region.layered_share(&occluding) > MAX_LAYERED_SHARE {
         return None;
     }
-    Some((normal, region.border_loops()))
+    let loops = region.border_loops();
+    Some((normal, Traced { loops, occluding }))
 }
 
 /// The share of the points in two layers of the image of the cloud's own
@@ -114,7 +134,7 @@ pub(crate) fn traced_loops_in_own_plane(
 /// measurements.
 pub fn own_plane_layered_share(points: &[Point3], detection: &Detection) -> Option<f64> {
     let region = Region::seen(points, detection, View::Along(own_normal(points)))?;
-    Some(region.layered_share(points, detection))
+    Some(region.layered_share(&region.layered(points, detection)))
 }
 
 /// The largest share of the points that may lie in two layers of the image
@@ -172,14 +192,20 @@ impl Region {
         cycles.into_iter().flat_map(simple_cycles).collect()
     }
 
-    /// The share of the image's points that lie in two layers: joined by an
-    /// image edge shorter (in the cloud's units) than the smaller β of its
-    /// ends to a point outside their neighbourhoods. A single view has such
-    /// points only along occluding silhouettes; a surface folding over
-    /// itself in the image has them all over the fold.
-    fn layered_share(&self, points: &[Point3], detection: &Detection) -> f64 {
+    /// The share of the image's points that [`Region::layered`] marks.
+    fn layered_share(&self, layered: &[bool]) -> f64 {
+        layered.iter().filter(|&&l| l).count() as f64 / self.image.num_vertices() as f64
+    }
+
+    /// Per input point, whether it lies in two layers of the image: joined
+    /// by an image edge shorter (in the cloud's units) than the smaller β
+    /// of its ends to a point outside their neighbourhoods. A single view
+    /// has such points only along occluding silhouettes; a surface folding
+    /// over itself in the image has them all over the fold. Points that
+    /// share an image position with an earlier one are not in the image.
+    fn layered(&self, points: &[Point3], detection: &Detection) -> Vec<bool> {
         let image = &self.image;
-        let mut layered = vec![false; image.num_vertices()];
+        let mut layered = vec![false; points.len()];
         for edge in image.undirected_edges() {
             let [a, b] = edge.vertices();
             let (i, j) = (a.data().id as usize, b.data().id as usize);
@@ -189,11 +215,11 @@ impl Region {
             if length < detection.beta[i].min(detection.beta[j])
                 && !within_reach(points, detection, i, j)
             {
-                layered[a.fix().index()] = true;
-                layered[b.fix().index()] = true;
+                layered[i] = true;
+                layered[j] = true;
             }
         }
-        layered.iter().filter(|&&l| l).count() as f64 / image.num_vertices() as f64
+        layered
     }
 }
 
@@ -480,7 +506,7 @@ mod tests {
 
     fn loops_of(points: &[Point3]) -> Vec<Vec<u32>> {
         let detection = detect_boundary(points, &along_z()).unwrap();
-        traced_loops(points, &detection).unwrap()
+        traced_loops(points, &detection).unwrap().loops
     }
 
     /// The traced loops' sides are exactly the triangulation's sides that
@@ -508,7 +534,7 @@ mod tests {
                 .filter(|&(_, n)| n == 1)
                 .map(|(s, _)| s)
                 .collect();
-            let loops = traced_loops(&points, &detection).unwrap();
+            let loops = traced_loops(&points, &detection).unwrap().loops;
             let mut traced = Vec::new();
             for cycle in &loops {
                 let mut seen = cycle.clone();
@@ -679,8 +705,9 @@ mod tests {
     fn a_ragged_border_is_traced_in_its_own_plane_whatever_the_order() {
         let loop_sets = |points: &[Point3], input: &dyn Fn(u32) -> u32| {
             let detection = paper_detection(points);
-            let (_, loops) = traced_loops_in_own_plane(points, &detection).unwrap();
-            let mut sets: Vec<Vec<u32>> = loops
+            let (_, traced) = traced_loops_in_own_plane(points, &detection).unwrap();
+            let mut sets: Vec<Vec<u32>> = traced
+                .loops
                 .iter()
                 .map(|l| {
                     let mut ids: Vec<u32> = l.iter().map(|&i| input(i)).collect();
@@ -721,7 +748,7 @@ mod tests {
             // Measured: 47 % of the points in two layers.
             let region =
                 Region::seen(&folding, &detection, View::Along(own_normal(&folding))).unwrap();
-            let layered = region.layered_share(&folding, &detection);
+            let layered = region.layered_share(&region.layered(&folding, &detection));
             assert!(layered > 0.3, "seed {seed}: {layered}");
             assert!(traced_loops_in_own_plane(&folding, &detection).is_none());
         }
