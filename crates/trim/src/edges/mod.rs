@@ -12,7 +12,8 @@
 //!    it into edges;
 //! 4. each edge is smoothed by a spatial low-pass filter (section 3.3);
 //! 5. optionally, each smoothed loop is moved out to where the surface
-//!    really ends.
+//!    really ends ([`offset`]); not where a traced loop runs along an
+//!    occlusion, where the region ends at the samples themselves.
 
 pub mod cluster;
 pub mod corners;

@@ -19,7 +19,9 @@
 //! which stays unbiased where the neighbourhood is cut by the edge. Both
 //! estimates are averaged along the loop over ±[`WINDOW`] points, and the
 //! smoothed loop is moved by r/2 along its outward normal in the surface's
-//! tangent plane.
+//! tangent plane. Along an occlusion of a loop traced in a scanner's image
+//! the offset is held back ([`hold_at_occlusions`]): no row of samples
+//! lies beyond the outermost one there.
 
 use crate::frame::fit_plane;
 use crate::geom::{cross, dot, norm2, sub, Point3};
