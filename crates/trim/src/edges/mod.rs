@@ -274,7 +274,11 @@ fn edges_of_traced_loops(
     let loops = traced
         .into_par_iter()
         .map(|tour| {
-            let held = tour.iter().map(|&i| occluding[i as usize]).collect();
+            let held = if occluding.is_empty() {
+                Vec::new()
+            } else {
+                tour.iter().map(|&i| occluding[i as usize]).collect()
+            };
             loop_held_at_occlusions(points, &detection.beta, tour, index.as_ref(), held)
         })
         .collect();

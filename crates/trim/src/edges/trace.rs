@@ -100,9 +100,9 @@ pub(crate) struct Traced {
     /// Each loop's points (input indices), a simple cycle, the region on
     /// its left in the image plane.
     pub(crate) loops: Vec<Vec<u32>>,
-    /// Per input point, whether it lies next to another layer of the
-    /// image: a point of another surface beside it in the image, out of
-    /// its reach in space. The region ends there at an occlusion (a nearer
+    /// Per input point (empty for none), whether it lies next to another
+    /// layer of the scanner's image: a point of another surface beside it
+    /// in the image, out of its reach in space. The region ends there at an occlusion (a nearer
     /// surface's silhouette, or the farther one's edge where the nearer
     /// one hides it), not where the samples end, so its edge is there and
     /// not half a row beyond.
@@ -120,10 +120,12 @@ pub(crate) fn traced_loops_in_own_plane(
 ) -> Option<(Point3, Traced)> {
     let normal = own_normal(points);
     let region = Region::seen(points, detection, View::Along(normal))?;
-    let occluding = region.layered(points, detection);
-    if region.layered_share(&occluding) > MAX_LAYERED_SHARE {
+    if region.layered_share(&region.layered(points, detection)) > MAX_LAYERED_SHARE {
         return None;
     }
+    // The best-fit plane is no scanner's view: which side of a jump in
+    // depth was hidden is not known, so no occlusion is marked.
+    let occluding = Vec::new();
     let loops = region.border_loops();
     Some((normal, Traced { loops, occluding }))
 }
