@@ -1042,20 +1042,14 @@ impl LoopCdt {
         cloud: &[Point3],
         used: &[bool],
     ) -> (Vec<u32>, Vec<Point3>, Vec<u32>) {
-        let n = self.n;
         let mut out_index = vec![u32::MAX; used.len()];
         let mut vertices = Vec::new();
         let mut reference = Vec::new();
         for (id, slot) in out_index.iter_mut().enumerate() {
             if used[id] {
                 *slot = vertices.len() as u32;
-                if id < n {
-                    vertices.push(cloud[id]);
-                    reference.push(id as u32);
-                } else {
-                    vertices.push(self.loop_p3[id - n]);
-                    reference.push(self.loop_ref[id - n]);
-                }
+                vertices.push(self.position(id as u32, cloud));
+                reference.push(self.reference(id as u32));
             }
         }
         (out_index, vertices, reference)
@@ -1265,7 +1259,9 @@ mod tests {
 
     /// A 30 × 30 grid of spacing 0.5, jittered by up to 0.1, on the wave
     /// z = `bump`·sin(0.7x).
-    fn jittered_sheet(rng: &mut rand_chacha::ChaCha8Rng, bump: f64) -> Vec<Point3> {
+    /// A 30 × 30 jittered sheet, bumped by `bump`·sin(0.7 x), and its
+    /// detection.
+    fn detected_sheet(rng: &mut rand_chacha::ChaCha8Rng, bump: f64) -> (Vec<Point3>, Detection) {
         let mut cloud = Vec::new();
         for i in 0..30 {
             for j in 0..30 {
@@ -1274,24 +1270,30 @@ mod tests {
                 cloud.push([x, y, bump * (x * 0.7).sin()]);
             }
         }
-        cloud
+        let detection =
+            crate::bpd::detect_boundary(&cloud, &crate::bpd::BpdOptions::default()).unwrap();
+        (cloud, detection)
     }
 
-    /// A random number of circles over the sheet, of random centres,
-    /// radii, vertex counts and senses.
+    /// Edges of a random number of circles over the sheet, of random
+    /// centres, radii, vertex counts and senses.
     fn random_circles(
         rng: &mut rand_chacha::ChaCha8Rng,
         cloud: &[Point3],
         count: std::ops::Range<usize>,
         radius: std::ops::Range<f64>,
-    ) -> Vec<crate::edges::Loop> {
-        (0..rng.random_range(count))
+    ) -> Edges {
+        let loops = (0..rng.random_range(count))
             .map(|_| {
                 let c = [rng.random_range(2.0..13.0), rng.random_range(2.0..13.0)];
                 let (r, m) = (rng.random_range(radius.clone()), rng.random_range(4..40));
                 circle(cloud, c, r, m, rng.random_bool(0.5))
             })
-            .collect()
+            .collect();
+        Edges {
+            loops,
+            ..Default::default()
+        }
     }
 
     /// A point near a loop in the projection but far from it in 3D, where
@@ -1391,18 +1393,12 @@ mod tests {
     #[test]
     fn the_filled_faces_match_a_ray_cast_at_every_centroid() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
-        let cloud = jittered_sheet(&mut rng, 0.0);
-        let detection =
-            crate::bpd::detect_boundary(&cloud, &crate::bpd::BpdOptions::default()).unwrap();
+        let (cloud, detection) = detected_sheet(&mut rng, 0.0);
         let beta_median = median(&detection.beta);
         let plane = Projection::new(&cloud, None).unwrap();
         let (mut crossed, mut compared) = (0, 0);
         for case in 0..60 {
-            let loops = random_circles(&mut rng, &cloud, 1..6, 1.0..6.0);
-            let edges = Edges {
-                loops,
-                ..Default::default()
-            };
+            let edges = random_circles(&mut rng, &cloud, 1..6, 1.0..6.0);
             let options = DelaunayOptions::default();
             let mut report = DelaunayReport::default();
             let Ok(bounds) = valid_rings(
@@ -1452,16 +1448,10 @@ mod tests {
     #[test]
     fn random_loops_give_an_error_or_a_manifold_mesh() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(17);
-        let cloud = jittered_sheet(&mut rng, 0.05);
-        let detection =
-            crate::bpd::detect_boundary(&cloud, &crate::bpd::BpdOptions::default()).unwrap();
+        let (cloud, detection) = detected_sheet(&mut rng, 0.05);
         let (mut meshed, mut crossed) = (0, 0);
         for case in 0..80 {
-            let loops = random_circles(&mut rng, &cloud, 1..7, 0.3..7.0);
-            let edges = Edges {
-                loops,
-                ..Default::default()
-            };
+            let edges = random_circles(&mut rng, &cloud, 1..7, 0.3..7.0);
             let options = DelaunayOptions::default();
             let Ok((mesh, report)) =
                 delaunay_mesh_with_report(&cloud, &detection, &edges, &options)

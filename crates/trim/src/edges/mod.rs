@@ -158,7 +158,7 @@ pub fn reconstruct_edges(points: &[Point3], detection: &Detection, options: &Edg
         }
     }
     Edges {
-        loops: loops_of_tours(points, &detection.beta, linked.tours, options),
+        loops: loops_of_tours(points, &detection.beta, linked.tours, options, &[]),
         dropped_clusters: linked.dropped_clusters,
         thinned_points: linked.thinned_points,
         loops_from: LoopSource::Links,
@@ -270,20 +270,8 @@ fn edges_of_traced_loops(
     let thinned = (0..points.len() as u32)
         .filter(|i| detection.boundary[*i as usize] && on_loops.binary_search(i).is_err())
         .count();
-    let index = options.offset.then(|| NeighbourIndex::new(points));
-    let loops = traced
-        .into_par_iter()
-        .map(|tour| {
-            let held = if occluding.is_empty() {
-                Vec::new()
-            } else {
-                tour.iter().map(|&i| occluding[i as usize]).collect()
-            };
-            loop_held_at_occlusions(points, &detection.beta, tour, index.as_ref(), held)
-        })
-        .collect();
     Edges {
-        loops,
+        loops: loops_of_tours(points, &detection.beta, traced, options, &occluding),
         dropped_clusters: dropped,
         thinned_points: thinned,
         loops_from,
@@ -319,17 +307,27 @@ fn in_geometric_order(points: &[Point3], loops: Vec<Vec<u32>>) -> (Vec<Vec<u32>>
 }
 
 /// Each closed tour (input indices, in loop order) made a loop by
-/// [`loop_from_tour`], with the outward offset when `options` asks for it.
+/// [`loop_from_tour`], with the outward offset when `options` asks for it,
+/// held back at the points `occluding` marks (per input point; empty for
+/// none).
 fn loops_of_tours(
     points: &[Point3],
     beta: &[f64],
     tours: Vec<Vec<u32>>,
     options: &EdgeOptions,
+    occluding: &[bool],
 ) -> Vec<Loop> {
     let index = options.offset.then(|| NeighbourIndex::new(points));
     tours
         .into_par_iter()
-        .map(|tour| loop_from_tour(points, beta, tour, index.as_ref()))
+        .map(|tour| {
+            let held = if occluding.is_empty() {
+                Vec::new()
+            } else {
+                tour.iter().map(|&i| occluding[i as usize]).collect()
+            };
+            loop_held_at_occlusions(points, beta, tour, index.as_ref(), held)
+        })
         .collect()
 }
 
