@@ -4,7 +4,8 @@
 # meshtrim package's tests, in the .venv-test venv, which this creates or
 # checks first: about 1.5 min the first time, 3 s after; the package is
 # built and installed into it),
-# then a short seeded fuzzing pass of the CLI (scripts/fuzz_cli.py).
+# then a short seeded fuzzing pass of the CLI (scripts/fuzz_cli.py) and a
+# short soak of the commands on fresh samplings (scripts/soak.py).
 #
 # The PCL scans the tests read are shipped in fixtures/scans; the other
 # real scans (the Stanford bunny's, MeshLab's, the Kinect blade) are read
@@ -52,3 +53,6 @@ MESHTRIM="$PWD/target/release/meshtrim" .venv-test/bin/python -m pytest -q -rsx 
 # A short seeded fuzzing pass of the CLI (about 40 s): no mutated input may
 # make it panic, die by a signal or hang.
 .venv-test/bin/python scripts/fuzz_cli.py --seed 2026 --cases 150 --timeout 60
+# A short soak of the commands on samplings no test uses (about 15 s):
+# every output valid by PyMeshLab.
+.venv-test/bin/python scripts/soak.py --first-seed 2026 --seeds 2

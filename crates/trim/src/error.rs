@@ -168,13 +168,13 @@ pub enum DelaunayError {
     /// The cloud is not a height field over the plane it is projected
     /// onto: the Delaunay path, which triangulates in that projection,
     /// cannot mesh it.
-    #[error("the surface folds over {onto} ({percent:.1}% of the {what} stand on edge or face away from it, at most {limit}% allowed), so a mesh built in that projection would be broken; mesh it with screened Poisson and trim that mesh instead")]
+    #[error("the surface folds over {onto} ({percent:.1}% of the {what} on edge or facing away from it, at most {limit}% allowed), so a mesh built in that projection would be broken; mesh it with screened Poisson and trim that mesh instead")]
     NotAHeightField {
         /// The plane: "its best-fit plane" or "the scanner's image".
         onto: &'static str,
         /// Share of the offending elements, in percent.
         percent: f64,
-        /// What was counted: "local normals" or "triangles".
+        /// What was measured: "local normals" or "triangles' area".
         what: &'static str,
         /// Largest accepted share, in percent.
         limit: f64,

@@ -99,10 +99,15 @@ pub(super) fn check_steep_normals(
 /// Step 7, **height-field check on the triangles**: a lifted
 /// counter-clockwise triangle can never be flipped relative to the plane
 /// normal, so folds show instead as triangles joining the overlapping
-/// sheets, steep to the surface. More than [`DelaunayOptions::max_misfit_share`] of misfits
-/// ([`is_misfit`]) is [`DelaunayError::NotAHeightField`]. Fills
-/// `degenerate_faces` (below 10⁻¹²·β², counted, not removed) and
-/// `misfit_triangles_percent`.
+/// sheets, steep to the surface. Misfits ([`is_misfit`]) holding more than
+/// [`DelaunayOptions::max_misfit_share`] of the mesh's area is
+/// [`DelaunayError::NotAHeightField`]. The share is of the area, not of
+/// the triangles: a fold's triangles span the gap between its sheets,
+/// while a sliver between two loops that nearly touch has a normal that
+/// says nothing of the surface and covers almost none of it (on a blade
+/// of 101 points, 2 such slivers were 1.1 % of the triangles and 0.09 %
+/// of the area). Fills `degenerate_faces` (below 10⁻¹²·β², counted, not
+/// removed) and `misfit_area_percent`.
 pub(super) fn check_triangles(
     mesh: &Mesh,
     reference: &[u32],
@@ -112,7 +117,7 @@ pub(super) fn check_triangles(
     options: &DelaunayOptions,
     report: &mut DelaunayReport,
 ) -> Result<(), DelaunayError> {
-    let mut misfits = 0;
+    let (mut misfit_area, mut area) = (0.0, 0.0);
     for face in &mesh.faces {
         let [a, b, c] = face.map(|v| mesh.vertices[v as usize]);
         let nt = cross(sub(b, a), sub(c, a));
@@ -122,16 +127,17 @@ pub(super) fn check_triangles(
         }
         // The local normals of the points the face's vertices stand for.
         let vertex_normals = face.map(|v| normals[reference[v as usize] as usize]);
+        area += 0.5 * len;
         if is_misfit(nt, len, vertex_normals) {
-            misfits += 1;
+            misfit_area += 0.5 * len;
         }
     }
-    report.misfit_triangles_percent = 100.0 * misfits as f64 / mesh.faces.len() as f64;
-    if misfits as f64 > options.max_misfit_share * mesh.faces.len() as f64 {
+    report.misfit_area_percent = 100.0 * misfit_area / area;
+    if misfit_area > options.max_misfit_share * area {
         return Err(DelaunayError::NotAHeightField {
             onto,
-            percent: report.misfit_triangles_percent,
-            what: "triangles",
+            percent: report.misfit_area_percent,
+            what: "triangles' area",
             limit: 100.0 * options.max_misfit_share,
         });
     }

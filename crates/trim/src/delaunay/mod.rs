@@ -111,8 +111,11 @@
 //!    along n is its projected area), so folds show instead as triangles
 //!    joining the overlapping sheets, steep to the surface: a triangle is a
 //!    misfit when the mean |n_t·nᵥ| over its vertices' local normals is
-//!    below 0.5; more than [`DelaunayOptions::max_misfit_share`] of misfits gives
-//!    [`DelaunayError::NotAHeightField`].
+//!    below 0.5; misfits holding more than
+//!    [`DelaunayOptions::max_misfit_share`] of the area give
+//!    [`DelaunayError::NotAHeightField`]. The area, not the count: a sliver
+//!    between two loops that nearly touch has an arbitrary normal but
+//!    covers almost nothing, while a fold's triangles span its sheets.
 //!
 //! Degenerate faces: a projected Delaunay triangle has a positive area and
 //! its lift is never smaller, so no face has zero area. Slivers are
@@ -163,8 +166,8 @@ pub struct DelaunayOptions {
     /// the best-fit plane (|nᵢ·n| < 0.1) before the cloud is no height
     /// field (step 2). Default 0.01.
     pub max_steep_share: f64,
-    /// Largest share of the kept triangles that may not follow the surface
-    /// (step 7). Default 0.01.
+    /// Largest share of the mesh's area in triangles that do not follow
+    /// the surface (step 7). Default 0.01.
     pub max_misfit_share: f64,
     /// Cloud points closer to a loop than this many β (in 3D) are left
     /// out: the loop stands for the border there (step 4). Default 0.3.
@@ -224,8 +227,8 @@ pub struct DelaunayReport {
     pub occlusion_faces_dropped: usize,
     /// Share of local normals standing on edge (|nᵢ·n| < 0.1), %.
     pub steep_normals_percent: f64,
-    /// Share of kept triangles not following the surface, %.
-    pub misfit_triangles_percent: f64,
+    /// Share of the mesh's area in triangles not following the surface, %.
+    pub misfit_area_percent: f64,
     /// Faces below 10⁻¹²·β² (kept, counted).
     pub degenerate_faces: usize,
     /// Diagonals of co-circular quads flipped to their canonical side (the

@@ -282,3 +282,52 @@ fn random_loops_give_an_error_or_a_manifold_mesh() {
     }
     assert!(meshed >= 40 && crossed >= 20, "{meshed} {crossed}");
 }
+
+/// A flat 10 × 10 grid (162 triangles, area 81) with `extra` triangles standing on
+/// edge above it, each `size` long: the triangle check counts their area.
+fn grid_with_steep_triangles(extra: usize, size: f64) -> (Mesh, Vec<u32>, Vec<Point3>) {
+    let n = 10;
+    let mut vertices: Vec<Point3> = (0..n * n)
+        .map(|i| [(i % n) as f64, (i / n) as f64, 0.0])
+        .collect();
+    let mut faces = Vec::new();
+    for y in 0..n - 1 {
+        for x in 0..n - 1 {
+            let v = |dx: usize, dy: usize| ((y + dy) * n + x + dx) as u32;
+            faces.extend([[v(0, 0), v(1, 0), v(1, 1)], [v(0, 0), v(1, 1), v(0, 1)]]);
+        }
+    }
+    for k in 0..extra {
+        let base = vertices.len() as u32;
+        let x = k as f64;
+        vertices.extend([[x, 0.5, 0.0], [x + size, 0.5, 0.0], [x, 0.5, size]]);
+        faces.push([base, base + 1, base + 2]);
+    }
+    let reference: Vec<u32> = (0..vertices.len() as u32).collect();
+    let normals = vec![[0.0, 0.0, 1.0]; vertices.len()];
+    (Mesh { vertices, faces }, reference, normals)
+}
+
+#[test]
+fn the_triangle_check_weighs_misfits_by_their_area() {
+    let check = |extra: usize, size: f64| {
+        let (mesh, reference, normals) = grid_with_steep_triangles(extra, size);
+        let mut report = DelaunayReport::default();
+        let result = check_triangles(
+            &mesh,
+            &reference,
+            &normals,
+            1.0,
+            "the best-fit plane",
+            &DelaunayOptions::default(),
+            &mut report,
+        );
+        (result.is_ok(), report.misfit_area_percent)
+    };
+    // Three slivers on edge: 1.8 % of the triangles, 0.02 % of the area.
+    let (accepted, percent) = check(3, 0.1);
+    assert!(accepted && percent < 0.1, "{percent}");
+    // Three triangles on edge, each larger than a grid cell: 4 % of the area.
+    let (accepted, percent) = check(3, 1.5);
+    assert!(!accepted && percent > 3.0, "{percent}");
+}

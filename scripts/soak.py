@@ -1,0 +1,155 @@
+"""Soak test of the commands on fresh samplings: every output valid.
+
+    .venv-test/bin/python scripts/soak.py [--first-seed N] [--seeds N] [--stages clean,mesh,trim]
+
+Where the fuzzer (scripts/fuzz_cli.py) feeds meshtrim broken files, this
+feeds it good ones it has not seen: the synthetic surfaces of
+tests/python/synthetic.py (the paper's blade at 4, 8, 16 and 34 mm, the
+notched plate, the curved disc, a cylinder wrapped 110 degrees past both
+silhouettes), sampled with seeds the tests do not use, and runs
+
+- `clean` on each sampling's jagged mesh (tests/python/jagged.py),
+- `mesh` on each cloud (not the wrapped cylinder, which no plane sees as
+  a height field: it is refused, as it should be),
+- the main job on the screened-Poisson mesh of the blades at 4 and 8 mm,
+  the plate and the disc (PyMeshLab, as tests/python/poisson.py makes it).
+
+A case **fails** when a command exits with anything but a clear error it
+was expected to give, or writes a mesh PyMeshLab finds broken
+(non-manifold edges or vertices, faces to re-orient, null or duplicate
+faces). Loops `clean` leaves, new faces under 5 degrees and trimmed
+borders farther than half a spacing from the truth on average are printed
+as **remarks**: the product's measured limits, not defects of the run.
+Exits 1 if any case failed. CI runs a short seeded pass
+(scripts/test.sh); docs/tests.md has a long run's counts.
+"""
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "tests", "python"))
+
+import jagged  # noqa: E402
+import poisson  # noqa: E402
+import synthetic  # noqa: E402
+
+EXE = os.path.join(ROOT, "target", "release", "meshtrim")
+
+SURFACES = {
+    "blade 4 mm": lambda s: synthetic.blade(4.0, s),
+    "blade 8 mm": lambda s: synthetic.blade(8.0, s),
+    "blade 16 mm": lambda s: synthetic.blade(16.0, s),
+    "blade 34 mm": lambda s: synthetic.blade(34.0, s),
+    "notched plate": lambda s: synthetic.notched_plate(1.0, s),
+    "curved disc": lambda s: synthetic.curved_disc(1.5, s),
+    "wrapped cylinder": lambda s: synthetic.wrapped_cylinder(1.5, s),
+}
+# Surfaces no plane sees as a height field: `mesh` refuses them.
+NOT_A_HEIGHT_FIELD = {"wrapped cylinder"}
+# Poisson meshes take a second or two each: the main job on four surfaces.
+TRIMMED = {"blade 4 mm", "blade 8 mm", "notched plate", "curved disc"}
+
+
+def broken(vertices, faces):
+    """What PyMeshLab finds wrong with a mesh, or None."""
+    pm = poisson.pymeshlab_validity(vertices, faces)
+    keys = ["non_manifold_edges", "non_manifold_vertices", "reoriented", "null_faces", "duplicate_faces"]
+    wrong = {k: pm[k] for k in keys if pm[k]}
+    return wrong or None
+
+
+def run(args):
+    return subprocess.run([EXE, *map(str, args)], capture_output=True, text=True)
+
+
+def soak_clean(cloud, work):
+    """(failures, remarks) of `clean` on the sampling's jagged mesh."""
+    v, f, _ = jagged.jagged_mesh(cloud)
+    src, out, rep = work / "jagged.ply", work / "clean.ply", work / "clean.json"
+    synthetic.write_mesh_ply(src, v, f, double=True)
+    r = run(["clean", src, out, "--report", rep])
+    if r.returncode:
+        return [f"clean exited {r.returncode}: {r.stderr.strip()[-300:]}"], []
+    wrong = broken(*poisson.load_mesh(out))
+    failures = [f"clean wrote a broken mesh: {wrong}"] if wrong else []
+    report = json.loads(rep.read_text())
+    remarks = [f"clean left {x['vertices']}: {x['reason']}" for x in report["loops_left"]]
+    if report["faces_added"] and report["min_angle_new"] < 5.0:
+        remarks.append(f"clean's smallest new angle {report['min_angle_new']:.2f}°")
+    return failures, remarks
+
+
+def soak_mesh(name, cloud, work):
+    cloud_path, out = work / "cloud.ply", work / "mesh.ply"
+    synthetic.write_cloud_ply(cloud_path, cloud.points)
+    r = run(["mesh", cloud_path, out])
+    if name in NOT_A_HEIGHT_FIELD:
+        if r.returncode == 1 and "folds over the best-fit plane" in r.stderr:
+            return [], []
+        return [f"mesh should refuse it (exit 1, the surface folds): exited {r.returncode}: {r.stderr.strip()[-300:]}"], []
+    if r.returncode:
+        return [f"mesh exited {r.returncode}: {r.stderr.strip()[-300:]}"], []
+    wrong = broken(*poisson.load_mesh(out))
+    return ([f"mesh wrote a broken mesh: {wrong}"] if wrong else []), []
+
+
+def soak_trim(cloud, work):
+    v, f, _ = poisson.reconstruct(cloud.points, cloud.normals, threads=1)
+    mesh_path, cloud_path, out = work / "poisson.ply", work / "cloud.ply", work / "trimmed.ply"
+    poisson.save_mesh(mesh_path, v, f)
+    synthetic.write_cloud_ply(cloud_path, cloud.points)
+    r = run([mesh_path, cloud_path, out])
+    if r.returncode:
+        return [f"trim exited {r.returncode}: {r.stderr.strip()[-300:]}"], []
+    ov, of = poisson.load_mesh(out)
+    wrong = broken(ov, of)
+    failures = [f"trim wrote a broken mesh: {wrong}"] if wrong else []
+    m = poisson.border_metrics(ov, of, cloud)
+    remarks = []
+    if m["loops"] != m["true_loops"] or m["border_mean"] > 0.5:
+        remarks.append(f"trim: {m['loops']} loops for {m['true_loops']}, border {m['border_mean']:.3f} spacings from the truth")
+    return failures, remarks
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--first-seed", type=int, default=100)
+    ap.add_argument("--seeds", type=int, default=10, help="samplings per surface")
+    ap.add_argument("--stages", default="clean,mesh,trim")
+    args = ap.parse_args()
+    stages = set(args.stages.split(","))
+    if not os.path.exists(EXE):
+        sys.exit(f"{EXE} not found: build it first (cargo build --release)")
+    cases = failed = remarked = 0
+    with tempfile.TemporaryDirectory() as tmp:
+        from pathlib import Path
+
+        work = Path(tmp)
+        for name, make in SURFACES.items():
+            for seed in range(args.first_seed, args.first_seed + args.seeds):
+                cloud = make(seed)
+                results = []
+                if "clean" in stages:
+                    results.append(soak_clean(cloud, work))
+                if "mesh" in stages:
+                    results.append(soak_mesh(name, cloud, work))
+                if "trim" in stages and name in TRIMMED:
+                    results.append(soak_trim(cloud, work))
+                failures = [x for fs, _ in results for x in fs]
+                remarks = [x for _, rs in results for x in rs]
+                cases += 1
+                failed += bool(failures)
+                remarked += bool(remarks) and not failures
+                for line in [f"FAIL {x}" for x in failures] + [f"remark: {x}" for x in remarks]:
+                    print(f"{name}, seed {seed}: {line}", flush=True)
+    print(f"{cases} samplings, {failed} failed, {remarked} with remarks only")
+    sys.exit(1 if failed else 0)
+
+
+if __name__ == "__main__":
+    main()
