@@ -30,6 +30,7 @@ import os
 import subprocess
 import sys
 import tempfile
+from pathlib import Path
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "tests", "python"))
@@ -127,8 +128,6 @@ def main():
         sys.exit(f"{EXE} not found: build it first (cargo build --release)")
     cases = failed = remarked = 0
     with tempfile.TemporaryDirectory() as tmp:
-        from pathlib import Path
-
         work = Path(tmp)
         for name, make in SURFACES.items():
             for seed in range(args.first_seed, args.first_seed + args.seeds):
