@@ -82,6 +82,7 @@ fn trims_the_fixture_and_reports() {
         "pieces_dropped",
         "pieces_restored",
         "faces_out_of_reach",
+        "pinch_faces_dropped",
     ] {
         assert!(json.get(key).is_some(), "missing {key}");
     }

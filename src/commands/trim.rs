@@ -139,6 +139,9 @@ pub struct Report {
     /// Parts of faces dropped because no cloud point lies within reach
     /// (2 local resolutions): envelope that no wall cut off.
     pub faces_out_of_reach: usize,
+    /// Kept faces dropped where two kept pieces would touch at one vertex
+    /// the input did not pinch.
+    pub pinch_faces_dropped: usize,
     /// Zero-area or repeated faces of the output repaired (screened
     /// Poisson leaves a few tiny triangles).
     pub faces_repaired: usize,
@@ -337,6 +340,7 @@ impl Report {
             pieces_restored: r.pieces_restored,
             vertices_snapped: r.vertices_snapped,
             faces_out_of_reach: r.faces_out_of_reach,
+            pinch_faces_dropped: r.pinch_faces_dropped,
             faces_repaired: r.repaired.repaired(),
             zero_area_faces_left: r.repaired.left,
             area_in: r.area_in,
@@ -408,6 +412,13 @@ impl crate::report::Table for Report {
                 format!(
                     "{} parts of faces no cloud point reaches, dropped",
                     self.faces_out_of_reach
+                ),
+            ),
+            (
+                "pinches opened",
+                format!(
+                    "{} faces dropped where kept pieces touched at one vertex",
+                    self.pinch_faces_dropped
                 ),
             ),
             ("faces repaired", self.faces_repaired.to_string()),

@@ -43,6 +43,7 @@ use super::ring::Ring;
 use super::{Contact, SegmentGrid};
 use crate::geom::{orient, UnionFind};
 use crate::hash::{HashMap, HashSet};
+use crate::mesh::pinches::fan_labels;
 
 /// Cloud points within this many β of a loop vote for its surface side.
 pub(crate) const VOTE_REACH: f64 = 2.0;
@@ -345,19 +346,7 @@ pub(crate) fn pinched_faces(faces: &[[u32; 3]], ids: usize, points: usize) -> Ve
         if star.len() < 2 {
             continue;
         }
-        // Faces round v joined through their other vertices.
-        let mut fans = UnionFind::new(star.len());
-        let mut by_vertex: HashMap<u32, u32> = HashMap::default();
-        for (x, &k) in star.iter().enumerate() {
-            for &w in faces[k as usize].iter().filter(|&&w| w as usize != v) {
-                if let Some(&y) = by_vertex.get(&w) {
-                    fans.union(x as u32, y);
-                } else {
-                    by_vertex.insert(w, x as u32);
-                }
-            }
-        }
-        let fan: Vec<u32> = (0..star.len() as u32).map(|x| fans.find(x)).collect();
+        let fan = fan_labels(faces, v as u32, star);
         let mut size: HashMap<u32, usize> = HashMap::default();
         fan.iter().for_each(|&r| *size.entry(r).or_default() += 1);
         if size.len() < 2 {

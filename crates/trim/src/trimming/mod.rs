@@ -58,7 +58,12 @@
 //!    small loops (holes, sparse spots) sign vertices far from them too,
 //!    and dropping every piece beyond them would take about 30 % of the
 //!    zippered bunny with them.
-//! 6. Unused vertices are removed.
+//! 6. **No new pinch.** Where the faces between two kept pieces went, the
+//!    pieces may touch at one vertex, which the input did not pinch (a
+//!    range grid's slits and skirts leave such pieces on real scans); the
+//!    smaller piece's faces round that vertex go
+//!    ([`crate::mesh::pinches`]). Then zero-area and repeated faces are
+//!    repaired and unused vertices removed.
 
 mod cut;
 mod field;
@@ -70,6 +75,7 @@ use support::*;
 
 use crate::hash::HashMap;
 
+use crate::mesh::pinches::open_new_pinches;
 use crate::mesh::repair::{repair_degenerate_faces, FaceRepair};
 use crate::spatial::PointTree;
 use rayon::prelude::*;
@@ -140,6 +146,11 @@ pub struct TrimReport {
     /// them (see [`TrimOptions::reach`]): envelope that no wall cuts off, where a
     /// border did not close into a loop.
     pub faces_out_of_reach: usize,
+    /// Kept faces dropped where the kept surface would pinch to a vertex
+    /// the input did not pinch (two kept pieces touching at one vertex
+    /// once the faces between them went): the faces of the smaller
+    /// piece's fan there.
+    pub pinch_faces_dropped: usize,
     /// Area of the input mesh.
     pub area_in: f64,
     /// Area of the output mesh.
@@ -199,7 +210,8 @@ pub fn trim_mesh(
     ) = within_reach(first_cut, &reach, options.snap);
     snapped_count += out_of_reach.snapped;
     let support = supported_faces(&cut, &beyond, cloud, &detection.beta, options.support)?;
-    let keep = support.keep;
+    let mut keep = support.keep;
+    let pinch_faces_dropped = open_new_pinches(mesh, &cut, &mut keep);
     let mut survived = vec![false; mesh.faces.len()];
     for (&o, &k) in origin.iter().zip(&keep) {
         survived[o as usize] |= k;
@@ -217,6 +229,7 @@ pub fn trim_mesh(
         pieces_restored: support.restored,
         vertices_snapped: snapped_count,
         faces_out_of_reach: out_of_reach.faces,
+        pinch_faces_dropped,
         area_in: mesh.area(),
         area_out: kept.area(),
         loops: walls.border_fit(&kept),
