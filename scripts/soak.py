@@ -1,6 +1,6 @@
 """Soak test of the commands on fresh samplings: every output valid.
 
-    .venv-test/bin/python scripts/soak.py [--first-seed N] [--seeds N] [--stages clean,mesh,trim]
+    .venv-test/bin/python scripts/soak.py [--first-seed N] [--seeds N] [--stages clean,mesh,trim,crops]
 
 Where the fuzzer (scripts/fuzz_cli.py) feeds meshtrim broken files, this
 feeds it good ones it has not seen: the synthetic surfaces of
@@ -12,12 +12,19 @@ silhouettes), sampled with seeds the tests do not use, and runs
 - `mesh` on each cloud (not the wrapped cylinder, which no plane sees as
   a height field: it is refused, as it should be),
 - the main job on the screened-Poisson mesh of the blades at 4 and 8 mm,
-  the plate and the disc (PyMeshLab, as tests/python/poisson.py makes it).
+  the plate and the disc (PyMeshLab, as tests/python/poisson.py makes it);
+
+and crops of the real range scans (`crops`: a ball, one side of a plane,
+or holes punched, tests/python/crops.py; the scans of
+test_clean_validation.py, read from the shared data) through all three,
+the crop's own vertices as the cloud.
 
 A case **fails** when a command exits with anything but a clear error it
 was expected to give, or writes a mesh PyMeshLab finds broken
 (non-manifold edges or vertices, faces to re-orient, null or duplicate
-faces). Loops `clean` leaves, new faces under 5 degrees and trimmed
+faces; for a crop, more non-manifold elements than the crop had). A
+crop may be refused with a clear error (exit 1, the file named, nothing
+written): `mesh` refuses a crop that folds over its plane. Loops `clean` leaves, new faces under 5 degrees and trimmed
 borders farther than half a spacing from the truth on average are printed
 as **remarks**: the product's measured limits, not defects of the run.
 Exits 1 if any case failed. CI runs a short seeded pass
@@ -35,9 +42,13 @@ from pathlib import Path
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "tests", "python"))
 
+import crops  # noqa: E402
 import jagged  # noqa: E402
+import numpy as np  # noqa: E402
 import poisson  # noqa: E402
+import pytest  # noqa: E402
 import synthetic  # noqa: E402
+from meshtrim_cli import shared_data  # noqa: E402
 
 EXE = os.path.join(ROOT, "target", "release", "meshtrim")
 
@@ -54,13 +65,26 @@ SURFACES = {
 NOT_A_HEIGHT_FIELD = {"wrapped cylinder"}
 # Poisson meshes take a second or two each: the main job on four surfaces.
 TRIMMED = {"blade 4 mm", "blade 8 mm", "notched plate", "curved disc"}
+# The real scans whose crops are soaked, as test_clean_validation.py's.
+SCANS = {
+    "face000": "meshlab_scans/face000.ply",
+    "lato000": "meshlab_scans/lato000.ply",
+    "Laurana50k": "meshlab_scans/Laurana50k.ply",
+    "bun000": "stanford_bunny/bun000.ply",
+    "bun045": "stanford_bunny/bun045.ply",
+    "bun090": "stanford_bunny/bun090.ply",
+    "chin": "stanford_bunny/chin.ply",
+}
+MANIFOLD_KEYS = ["non_manifold_edges", "non_manifold_vertices"]
 
 
-def broken(vertices, faces):
-    """What PyMeshLab finds wrong with a mesh, or None."""
+def broken(vertices, faces, allowed=None):
+    """What PyMeshLab finds wrong with a mesh, or None. ``allowed``: the
+    input's own counts of non-manifold elements, which are not wrong."""
     pm = poisson.pymeshlab_validity(vertices, faces)
-    keys = ["non_manifold_edges", "non_manifold_vertices", "reoriented", "null_faces", "duplicate_faces"]
-    wrong = {k: pm[k] for k in keys if pm[k]}
+    allowed = allowed or {}
+    keys = MANIFOLD_KEYS + ["reoriented", "null_faces", "duplicate_faces"]
+    wrong = {k: pm[k] for k in keys if pm[k] > allowed.get(k, 0)}
     return wrong or None
 
 
@@ -117,16 +141,62 @@ def soak_trim(cloud, work):
     return failures, remarks
 
 
+def soak_crop(vertices, faces, work):
+    """(failures, remarks) of clean, mesh and the main job on one crop."""
+    src, cloud = work / "crop.ply", work / "crop_cloud.ply"
+    synthetic.write_mesh_ply(src, vertices, faces, double=True)
+    synthetic.write_cloud_ply(cloud, vertices)
+    pm_in = poisson.pymeshlab_validity(vertices, faces)
+    allowed = {k: pm_in[k] for k in MANIFOLD_KEYS}
+    failures, remarks = [], []
+    for command, args in [("clean", ["clean", src]), ("mesh", ["mesh", cloud]), ("trim", [src, cloud])]:
+        out, rep = work / f"{command}.ply", work / f"{command}.json"
+        for path in (out, rep):
+            path.unlink(missing_ok=True)
+        r = run([*args, out, "--report", rep])
+        if r.returncode == 1 and r.stderr.startswith("error: ") and not out.exists():
+            remarks.append(f"{command} refused: {r.stderr.strip().splitlines()[0][:160]}")
+            continue
+        if r.returncode:
+            failures.append(f"{command} exited {r.returncode}: {r.stderr.strip()[-300:]}")
+            continue
+        wrong = broken(*poisson.load_mesh(out), allowed)
+        if wrong:
+            failures.append(f"{command} wrote a broken mesh: {wrong} (the crop had {allowed})")
+        if command == "clean":
+            left = [n for x in json.loads(rep.read_text())["loops_left"] for n in x["vertices"] if n >= 8]
+            if left:
+                remarks.append(f"clean left loops of {left} vertices")
+    return failures, remarks
+
+
+def soak_crops(first_seed, seeds, work):
+    """Yields (case name, failures, remarks) for each crop."""
+    for index, (name, rel) in enumerate(SCANS.items()):
+        try:
+            path = shared_data(rel)
+        except pytest.skip.Exception as missing:
+            print(f"{name}: crops {missing}", flush=True)
+            continue
+        except pytest.fail.Exception as missing:
+            yield f"{name} crops", [str(missing)], []
+            continue
+        vertices, faces = poisson.load_mesh(path)
+        for seed in range(first_seed, first_seed + seeds):
+            kind, (v, f) = crops.crop(vertices, faces, np.random.default_rng([seed, index]))
+            yield f"{name} crop {seed} ({kind}, {len(f)} faces)", *soak_crop(v, f, work)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--first-seed", type=int, default=100)
-    ap.add_argument("--seeds", type=int, default=10, help="samplings per surface")
-    ap.add_argument("--stages", default="clean,mesh,trim")
+    ap.add_argument("--seeds", type=int, default=10, help="samplings per surface, crops per scan")
+    ap.add_argument("--stages", default="clean,mesh,trim,crops")
     args = ap.parse_args()
     stages = set(args.stages.split(","))
     if not os.path.exists(EXE):
         sys.exit(f"{EXE} not found: build it first (cargo build --release)")
-    cases = failed = remarked = 0
+    counts = []
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
         for name, make in SURFACES.items():
@@ -141,13 +211,22 @@ def main():
                     results.append(soak_trim(cloud, work))
                 failures = [x for fs, _ in results for x in fs]
                 remarks = [x for _, rs in results for x in rs]
-                cases += 1
-                failed += bool(failures)
-                remarked += bool(remarks) and not failures
-                for line in [f"FAIL {x}" for x in failures] + [f"remark: {x}" for x in remarks]:
-                    print(f"{name}, seed {seed}: {line}", flush=True)
-    print(f"{cases} samplings, {failed} failed, {remarked} with remarks only")
+                if results:
+                    counts.append(tell(f"{name}, seed {seed}", failures, remarks))
+        if "crops" in stages:
+            for case, failures, remarks in soak_crops(args.first_seed, args.seeds, work):
+                counts.append(tell(case, failures, remarks))
+    failed = sum(c == "failed" for c in counts)
+    remarked = sum(c == "remarked" for c in counts)
+    print(f"{len(counts)} cases, {failed} failed, {remarked} with remarks only")
     sys.exit(1 if failed else 0)
+
+
+def tell(case, failures, remarks):
+    """Prints a case's failures and remarks; returns its outcome."""
+    for line in [f"FAIL {x}" for x in failures] + [f"remark: {x}" for x in remarks]:
+        print(f"{case}: {line}", flush=True)
+    return "failed" if failures else "remarked" if remarks else "passed"
 
 
 if __name__ == "__main__":

@@ -53,6 +53,6 @@ MESHTRIM="$PWD/target/release/meshtrim" .venv-test/bin/python -m pytest -q -rsx 
 # A short seeded fuzzing pass of the CLI (about 40 s): no mutated input may
 # make it panic, die by a signal or hang.
 .venv-test/bin/python scripts/fuzz_cli.py --seed 2026 --cases 150 --timeout 60
-# A short soak of the commands on samplings no test uses (about 15 s):
-# every output valid by PyMeshLab.
+# A short soak of the commands on samplings and crops of real scans no
+# test uses (about 25 s): every output valid by PyMeshLab.
 .venv-test/bin/python scripts/soak.py --first-seed 2026 --seeds 2

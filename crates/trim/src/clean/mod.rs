@@ -401,6 +401,7 @@ fn replace_left_by_strips(cx: &Context, outcomes: &mut Vec<Outcome>) {
         .iter()
         .flat_map(|o| o.left.iter().flat_map(|x| x.loops.iter().copied()))
         .collect();
+
     let far_reaching: BTreeSet<usize> = outcomes
         .iter()
         .filter_map(|o| o.patch.as_ref().filter(|p| p.reaches_far))
@@ -462,9 +463,9 @@ fn strip_in_place_of_planar(
 ) -> StripOutcome {
     let mut taken_out: Vec<(usize, Patch, Vec<u32>)> = Vec::new();
     let own_far_patch = outcomes.iter().position(|o| {
-        o.patch
-            .as_ref()
-            .is_some_and(|p| p.reaches_far && p.loops.contains(&l))
+        o.patch.as_ref().is_some_and(|p| {
+            p.reaches_far && p.loops.contains(&l) && !holds_longer_loop(cx, p, l)
+        })
     });
     if let Some(o) = own_far_patch {
         if let Some(patch) = outcomes[o].patch.take() {
@@ -493,7 +494,10 @@ fn strip_in_place_of_planar(
             .copied()
             .filter(|&o| !outcomes[o].strip)
             .collect();
-        if planar.is_empty() || planar.len() < conflict.len() {
+        let outranked = planar
+            .iter()
+            .any(|&o| outcomes[o].patch.as_ref().is_some_and(|p| holds_longer_loop(cx, p, l)));
+        if planar.is_empty() || planar.len() < conflict.len() || outranked {
             break match strip {
                 Err(failure) => StripOutcome::Left(failure.reason()),
                 Ok(_) if !conflict.is_empty() => StripOutcome::Left(LeftReason::MeetsAnotherBorder),
@@ -525,6 +529,16 @@ fn strip_in_place_of_planar(
             other
         }
     }
+}
+
+/// Whether `patch` replaces a border longer (in vertices) than loop `l`:
+/// a strip takes the place of a planar patch only for a border at least
+/// as long as any the patch replaces, since the planar patch's borders
+/// may find no strip (a hole's strip would otherwise trade an outer
+/// border's planar patch for itself).
+fn holds_longer_loop(cx: &Context, patch: &Patch, l: usize) -> bool {
+    let length = cx.borders[l].len();
+    patch.loops.iter().any(|&k| cx.borders[k].len() > length)
 }
 
 /// The outcomes' lists of loops left, once the strips are in: replaced
