@@ -463,9 +463,9 @@ fn strip_in_place_of_planar(
 ) -> StripOutcome {
     let mut taken_out: Vec<(usize, Patch, Vec<u32>)> = Vec::new();
     let own_far_patch = outcomes.iter().position(|o| {
-        o.patch.as_ref().is_some_and(|p| {
-            p.reaches_far && p.loops.contains(&l) && !holds_longer_loop(cx, p, l)
-        })
+        o.patch
+            .as_ref()
+            .is_some_and(|p| p.reaches_far && p.loops.contains(&l) && !holds_longer_loop(cx, p, l))
     });
     if let Some(o) = own_far_patch {
         if let Some(patch) = outcomes[o].patch.take() {
@@ -494,9 +494,12 @@ fn strip_in_place_of_planar(
             .copied()
             .filter(|&o| !outcomes[o].strip)
             .collect();
-        let outranked = planar
-            .iter()
-            .any(|&o| outcomes[o].patch.as_ref().is_some_and(|p| holds_longer_loop(cx, p, l)));
+        let outranked = planar.iter().any(|&o| {
+            outcomes[o]
+                .patch
+                .as_ref()
+                .is_some_and(|p| holds_longer_loop(cx, p, l))
+        });
         if planar.is_empty() || planar.len() < conflict.len() || outranked {
             break match strip {
                 Err(failure) => StripOutcome::Left(failure.reason()),
