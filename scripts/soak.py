@@ -48,7 +48,7 @@ import numpy as np  # noqa: E402
 import poisson  # noqa: E402
 import pytest  # noqa: E402
 import synthetic  # noqa: E402
-from meshtrim_cli import shared_data  # noqa: E402
+from meshtrim_cli import REAL_MESHES, shared_data  # noqa: E402
 
 EXE = os.path.join(ROOT, "target", "release", "meshtrim")
 
@@ -65,16 +65,8 @@ SURFACES = {
 NOT_A_HEIGHT_FIELD = {"wrapped cylinder"}
 # Poisson meshes take a second or two each: the main job on four surfaces.
 TRIMMED = {"blade 4 mm", "blade 8 mm", "notched plate", "curved disc"}
-# The real scans whose crops are soaked, as test_clean_validation.py's.
-SCANS = {
-    "face000": "meshlab_scans/face000.ply",
-    "lato000": "meshlab_scans/lato000.ply",
-    "Laurana50k": "meshlab_scans/Laurana50k.ply",
-    "bun000": "stanford_bunny/bun000.ply",
-    "bun045": "stanford_bunny/bun045.ply",
-    "bun090": "stanford_bunny/bun090.ply",
-    "chin": "stanford_bunny/chin.ply",
-}
+# The real scans whose crops are soaked.
+SCANS = REAL_MESHES
 MANIFOLD_KEYS = ["non_manifold_edges", "non_manifold_vertices"]
 
 

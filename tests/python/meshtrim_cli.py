@@ -13,6 +13,18 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent.parent
 MESHTRIM = Path(os.environ.get("MESHTRIM", ROOT / "target" / "release" / "meshtrim"))
 
+# The real scans that are meshes (range maps, range grids, a decimated
+# bust), by name: their paths under the shared data.
+REAL_MESHES = {
+    "face000": "meshlab_scans/face000.ply",
+    "lato000": "meshlab_scans/lato000.ply",
+    "Laurana50k": "meshlab_scans/Laurana50k.ply",
+    "bun000": "stanford_bunny/bun000.ply",
+    "bun045": "stanford_bunny/bun045.ply",
+    "bun090": "stanford_bunny/bun090.ply",
+    "chin": "stanford_bunny/chin.ply",
+}
+
 
 def shared_data(rel: str) -> Path:
     """A real scan by its path under the shared data directory: the PCL

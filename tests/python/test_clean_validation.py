@@ -76,7 +76,7 @@ import crops  # noqa: E402
 import jagged  # noqa: E402
 import poisson  # noqa: E402
 import synthetic  # noqa: E402
-from meshtrim_cli import run_meshtrim, shared_data  # noqa: E402
+from meshtrim_cli import REAL_MESHES, run_meshtrim, shared_data  # noqa: E402
 
 CASES = synthetic.VALIDATION_CASES
 
@@ -306,18 +306,10 @@ def test_batch_cleans_a_directory(tmp_path):
 # --------------------------------------------------------------------------
 # Real scans.
 
-REAL = {
-    # name: path. What must be replaced is asserted as requirements below
-    # (every outer border; loops of 8 vertices or more), not as shares of
-    # today's output.
-    "face000": "meshlab_scans/face000.ply",
-    "lato000": "meshlab_scans/lato000.ply",
-    "Laurana50k": "meshlab_scans/Laurana50k.ply",
-    "bun000": "stanford_bunny/bun000.ply",
-    "bun045": "stanford_bunny/bun045.ply",
-    "bun090": "stanford_bunny/bun090.ply",
-    "chin": "stanford_bunny/chin.ply",
-}
+# name: path. What must be replaced is asserted as requirements below
+# (every outer border; loops of 8 vertices or more), not as shares of
+# today's output.
+REAL = REAL_MESHES
 
 OUTER_SHRINK = {
     # name: largest output / input length of the outer border. Measured:
