@@ -19,6 +19,7 @@ use super::topology::Topology;
 use super::{sorted_edges_of, Mesh};
 use crate::geom::UnionFind;
 use crate::hash::HashMap;
+use std::cell::OnceCell;
 
 /// Labels the faces `star` round vertex `v` by fan: each gets the index
 /// (in `star`) of a representative face of its fan.
@@ -57,24 +58,29 @@ pub(crate) fn open_new_pinches(input: &Mesh, cut: &Mesh, keep: &mut [bool]) -> u
         return 0;
     }
     let topology = Topology::new(cut);
-    let input_topology = Topology::new(input);
-    let input_fans = |v: u32| match (v as usize) < input.vertices.len() {
-        true => fan_count(&fan_labels(&input.faces, v, input_topology.faces_of(v))).max(1),
-        false => 1,
-    };
-    let piece_size = kept_piece_sizes(cut, keep);
+    // Built only where a vertex has several kept fans (a trim usually has
+    // none), from `keep` as it is before any face goes.
+    let input_topology = OnceCell::new();
+    let piece_size = OnceCell::new();
     let mut dropped = 0;
     while !suspects.is_empty() {
         let mut gone = Vec::new();
         for &v in &suspects {
-            gone.extend(fans_beyond(
-                cut,
-                &topology,
-                keep,
-                &piece_size,
-                v,
-                input_fans(v),
-            ));
+            let (kept, labels) = kept_fans(cut, &topology, keep, v);
+            if fan_count(&labels) < 2 {
+                continue;
+            }
+            // A vertex the cut made lies inside an input edge: one fan.
+            let allowed = if (v as usize) < input.vertices.len() {
+                let star = input_topology
+                    .get_or_init(|| Topology::new(input))
+                    .faces_of(v);
+                fan_count(&fan_labels(&input.faces, v, star)).max(1)
+            } else {
+                1
+            };
+            let piece_size = piece_size.get_or_init(|| kept_piece_sizes(cut, keep));
+            gone.extend(fans_beyond(&kept, &labels, piece_size, allowed));
         }
         gone.sort_unstable();
         gone.dedup();
@@ -87,6 +93,18 @@ pub(crate) fn open_new_pinches(input: &Mesh, cut: &Mesh, keep: &mut [bool]) -> u
         suspects.dedup();
     }
     dropped
+}
+
+/// The kept faces round `v` and their fan labels ([`fan_labels`]).
+fn kept_fans(mesh: &Mesh, topology: &Topology, keep: &[bool], v: u32) -> (Vec<u32>, Vec<u32>) {
+    let kept: Vec<u32> = topology
+        .faces_of(v)
+        .iter()
+        .copied()
+        .filter(|&k| keep[k as usize])
+        .collect();
+    let labels = fan_labels(&mesh.faces, v, &kept);
+    (kept, labels)
 }
 
 /// For each face, the number of kept faces in its piece (kept faces
@@ -135,22 +153,13 @@ fn kept_border_vertices(mesh: &Mesh, keep: &[bool]) -> Vec<u32> {
     border
 }
 
-/// The kept faces round `v` in fans beyond the `allowed` number: those of
-/// the smaller pieces, then the smaller fans.
-fn fans_beyond(
-    mesh: &Mesh,
-    topology: &Topology,
-    keep: &[bool],
-    piece_size: &[usize],
-    v: u32,
-    allowed: usize,
-) -> Vec<u32> {
-    let star = topology.faces_of(v);
-    let kept: Vec<u32> = star.iter().copied().filter(|&k| keep[k as usize]).collect();
-    let labels = fan_labels(&mesh.faces, v, &kept);
+/// The faces `kept` (round one vertex, in fans by `labels`) of the fans
+/// beyond the `allowed` number: those of the smaller pieces, then the
+/// smaller fans.
+fn fans_beyond(kept: &[u32], labels: &[u32], piece_size: &[usize], allowed: usize) -> Vec<u32> {
     // Per fan (by its representative): its piece's size and its own.
     let mut sizes: HashMap<u32, (usize, usize)> = HashMap::default();
-    for (&k, &r) in kept.iter().zip(&labels) {
+    for (&k, &r) in kept.iter().zip(labels) {
         let entry = sizes.entry(r).or_insert((piece_size[k as usize], 0));
         entry.1 += 1;
     }
@@ -163,7 +172,7 @@ fn fans_beyond(
     fans.sort_unstable_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
     let staying: Vec<u32> = fans[..allowed].iter().map(|&(r, _)| r).collect();
     kept.iter()
-        .zip(&labels)
+        .zip(labels)
         .filter(|(_, r)| !staying.contains(r))
         .map(|(&k, _)| k)
         .collect()
