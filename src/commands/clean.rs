@@ -95,6 +95,9 @@ pub struct Report {
     pub zero_area_faces_repaired: usize,
     /// Zero-area faces left where no repair keeps the mesh manifold.
     pub zero_area_faces_left: usize,
+    /// Faces dropped where the new border would pinch the surface at a
+    /// vertex the input did not pinch.
+    pub pinch_faces_dropped: usize,
     /// Input faces removed in the border bands.
     pub faces_removed: usize,
     /// New faces.
@@ -235,6 +238,7 @@ impl Report {
             repeated_faces_dropped: r.repeated_faces_dropped,
             zero_area_faces_repaired: r.repaired.repaired(),
             zero_area_faces_left: r.repaired.left,
+            pinch_faces_dropped: r.pinch_faces_dropped,
             faces_removed: r.faces_removed,
             faces_added: r.faces_added,
             faces_out: r.faces_out,
@@ -325,6 +329,18 @@ impl crate::report::Table for Report {
                     format!(
                         "{} repaired, {} left",
                         self.zero_area_faces_repaired, self.zero_area_faces_left
+                    ),
+                ),
+            );
+        }
+        if self.pinch_faces_dropped > 0 {
+            rows.insert(
+                3,
+                (
+                    "pinches opened",
+                    format!(
+                        "{} faces dropped where the new border met itself at a vertex",
+                        self.pinch_faces_dropped
                     ),
                 ),
             );

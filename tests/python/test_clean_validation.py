@@ -68,6 +68,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy.spatial import cKDTree
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
@@ -374,8 +375,18 @@ def test_scan_valid(scan):
     pm_in, pm = scan["pm_in"], scan["pm_out"]
     assert pm["non_manifold_edges"] == 0, pm
     # Pinched border vertices of the scan itself stay (face000: 6 in, 4
-    # out; bun000: 4 and 4); cleaning adds none.
+    # out; bun000: 4 and 4); cleaning adds none: every pinched vertex of
+    # the output is one of the input's (within float32 rounding: PyMeshLab
+    # reads the ASCII scans in single precision, meshtrim in double).
     assert pm["non_manifold_vertices"] <= pm_in["non_manifold_vertices"], (pm_in, pm)
+    (vi, fi), (v, f) = scan["in"], scan["out"]
+    pinched_in = sorted(crops.pinched_vertices(fi))
+    pinched_out = sorted(crops.pinched_vertices(f))
+    if pinched_out:
+        assert pinched_in, pinched_out
+        gap, _ = cKDTree(vi[pinched_in]).query(v[pinched_out])
+        scale = np.linalg.norm(vi.max(0) - vi.min(0))
+        assert gap.max() <= 1e-6 * scale, (gap, scale)
     assert pm["reoriented"] == 0 and poisson.orientation_consistent(scan["out"][1]), pm
     assert pm["duplicate_vertices"] == 0 and pm["null_faces"] == 0 and pm["duplicate_faces"] == 0, pm
     v, f = scan["out"]
@@ -518,7 +529,7 @@ def test_scan_new_faces_are_rarely_thin(scan):
     several spacings behind the smoothed loop; the strip is refined in its
     unfolded plane, and about a third of what stays thin lies where the
     strip folds and cannot be refined: bun000 15 / 48 of 2547, bun045
-    59 / 83 of 2479, bun090 36 / 88 of 2330, chin 70 / 130 of 2451 (96 /
+    59 / 83 of 2479, bun090 35 / 87 of 2329, chin 70 / 130 of 2451 (96 /
     289, 168 / 332, 116 / 291, 180 / 351 unrefined). Bounds: 4 % below 5,
     8 % below 10."""
     angles = new_face_angles(scan)
@@ -545,7 +556,7 @@ SHORT_OF_THE_FLOOR = {
     # between them has a needle.
     "face000": 0.29,
     "bun045": 0.43,
-    "bun090": 0.30,
+    "bun090": 0.44,
     "chin": 0.36,
 }
 
@@ -606,18 +617,22 @@ def test_fan_boundary_loops_split_pinched_vertices():
 
 
 # Crops of face000 (scripts/soak.py's: crops.crop with the generator
-# seeded [seed, 0]) where a hole's strip once took the place of the planar
-# patch replacing the outer border with its neighbouring holes, and the
-# outer border was then left.
-CROPS_OUTER_BORDER = [100, 106]
+# seeded [seed, 0]) whose outer border was once left: on 100 and 106 a
+# hole's strip took the place of the planar patch replacing the outer
+# border with its neighbouring holes; on 104 and 107 that patch lay on kept
+# faces beside another hole (the projection folds there) and the safety
+# net dropped it whole.
+CROPS_OUTER_BORDER = [100, 104, 106, 107]
 
 
 @pytest.mark.parametrize("seed", CROPS_OUTER_BORDER)
-def test_a_holes_strip_does_not_cost_the_outer_border(tmp_path, seed):
+def test_a_cropped_scan_keeps_its_outer_border_replaced(tmp_path, seed):
     """The outer border of a cropped range map is replaced: a strip takes
     the place of a planar patch only for a border at least as long as the
-    patch's. Measured before the rule: the outer border (2,545 and 1,780
-    vertices) left on both."""
+    patch's, and a planar group whose patch breaks the manifold is
+    replaced again without the loops where it breaks. Measured before:
+    the outer border (2,545, 2,505, 1,780 and 1,390 vertices) left on all
+    four."""
     v0, f0 = poisson.load_mesh(shared_data(REAL["face000"]))
     _, (v, f) = crops.crop(v0, f0, np.random.default_rng([seed, 0]))
     src, out, report_path = tmp_path / "crop.ply", tmp_path / "clean.ply", tmp_path / "report.json"

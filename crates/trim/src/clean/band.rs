@@ -59,7 +59,14 @@ impl Band {
     /// The patch replacing the group's loops, or why not: the smoothed
     /// loops in the band's projection (steps 2 and 3), what goes (step 4)
     /// and the gap filled (step 5).
-    pub(super) fn replace(&self, cx: &Context, group: &[usize]) -> Result<Patch, Retry> {
+    /// With `check`, a patch that would break the manifold by itself
+    /// ([`where_patch_breaks`]) is refused, its loops there left.
+    pub(super) fn replace(
+        &self,
+        cx: &Context,
+        group: &[usize],
+        check: bool,
+    ) -> Result<Patch, Retry> {
         let mesh = cx.mesh;
         let projection = Projection::of(cx, &self.faces);
         let mut rings = projected_rings(cx, group, &projection);
@@ -79,7 +86,7 @@ impl Band {
             rings,
             stay,
         };
-        self.fill_gap(cx, &gap, removed)
+        self.fill_gap(cx, &gap, removed, check)
     }
 
     /// Whether each vertex of the band's faces stays: it lies on the
@@ -173,6 +180,7 @@ impl Band {
         cx: &Context,
         gap: &Gap,
         mut removed: Vec<u32>,
+        check: bool,
     ) -> Result<Patch, Retry> {
         for _ in 0..=WALL_REPAIRS {
             let at_rim = self.loops_reaching_rim(cx.mesh, &removed);
@@ -183,7 +191,23 @@ impl Band {
                 Ok(mut patch) => {
                     patch.reaches_far = removes_far_vertices(cx, &gap.rings, &removed);
                     patch.removed = removed;
-                    return Ok(patch);
+                    let breaks = if check {
+                        where_patch_breaks(cx, &patch)
+                    } else {
+                        Vec::new()
+                    };
+                    if breaks.is_empty() {
+                        return Ok(patch);
+                    }
+                    let culprits: BTreeSet<usize> = breaks
+                        .iter()
+                        .filter_map(|v| self.rings_from_border.get(v))
+                        .map(|&(_, origin)| origin)
+                        .collect();
+                    return Err(leave(
+                        LeftReason::NonManifold,
+                        culprits.into_iter().collect(),
+                    ));
                 }
                 Err(Blocked::Walls(vertices)) => {
                     let before = removed.len();
@@ -377,6 +401,41 @@ pub(super) fn untwist_failure(tangle: Tangle, rings: &[Ring]) -> Retry {
             leave(LeftReason::CrossesAnotherLoop, vec![smaller])
         }
     }
+}
+
+/// The mesh vertices where `patch`, applied alone, would make an edge
+/// non-manifold: ends of its new edges that kept faces already cover (run
+/// the same way by a kept face, or shared by two). This happens where the
+/// band's projection folds: a hole's border beside the group bounds no
+/// wall where its vertices stay, so the parity of the gap's fill leaks
+/// past a wall onto the kept side.
+pub(super) fn where_patch_breaks(cx: &Context, patch: &Patch) -> Vec<u32> {
+    let n = cx.mesh.vertices.len() as u32;
+    let removed: HashSet<u32> = patch.removed.iter().copied().collect();
+    let mut breaks = BTreeSet::new();
+    for face in &patch.faces {
+        for k in 0..3 {
+            let (a, b) = (face[k], face[(k + 1) % 3]);
+            if a >= n || b >= n {
+                continue;
+            }
+            let kept: Vec<[u32; 3]> = cx
+                .topology
+                .faces_of(a)
+                .iter()
+                .filter(|f| !removed.contains(f))
+                .map(|&f| cx.mesh.faces[f as usize])
+                .filter(|g| g.contains(&b))
+                .collect();
+            let same_way = kept
+                .iter()
+                .any(|g| (0..3).any(|j| g[j] == a && g[(j + 1) % 3] == b));
+            if same_way || kept.len() > 1 {
+                breaks.insert(a);
+            }
+        }
+    }
+    breaks.into_iter().collect()
 }
 
 /// Whether the faces `removed` take away more than [`MAX_FAR_REMOVED`]

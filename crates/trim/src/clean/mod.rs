@@ -87,6 +87,7 @@ use crate::error::{CleanError, MeshError};
 use crate::frame::fit_plane;
 use crate::geom::{add, cross, dist2, dot, norm2, sub, Point3};
 use crate::geom::{median, orient, orientation};
+use crate::mesh::pinches::open_new_pinches;
 use crate::mesh::repair::{repair_degenerate_faces, FaceRepair};
 use crate::mesh::topology::{check_manifold, Topology};
 use crate::mesh::{lowest_first, Mesh};
@@ -283,6 +284,10 @@ pub struct CleanReport {
     /// Zero-area faces of the output repaired (those the input had
     /// inside, away from the border); none is written.
     pub repaired: FaceRepair,
+    /// Faces dropped where the new border would pinch the surface at a
+    /// vertex the input did not pinch (it runs through a neck one vertex
+    /// wide): the faces of the smaller piece's fan there.
+    pub pinch_faces_dropped: usize,
 }
 
 /// Replaces the jagged border of `mesh` by its smoothed boundary (see the
@@ -315,7 +320,7 @@ pub fn clean_mesh(
         .flatten();
     let mut outcomes = replace_bands(mesh, beta, &borders, &rings, view);
     let out = assemble_manifold(mesh, &mut outcomes);
-    let (out, mut report) = finish(out, &outcomes, report)?;
+    let (out, mut report) = finish(mesh, out, &outcomes, report)?;
     // Small loops a strip absorbed count as replaced.
     let replaced = replaced_loops(borders.len(), &outcomes);
     report.loops_smoothed = replaced.iter().filter(|&&r| r).count();
@@ -387,7 +392,40 @@ fn replace_bands(
     };
     let mut outcomes = replace_all(&context);
     replace_left_by_strips(&context, &mut outcomes);
+    if replace_breaking_groups_again(&context, &mut outcomes) {
+        replace_left_by_strips(&context, &mut outcomes);
+    }
     outcomes
+}
+
+/// Planar groups whose patches make an edge non-manifold once every patch
+/// is in, replaced again with each patch checked by itself
+/// ([`band::where_patch_breaks`]): the loops where it breaks are left (to
+/// strips, tried again for them) and the others tried again without them,
+/// rather than the whole group dropped by the safety net of
+/// [`assemble_manifold`]. Only such groups: a patch may lie on faces that
+/// another patch removes, which the check by itself cannot see. Returns
+/// whether any group was replaced again.
+fn replace_breaking_groups_again(cx: &Context, outcomes: &mut [Outcome]) -> bool {
+    let mut done = BTreeSet::new();
+    loop {
+        let (out, origin) = assemble(cx.mesh, outcomes);
+        let again: Vec<usize> = patches_breaking_manifold(&out, &origin)
+            .into_iter()
+            .filter(|&g| !outcomes[g].strip && done.insert(g))
+            .collect();
+        if again.is_empty() {
+            return !done.is_empty();
+        }
+        for g in again {
+            let Some(patch) = outcomes[g].patch.take() else {
+                continue;
+            };
+            let mut checked = replace_group(cx, &patch.loops, true);
+            checked.left.splice(0..0, outcomes[g].left.drain(..));
+            outcomes[g] = checked;
+        }
+    }
 }
 
 /// The loops the planar way left, replaced by strips (see [`strip`]).
@@ -610,8 +648,9 @@ fn conflicting_outcomes(outcomes: &[Outcome], strip: &Strip) -> Vec<usize> {
 }
 
 /// The input with every patch applied. A safety net: a patch whose faces
-/// would make an edge non-manifold (not seen on the test data) is
-/// dropped, its loops left, and the rest is assembled again.
+/// would make an edge non-manifold (not seen on the test data once each
+/// group's patch is checked by itself) is dropped, its loops left, and the
+/// rest is assembled again.
 fn assemble_manifold(mesh: &Mesh, outcomes: &mut [Outcome]) -> Mesh {
     loop {
         let (out, origin) = assemble(mesh, outcomes);
@@ -632,13 +671,18 @@ fn assemble_manifold(mesh: &Mesh, outcomes: &mut [Outcome]) -> Mesh {
 }
 
 /// Step 6 and the output's part of the report: what the patches did,
-/// unused vertices removed, the result checked, its faces and area.
+/// the pinches they made opened, unused vertices removed, the result
+/// checked, its faces and area.
 fn finish(
+    input: &Mesh,
     mut out: Mesh,
     outcomes: &[Outcome],
     mut report: CleanReport,
 ) -> Result<(Mesh, CleanReport), CleanError> {
     summarise(outcomes, &out, &mut report);
+    let mut keep = vec![true; out.faces.len()];
+    report.pinch_faces_dropped = open_new_pinches(input, &out, &mut keep);
+    out.retain_faces(&keep);
     report.repaired = repair_degenerate_faces(&mut out);
     out.remove_unused_vertices();
     check_manifold(&out)?;
@@ -696,14 +740,17 @@ fn replace_all(cx: &Context) -> Vec<Outcome> {
         .filter(|&l| cx.rings[l].is_some())
         .map(|l| vec![l])
         .collect();
-    let mut outcomes: Vec<Outcome> = groups.par_iter().map(|g| replace_group(cx, g)).collect();
+    let mut outcomes: Vec<Outcome> = groups
+        .par_iter()
+        .map(|g| replace_group(cx, g, false))
+        .collect();
     // Only the merged group is replaced again: the others do not change.
     while let Some((a, b)) = first_overlap(&outcomes) {
         let taken = groups.remove(b);
         outcomes.remove(b);
         groups[a].extend(taken);
         groups[a].sort_unstable();
-        outcomes[a] = replace_group(cx, &groups[a]);
+        outcomes[a] = replace_group(cx, &groups[a], false);
     }
     outcomes
 }
@@ -726,15 +773,16 @@ fn first_overlap(outcomes: &[Outcome]) -> Option<(usize, usize)> {
 /// its rim. A loop that cannot be replaced (its band folds, its smoothed
 /// loop crosses itself or the kept mesh) is left as it is and the others
 /// are tried again without it, so one bad border does not spoil its
-/// neighbours.
-fn replace_group(cx: &Context, group: &[usize]) -> Outcome {
+/// neighbours. With `check`, a patch that would break the manifold by
+/// itself is such a failure too.
+fn replace_group(cx: &Context, group: &[usize], check: bool) -> Outcome {
     let mut active = group.to_vec();
     let mut left = Vec::new();
     'attempt: while !active.is_empty() {
         let mut depth = FIRST_DEPTH;
         loop {
             let band = Band::around(cx, &active, depth);
-            let failure = match band.replace(cx, &active) {
+            let failure = match band.replace(cx, &active, check) {
                 Ok(mut patch) => {
                     patch.loops = active;
                     return Outcome {
