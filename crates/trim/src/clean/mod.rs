@@ -318,8 +318,7 @@ pub fn clean_mesh(
     let view = (report.area_facing_one_way >= SEEN_FROM_ONE_SIDE)
         .then(|| mesh.mean_normal())
         .flatten();
-    let mut outcomes = replace_bands(mesh, beta, &borders, &rings, view);
-    let out = assemble_manifold(mesh, &mut outcomes);
+    let (outcomes, out) = replace_bands(mesh, beta, &borders, &rings, view);
     let (out, mut report) = finish(mesh, out, &outcomes, report)?;
     // Small loops a strip absorbed count as replaced.
     let replaced = replaced_loops(borders.len(), &outcomes);
@@ -372,14 +371,15 @@ fn smoothed_loops(
 }
 
 /// Steps 3 to 5 for every smoothed loop: its band, what goes and the new
-/// faces, one outcome per group of loops whose bands overlap.
+/// faces, one outcome per group of loops whose bands overlap, and the mesh
+/// with every patch applied.
 fn replace_bands(
     mesh: &Mesh,
     beta: &[f64],
     borders: &[Vec<u32>],
     rings: &[Option<Ring>],
     view: Option<Point3>,
-) -> Vec<Outcome> {
+) -> (Vec<Outcome>, Mesh) {
     let topology = Topology::new(mesh);
     let context = Context {
         mesh,
@@ -392,40 +392,8 @@ fn replace_bands(
     };
     let mut outcomes = replace_all(&context);
     replace_left_by_strips(&context, &mut outcomes);
-    if replace_breaking_groups_again(&context, &mut outcomes) {
-        replace_left_by_strips(&context, &mut outcomes);
-    }
-    outcomes
-}
-
-/// Planar groups whose patches make an edge non-manifold once every patch
-/// is in, replaced again with each patch checked by itself
-/// ([`band::where_patch_breaks`]): the loops where it breaks are left (to
-/// strips, tried again for them) and the others tried again without them,
-/// rather than the whole group dropped by the safety net of
-/// [`assemble_manifold`]. Only such groups: a patch may lie on faces that
-/// another patch removes, which the check by itself cannot see. Returns
-/// whether any group was replaced again.
-fn replace_breaking_groups_again(cx: &Context, outcomes: &mut [Outcome]) -> bool {
-    let mut done = BTreeSet::new();
-    loop {
-        let (out, origin) = assemble(cx.mesh, outcomes);
-        let again: Vec<usize> = patches_breaking_manifold(&out, &origin)
-            .into_iter()
-            .filter(|&g| !outcomes[g].strip && done.insert(g))
-            .collect();
-        if again.is_empty() {
-            return !done.is_empty();
-        }
-        for g in again {
-            let Some(patch) = outcomes[g].patch.take() else {
-                continue;
-            };
-            let mut checked = replace_group(cx, &patch.loops, true);
-            checked.left.splice(0..0, outcomes[g].left.drain(..));
-            outcomes[g] = checked;
-        }
-    }
+    let out = assemble_manifold(&context, &mut outcomes);
+    (outcomes, out)
 }
 
 /// The loops the planar way left, replaced by strips (see [`strip`]).
@@ -647,16 +615,37 @@ fn conflicting_outcomes(outcomes: &[Outcome], strip: &Strip) -> Vec<usize> {
         .collect()
 }
 
-/// The input with every patch applied. A safety net: a patch whose faces
-/// would make an edge non-manifold (not seen on the test data once each
-/// group's patch is checked by itself) is dropped, its loops left, and the
-/// rest is assembled again.
-fn assemble_manifold(mesh: &Mesh, outcomes: &mut [Outcome]) -> Mesh {
+/// The input with every patch applied. A planar group whose
+/// patch makes an edge non-manifold once every patch is in is replaced
+/// again with each patch checked by itself ([`band::where_patch_breaks`]):
+/// the loops where it breaks are left, the others tried again without
+/// them, and strips are tried again for the loops left. Only such groups:
+/// a patch may lie on faces another patch removes, which the check by
+/// itself cannot see. A safety net last: a patch that still breaks an edge
+/// (not seen on the test data) is dropped, its loops left.
+fn assemble_manifold(cx: &Context, outcomes: &mut Vec<Outcome>) -> Mesh {
+    let mut remade = BTreeSet::new();
     loop {
-        let (out, origin) = assemble(mesh, outcomes);
+        let (out, origin) = assemble(cx.mesh, outcomes);
         let bad = patches_breaking_manifold(&out, &origin);
         if bad.is_empty() {
             return out;
+        }
+        let again: Vec<usize> = bad
+            .iter()
+            .copied()
+            .filter(|&g| !outcomes[g].strip && remade.insert(g))
+            .collect();
+        for &g in &again {
+            if let Some(patch) = outcomes[g].patch.take() {
+                let mut checked = replace_group(cx, &patch.loops, true);
+                checked.left.splice(0..0, outcomes[g].left.drain(..));
+                outcomes[g] = checked;
+            }
+        }
+        if !again.is_empty() {
+            replace_left_by_strips(cx, outcomes);
+            continue;
         }
         for g in bad {
             if let Some(patch) = outcomes[g].patch.take() {
