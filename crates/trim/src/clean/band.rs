@@ -427,9 +427,7 @@ pub(super) fn where_patch_breaks(cx: &Context, patch: &Patch) -> Vec<u32> {
                 .map(|&f| cx.mesh.faces[f as usize])
                 .filter(|g| g.contains(&b))
                 .collect();
-            let same_way = kept
-                .iter()
-                .any(|g| (0..3).any(|j| g[j] == a && g[(j + 1) % 3] == b));
+            let same_way = kept.iter().any(|&g| runs(g, a, b));
             if same_way || kept.len() > 1 {
                 breaks.insert(a);
             }

@@ -650,7 +650,7 @@ fn wall_edges(cx: &Context, removed: &[u32]) -> Vec<(u32, u32)> {
 }
 
 /// Whether `face` runs the edge from `a` to `b`.
-fn runs(face: [u32; 3], a: u32, b: u32) -> bool {
+pub(super) fn runs(face: [u32; 3], a: u32, b: u32) -> bool {
     (0..3).any(|k| face[k] == a && face[(k + 1) % 3] == b)
 }
 
