@@ -555,9 +555,9 @@ SHORT_OF_THE_FLOOR = {
     # silhouette, run within a fraction of a spacing, the strip or patch
     # between them has a needle.
     "face000": 0.29,
-    "bun045": 0.43,
+    "bun045": 0.23,
     "bun090": 0.44,
-    "chin": 0.36,
+    "chin": 0.95,
 }
 
 
@@ -616,33 +616,79 @@ def test_fan_boundary_loops_split_pinched_vertices():
     assert poisson.pymeshlab_validity(v, np.array([[0, 1, 4], [0, 1, 2]]))["null_faces"] == 1
 
 
-# Crops of face000 (scripts/soak.py's: crops.crop with the generator
-# seeded [seed, 0]) whose outer border was once left: on 100 and 106 a
-# hole's strip took the place of the planar patch replacing the outer
-# border with its neighbouring holes; on 104 and 107 that patch lay on kept
-# faces beside another hole (the projection folds there) and the safety
-# net dropped it whole.
-CROPS_OUTER_BORDER = [100, 104, 106, 107]
+# Crops (scripts/soak.py's: crops.crop with the generator seeded
+# [seed, the scan's place in REAL_MESHES]) whose outer border was once left.
+# face000 100 and 106: a hole's strip took the place of the planar patch
+# replacing the outer border with its neighbouring holes; face000 104 and
+# 107: that patch lay on kept faces beside another hole (the projection
+# folds there) and the safety net dropped it whole; face000 127, Laurana50k
+# 123, bun000 107 (the strip's wall "does not close") and face000 102, chin
+# 111 ("doubles back"): the wall's vertices, placed along the smoothed loop
+# by following the nearest segment, lost it where the crop's cut runs
+# across a bay of the loop.
+CROPS_OUTER_BORDER = [
+    ("face000", 100),
+    ("face000", 104),
+    ("face000", 106),
+    ("face000", 107),
+    ("face000", 102),
+    ("face000", 127),
+    ("Laurana50k", 123),
+    ("bun000", 107),
+    ("chin", 111),
+]
 
 
-@pytest.mark.parametrize("seed", CROPS_OUTER_BORDER)
-def test_a_cropped_scan_keeps_its_outer_border_replaced(tmp_path, seed):
-    """The outer border of a cropped range map is replaced: a strip takes
-    the place of a planar patch only for a border at least as long as the
-    patch's, and a planar group whose patch breaks the manifold is
-    replaced again without the loops where it breaks. Measured before:
-    the outer border (2,545, 2,505, 1,780 and 1,390 vertices) left on all
-    four."""
-    v0, f0 = poisson.load_mesh(shared_data(REAL["face000"]))
-    _, (v, f) = crops.crop(v0, f0, np.random.default_rng([seed, 0]))
+def cropped_scan(name, seed):
+    """soak.py's crop ``seed`` of the real scan ``name``."""
+    v0, f0 = poisson.load_mesh(shared_data(REAL[name]))
+    _, (v, f) = crops.crop(v0, f0, np.random.default_rng([seed, list(REAL).index(name)]))
+    return v, f
+
+
+@pytest.mark.parametrize("name,seed", CROPS_OUTER_BORDER)
+def test_a_cropped_scan_keeps_its_outer_border_replaced(tmp_path, name, seed):
+    """The outer border of a cropped scan is replaced: a strip takes the
+    place of a planar patch only for a border at least as long as the
+    patch's, a planar group whose patch breaks the manifold is replaced
+    again without the loops where it breaks, and the wall is aligned with
+    the smoothed loop as a whole. Measured before: every one of these
+    outer borders (458 to 2,545 vertices) left."""
+    v, f = cropped_scan(name, seed)
     src, out, report_path = tmp_path / "crop.ply", tmp_path / "clean.ply", tmp_path / "report.json"
     synthetic.write_mesh_ply(src, v, f, double=True)
     run_meshtrim("clean", src, out, "--report", report_path)
     report = json.loads(report_path.read_text())
     longest_in = max(len(lp) for lp in poisson.fan_boundary_loops(f))
     left = [n for x in report["loops_left"] for n in x["vertices"]]
-    assert longest_in > 1000, longest_in
+    assert longest_in > 400, longest_in
     assert all(n < 100 for n in left), (longest_in, left)
     pm_in, pm = poisson.pymeshlab_validity(v, f), poisson.pymeshlab_validity(*poisson.load_mesh(out))
     assert pm["non_manifold_edges"] == 0 and pm["reoriented"] == 0, pm
     assert pm["non_manifold_vertices"] <= pm_in["non_manifold_vertices"], (pm_in, pm)
+
+
+# Punched crops whose holes lie a few faces from the outer border: the
+# outer border's strip goes round them, and their own patches, which would
+# touch the strip's faces, were left ("its new faces would reach those of
+# another border": 27 and 20 vertices on bun000 114, 28 and 32 on chin 118,
+# 50 and 42 on Laurana50k 101).
+CROPS_HOLES_BESIDE_THE_STRIP = [("bun000", 114), ("chin", 118), ("Laurana50k", 101)]
+
+
+@pytest.mark.parametrize("name,seed", CROPS_HOLES_BESIDE_THE_STRIP)
+def test_holes_beside_a_strip_are_replaced_once_it_is_in(tmp_path, name, seed):
+    """A loop blocked by another border's new faces is tried again on the
+    mesh with those faces in: no loop of 8 or more vertices is left, and
+    the output is valid."""
+    v, f = cropped_scan(name, seed)
+    src, out, report_path = tmp_path / "crop.ply", tmp_path / "clean.ply", tmp_path / "report.json"
+    synthetic.write_mesh_ply(src, v, f, double=True)
+    run_meshtrim("clean", src, out, "--report", report_path)
+    report = json.loads(report_path.read_text())
+    left = [(n, x["reason"]) for x in report["loops_left"] for n in x["vertices"] if n >= 8]
+    assert not left, left
+    pm_in, pm = poisson.pymeshlab_validity(v, f), poisson.pymeshlab_validity(*poisson.load_mesh(out))
+    assert pm["non_manifold_edges"] == 0 and pm["reoriented"] == 0, pm
+    assert pm["non_manifold_vertices"] <= pm_in["non_manifold_vertices"], (pm_in, pm)
+    assert pm["null_faces"] == 0 and pm["duplicate_faces"] == 0, pm

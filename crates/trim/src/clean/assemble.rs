@@ -50,22 +50,26 @@ pub(super) fn patches_breaking_manifold(mesh: &Mesh, origin: &[Option<usize>]) -
     bad
 }
 
-/// Counts what the applied patches did.
-pub(super) fn summarise(outcomes: &[Outcome], out: &Mesh, report: &mut CleanReport) {
-    let mut min_angle = f64::INFINITY;
-    for outcome in outcomes {
-        report.loops_left.extend(outcome.left.iter().cloned());
-        if let Some(patch) = &outcome.patch {
-            report.loops_smoothed += patch.loops.len();
-            report.faces_removed += patch.removed.len();
-            report.faces_added += patch.faces.len();
-            report.vertices_added += patch.vertices.len();
-        }
-    }
-    let new_faces = &out.faces[out.faces.len() - report.faces_added..];
-    for &face in new_faces {
-        min_angle = min_angle.min(smallest_angle(&out.vertices, face));
-    }
+/// Counts what the applied patches did: the loops left, and the new faces
+/// and vertices (those of the output that are not the input's).
+pub(super) fn summarise(input: &Mesh, replaced: &Replaced, report: &mut CleanReport) {
+    let out = &replaced.mesh;
+    report.loops_left.extend(replaced.left.iter().cloned());
+    let new_faces = &out.faces[replaced.kept_input_faces..];
+    report.faces_removed = input.faces.len() - replaced.kept_input_faces;
+    report.faces_added = new_faces.len();
+    let n = input.vertices.len() as u32;
+    let new_vertices: BTreeSet<u32> = new_faces
+        .iter()
+        .flatten()
+        .copied()
+        .filter(|&v| v >= n)
+        .collect();
+    report.vertices_added = new_vertices.len();
+    let min_angle = new_faces
+        .iter()
+        .map(|&face| smallest_angle(&out.vertices, face))
+        .fold(f64::INFINITY, f64::min);
     report.min_angle_new = if min_angle.is_finite() {
         min_angle
     } else {

@@ -56,17 +56,23 @@
 //! rings) is left unchanged and reported, and the other loops of its band
 //! are tried again without it. A patch whose faces would meet others at a
 //! non-manifold or same-direction edge is dropped the same way, so the
-//! output is never a broken mesh.
+//! output is never a broken mesh. A loop left only because its new faces
+//! would touch another border's is tried again on the mesh with that
+//! border's faces in ([`rounds`]).
 
+mod align;
 mod assemble;
 mod band;
 mod gap;
+mod rounds;
 mod strip;
 mod unfold;
 
+use align::place_along;
 use assemble::*;
 use band::*;
 use gap::*;
+use rounds::{replace_in_rounds, Replaced};
 use strip::*;
 use unfold::refine_strip;
 
@@ -305,7 +311,7 @@ pub fn clean_mesh(
     check_cleanable(mesh, beta)?;
     let borders = mesh.boundary_loops();
     let rings = smoothed_loops(mesh, beta, &borders, options);
-    let report = CleanReport {
+    let mut report = CleanReport {
         loops_in: borders.len(),
         faces_in,
         slivers_dropped: dropped.slivers,
@@ -318,14 +324,13 @@ pub fn clean_mesh(
     let view = (report.area_facing_one_way >= SEEN_FROM_ONE_SIDE)
         .then(|| mesh.mean_normal())
         .flatten();
-    let (outcomes, out) = replace_bands(mesh, beta, &borders, &rings, view);
-    let (out, mut report) = finish(mesh, out, &outcomes, report)?;
+    let replaced = replace_in_rounds(mesh, beta, &borders, &rings, view);
     // Small loops a strip absorbed count as replaced.
-    let replaced = replaced_loops(borders.len(), &outcomes);
-    report.loops_smoothed = replaced.iter().filter(|&&r| r).count();
+    report.loops_smoothed = replaced.replaced.iter().filter(|&&r| r).count();
     report.loops_too_small = (0..borders.len())
-        .filter(|&l| rings[l].is_none() && !replaced[l])
+        .filter(|&l| rings[l].is_none() && !replaced.replaced[l])
         .count();
+    let (out, mut report) = finish(mesh, replaced, report)?;
     for left in &mut report.loops_left {
         left.vertices = left.loops.iter().map(|&l| borders[l].len()).collect();
     }
@@ -379,6 +384,7 @@ fn replace_bands(
     borders: &[Vec<u32>],
     rings: &[Option<Ring>],
     view: Option<Point3>,
+    beta_median: f64,
 ) -> (Vec<Outcome>, Mesh) {
     let topology = Topology::new(mesh);
     let context = Context {
@@ -387,7 +393,7 @@ fn replace_bands(
         borders,
         rings,
         topology: &topology,
-        beta_median: median(beta),
+        beta_median,
         view,
     };
     let mut outcomes = replace_all(&context);
@@ -664,11 +670,11 @@ fn assemble_manifold(cx: &Context, outcomes: &mut Vec<Outcome>) -> Mesh {
 /// checked, its faces and area.
 fn finish(
     input: &Mesh,
-    mut out: Mesh,
-    outcomes: &[Outcome],
+    replaced: Replaced,
     mut report: CleanReport,
 ) -> Result<(Mesh, CleanReport), CleanError> {
-    summarise(outcomes, &out, &mut report);
+    summarise(input, &replaced, &mut report);
+    let mut out = replaced.mesh;
     let mut keep = vec![true; out.faces.len()];
     report.pinch_faces_dropped = open_new_pinches(input, &out, &mut keep);
     out.retain_faces(&keep);

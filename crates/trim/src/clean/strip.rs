@@ -33,9 +33,10 @@
 //!    itself (the cut pinches there) loses its faces too; kept islands the
 //!    cut surrounds go.
 //! 4. **The strip.** The wall's vertices are placed along the smoothed
-//!    loop by the arc length of their nearest point (tracked from vertex to
-//!    vertex, so that a neck of the surface cannot make it jump), and the
-//!    two polylines are zipped in that order: each new face joins one
+//!    loop in order, each on the segment that makes the sum of squared
+//!    distances least ([`place_along`]: a wall cutting across a bay of the
+//!    loop skips it, and a neck of the surface draws no vertex across), and
+//!    the two polylines are zipped in that order: each new face joins one
 //!    segment of either polyline to a vertex of the other. Every corner is
 //!    a mesh vertex or a smoothed loop vertex, so the strip follows the
 //!    surface without any lifting, and its faces turn as the kept faces
@@ -64,11 +65,6 @@ const DEPTH_SIGMA: f64 = 3.0;
 /// The Gaussian's window, in σ on either side.
 const DEPTH_WINDOW: f64 = 2.0;
 
-/// Segments of the smoothed loop searched, ahead of the last wall vertex's
-/// nearest one, for the next wall vertex's nearest point …
-const TRACK_AHEAD: usize = 48;
-/// … and behind it.
-const TRACK_BEHIND: usize = 4;
 /// Borders one strip may absorb because they lie one face from others it
 /// absorbs.
 const MAX_ABSORBED: usize = 64;
@@ -230,26 +226,6 @@ impl Guide {
             t: 0.0,
             d2: f64::INFINITY,
         })
-    }
-
-    /// The nearest point among the segments from `around` − [`TRACK_BEHIND`]
-    /// to `around` + [`TRACK_AHEAD`].
-    fn nearest_near(&self, p: Point3, around: usize) -> Nearest {
-        let m = self.len();
-        let mut best = self.on_segment(around, p);
-        for step in 1..=TRACK_AHEAD.min(m) {
-            let near = self.on_segment((around + step) % m, p);
-            if near.d2 < best.d2 {
-                best = near;
-            }
-        }
-        for step in 1..=TRACK_BEHIND.min(m) {
-            let near = self.on_segment((around + m - step) % m, p);
-            if near.d2 < best.d2 {
-                best = near;
-            }
-        }
-        best
     }
 
     /// Whether a vertex at `p` of local resolution `beta` goes: it lies
@@ -773,24 +749,14 @@ fn zip(cx: &Context, guide: &Guide, wall: &[u32]) -> Result<Vec<[u32; 3]>, Strip
     let along = |near: Nearest| {
         guide.arc[near.segment] + near.t * (guide.arc[near.segment + 1] - guide.arc[near.segment])
     };
-    // Wall positions, unwrapped and made non-decreasing from the first.
     let origin = along(start);
-    let mut wall_at = Vec::with_capacity(p + 1);
-    wall_at.push(0.0);
-    let mut segment = start.segment;
-    for &v in &wall[1..] {
-        let near = guide.nearest_near(position(v), segment);
-        segment = near.segment;
-        let raw = (along(near) - origin).rem_euclid(length);
-        let last: f64 = *wall_at.last().unwrap_or(&0.0);
-        let mut step = raw - last.rem_euclid(length);
-        if step > length / 2.0 {
-            step -= length;
-        } else if step < -length / 2.0 {
-            step += length;
-        }
-        wall_at.push((last + step.max(0.0)).min(length));
-    }
+    let wall_points: Vec<Point3> = wall.iter().map(|&v| position(v)).collect();
+    let mut wall_at = place_along(
+        &guide.points,
+        &guide.arc,
+        &wall_points,
+        (start.segment, start.t),
+    );
     let turns = *wall_at.last().unwrap_or(&0.0);
     if turns < length / 2.0 {
         return Err(StripFailure::Wall);

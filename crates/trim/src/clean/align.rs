@@ -1,0 +1,204 @@
+//! Where the wall's vertices lie along the smoothed loop (step 4 of the
+//! strip): each wall vertex gets a segment of the loop, in order, so that
+//! the squared distances from the vertices to their segments sum to the
+//! least (a monotone alignment by dynamic programming, as dynamic time
+//! warping aligns two series).
+//!
+//! Following the nearest segment from vertex to vertex gets lost where the
+//! wall cuts across a stretch of the loop: where the cut of a cropped scan
+//! runs straight across a bay of the smoothed loop, the next wall vertex's
+//! nearest segment lies 70 segments on, and a search a few dozen segments
+//! ahead finds only the bay's near side, then follows it back. The
+//! alignment weighs the whole wall at once, so it skips the bay, and a
+//! neck of the surface (two stretches of the loop close in space, far
+//! apart along it) draws no vertex across, since the vertices after it
+//! would lie far from their segments.
+
+use crate::geom::{segment_dist2, segment_param, Point3};
+
+/// The wall's positions along the guide: arc length from the place of the
+/// first wall vertex (`start`: its segment and the position along it, 0
+/// to 1), non-decreasing and at most the loop's length. `guide` is the
+/// closed loop's vertices, `arc` the arc length at each vertex (one more
+/// entry than vertices: the last is the loop's length).
+pub(super) fn place_along(
+    guide: &[Point3],
+    arc: &[f64],
+    wall: &[Point3],
+    start: (usize, f64),
+) -> Vec<f64> {
+    let m = guide.len();
+    if m == 0 || wall.is_empty() {
+        return vec![0.0; wall.len()];
+    }
+    let segments = cheapest_segments(guide, wall, start.0);
+    let length = arc[m];
+    let origin = arc[start.0] + start.1 * (arc[start.0 + 1] - arc[start.0]);
+    let mut placed = Vec::with_capacity(wall.len());
+    let mut last = 0.0;
+    for (i, &s) in segments.iter().enumerate() {
+        let j = (start.0 + s) % m;
+        let (a, b) = (guide[j], guide[(j + 1) % m]);
+        let t = if i == 0 {
+            start.1
+        } else {
+            segment_param(wall[i], a, b)
+        };
+        // Arc length from the guide's vertex 0, unwrapped past the start.
+        let at = arc[j] + t * (arc[j + 1] - arc[j]) + if start.0 + s >= m { length } else { 0.0 };
+        last = (at - origin).clamp(last, length);
+        placed.push(last);
+    }
+    placed
+}
+
+/// For each wall vertex, its segment counted from the start segment
+/// (0 to m: m is the start segment again, after a whole turn), non-
+/// decreasing, the first at 0, with the least sum of squared distances.
+fn cheapest_segments(guide: &[Point3], wall: &[Point3], first: usize) -> Vec<usize> {
+    let m = guide.len();
+    let columns = m + 1;
+    let cost = |i: usize, s: usize| {
+        let j = (first + s) % m;
+        segment_dist2(wall[i], guide[j], guide[(j + 1) % m])
+    };
+    // total[s]: the least cost of the vertices so far with the last on
+    // segment s. choice[i]: for vertex i, the segment of vertex i − 1 at
+    // each s, as runs (from which s on, that segment): the running minimum
+    // changes seldom, so the runs are few.
+    let mut total = vec![f64::INFINITY; columns];
+    total[0] = 0.0;
+    let mut choice: Vec<Vec<(usize, usize)>> = vec![Vec::new(); wall.len()];
+    let mut next = vec![0.0; columns];
+    for (i, runs) in choice.iter_mut().enumerate().skip(1) {
+        let mut best = f64::INFINITY;
+        for s in 0..columns {
+            if total[s] < best {
+                best = total[s];
+                runs.push((s, s));
+            }
+            next[s] = best + cost(i, s);
+        }
+        std::mem::swap(&mut total, &mut next);
+    }
+    let mut s = (0..columns)
+        .min_by(|&a, &b| total[a].total_cmp(&total[b]).then(a.cmp(&b)))
+        .unwrap_or(0);
+    let mut segments = vec![0; wall.len()];
+    for i in (1..wall.len()).rev() {
+        segments[i] = s;
+        let runs = &choice[i];
+        let k = runs.partition_point(|&(from, _)| from <= s);
+        s = runs[k.saturating_sub(1)].1;
+    }
+    segments
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::edges::smooth::arc_lengths;
+    use rand::{RngExt, SeedableRng};
+
+    fn circle(m: usize, radius: f64) -> Vec<Point3> {
+        (0..m)
+            .map(|j| {
+                let a = std::f64::consts::TAU * j as f64 / m as f64;
+                [radius * a.cos(), radius * a.sin(), 0.0]
+            })
+            .collect()
+    }
+
+    /// The least cost over every non-decreasing choice of segments, by
+    /// enumeration.
+    fn least_cost(guide: &[Point3], wall: &[Point3], first: usize) -> f64 {
+        let m = guide.len();
+        let cost = |i: usize, s: usize| {
+            let j = (first + s) % m;
+            segment_dist2(wall[i], guide[j], guide[(j + 1) % m])
+        };
+        fn walk(
+            i: usize,
+            from: usize,
+            n: usize,
+            m: usize,
+            cost: &dyn Fn(usize, usize) -> f64,
+        ) -> f64 {
+            if i == n {
+                return 0.0;
+            }
+            (from..=m)
+                .map(|s| cost(i, s) + walk(i + 1, s, n, m, cost))
+                .fold(f64::INFINITY, f64::min)
+        }
+        walk(1, 0, wall.len(), m, &cost)
+    }
+
+    #[test]
+    fn the_alignment_is_the_cheapest_monotone_one() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        for _ in 0..200 {
+            let m = rng.random_range(3..7);
+            let p = rng.random_range(1..6);
+            let guide: Vec<Point3> = (0..m)
+                .map(|_| {
+                    [
+                        rng.random_range(-1.0..1.0),
+                        rng.random_range(-1.0..1.0),
+                        rng.random_range(-0.2..0.2),
+                    ]
+                })
+                .collect();
+            let wall: Vec<Point3> = (0..p)
+                .map(|_| {
+                    [
+                        rng.random_range(-1.0..1.0),
+                        rng.random_range(-1.0..1.0),
+                        rng.random_range(-0.2..0.2),
+                    ]
+                })
+                .collect();
+            let first = rng.random_range(0..m);
+            let segments = cheapest_segments(&guide, &wall, first);
+            assert!(segments.windows(2).all(|w| w[0] <= w[1]) && segments[0] == 0);
+            let cost: f64 = (1..p)
+                .map(|i| {
+                    let j = (first + segments[i]) % m;
+                    segment_dist2(wall[i], guide[j], guide[(j + 1) % m])
+                })
+                .sum();
+            let best = least_cost(&guide, &wall, first);
+            assert!(
+                (cost - best).abs() <= 1e-12 * (1.0 + best),
+                "{cost} vs {best}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_wall_cutting_across_a_bay_skips_it() {
+        // A circle of 200 segments with a deep bay cut into one side
+        // (segments 40 to 120 pulled in), and a wall just outside the
+        // circle that runs straight across the bay's mouth.
+        let m = 200;
+        let mut guide = circle(m, 10.0);
+        for (j, p) in guide.iter_mut().enumerate().take(120).skip(40) {
+            let depth = 1.0 - 0.6 * ((j - 40) as f64 / 80.0 * std::f64::consts::PI).sin();
+            *p = [p[0] * depth, p[1] * depth, 0.0];
+        }
+        let outside = circle(400, 10.3);
+        let wall: Vec<Point3> = outside.iter().step_by(2).copied().collect();
+        let arc = arc_lengths(&guide, true);
+        let placed = place_along(&guide, &arc, &wall, (0, 0.0));
+        assert!(placed.windows(2).all(|w| w[0] <= w[1]));
+        // The wall goes round once.
+        assert!(
+            placed[wall.len() - 1] > 0.95 * arc[m],
+            "{:?}",
+            placed.last()
+        );
+        // Past the bay, the wall vertices are placed past it on the loop.
+        let past_bay = arc[125];
+        assert!(placed[130] > past_bay, "{} vs {past_bay}", placed[130]);
+    }
+}

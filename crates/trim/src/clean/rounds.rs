@@ -1,0 +1,203 @@
+//! Loops blocked by another border's new faces, tried again on the mesh
+//! with those faces in (step 5 of the cleanup, repeated).
+//!
+//! Two patches applied to one mesh must keep apart: a strip keeps clear of
+//! every face another patch removes or touches. Where a hole lies a few
+//! faces from the outer border, the outer border's strip goes round it and
+//! the hole's own patch would then touch the strip's faces, so it was left
+//! (`MeetsAnotherBorder`). Once the strip is in, the hole is a loop of an
+//! ordinary mesh again, and its smoothed loop (unchanged: its vertices are
+//! the input's) can be put in beside the strip's new border. A round takes
+//! only the loops blocked in the one before, until a round replaces none
+//! of them or after [`MAX_ROUNDS`].
+
+use super::*;
+use crate::spatial::PointTree;
+
+/// Rounds of replacement, the first included.
+const MAX_ROUNDS: usize = 3;
+
+/// The mesh with every patch of every round applied, and what became of
+/// the input's loops.
+pub(super) struct Replaced {
+    pub(super) mesh: Mesh,
+    /// The number of input faces the mesh keeps: they come first, in the
+    /// input's order; the faces from here on are new.
+    pub(super) kept_input_faces: usize,
+    /// Whether each input loop was replaced.
+    pub(super) replaced: Vec<bool>,
+    /// The input loops left, with why.
+    pub(super) left: Vec<LeftLoops>,
+}
+
+/// Steps 3 to 5 for every smoothed loop, in rounds (see the module doc).
+pub(super) fn replace_in_rounds(
+    mesh: &Mesh,
+    beta: &[f64],
+    borders: &[Vec<u32>],
+    rings: &[Option<Ring>],
+    view: Option<Point3>,
+) -> Replaced {
+    let beta_median = median(beta);
+    let (outcomes, out) = replace_bands(mesh, beta, borders, rings, view, beta_median);
+    let mut done = Replaced {
+        kept_input_faces: kept_below(mesh.faces.len(), &outcomes),
+        replaced: replaced_loops(borders.len(), &outcomes),
+        left: outcomes.into_iter().flat_map(|o| o.left).collect(),
+        mesh: out,
+    };
+    for _ in 1..MAX_ROUNDS {
+        if !done.round(mesh, beta, borders, rings, view, beta_median) {
+            break;
+        }
+    }
+    done
+}
+
+impl Replaced {
+    /// One more round for the loops another border's new faces blocked;
+    /// whether it replaced any.
+    fn round(
+        &mut self,
+        input: &Mesh,
+        beta: &[f64],
+        borders: &[Vec<u32>],
+        rings: &[Option<Ring>],
+        view: Option<Point3>,
+        beta_median: f64,
+    ) -> bool {
+        let blocked: BTreeSet<usize> = self
+            .left
+            .iter()
+            .filter(|x| x.reason == LeftReason::MeetsAnotherBorder)
+            .flat_map(|x| x.loops.iter().copied())
+            .collect();
+        if blocked.is_empty() {
+            return false;
+        }
+        let mesh = &self.mesh;
+        let here = mesh.boundary_loops();
+        let input_loop = as_input_loops(borders, &here);
+        let here_rings: Vec<Option<Ring>> = input_loop
+            .iter()
+            .map(|l| {
+                l.filter(|l| blocked.contains(l))
+                    .and_then(|l| rings[l].clone())
+            })
+            .collect();
+        let here_beta = beta_of_new_vertices(input, beta, mesh);
+        let (outcomes, out) =
+            replace_bands(mesh, &here_beta, &here, &here_rings, view, beta_median);
+        let now_replaced: Vec<usize> = replaced_loops(here.len(), &outcomes)
+            .iter()
+            .enumerate()
+            .filter(|&(_, &r)| r)
+            .filter_map(|(k, _)| input_loop[k])
+            .collect();
+        if now_replaced.is_empty() {
+            return false;
+        }
+        let left_here: Vec<LeftLoops> = outcomes
+            .iter()
+            .flat_map(|o| o.left.iter())
+            .map(|x| LeftLoops {
+                loops: x.loops.iter().filter_map(|&k| input_loop[k]).collect(),
+                vertices: Vec::new(),
+                reason: x.reason,
+            })
+            .filter(|x| !x.loops.is_empty())
+            .collect();
+        self.kept_input_faces = kept_below(self.kept_input_faces, &outcomes);
+        self.mesh = out;
+        // The loops tried this round take this round's reasons; loops a
+        // patch absorbed are replaced, whichever round left them.
+        for &l in &now_replaced {
+            self.replaced[l] = true;
+        }
+        let retried: BTreeSet<usize> = blocked.iter().copied().chain(now_replaced).collect();
+        for entry in &mut self.left {
+            entry.loops.retain(|l| !retried.contains(l));
+        }
+        self.left.retain(|x| !x.loops.is_empty());
+        self.left.extend(left_here);
+        true
+    }
+}
+
+/// For each border of the mesh, the input loop it is (the same vertices),
+/// if any: the new borders of replaced loops are none.
+fn as_input_loops(input: &[Vec<u32>], here: &[Vec<u32>]) -> Vec<Option<usize>> {
+    let owner: HashMap<u32, usize> = input
+        .iter()
+        .enumerate()
+        .flat_map(|(l, b)| b.iter().map(move |&v| (v, l)))
+        .collect();
+    here.iter()
+        .map(|border| {
+            let l = *owner.get(border.first()?)?;
+            let same =
+                input[l].len() == border.len() && border.iter().all(|v| owner.get(v) == Some(&l));
+            same.then_some(l)
+        })
+        .collect()
+}
+
+/// β for every vertex of `mesh`, whose first vertices are the input's:
+/// theirs, and for the new ones that of the nearest input vertex.
+fn beta_of_new_vertices(input: &Mesh, beta: &[f64], mesh: &Mesh) -> Vec<f64> {
+    let n = input.vertices.len();
+    let mut all = beta.to_vec();
+    if let Some(tree) = PointTree::new(&input.vertices) {
+        all.extend(mesh.vertices[n..].iter().map(|p| beta[tree.nearest(p).0]));
+    }
+    all.resize(mesh.vertices.len(), median(beta));
+    all
+}
+
+/// How many of a mesh's first `count` faces no patch removes.
+fn kept_below(count: usize, outcomes: &[Outcome]) -> usize {
+    let mut removed = vec![false; count];
+    for patch in outcomes.iter().filter_map(|o| o.patch.as_ref()) {
+        for &f in patch.removed.iter().filter(|&&f| (f as usize) < count) {
+            removed[f as usize] = true;
+        }
+    }
+    removed.iter().filter(|&&r| !r).count()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_border_is_an_input_loop_only_with_the_same_vertices() {
+        let input = vec![vec![0, 1, 2, 3], vec![10, 11, 12]];
+        let here = vec![
+            vec![11, 12, 10],    // the second loop, from another vertex
+            vec![0, 1, 2, 7, 3], // the first, with a new vertex in it
+            vec![20, 21, 22],    // a new border
+            vec![0, 1, 2],       // part of the first
+        ];
+        assert_eq!(
+            as_input_loops(&input, &here),
+            vec![Some(1), None, None, None]
+        );
+    }
+
+    #[test]
+    fn kept_faces_are_counted_below_the_limit_once() {
+        let patch = |removed: Vec<u32>| Outcome {
+            band: Vec::new(),
+            patch: Some(Patch {
+                removed,
+                ..Default::default()
+            }),
+            left: Vec::new(),
+            strip: false,
+        };
+        let outcomes = vec![patch(vec![1, 3, 8]), patch(vec![3, 4])];
+        // Faces 0..6: 1, 3 and 4 removed (3 by both).
+        assert_eq!(kept_below(6, &outcomes), 3);
+        assert_eq!(kept_below(10, &outcomes), 6);
+    }
+}
