@@ -56,9 +56,8 @@
 //! rings) is left unchanged and reported, and the other loops of its band
 //! are tried again without it. A patch whose faces would meet others at a
 //! non-manifold or same-direction edge is dropped the same way, so the
-//! output is never a broken mesh. A loop left only because its new faces
-//! would touch another border's is tried again on the mesh with that
-//! border's faces in ([`rounds`]).
+//! output is never a broken mesh. The loops left are tried again on the
+//! mesh with the other loops' patches in ([`rounds`]).
 
 mod align;
 mod assemble;

@@ -1,15 +1,26 @@
-//! Loops blocked by another border's new faces, tried again on the mesh
-//! with those faces in (step 5 of the cleanup, repeated).
+//! Loops left, tried again on the mesh with the other loops' patches in
+//! (step 5 of the cleanup, repeated).
 //!
-//! Two patches applied to one mesh must keep apart: a strip keeps clear of
-//! every face another patch removes or touches. Where a hole lies a few
-//! faces from the outer border, the outer border's strip goes round it and
-//! the hole's own patch would then touch the strip's faces, so it was left
-//! (`MeetsAnotherBorder`). Once the strip is in, the hole is a loop of an
-//! ordinary mesh again, and its smoothed loop (unchanged: its vertices are
-//! the input's) can be put in beside the strip's new border. A round takes
-//! only the loops blocked in the one before, until a round replaces none
-//! of them or after [`MAX_ROUNDS`].
+//! Where a loop is left, what stood in the way is often another border's
+//! patch, which a round later is part of the mesh:
+//!
+//! - Two patches applied to one mesh must keep apart: a strip keeps clear
+//!   of every face another patch removes or touches. Where a hole lies a
+//!   few faces from the outer border, the outer border's strip goes round
+//!   it, and the hole's own patch would touch the strip's faces
+//!   (`MeetsAnotherBorder`).
+//! - A strip takes the place of the planar patches it reaches, and the
+//!   holes whose planar patch it took out need strips of their own, which
+//!   fail more often on a small hole (`DoublesBack`, `TangledWall`) than
+//!   the planar way.
+//!
+//! Once those patches are in, the hole is a loop of an ordinary mesh
+//! again, its smoothed loop is the same (its vertices are the input's),
+//! and both ways are tried for it as in the first round; the new borders
+//! are borders like any other, which it keeps clear of or absorbs. New
+//! vertices take the β of the nearest input vertex. A round takes the
+//! loops the round before left, until a round replaces none of them, or
+//! after [`MAX_ROUNDS`].
 
 use super::*;
 use crate::spatial::PointTree;
@@ -55,8 +66,7 @@ pub(super) fn replace_in_rounds(
 }
 
 impl Replaced {
-    /// One more round for the loops another border's new faces blocked;
-    /// whether it replaced any.
+    /// One more round for the loops left; whether it replaced any.
     fn round(
         &mut self,
         input: &Mesh,
@@ -66,13 +76,13 @@ impl Replaced {
         view: Option<Point3>,
         beta_median: f64,
     ) -> bool {
-        let blocked: BTreeSet<usize> = self
+        let again: BTreeSet<usize> = self
             .left
             .iter()
-            .filter(|x| x.reason == LeftReason::MeetsAnotherBorder)
             .flat_map(|x| x.loops.iter().copied())
+            .filter(|&l| rings[l].is_some())
             .collect();
-        if blocked.is_empty() {
+        if again.is_empty() {
             return false;
         }
         let mesh = &self.mesh;
@@ -81,7 +91,7 @@ impl Replaced {
         let here_rings: Vec<Option<Ring>> = input_loop
             .iter()
             .map(|l| {
-                l.filter(|l| blocked.contains(l))
+                l.filter(|l| again.contains(l))
                     .and_then(|l| rings[l].clone())
             })
             .collect();
@@ -114,7 +124,10 @@ impl Replaced {
         for &l in &now_replaced {
             self.replaced[l] = true;
         }
-        let retried: BTreeSet<usize> = blocked.iter().copied().chain(now_replaced).collect();
+        // A loop whose border a patch changed was not tried: it keeps its
+        // reason.
+        let tried = input_loop.iter().flatten().filter(|l| again.contains(l));
+        let retried: BTreeSet<usize> = tried.copied().chain(now_replaced).collect();
         for entry in &mut self.left {
             entry.loops.retain(|l| !retried.contains(l));
         }
