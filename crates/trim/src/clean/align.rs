@@ -15,6 +15,17 @@
 //! would lie far from their segments.
 
 use crate::geom::{segment_dist2, segment_param, Point3};
+use crate::spatial::PointTree;
+use std::num::NonZeroUsize;
+
+/// Above this many wall vertex × segment pairs, each wall vertex is
+/// aligned only with the segments round its nearest guide vertices
+/// ([`CANDIDATES`]): the full table grows as the square of the loop's
+/// length (a 2,160-vertex wall on a 2,330-segment loop: 37 ms).
+const FULL_TABLE_LIMIT: usize = 16_000_000;
+/// Guide vertices round which a wall vertex's segments are taken when the
+/// table is not full.
+const CANDIDATES: usize = 64;
 
 /// The wall's positions along the guide: arc length from the place of the
 /// first wall vertex (`start`: its segment and the position along it, 0
@@ -31,7 +42,11 @@ pub(super) fn place_along(
     if m == 0 || wall.is_empty() {
         return vec![0.0; wall.len()];
     }
-    let segments = cheapest_segments(guide, wall, start.0);
+    let segments = if wall.len() * (m + 1) <= FULL_TABLE_LIMIT {
+        cheapest_segments(guide, wall, start.0)
+    } else {
+        cheapest_near_segments(guide, wall, start.0)
+    };
     let length = arc[m];
     let origin = arc[start.0] + start.1 * (arc[start.0 + 1] - arc[start.0]);
     let mut placed = Vec::with_capacity(wall.len());
@@ -90,6 +105,76 @@ fn cheapest_segments(guide: &[Point3], wall: &[Point3], first: usize) -> Vec<usi
         let runs = &choice[i];
         let k = runs.partition_point(|&(from, _)| from <= s);
         s = runs[k.saturating_sub(1)].1;
+    }
+    segments
+}
+
+/// [`cheapest_segments`] with each wall vertex's segments limited to those
+/// round its [`CANDIDATES`] nearest guide vertices, and the previous wall
+/// vertex's cheapest segment (so that an order-keeping choice always
+/// exists).
+fn cheapest_near_segments(guide: &[Point3], wall: &[Point3], first: usize) -> Vec<usize> {
+    let m = guide.len();
+    let Some(tree) = PointTree::new(guide) else {
+        return vec![0; wall.len()];
+    };
+    let k = NonZeroUsize::new(CANDIDATES.min(m)).unwrap_or(NonZeroUsize::MIN);
+    let cost = |i: usize, s: usize| {
+        let j = (first + s) % m;
+        segment_dist2(wall[i], guide[j], guide[(j + 1) % m])
+    };
+    // Segment j counted from the start segment, 0 to m − 1 (and m: the
+    // start segment after a whole turn).
+    let counted = |j: usize| (j + m - first) % m;
+    // Per wall vertex: its candidate segments, ascending, with the least
+    // cost of the vertices so far ending there and the predecessor's index.
+    let mut rows: Vec<Vec<(usize, f64, usize)>> = Vec::with_capacity(wall.len());
+    rows.push(vec![(0, 0.0, 0)]);
+    for i in 1..wall.len() {
+        let previous = &rows[i - 1];
+        // The previous vertex's cheapest segment: staying there is always
+        // in order.
+        let cheapest = previous
+            .iter()
+            .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)))
+            .map_or(0, |c| c.0);
+        let mut candidates: Vec<usize> = vec![cheapest];
+        for (_, v) in tree.nearest_n(&wall[i], k) {
+            let v = v as usize;
+            for j in [(v + m - 1) % m, v] {
+                let s = counted(j);
+                candidates.push(s);
+                if s == 0 {
+                    candidates.push(m);
+                }
+            }
+        }
+        candidates.sort_unstable();
+        candidates.dedup();
+        let mut row = Vec::with_capacity(candidates.len());
+        let (mut best, mut best_at, mut p) = (f64::INFINITY, 0, 0);
+        for s in candidates {
+            while p < previous.len() && previous[p].0 <= s {
+                if previous[p].1 < best {
+                    best = previous[p].1;
+                    best_at = p;
+                }
+                p += 1;
+            }
+            if best.is_finite() {
+                row.push((s, best + cost(i, s), best_at));
+            }
+        }
+        rows.push(row);
+    }
+    let last = rows.last().map_or(&[][..], |r| &r[..]);
+    let mut at = (0..last.len())
+        .min_by(|&a, &b| last[a].1.total_cmp(&last[b].1).then(a.cmp(&b)))
+        .unwrap_or(0);
+    let mut segments = vec![0; wall.len()];
+    for i in (1..wall.len()).rev() {
+        segments[i] = rows[i][at].0;
+        at = rows[i][at].2;
     }
     segments
 }
@@ -171,6 +256,60 @@ mod tests {
             assert!(
                 (cost - best).abs() <= 1e-12 * (1.0 + best),
                 "{cost} vs {best}"
+            );
+        }
+    }
+
+    /// A circle of `m` segments with a bay pulled in between two random
+    /// places, and a wall of `p` vertices just outside the circle, both
+    /// with noise.
+    fn bay_and_wall(
+        rng: &mut rand_chacha::ChaCha8Rng,
+        m: usize,
+        p: usize,
+    ) -> (Vec<Point3>, Vec<Point3>) {
+        let from = rng.random_range(0..m / 2);
+        let to = from + rng.random_range(m / 8..m / 2);
+        let depth = rng.random_range(0.2..0.7);
+        let mut guide = circle(m, 10.0);
+        for (j, q) in guide.iter_mut().enumerate() {
+            let mut r = 1.0 + rng.random_range(-0.01..0.01);
+            if (from..to).contains(&j) {
+                r -= depth * ((j - from) as f64 / (to - from) as f64 * std::f64::consts::PI).sin();
+            }
+            *q = [q[0] * r, q[1] * r, rng.random_range(-0.02..0.02)];
+        }
+        let wall = circle(p, 10.2)
+            .into_iter()
+            .map(|q| {
+                [
+                    q[0] + rng.random_range(-0.1..0.1),
+                    q[1] + rng.random_range(-0.1..0.1),
+                    0.0,
+                ]
+            })
+            .collect();
+        (guide, wall)
+    }
+
+    #[test]
+    fn the_near_segments_agree_with_the_full_table() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        for _ in 0..40 {
+            let m = rng.random_range(40..400);
+            let p = rng.random_range(40..400);
+            let (guide, wall) = bay_and_wall(&mut rng, m, p);
+            // As the zip starts: on the first wall vertex's nearest segment.
+            let first = (0..m)
+                .min_by(|&a, &b| {
+                    let d = |j: usize| segment_dist2(wall[0], guide[j], guide[(j + 1) % m]);
+                    d(a).total_cmp(&d(b))
+                })
+                .unwrap_or(0);
+            assert_eq!(
+                cheapest_near_segments(&guide, &wall, first),
+                cheapest_segments(&guide, &wall, first),
+                "m {m} p {p}"
             );
         }
     }
