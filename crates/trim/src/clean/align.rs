@@ -61,7 +61,9 @@ pub(super) fn place_along(
         };
         // Arc length from the guide's vertex 0, unwrapped past the start.
         let at = arc[j] + t * (arc[j + 1] - arc[j]) + if start.0 + s >= m { length } else { 0.0 };
-        last = (at - origin).clamp(last, length);
+        // max and min rather than clamp: a position that is not a number
+        // stays where the last one was.
+        last = (at - origin).max(last).min(length);
         placed.push(last);
     }
     placed
@@ -78,19 +80,20 @@ fn cheapest_segments(guide: &[Point3], wall: &[Point3], first: usize) -> Vec<usi
         segment_dist2(wall[i], guide[j], guide[(j + 1) % m])
     };
     // total[s]: the least cost of the vertices so far with the last on
-    // segment s. choice[i]: for vertex i, the segment of vertex i − 1 at
-    // each s, as runs (from which s on, that segment): the running minimum
-    // changes seldom, so the runs are few.
+    // segment s. minima[i]: the segments at which the running minimum of
+    // vertex i − 1's totals falls, ascending: vertex i − 1's segment, for
+    // vertex i on segment s, is the last of them up to s. The running
+    // minimum falls seldom, so they are few.
     let mut total = vec![f64::INFINITY; columns];
     total[0] = 0.0;
-    let mut choice: Vec<Vec<(usize, usize)>> = vec![Vec::new(); wall.len()];
+    let mut minima: Vec<Vec<usize>> = vec![Vec::new(); wall.len()];
     let mut next = vec![0.0; columns];
-    for (i, runs) in choice.iter_mut().enumerate().skip(1) {
+    for (i, falls) in minima.iter_mut().enumerate().skip(1) {
         let mut best = f64::INFINITY;
         for s in 0..columns {
             if total[s] < best {
                 best = total[s];
-                runs.push((s, s));
+                falls.push(s);
             }
             next[s] = best + cost(i, s);
         }
@@ -102,9 +105,8 @@ fn cheapest_segments(guide: &[Point3], wall: &[Point3], first: usize) -> Vec<usi
     let mut segments = vec![0; wall.len()];
     for i in (1..wall.len()).rev() {
         segments[i] = s;
-        let runs = &choice[i];
-        let k = runs.partition_point(|&(from, _)| from <= s);
-        s = runs[k.saturating_sub(1)].1;
+        let k = minima[i].partition_point(|&from| from <= s);
+        s = k.checked_sub(1).map_or(0, |k| minima[i][k]);
     }
     segments
 }
@@ -173,8 +175,12 @@ fn cheapest_near_segments(guide: &[Point3], wall: &[Point3], first: usize) -> Ve
         .unwrap_or(0);
     let mut segments = vec![0; wall.len()];
     for i in (1..wall.len()).rev() {
-        segments[i] = rows[i][at].0;
-        at = rows[i][at].2;
+        // Every row holds a finite total when the coordinates are finite.
+        let Some(&(s, _, before)) = rows[i].get(at) else {
+            break;
+        };
+        segments[i] = s;
+        at = before;
     }
     segments
 }
@@ -312,6 +318,21 @@ mod tests {
                 "m {m} p {p}"
             );
         }
+    }
+
+    #[test]
+    fn a_wall_vertex_not_a_number_is_placed_without_a_panic() {
+        let guide = circle(50, 10.0);
+        let arc = arc_lengths(&guide, true);
+        let mut wall = circle(60, 10.2);
+        wall[7] = [f64::NAN, 0.0, 0.0];
+        for first in [0, 13] {
+            let full = cheapest_segments(&guide, &wall, first);
+            let near = cheapest_near_segments(&guide, &wall, first);
+            assert_eq!((full.len(), near.len()), (60, 60));
+        }
+        let placed = place_along(&guide, &arc, &wall, (0, 0.0));
+        assert!(placed.windows(2).all(|w| w[0] <= w[1]), "{placed:?}");
     }
 
     #[test]
