@@ -333,6 +333,15 @@ pub(super) fn replace_by_strip(
         let cut = Cut::new(cx, l, &guide, &owner, replaced, &forced)?;
         let removed = cut.removed_faces(cx);
         let (kept, touched) = clear_of_other_borders(cx, l, &cut, &owner, removed);
+        // A smaller border another patch replaces would be absorbed if that
+        // patch gave way: say so, rather than leave a wall that runs into
+        // it.
+        if let Some(&k) = touched
+            .iter()
+            .find(|&&k| replaced[k] && cx.borders[k].len() < cx.borders[l].len())
+        {
+            return Err(StripFailure::MeetsReplaced(k));
+        }
         let absorbable = touched
             .iter()
             .all(|&k| !replaced[k] && cx.borders[k].len() < cx.borders[l].len());
