@@ -69,16 +69,21 @@ pub(super) fn place_along(
     placed
 }
 
+/// The squared distance from `p` to segment `s` of the guide, counted
+/// from segment `first`.
+fn segment_cost(guide: &[Point3], first: usize, p: Point3, s: usize) -> f64 {
+    let m = guide.len();
+    let j = (first + s) % m;
+    segment_dist2(p, guide[j], guide[(j + 1) % m])
+}
+
 /// For each wall vertex, its segment counted from the start segment
 /// (0 to m: m is the start segment again, after a whole turn), non-
 /// decreasing, the first at 0, with the least sum of squared distances.
 fn cheapest_segments(guide: &[Point3], wall: &[Point3], first: usize) -> Vec<usize> {
     let m = guide.len();
     let columns = m + 1;
-    let cost = |i: usize, s: usize| {
-        let j = (first + s) % m;
-        segment_dist2(wall[i], guide[j], guide[(j + 1) % m])
-    };
+    let cost = |i: usize, s: usize| segment_cost(guide, first, wall[i], s);
     // total[s]: the least cost of the vertices so far with the last on
     // segment s. minima[i]: the segments at which the running minimum of
     // vertex i − 1's totals falls, ascending: vertex i − 1's segment, for
@@ -121,10 +126,7 @@ fn cheapest_near_segments(guide: &[Point3], wall: &[Point3], first: usize) -> Ve
         return vec![0; wall.len()];
     };
     let k = NonZeroUsize::new(CANDIDATES.min(m)).unwrap_or(NonZeroUsize::MIN);
-    let cost = |i: usize, s: usize| {
-        let j = (first + s) % m;
-        segment_dist2(wall[i], guide[j], guide[(j + 1) % m])
-    };
+    let cost = |i: usize, s: usize| segment_cost(guide, first, wall[i], s);
     // Segment j counted from the start segment, 0 to m − 1 (and m: the
     // start segment after a whole turn).
     let counted = |j: usize| (j + m - first) % m;
@@ -200,14 +202,24 @@ mod tests {
             .collect()
     }
 
+    /// `n` points in a flat box, 2 × 2 × 0.4.
+    fn random_points(rng: &mut rand_chacha::ChaCha8Rng, n: usize) -> Vec<Point3> {
+        (0..n)
+            .map(|_| {
+                [
+                    rng.random_range(-1.0..1.0),
+                    rng.random_range(-1.0..1.0),
+                    rng.random_range(-0.2..0.2),
+                ]
+            })
+            .collect()
+    }
+
     /// The least cost over every non-decreasing choice of segments, by
     /// enumeration.
     fn least_cost(guide: &[Point3], wall: &[Point3], first: usize) -> f64 {
         let m = guide.len();
-        let cost = |i: usize, s: usize| {
-            let j = (first + s) % m;
-            segment_dist2(wall[i], guide[j], guide[(j + 1) % m])
-        };
+        let cost = |i: usize, s: usize| segment_cost(guide, first, wall[i], s);
         fn walk(
             i: usize,
             from: usize,
@@ -231,32 +243,13 @@ mod tests {
         for _ in 0..200 {
             let m = rng.random_range(3..7);
             let p = rng.random_range(1..6);
-            let guide: Vec<Point3> = (0..m)
-                .map(|_| {
-                    [
-                        rng.random_range(-1.0..1.0),
-                        rng.random_range(-1.0..1.0),
-                        rng.random_range(-0.2..0.2),
-                    ]
-                })
-                .collect();
-            let wall: Vec<Point3> = (0..p)
-                .map(|_| {
-                    [
-                        rng.random_range(-1.0..1.0),
-                        rng.random_range(-1.0..1.0),
-                        rng.random_range(-0.2..0.2),
-                    ]
-                })
-                .collect();
+            let guide = random_points(&mut rng, m);
+            let wall = random_points(&mut rng, p);
             let first = rng.random_range(0..m);
             let segments = cheapest_segments(&guide, &wall, first);
             assert!(segments.windows(2).all(|w| w[0] <= w[1]) && segments[0] == 0);
             let cost: f64 = (1..p)
-                .map(|i| {
-                    let j = (first + segments[i]) % m;
-                    segment_dist2(wall[i], guide[j], guide[(j + 1) % m])
-                })
+                .map(|i| segment_cost(&guide, first, wall[i], segments[i]))
                 .sum();
             let best = least_cost(&guide, &wall, first);
             assert!(
@@ -308,7 +301,7 @@ mod tests {
             // As the zip starts: on the first wall vertex's nearest segment.
             let first = (0..m)
                 .min_by(|&a, &b| {
-                    let d = |j: usize| segment_dist2(wall[0], guide[j], guide[(j + 1) % m]);
+                    let d = |j: usize| segment_cost(&guide, 0, wall[0], j);
                     d(a).total_cmp(&d(b))
                 })
                 .unwrap_or(0);
