@@ -42,6 +42,10 @@ pub(super) fn assemble(mesh: &Mesh, outcomes: &[Outcome]) -> (Mesh, Vec<Option<u
 /// same way.
 pub(super) fn patches_breaking_manifold(mesh: &Mesh, origin: &[Option<usize>]) -> BTreeSet<usize> {
     let mut bad = BTreeSet::new();
+    // The usual case, told without counting each edge's uses.
+    if EdgeRows::new(&mesh.faces).no_edge_run_twice() {
+        return bad;
+    }
     for_each_edge(mesh, |faces, forward, backward| {
         if forward > 1 || backward > 1 {
             bad.extend(faces.iter().filter_map(|e| origin[e.2 as usize]));

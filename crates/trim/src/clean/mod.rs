@@ -92,9 +92,10 @@ use crate::error::{CleanError, MeshError};
 use crate::frame::fit_plane;
 use crate::geom::{add, cross, dist2, dot, norm2, sub, Point3};
 use crate::geom::{median, orient, orientation};
+use crate::mesh::boundary_loops_of;
 use crate::mesh::pinches::open_new_pinches;
 use crate::mesh::repair::{repair_degenerate_faces, FaceRepair};
-use crate::mesh::topology::{check_manifold, Topology};
+use crate::mesh::topology::{check_manifold, check_manifold_with, distinct, EdgeRows, Topology};
 use crate::mesh::{lowest_first, Mesh};
 use crate::planar::{
     inside_faces, obstacle, untwist, Cdt, Node, Ring, SegmentGrid, Tangle, STEINER,
@@ -305,10 +306,11 @@ pub fn clean_mesh(
 ) -> Result<(Mesh, CleanReport), CleanError> {
     mesh.validate()?;
     let faces_in = mesh.faces.len();
-    let (kept, dropped) = without_empty_faces(mesh);
+    let (kept, dropped, edges) = without_empty_faces(mesh);
     let mesh: &Mesh = &kept;
-    check_cleanable(mesh, beta)?;
-    let borders = mesh.boundary_loops();
+    check_cleanable(mesh, beta, &edges)?;
+    let borders = boundary_loops_of(&edges);
+    drop(edges);
     let rings = smoothed_loops(mesh, beta, &borders, options);
     let mut report = CleanReport {
         loops_in: borders.len(),
@@ -339,7 +341,7 @@ pub fn clean_mesh(
 /// What the cleanup needs of the mesh left once its empty faces are dropped:
 /// faces, one β per vertex, every edge used at most twice and never twice
 /// the same way.
-fn check_cleanable(mesh: &Mesh, beta: &[f64]) -> Result<(), CleanError> {
+fn check_cleanable(mesh: &Mesh, beta: &[f64], edges: &EdgeRows) -> Result<(), CleanError> {
     if mesh.faces.is_empty() {
         return Err(MeshError::NoFaces.into());
     }
@@ -349,7 +351,7 @@ fn check_cleanable(mesh: &Mesh, beta: &[f64]) -> Result<(), CleanError> {
             vertices: mesh.vertices.len(),
         });
     }
-    Ok(check_manifold(mesh)?)
+    Ok(check_manifold_with(mesh, edges)?)
 }
 
 /// Step 2: each border loop smoothed (corners, FFT edges and, with
@@ -877,15 +879,23 @@ struct DroppedFaces {
 /// and so does a face that repeats another's corners in the opposite turn:
 /// which of the two agrees with its neighbours is not known here, so the
 /// mesh stays as it is and its edges are reported as non-manifold.
-fn without_empty_faces(mesh: &Mesh) -> (Cow<'_, Mesh>, DroppedFaces) {
-    let distinct = |f: &[u32; 3]| f[0] != f[1] && f[1] != f[2] && f[2] != f[0];
+/// Returns the edges of the faces that stay, for the manifold check and
+/// the border.
+fn without_empty_faces(mesh: &Mesh) -> (Cow<'_, Mesh>, DroppedFaces, EdgeRows) {
+    let edges = EdgeRows::new(&mesh.faces);
+    // A face repeated in the same turn runs its edges twice: where no edge
+    // is run twice and every face has three vertices, none goes (the usual
+    // case, without hashing every face).
+    if edges.no_edge_run_twice() && mesh.faces.iter().all(|&f| distinct(f)) {
+        return (Cow::Borrowed(mesh), DroppedFaces::default(), edges);
+    }
     let mut seen = HashSet::with_capacity_and_hasher(mesh.faces.len(), Default::default());
     let mut dropped = DroppedFaces::default();
     let keep: Vec<bool> = mesh
         .faces
         .iter()
         .map(|f| {
-            if !distinct(f) {
+            if !distinct(*f) {
                 dropped.slivers += 1;
                 false
             } else if !seen.insert(lowest_first(*f)) {
@@ -897,11 +907,12 @@ fn without_empty_faces(mesh: &Mesh) -> (Cow<'_, Mesh>, DroppedFaces) {
         })
         .collect();
     if dropped == DroppedFaces::default() {
-        return (Cow::Borrowed(mesh), dropped);
+        return (Cow::Borrowed(mesh), dropped, edges);
     }
     let mut kept = mesh.clone();
     kept.retain_faces(&keep);
-    (Cow::Owned(kept), dropped)
+    let edges = EdgeRows::new(&kept.faces);
+    (Cow::Owned(kept), dropped, edges)
 }
 
 /// Drops each smoothed loop vertex closer than [`MIN_GAP`]·β (in 3D) to

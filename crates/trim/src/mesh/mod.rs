@@ -12,6 +12,7 @@ pub(crate) mod pinches;
 pub(crate) mod repair;
 pub(crate) mod topology;
 use crate::geom::{add, cross, dot, norm2, sub, Point3};
+use topology::EdgeRows;
 
 /// An indexed triangle mesh.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -209,18 +210,7 @@ impl Mesh {
     /// (a zero-area sliver) is no border: it would be a loop of one
     /// vertex, anywhere on the surface.
     pub fn boundary_loops(&self) -> Vec<Vec<u32>> {
-        let edges = self.sorted_edges();
-        let mut next: HashMap<u32, Vec<u32>> = HashMap::default();
-        for on_edge in edges.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
-            if let [(low, high, face)] = on_edge {
-                if low == high {
-                    continue;
-                }
-                let (a, b) = directed_edge(self.faces[*face as usize], *low, *high);
-                next.entry(a).or_default().push(b);
-            }
-        }
-        chain_loops(next)
+        boundary_loops_of(&EdgeRows::new(&self.faces))
     }
 
     /// [`Self::boundary_loops`] with a hash map of edge uses, the plain way;
@@ -270,6 +260,11 @@ impl Mesh {
     }
 }
 
+/// [`Mesh::boundary_loops`] of a mesh whose directed edges are built.
+pub(crate) fn boundary_loops_of(edges: &EdgeRows) -> Vec<Vec<u32>> {
+    chain_loops(edges.border())
+}
+
 /// Chains border edges (`next[a]` holds every b of an edge a → b) into
 /// loops, taking the edges at a vertex in index order.
 fn chain_loops(mut next: HashMap<u32, Vec<u32>>) -> Vec<Vec<u32>> {
@@ -294,14 +289,6 @@ fn chain_loops(mut next: HashMap<u32, Vec<u32>>) -> Vec<Vec<u32>> {
         }
     }
     loops
-}
-
-/// The edge {low, high} of `face` as the face runs along it.
-fn directed_edge(face: [u32; 3], low: u32, high: u32) -> (u32, u32) {
-    (0..3)
-        .map(|k| (face[k], face[(k + 1) % 3]))
-        .find(|&(a, b)| (a.min(b), a.max(b)) == (low, high))
-        .unwrap_or((low, high))
 }
 
 /// Cells per side of a cube face in [`Mesh::area_facing_one_way`]'s normal

@@ -15,8 +15,8 @@
 //! that touched another, usually one to three faces). A pinch the input
 //! had is the input's, and stays.
 
-use super::topology::Topology;
-use super::{sorted_edges_of, Mesh};
+use super::topology::{EdgeRows, Topology};
+use super::Mesh;
 use crate::geom::UnionFind;
 use crate::hash::HashMap;
 use std::cell::OnceCell;
@@ -140,17 +140,7 @@ fn kept_border_vertices(mesh: &Mesh, keep: &[bool]) -> Vec<u32> {
         .filter(|(_, &k)| k)
         .map(|(&f, _)| f)
         .collect();
-    let edges = sorted_edges_of(&kept);
-    let mut border = Vec::new();
-    for (i, &(a, b, _)) in edges.iter().enumerate() {
-        let same = |j: usize| edges.get(j).is_some_and(|&(c, d, _)| (c, d) == (a, b));
-        if !same(i + 1) && (i == 0 || !same(i - 1)) {
-            border.extend([a, b]);
-        }
-    }
-    border.sort_unstable();
-    border.dedup();
-    border
+    EdgeRows::new(&kept).border_vertices()
 }
 
 /// The faces `kept` (round one vertex, in fans by `labels`) of the fans
