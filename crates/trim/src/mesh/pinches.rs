@@ -133,6 +133,9 @@ fn kept_piece_sizes(mesh: &Mesh, keep: &[bool]) -> Vec<usize> {
 /// The vertices on the border of the kept faces (ascending): a vertex
 /// inside them has one fan.
 fn kept_border_vertices(mesh: &Mesh, keep: &[bool]) -> Vec<u32> {
+    if keep.iter().all(|&k| k) {
+        return EdgeRows::new(&mesh.faces).border_vertices();
+    }
     let kept: Vec<[u32; 3]> = mesh
         .faces
         .iter()
