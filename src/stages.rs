@@ -97,6 +97,7 @@ pub fn in_cli_words(message: &str) -> String {
             "use `meshtrim MESH CLOUD OUT` instead",
         )
         .replace("check the view's position", "check --view-from")
+        .replace("clean with repair on", "clean with --repair")
 }
 
 #[cfg(test)]

@@ -814,3 +814,48 @@ fn shards_beyond_the_inputs_and_at_the_same_time_into_one_directory() {
         );
     }
 }
+
+/// A mesh whose faces are not all wound one way fails alone without
+/// `--repair` (its error names the flag), and is cleaned with it, as
+/// `meshtrim clean --repair` cleans it.
+#[test]
+fn repair_lets_a_mesh_wound_both_ways_through() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::create_dir_all(d.join("scans")).unwrap();
+    std::fs::copy(JAGGED, d.join("scans/right.stl")).unwrap();
+    // Every fifth triangle's last two corners swapped.
+    let mut stl = std::fs::read(JAGGED).unwrap();
+    let count = u32::from_le_bytes(stl[80..84].try_into().unwrap()) as usize;
+    for t in (0..count).step_by(5) {
+        let at = 84 + 50 * t;
+        let second: Vec<u8> = stl[at + 24..at + 36].to_vec();
+        stl.copy_within(at + 36..at + 48, at + 24);
+        stl[at + 36..at + 48].copy_from_slice(&second);
+    }
+    std::fs::write(d.join("scans/wrong.stl"), &stl).unwrap();
+    let run = batch(
+        d,
+        &["scans", "--out-dir", "plain", "--report", "plain.json"],
+    );
+    assert!(!run.status.success());
+    let files = json_report(&d.join("plain.json"))["files"].clone();
+    assert_eq!(files[0]["status"], "ok");
+    assert_eq!(files[1]["status"], "failed");
+    let error = files[1]["error"].as_str().unwrap();
+    assert!(error.contains("clean with --repair"), "{error}");
+    assert_ok(&batch(d, &["scans", "--out-dir", "fixed", "--repair"]));
+    let single = d.join("single.stl");
+    let run = Command::new(env!("CARGO_BIN_EXE_meshtrim"))
+        .args([
+            "clean",
+            "scans/wrong.stl",
+            single.to_str().unwrap(),
+            "--repair",
+        ])
+        .current_dir(d)
+        .output()
+        .unwrap();
+    assert_ok(&run);
+    assert!(std::fs::read(d.join("fixed/wrong.stl")).unwrap() == std::fs::read(single).unwrap());
+}

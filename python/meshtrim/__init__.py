@@ -304,16 +304,21 @@ def clean(
     offset: bool = True,
     view_along: Vector = None,
     view_from: Vector = None,
+    repair: bool = False,
 ) -> tuple:
     """Replaces a triangulated scan's jagged border by its smoothed edge
     (``meshtrim clean``): the mesh's own vertices are the cloud. Returns
     ``(vertices, faces, report)``, the report with the keys of the CLI's
-    ``--report`` JSON. Options as :func:`edges`.
+    ``--report`` JSON. Options as :func:`edges`; ``repair`` (the CLI's
+    ``--repair``) makes a mesh that is not edge-manifold or consistently
+    oriented so first (faces on edges of more than two faces removed,
+    smallest first; faces wound against their neighbours turned) rather
+    than refusing it.
     """
     k, anisotropy, along, from_ = _options(k, anisotropy, view_along, view_from)
     v = _float_rows(vertices, "vertices")
     f = _face_rows(faces, len(v))
-    out_v, out_f, report = _meshtrim.clean(v, f, k, anisotropy, bool(offset), along, from_)
+    out_v, out_f, report = _meshtrim.clean(v, f, k, anisotropy, bool(offset), along, from_, bool(repair))
     return out_v, out_f, json.loads(report)
 
 

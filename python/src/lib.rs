@@ -322,7 +322,7 @@ fn mesh_py<'py>(
 
 /// The cleaned mesh and the report as JSON.
 #[pyfunction]
-#[pyo3(name = "clean", signature = (vertices, faces, k, anisotropy, offset, view_along, view_from))]
+#[pyo3(name = "clean", signature = (vertices, faces, k, anisotropy, offset, view_along, view_from, repair))]
 #[allow(clippy::too_many_arguments)] // the CLI's options, as keywords
 fn clean_py<'py>(
     py: Python<'py>,
@@ -333,6 +333,7 @@ fn clean_py<'py>(
     offset: bool,
     view_along: Option<[f64; 3]>,
     view_from: Option<[f64; 3]>,
+    repair: bool,
 ) -> PyResult<MeshResult<'py>> {
     let stages = Options {
         k,
@@ -344,7 +345,7 @@ fn clean_py<'py>(
     .stages()?;
     let mesh = mesh_of(&vertices, &faces)?;
     let (out, report) = without_gil(py, || {
-        commands::clean::clean_in_memory(&mesh, &stages, "mesh")
+        commands::clean::clean_in_memory(&mesh, &stages, repair, "mesh")
     })?;
     mesh_result(py, &out, &report)
 }

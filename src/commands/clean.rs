@@ -29,6 +29,12 @@ pub struct Args {
     /// Also write the report as JSON to this file.
     #[arg(long, value_name = "FILE.json")]
     pub report: Option<PathBuf>,
+    /// Repair a mesh that is not edge-manifold or consistently oriented
+    /// instead of refusing it: faces on edges of more than two faces are
+    /// removed (smallest first, as MeshLab's "Repair non Manifold Edges"),
+    /// faces wound against their neighbours turned over.
+    #[arg(long)]
+    pub repair: bool,
     /// Detection and edge options.
     #[command(flatten)]
     pub stages: StageArgs,
@@ -90,6 +96,13 @@ pub struct Report {
     /// Input faces that repeated an earlier one (same corners, same turn),
     /// dropped.
     pub repeated_faces_dropped: usize,
+    /// With `--repair`: faces removed from edges of more than two faces.
+    pub crowded_faces_removed: usize,
+    /// With `--repair`: faces turned over to agree with their neighbours.
+    pub faces_flipped: usize,
+    /// With `--repair`: faces removed where no turn agrees with every
+    /// neighbour (a one-sided piece).
+    pub one_sided_faces_removed: usize,
     /// Zero-area faces of the output repaired (inside the mesh, away
     /// from the border bands).
     pub zero_area_faces_repaired: usize,
@@ -144,21 +157,23 @@ pub fn run(args: &Args) -> Result<()> {
         &args.input,
         &args.output,
         &args.stages.stages(),
+        args.repair,
         "`clean` smooths the border of a mesh",
     )?;
     crate::report::emit(&report, args.report.as_deref(), args.json)
 }
 
-/// Cleans one file without printing (the unit of `batch`).
-/// `no_faces` is the advice for a file without faces.
+/// Cleans one file without printing (the unit of `batch`); `repair` as
+/// `clean --repair`. `no_faces` is the advice for a file without faces.
 pub fn clean_file(
     input: &Path,
     output: &Path,
     stages: &Stages,
+    repair: bool,
     no_faces: &str,
 ) -> Result<CleanOutcome> {
     crate::report::check_outputs(output, None, &[input])?;
-    let r = clean(input, output, stages, no_faces)?;
+    let r = clean(input, output, stages, repair, no_faces)?;
     Ok(CleanOutcome {
         loops_in: r.loops_in,
         loops: r.loops_smoothed,
@@ -172,12 +187,18 @@ pub fn clean_file(
 }
 
 /// Reads, finds the local resolution, cleans, writes.
-fn clean(input: &Path, output: &Path, stages: &Stages, no_faces: &str) -> Result<Report> {
+fn clean(
+    input: &Path,
+    output: &Path,
+    stages: &Stages,
+    repair: bool,
+    no_faces: &str,
+) -> Result<Report> {
     let started = Instant::now();
     let mesh = read_mesh_with_faces(input, no_faces)?;
     let read_time = started.elapsed();
     let name = input.display().to_string();
-    let (out, mut report) = clean_in_memory(&mesh, stages, &name)?;
+    let (out, mut report) = clean_in_memory(&mesh, stages, repair, &name)?;
     let started = Instant::now();
     write_mesh(output, &out.vertices, &out.faces)?;
     report.read_ms = millis(read_time);
@@ -188,12 +209,14 @@ fn clean(input: &Path, output: &Path, stages: &Stages, no_faces: &str) -> Result
 }
 
 /// Cleans `mesh` in memory: everything `meshtrim clean` does between
-/// reading and writing, and what the Python package runs. Errors begin
-/// with `name` (the file's path, or the argument's name). The report names
-/// no file and has no read or write time.
+/// reading and writing (`repair` as `--repair`), and what the Python
+/// package runs. Errors begin with `name` (the file's path, or the
+/// argument's name). The report names no file and has no read or write
+/// time.
 pub fn clean_in_memory(
     mesh: &trim::Mesh,
     stages: &Stages,
+    repair: bool,
     name: &str,
 ) -> Result<(trim::Mesh, Report)> {
     let started = Instant::now();
@@ -205,8 +228,11 @@ pub fn clean_in_memory(
     let started = Instant::now();
     let options = CleanOptions {
         offset: stages.edges.offset,
+        repair,
     };
-    let (out, cleaned) = clean_mesh(mesh, &beta, &options).with_context(|| name.to_string())?;
+    let (out, cleaned) = clean_mesh(mesh, &beta, &options)
+        .map_err(|e| refused_unless_repaired(e, repair))
+        .with_context(|| name.to_string())?;
     let report = Report::new(
         mesh.vertices.len(),
         &cleaned,
@@ -214,6 +240,24 @@ pub fn clean_in_memory(
     );
     Ok((out, report))
 }
+
+/// A mesh refused for its edges is told of the `repair` option, which
+/// would have made it manifold and oriented (the CLI says `--repair`).
+fn refused_unless_repaired(error: trim::CleanError, repair: bool) -> anyhow::Error {
+    use trim::{CleanError, MeshError};
+    match error {
+        CleanError::Mesh(MeshError::NonManifold { .. } | MeshError::Misoriented { .. })
+            if !repair =>
+        {
+            anyhow::anyhow!("{error}; {REPAIR_ADVICE}")
+        }
+        _ => error.into(),
+    }
+}
+
+/// What [`refused_unless_repaired`] adds, in the library's words.
+pub const REPAIR_ADVICE: &str =
+    "or clean with repair on, which removes faces from edges of more than two and turns faces to agree";
 
 impl Report {
     fn new(vertices: usize, r: &CleanReport, [resolution, clean]: [Duration; 2]) -> Self {
@@ -236,6 +280,9 @@ impl Report {
             faces_in: r.faces_in,
             slivers_dropped: r.slivers_dropped,
             repeated_faces_dropped: r.repeated_faces_dropped,
+            crowded_faces_removed: r.manifold.crowded_faces_removed,
+            faces_flipped: r.manifold.faces_flipped,
+            one_sided_faces_removed: r.manifold.one_sided_faces_removed,
             zero_area_faces_repaired: r.repaired.repaired(),
             zero_area_faces_left: r.repaired.left,
             pinch_faces_dropped: r.pinch_faces_dropped,
@@ -341,6 +388,21 @@ impl crate::report::Table for Report {
                     format!(
                         "{} faces dropped where the new border met itself at a vertex",
                         self.pinch_faces_dropped
+                    ),
+                ),
+            );
+        }
+        if self.crowded_faces_removed + self.faces_flipped + self.one_sided_faces_removed > 0 {
+            rows.insert(
+                3,
+                (
+                    "repaired",
+                    format!(
+                        "{} faces removed from edges of 3+ faces, {} turned over, {} removed \
+                         from one-sided pieces",
+                        self.crowded_faces_removed,
+                        self.faces_flipped,
+                        self.one_sided_faces_removed
                     ),
                 ),
             );

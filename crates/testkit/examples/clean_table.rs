@@ -39,8 +39,15 @@ fn main() {
             };
             add(0, border_error(&input, &truth));
             for (k, offset) in [(1, false), (2, true)] {
-                let (out, report) = clean_mesh(&input, &beta, &CleanOptions { offset })
-                    .expect("jagged meshes are valid");
+                let (out, report) = clean_mesh(
+                    &input,
+                    &beta,
+                    &CleanOptions {
+                        offset,
+                        ..CleanOptions::default()
+                    },
+                )
+                .expect("jagged meshes are valid");
                 add(k, border_error(&out, &truth));
                 if offset {
                     min_angle = min_angle.min(report.min_angle_new);

@@ -85,6 +85,7 @@ pub use edges::{reconstruct_edges, Edge, EdgeOptions, Edges, Loop, LoopSource};
 pub use error::{CleanError, CloudError, DelaunayError, MeshError, TrimError};
 pub use frame::{fit_plane, Frame};
 pub use geom::rotation_from_quaternion;
+pub use mesh::manifold::ManifoldRepair;
 pub use mesh::repair::FaceRepair;
 pub use mesh::{check_vertex_range, Mesh};
 pub use spatial::neighbours::NeighbourIndex;

@@ -19,7 +19,15 @@ struct Case {
 fn clean(truth: SyntheticCloud, offset: bool) -> Case {
     let input = jagged_mesh(&truth);
     let detection = detect_boundary(&input.vertices, &BpdOptions::default()).unwrap();
-    let (output, report) = clean_mesh(&input, &detection.beta, &CleanOptions { offset }).unwrap();
+    let (output, report) = clean_mesh(
+        &input,
+        &detection.beta,
+        &CleanOptions {
+            offset,
+            ..CleanOptions::default()
+        },
+    )
+    .unwrap();
     Case {
         truth,
         input,

@@ -61,6 +61,10 @@ pub struct Args {
     /// list (1-based), e.g. one per machine or array task.
     #[arg(long, value_name = "K/N")]
     pub shard: Option<Shard>,
+    /// Repair meshes to clean that are not edge-manifold or consistently
+    /// oriented instead of refusing them (as `clean --repair`).
+    #[arg(long)]
+    pub repair: bool,
     /// Detection and edge options.
     #[command(flatten)]
     pub stages: StageArgs,
@@ -121,7 +125,7 @@ fn process_all(jobs: &[Job], args: &Args) -> Result<Vec<Row>> {
     let rows = pool.install(|| {
         jobs.par_iter()
             .map(|job| {
-                let row = process(job, args.skip_existing, &stages);
+                let row = process(job, args.skip_existing, args.repair, &stages);
                 // Printed above the bar, which is redrawn below it.
                 // Best effort: a failing stdout must not stop the files;
                 // the summary below reports it.
@@ -148,7 +152,7 @@ fn batch_bar(files: usize) -> ProgressBar {
 
 /// One file, whatever happens: skipped, done, failed, or panicked (the
 /// panic is caught and reported as the file's failure).
-fn process(job: &Job, skip_existing: bool, stages: &Stages) -> Row {
+fn process(job: &Job, skip_existing: bool, repair: bool, stages: &Stages) -> Row {
     let started = Instant::now();
     let mode = match job.cloud {
         CloudMatch::None => Mode::Clean,
@@ -172,7 +176,7 @@ fn process(job: &Job, skip_existing: bool, stages: &Stages) -> Row {
     if skip_existing && job.output.exists() {
         return row;
     }
-    let result = catch_unwind(AssertUnwindSafe(|| work(job, stages)))
+    let result = catch_unwind(AssertUnwindSafe(|| work(job, repair, stages)))
         .unwrap_or_else(|panic| Err(anyhow!("internal error: {}", panic_text(&*panic))));
     match result {
         Ok(o) => {
@@ -209,11 +213,12 @@ const CLOSED: &str = "no border: a closed mesh has nothing to clean; to trim a P
 const WRAPS: &str = "it wraps round an object, as an envelope cut open does: to trim a \
      reconstruction's envelope instead, put its cloud S.cloud.EXT beside it";
 
-/// Cleans or trims one file, writing its output atomically.
-fn work(job: &Job, stages: &Stages) -> Result<Outcome> {
+/// Cleans (repairing it first if `repair`) or trims one file, writing its
+/// output atomically.
+fn work(job: &Job, repair: bool, stages: &Stages) -> Result<Outcome> {
     match &job.cloud {
         CloudMatch::None => {
-            let o = clean_file(&job.input, &job.output, stages, NO_FACES)?;
+            let o = clean_file(&job.input, &job.output, stages, repair, NO_FACES)?;
             Ok(Outcome {
                 loops: o.loops,
                 faces_in: o.faces_in,

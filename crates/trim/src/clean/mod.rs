@@ -93,6 +93,7 @@ use crate::frame::fit_plane;
 use crate::geom::{add, cross, dist2, dot, norm2, sub, Point3};
 use crate::geom::{median, orient, orientation};
 use crate::mesh::boundary_loops_of;
+use crate::mesh::manifold::{make_manifold, ManifoldRepair};
 use crate::mesh::pinches::open_new_pinches;
 use crate::mesh::repair::{repair_degenerate_faces, FaceRepair};
 use crate::mesh::topology::{check_manifold, check_manifold_with, distinct, EdgeRows, Topology};
@@ -145,11 +146,19 @@ pub struct CleanOptions {
     /// Move the smoothed border out to the estimated physical edge (off
     /// gives the paper's edges, through the border vertices).
     pub offset: bool,
+    /// Make the mesh edge-manifold and consistently oriented first
+    /// (removing faces from edges of more than two faces, turning faces
+    /// wound against their neighbours: see [`ManifoldRepair`]) rather than
+    /// refusing it.
+    pub repair: bool,
 }
 
 impl Default for CleanOptions {
     fn default() -> Self {
-        Self { offset: true }
+        Self {
+            offset: true,
+            repair: false,
+        }
     }
 }
 
@@ -268,6 +277,9 @@ pub struct CleanReport {
     /// the same turn, dropped before anything else (see
     /// `without_empty_faces`).
     pub repeated_faces_dropped: usize,
+    /// What the `repair` option changed to make the mesh edge-manifold and
+    /// consistently oriented (nothing without it).
+    pub manifold: ManifoldRepair,
     /// Input faces removed (in the bands).
     pub faces_removed: usize,
     /// New faces (the bands triangulated again).
@@ -307,6 +319,13 @@ pub fn clean_mesh(
     mesh.validate()?;
     let faces_in = mesh.faces.len();
     let (kept, dropped, edges) = without_empty_faces(mesh);
+    let (kept, edges, manifold) = if options.repair {
+        let (repaired, manifold) = make_manifold(&kept);
+        let edges = EdgeRows::new(&repaired.faces);
+        (Cow::Owned(repaired), edges, manifold)
+    } else {
+        (kept, edges, ManifoldRepair::default())
+    };
     let mesh: &Mesh = &kept;
     check_cleanable(mesh, beta, &edges)?;
     let borders = boundary_loops_of(&edges);
@@ -317,6 +336,7 @@ pub fn clean_mesh(
         faces_in,
         slivers_dropped: dropped.slivers,
         repeated_faces_dropped: dropped.repeats,
+        manifold,
         area_in: mesh.area(),
         area_facing_one_way: mesh.area_facing_one_way(),
         ..Default::default()
