@@ -8,7 +8,9 @@ tests/python/synthetic.py (the paper's blade at 4, 8, 16 and 34 mm, the
 notched plate, the curved disc, a cylinder wrapped 110 degrees past both
 silhouettes), sampled with seeds the tests do not use, and runs
 
-- `clean` on each sampling's jagged mesh (tests/python/jagged.py),
+- `clean` on each sampling's jagged mesh (tests/python/jagged.py), and
+  `clean --repair` on it with a tenth of its faces turned and fins stood
+  on a hundredth of its edges (each must be taken out),
 - `mesh` on each cloud (not the wrapped cylinder, which no plane sees as
   a height field: it is refused, as it should be),
 - the main job on the screened-Poisson mesh of the blades at 4 and 8 mm,
@@ -87,6 +89,7 @@ def run(args):
 def soak_clean(cloud, work):
     """(failures, remarks) of `clean` on the sampling's jagged mesh."""
     v, f, _ = jagged.jagged_mesh(cloud)
+    repair = soak_repair(v, f, len(f), work)
     src, out, rep = work / "jagged.ply", work / "clean.ply", work / "clean.json"
     synthetic.write_mesh_ply(src, v, f, double=True)
     r = run(["clean", src, out, "--report", rep])
@@ -98,7 +101,53 @@ def soak_clean(cloud, work):
     remarks = [f"clean left {x['vertices']}: {x['reason']}" for x in report["loops_left"]]
     if report["faces_added"] and report["min_angle_new"] < 5.0:
         remarks.append(f"clean's smallest new angle {report['min_angle_new']:.2f}°")
-    return failures, remarks
+    return failures + repair[0], remarks
+
+
+def damaged(v, f, seed):
+    """The mesh with a tenth of its faces wound the wrong way and fins (a
+    thin face standing on an edge) on a hundredth of its interior edges
+    whose faces are both larger than the fin: what `clean --repair` takes
+    out; (vertices, faces, fins, turned)."""
+    rng = np.random.default_rng(seed)
+    edges = {}
+    for i, face in enumerate(f):
+        for k in range(3):
+            a, b = sorted((face[k], face[(k + 1) % 3]))
+            edges.setdefault((a, b), []).append(i)
+    area = poisson.triangle_areas(v, f)
+    new_v, fins = [v], []
+    for (a, b), faces in sorted(edges.items()):
+        length = np.linalg.norm(v[a] - v[b])
+        fin_area = 0.5 * length * 0.05 * length
+        if len(faces) == 2 and area[faces].min() > 2 * fin_area and rng.random() < 0.01:
+            normal = np.cross(v[f[faces[0]][1]] - v[f[faces[0]][0]], v[f[faces[0]][2]] - v[f[faces[0]][0]])
+            tip = (v[a] + v[b]) / 2 + 0.05 * length * normal / np.linalg.norm(normal)
+            new_v.append(tip[None])
+            fins.append([a, b, len(v) + len(fins)])
+    turn = rng.random(len(f)) < 0.1
+    out_f = f.copy()
+    out_f[turn] = out_f[turn][:, [0, 2, 1]]
+    return np.vstack(new_v), np.vstack([out_f, np.array(fins, dtype=f.dtype).reshape(-1, 3)]), len(fins), int(turn.sum())
+
+
+def soak_repair(v, f, seed, work):
+    """(failures, remarks) of `clean --repair` on the jagged mesh damaged
+    (see `damaged`): it must write a valid mesh, taking out each fin and
+    turning back each face turned."""
+    dv, df, fins, turned = damaged(v, f, seed)
+    src, out, rep = work / "damaged.ply", work / "repaired.ply", work / "repaired.json"
+    synthetic.write_mesh_ply(src, dv, df, double=True)
+    r = run(["clean", src, out, "--repair", "--report", rep])
+    if r.returncode:
+        return [f"clean --repair exited {r.returncode}: {r.stderr.strip()[-300:]}"], []
+    wrong = broken(*poisson.load_mesh(out))
+    failures = [f"clean --repair wrote a broken mesh: {wrong}"] if wrong else []
+    report = json.loads(rep.read_text())
+    got = (report["crowded_faces_removed"], report["faces_flipped"], report["one_sided_faces_removed"])
+    if got != (fins, turned, 0):
+        failures.append(f"clean --repair took out {got} (fins, turned, one-sided), not {(fins, turned, 0)}")
+    return failures, []
 
 
 def soak_mesh(name, cloud, work):

@@ -256,7 +256,7 @@ fn refused_unless_repaired(error: trim::CleanError, repair: bool) -> anyhow::Err
 }
 
 /// What [`refused_unless_repaired`] adds, in the library's words.
-pub const REPAIR_ADVICE: &str =
+const REPAIR_ADVICE: &str =
     "or clean with repair on, which removes faces from edges of more than two and turns faces to agree";
 
 impl Report {

@@ -32,7 +32,8 @@ use std::collections::VecDeque;
 use super::Mesh;
 use crate::hash::HashMap;
 
-/// What [`make_manifold`] changed.
+/// What [`CleanOptions::repair`](crate::CleanOptions::repair) changed to
+/// make a mesh edge-manifold and consistently oriented.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct ManifoldRepair {
     /// Faces removed from edges shared by more than two faces.

@@ -11,7 +11,7 @@ pub(crate) fn check_manifold(mesh: &Mesh) -> Result<(), MeshError> {
     check_manifold_with(mesh, &EdgeRows::new(&mesh.faces))
 }
 
-/// [`check_manifold`] with the mesh's directed edges already built. Where
+/// [`check_manifold`] with the mesh's edge rows already built. Where
 /// every face has three distinct vertices and no directed edge repeats,
 /// an undirected edge is run at most once each way, so at most twice: the
 /// mesh passes without counting each edge's uses, the costly part on a
