@@ -325,12 +325,12 @@ fn cube_map_direction(bin: usize) -> Point3 {
     d.map(|c| c / length)
 }
 
-/// [`Mesh::sorted_edges`] of a list of faces (which need not be a whole
-/// mesh's: the faces of one part of it, say).
-pub fn sorted_edges_of(faces: &[[u32; 3]]) -> Vec<(u32, u32, u32)> {
-    // Sized by the largest index used, so a face that names a vertex
-    // past the end (an invalid mesh, which `validate` reports) still
-    // gets its edges instead of a panic.
+/// Where each vertex's row starts when every edge of `faces` is filed
+/// under its smaller vertex (row v is `start[v]..start[v + 1]`): a
+/// counting sort's offsets. Sized by the largest index the faces name, so
+/// a face that names a vertex past the end (an invalid mesh, which
+/// `validate` reports) still gets its edges instead of a panic.
+pub(crate) fn rows_by_smaller_vertex(faces: &[[u32; 3]]) -> Vec<u32> {
     let vertices = faces.iter().flatten().max().map_or(0, |&v| v as usize + 1);
     let mut start = vec![0u32; vertices + 1];
     for face in faces {
@@ -341,6 +341,14 @@ pub fn sorted_edges_of(faces: &[[u32; 3]]) -> Vec<(u32, u32, u32)> {
     for v in 1..start.len() {
         start[v] += start[v - 1];
     }
+    start
+}
+
+/// [`Mesh::sorted_edges`] of a list of faces (which need not be a whole
+/// mesh's: the faces of one part of it, say).
+pub fn sorted_edges_of(faces: &[[u32; 3]]) -> Vec<(u32, u32, u32)> {
+    let start = rows_by_smaller_vertex(faces);
+    let vertices = start.len() - 1;
     let mut edges = vec![(0u32, 0u32, 0u32); 3 * faces.len()];
     let mut fill = start.clone();
     for (f, face) in faces.iter().enumerate() {

@@ -1,7 +1,7 @@
 //! Mesh topology: edge uses counted by sorting, the manifold and
 //! orientation check, and the faces round each vertex.
 
-use super::Mesh;
+use super::{rows_by_smaller_vertex, Mesh};
 use crate::error::MeshError;
 use crate::hash::HashMap;
 
@@ -85,19 +85,10 @@ pub(crate) struct EdgeRows {
 }
 
 impl EdgeRows {
-    /// The edges of `faces`, sized by the largest index they name (an
-    /// index past a mesh's vertices gets its row, not a panic).
+    /// The edges of `faces` (rows as [`rows_by_smaller_vertex`]).
     pub(crate) fn new(faces: &[[u32; 3]]) -> Self {
-        let vertices = faces.iter().flatten().max().map_or(0, |&v| v as usize + 1);
-        let mut start = vec![0u32; vertices + 1];
-        for face in faces {
-            for k in 0..3 {
-                start[face[k].min(face[(k + 1) % 3]) as usize + 1] += 1;
-            }
-        }
-        for v in 1..start.len() {
-            start[v] += start[v - 1];
-        }
+        let start = rows_by_smaller_vertex(faces);
+        let vertices = start.len() - 1;
         let mut entries = vec![0u64; 3 * faces.len()];
         let mut fill = start.clone();
         for face in faces {
