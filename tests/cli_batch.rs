@@ -379,7 +379,8 @@ fn bad_files_fail_alone_and_the_reports_say_why() {
             "read_ms",
             "algorithm_ms",
             "write_ms",
-            "total_ms"
+            "total_ms",
+            "repaired"
         ]
     );
     assert_eq!(rows.len(), 5, "{rows:?}");
@@ -844,7 +845,28 @@ fn repair_lets_a_mesh_wound_both_ways_through() {
     assert_eq!(files[1]["status"], "failed");
     let error = files[1]["error"].as_str().unwrap();
     assert!(error.contains("clean with --repair"), "{error}");
-    assert_ok(&batch(d, &["scans", "--out-dir", "fixed", "--repair"]));
+    let run = batch(
+        d,
+        &[
+            "scans",
+            "--out-dir",
+            "fixed",
+            "--repair",
+            "--report",
+            "fixed.csv",
+        ],
+    );
+    assert_ok(&run);
+    // The file repaired says how many faces were turned; the other none.
+    let turned = count.div_ceil(5);
+    assert!(
+        text(&run.stdout).contains(&format!("repaired={turned}")),
+        "{}",
+        text(&run.stdout)
+    );
+    let rows = parse_csv(&std::fs::read_to_string(d.join("fixed.csv")).unwrap());
+    assert_eq!(rows[0][12], "repaired");
+    assert_eq!([&rows[1][12], &rows[2][12]], ["0", &turned.to_string()]);
     let single = d.join("single.stl");
     let run = Command::new(env!("CARGO_BIN_EXE_meshtrim"))
         .args([

@@ -62,6 +62,8 @@ pub struct CleanOutcome {
     pub write_ms: f64,
     /// The input's largest share of area facing one direction.
     pub area_facing_one_way: f64,
+    /// Faces `--repair` removed or turned.
+    pub repaired: usize,
 }
 
 /// Below this share of its area facing one direction, a mesh with a
@@ -183,6 +185,7 @@ pub fn clean_file(
         clean_ms: ((r.resolution_ms + r.clean_ms) * 10.0).round() / 10.0,
         write_ms: r.write_ms,
         area_facing_one_way: r.area_facing_one_way,
+        repaired: r.crowded_faces_removed + r.faces_flipped + r.one_sided_faces_removed,
     })
 }
 

@@ -171,6 +171,7 @@ fn process(job: &Job, skip_existing: bool, repair: bool, stages: &Stages) -> Row
         algorithm_ms: None,
         write_ms: None,
         total_ms: 0.0,
+        repaired: None,
         note: None,
     };
     if skip_existing && job.output.exists() {
@@ -187,6 +188,7 @@ fn process(job: &Job, skip_existing: bool, repair: bool, stages: &Stages) -> Row
             row.read_ms = Some(o.read_ms);
             row.algorithm_ms = Some(o.algorithm_ms);
             row.write_ms = Some(o.write_ms);
+            row.repaired = o.repaired;
             row.note = o.note;
         }
         Err(e) => {
@@ -226,6 +228,7 @@ fn work(job: &Job, repair: bool, stages: &Stages) -> Result<Outcome> {
                 read_ms: o.read_ms,
                 algorithm_ms: o.clean_ms,
                 write_ms: o.write_ms,
+                repaired: Some(o.repaired),
                 note: if o.loops_in == 0 {
                     Some(CLOSED)
                 } else {
@@ -247,6 +250,7 @@ fn work(job: &Job, repair: bool, stages: &Stages) -> Result<Outcome> {
                 read_ms: r.read_ms,
                 algorithm_ms: ((r.detect_ms + r.edges_ms + r.trim_ms) * 10.0).round() / 10.0,
                 write_ms: r.write_ms,
+                repaired: None,
                 note: None,
             })
         }

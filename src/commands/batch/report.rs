@@ -66,6 +66,8 @@ pub struct Outcome {
     pub algorithm_ms: f64,
     /// Writing, in milliseconds.
     pub write_ms: f64,
+    /// Faces `--repair` removed or turned (none for a trim).
+    pub repaired: Option<usize>,
     /// What the user should know about the file (a closed mesh cleaned).
     pub note: Option<&'static str>,
 }
@@ -98,6 +100,9 @@ pub struct Row {
     pub write_ms: Option<f64>,
     /// Wall-clock time of the file, in milliseconds.
     pub total_ms: f64,
+    /// Faces `--repair` removed or turned to make the mesh manifold and
+    /// oriented (cleaned files only).
+    pub repaired: Option<usize>,
     /// What the user should know about the file, when anything.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub note: Option<&'static str>,
@@ -109,9 +114,13 @@ impl Row {
         let secs = self.total_ms / 1000.0;
         let mode = self.mode.name();
         let note = self.note.map(|n| format!("  ({n})")).unwrap_or_default();
+        let repaired = match self.repaired {
+            Some(n) if n > 0 => format!("  repaired={n}"),
+            _ => String::new(),
+        };
         match self.status {
             Status::Ok => format!(
-                "ok      {mode:<5}  {}  loops={}  faces {}→{}  {secs:.2} s{note}",
+                "ok      {mode:<5}  {}  loops={}  faces {}→{}{repaired}  {secs:.2} s{note}",
                 self.input,
                 self.loops.unwrap_or(0),
                 self.faces_in.unwrap_or(0),
@@ -127,7 +136,7 @@ impl Row {
     }
 
     /// The row's CSV fields, in [`CSV_HEADER`] order.
-    fn csv_fields(&self) -> [String; 12] {
+    fn csv_fields(&self) -> [String; 13] {
         let opt = |v: Option<String>| v.unwrap_or_default();
         [
             self.input.clone(),
@@ -142,12 +151,13 @@ impl Row {
             opt(self.algorithm_ms.map(|v| v.to_string())),
             opt(self.write_ms.map(|v| v.to_string())),
             self.total_ms.to_string(),
+            opt(self.repaired.map(|v| v.to_string())),
         ]
     }
 }
 
 /// The CSV columns.
-pub const CSV_HEADER: [&str; 12] = [
+pub const CSV_HEADER: [&str; 13] = [
     "input",
     "output",
     "mode",
@@ -160,6 +170,7 @@ pub const CSV_HEADER: [&str; 12] = [
     "algorithm_ms",
     "write_ms",
     "total_ms",
+    "repaired",
 ];
 
 /// The report formats, by the file's extension.
