@@ -70,8 +70,10 @@ impl Band {
         let mesh = cx.mesh;
         let projection = Projection::of(cx, &self.faces);
         let mut rings = projected_rings(cx, group, &projection);
-        let (grid, _) = untwist(&mut rings, GRID_CELL * cx.beta_median, MAX_UNTWIST)
+        let cell = GRID_CELL * cx.beta_median;
+        let (grid, _) = untwist(&mut rings, cell, MAX_UNTWIST)
             .map_err(|tangle| untwist_failure(tangle, &rings))?;
+        let (rings, grid) = apart(rings, grid, cell);
         let stay = self.staying_vertices(cx, group, &projection, &grid, &rings);
         let removed = self.cut_faces(mesh, &projection, &grid, &stay);
         let turned = self.turned_faces(mesh, &projection);
@@ -345,6 +347,19 @@ pub(super) fn projected_rings(cx: &Context, group: &[usize], projection: &Projec
 }
 
 /// The directed edges of the borders of the group's loops.
+/// The rings with loops that nearly touch moved apart to [`LOOP_GAP`]·β
+/// ([`kept_apart`]) where that makes no crossing, and their segment grid
+/// (cells no smaller than `cell`).
+fn apart(rings: Vec<Ring>, grid: SegmentGrid, cell: f64) -> (Vec<Ring>, SegmentGrid) {
+    if let Some(moved) = kept_apart(&rings, &grid, LOOP_GAP) {
+        let moved_grid = SegmentGrid::new(&moved, cell);
+        if moved_grid.first_crossing().is_none() {
+            return (moved, moved_grid);
+        }
+    }
+    (rings, grid)
+}
+
 pub(super) fn group_border_edges(cx: &Context, group: &[usize]) -> BTreeSet<(u32, u32)> {
     group
         .iter()

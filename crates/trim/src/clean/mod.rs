@@ -99,7 +99,7 @@ use crate::mesh::repair::{repair_degenerate_faces, FaceRepair};
 use crate::mesh::topology::{check_manifold, check_manifold_with, distinct, EdgeRows, Topology};
 use crate::mesh::{lowest_first, Mesh};
 use crate::planar::{
-    inside_faces, obstacle, untwist, Cdt, Node, Ring, SegmentGrid, Tangle, STEINER,
+    inside_faces, kept_apart, obstacle, untwist, Cdt, Node, Ring, SegmentGrid, Tangle, STEINER,
 };
 use crate::spatial::neighbours::NeighbourIndex;
 
@@ -111,6 +111,9 @@ const MARGIN: f64 = 0.5;
 /// (where the low-pass filter pulls the two sides of a deep, narrow notch
 /// across each other, the notch is cut off).
 const MAX_UNTWIST: f64 = 0.15;
+/// Smoothed loops of one band closer than this many β (in its projection)
+/// are moved apart to it: the strip between them would have no width.
+const LOOP_GAP: f64 = 0.25;
 /// Consecutive smoothed loop vertices closer than this many β are merged:
 /// where a zig-zag border is smoothed, its vertices bunch up, and a short
 /// border segment against interior vertices a spacing away makes a

@@ -21,7 +21,7 @@ use spade::{
 pub(crate) use diagonals::{canonical_diagonals, cocircular};
 #[cfg(test)]
 pub(crate) use ring::flat_ring;
-pub(crate) use ring::{untwist, Ring, Tangle};
+pub(crate) use ring::{kept_apart, untwist, Ring, Tangle};
 pub(crate) use segment_grid::{Contact, SegmentGrid};
 #[cfg(test)]
 pub(crate) use tangle::pinched_faces;

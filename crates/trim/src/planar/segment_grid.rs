@@ -160,24 +160,40 @@ impl SegmentGrid {
     /// the exact side `p` lies on (1 left of it as it runs, −1 right, 0 on
     /// its line).
     pub(crate) fn nearest(&self, p: [f64; 2], radius: f64) -> Option<(u32, f64)> {
+        self.nearest_where(p, radius, |_| true)
+            .map(|(s, _)| (s, orientation(self.a[s as usize], self.b[s as usize], p)))
+    }
+
+    /// The segment `s` nearest to `p` within `radius` among those for
+    /// which `accept(s)` holds (the lower index on a tie), and the
+    /// parameter of its point nearest to `p` (0 at its start, 1 at its
+    /// end).
+    pub(crate) fn nearest_where(
+        &self,
+        p: [f64; 2],
+        radius: f64,
+        accept: impl Fn(u32) -> bool,
+    ) -> Option<(u32, f64)> {
         if self.a.is_empty() {
             return None;
         }
         let (c0, c1) = (self.col(p[0] - radius), self.col(p[0] + radius));
         let (r0, r1) = (self.row(p[1] - radius), self.row(p[1] + radius));
-        let mut best: Option<(f64, u32)> = None;
+        let mut best: Option<(f64, u32, f64)> = None;
         for r in r0..=r1 {
             for c in c0..=c1 {
                 for &s in &self.cells[r * self.nx + c] {
-                    let d = dist2d(p, closest_on(self.a[s as usize], self.b[s as usize], p));
-                    let better = best.is_none_or(|(bd, bs)| d < bd || (d == bd && s < bs));
-                    if d < radius && better {
-                        best = Some((d, s));
+                    let (a, b) = (self.a[s as usize], self.b[s as usize]);
+                    let t = parameter_on(a, b, p);
+                    let d = dist2d(p, point_at(a, b, t));
+                    let better = best.is_none_or(|(bd, bs, _)| d < bd || (d == bd && s < bs));
+                    if d < radius && better && accept(s) {
+                        best = Some((d, s, t));
                     }
                 }
             }
         }
-        best.map(|(_, s)| (s, orientation(self.a[s as usize], self.b[s as usize], p)))
+        best.map(|(_, s, t)| (s, t))
     }
 
     /// Every place where two segments meet other than at the vertex two
@@ -342,12 +358,21 @@ impl SegmentGrid {
 
 /// The point of segment ab nearest to `p`.
 fn closest_on(a: [f64; 2], b: [f64; 2], p: [f64; 2]) -> [f64; 2] {
+    point_at(a, b, parameter_on(a, b, p))
+}
+
+/// The parameter of the point of segment a–b nearest to `p`.
+fn parameter_on(a: [f64; 2], b: [f64; 2], p: [f64; 2]) -> f64 {
     let ab = [b[0] - a[0], b[1] - a[1]];
     let len2 = ab[0] * ab[0] + ab[1] * ab[1];
-    let t = if len2 > 0.0 {
+    if len2 > 0.0 {
         (((p[0] - a[0]) * ab[0] + (p[1] - a[1]) * ab[1]) / len2).clamp(0.0, 1.0)
     } else {
         0.0
-    };
-    [a[0] + t * ab[0], a[1] + t * ab[1]]
+    }
+}
+
+/// The point at parameter `t` of segment a–b.
+pub(crate) fn point_at(a: [f64; 2], b: [f64; 2], t: f64) -> [f64; 2] {
+    [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]
 }
