@@ -98,6 +98,9 @@ pub struct Report {
     /// Input faces that repeated an earlier one (same corners, same turn),
     /// dropped.
     pub repeated_faces_dropped: usize,
+    /// With `--repair`: faces removed for repeating another's corners in
+    /// the opposite turn (a surface written twice, once each way).
+    pub double_sided_faces_removed: usize,
     /// With `--repair`: faces removed from edges of more than two faces.
     pub crowded_faces_removed: usize,
     /// With `--repair`: faces turned over to agree with their neighbours.
@@ -185,7 +188,10 @@ pub fn clean_file(
         clean_ms: ((r.resolution_ms + r.clean_ms) * 10.0).round() / 10.0,
         write_ms: r.write_ms,
         area_facing_one_way: r.area_facing_one_way,
-        repaired: r.crowded_faces_removed + r.faces_flipped + r.one_sided_faces_removed,
+        repaired: r.double_sided_faces_removed
+            + r.crowded_faces_removed
+            + r.faces_flipped
+            + r.one_sided_faces_removed,
     })
 }
 
@@ -283,6 +289,7 @@ impl Report {
             faces_in: r.faces_in,
             slivers_dropped: r.slivers_dropped,
             repeated_faces_dropped: r.repeated_faces_dropped,
+            double_sided_faces_removed: r.manifold.double_sided_faces_removed,
             crowded_faces_removed: r.manifold.crowded_faces_removed,
             faces_flipped: r.manifold.faces_flipped,
             one_sided_faces_removed: r.manifold.one_sided_faces_removed,
@@ -395,14 +402,19 @@ impl crate::report::Table for Report {
                 ),
             );
         }
-        if self.crowded_faces_removed + self.faces_flipped + self.one_sided_faces_removed > 0 {
+        let repaired = self.double_sided_faces_removed
+            + self.crowded_faces_removed
+            + self.faces_flipped
+            + self.one_sided_faces_removed;
+        if repaired > 0 {
             rows.insert(
                 3,
                 (
                     "repaired",
                     format!(
-                        "{} faces removed from edges of 3+ faces, {} turned over, {} removed \
-                         from one-sided pieces",
+                        "{} faces removed as second sides, {} from edges of 3+ faces, {} turned \
+                         over, {} removed from one-sided pieces",
+                        self.double_sided_faces_removed,
                         self.crowded_faces_removed,
                         self.faces_flipped,
                         self.one_sided_faces_removed

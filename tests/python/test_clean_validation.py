@@ -78,7 +78,7 @@ import crops  # noqa: E402
 import jagged  # noqa: E402
 import poisson  # noqa: E402
 import synthetic  # noqa: E402
-from meshtrim_cli import MESHTRIM, REAL_MESHES, run_meshtrim, shared_data  # noqa: E402
+from meshtrim_cli import MESHTRIM, REAL_MESHES, ROOT, run_meshtrim, shared_data  # noqa: E402
 
 CASES = synthetic.VALIDATION_CASES
 
@@ -604,16 +604,21 @@ def test_wrapped_cylinder_border_on_the_truth(seed, tmp_path):
     assert report["min_angle_new"] >= 10.0, report
 
 
-def pymeshlab_non_manifold_repair(path):
-    """Faces PyMeshLab's "Repair non Manifold Edges" removes (by removing
-    faces) from the mesh in `path`, and the face count it leaves."""
+def pymeshlab_repair(path):
+    """What PyMeshLab's "Remove Duplicate Faces" then "Repair non Manifold
+    Edges" (by removing faces) remove from the mesh in `path`: (faces
+    repeating another's corners, in either turn; faces taken off edges of
+    three or more faces)."""
     import pymeshlab
 
     ms = pymeshlab.MeshSet()
     ms.load_new_mesh(str(path))
-    before = ms.current_mesh().face_number()
+    counts = [ms.current_mesh().face_number()]
+    ms.meshing_remove_duplicate_faces()
+    counts.append(ms.current_mesh().face_number())
     ms.meshing_repair_non_manifold_edges(method=0)
-    return before - ms.current_mesh().face_number()
+    counts.append(ms.current_mesh().face_number())
+    return counts[0] - counts[1], counts[1] - counts[2]
 
 
 @pytest.mark.parametrize("name", ["bun_zipper_res2", "bun_zipper_res3"])
@@ -621,25 +626,42 @@ def test_repair_removes_the_faces_pymeshlab_removes(name, tmp_path):
     """The zippered bunny's decimations have 150 and 140 edges of three or
     more faces once their repeated faces are dropped (the Stanford README
     warns that their topology is not kept): `clean` refuses them, naming
-    `--repair`; with it the faces on those edges are removed as PyMeshLab's
-    own repair removes them, smallest first. PyMeshLab's count holds the
-    repeated faces too (a triangle written twice makes its edges crowded),
-    which `clean` drops before and counts apart: 177 + 6 and 156 + 14
-    against 183 and 170. PyMeshLab finds the cleaned mesh manifold and
-    oriented."""
+    `--repair`; with it the faces repeated in either turn (87 and 83: 6 and
+    14 in the same turn, dropped by `clean` anyway, and 81 and 69 the other
+    way) and then those on crowded edges (92 and 73, smallest first) go,
+    face for face as many as PyMeshLab's "Remove Duplicate Faces" and
+    "Repair non Manifold Edges" remove, and PyMeshLab finds the cleaned
+    mesh manifold and oriented."""
     src = shared_data(f"stanford_bunny/{name}.ply")
     out, report = tmp_path / "out.ply", tmp_path / "r.json"
     refused = subprocess.run([str(MESHTRIM), "clean", str(src), str(out)], capture_output=True, text=True)
     assert refused.returncode == 1 and "clean with --repair" in refused.stderr, refused.stderr
     run_meshtrim("clean", src, out, "--repair", "--report", report)
     rep = json.loads(report.read_text())
-    removed = rep["crowded_faces_removed"] + rep["repeated_faces_dropped"]
-    assert rep["crowded_faces_removed"] > 100 and removed == pymeshlab_non_manifold_repair(src), rep
+    repeats = rep["repeated_faces_dropped"] + rep["double_sided_faces_removed"]
+    assert rep["crowded_faces_removed"] > 50 and (repeats, rep["crowded_faces_removed"]) == pymeshlab_repair(src), rep
     v, f = read_mesh(out)
     pm = poisson.pymeshlab_validity(v, f)
     assert pm["non_manifold_edges"] == 0 and pm["reoriented"] == 0, pm
     assert pm["null_faces"] == 0 and pm["duplicate_faces"] == 0, pm
     assert rep["loops_smoothed"] > 0, rep
+
+
+def test_a_double_sided_scan_keeps_one_side(tmp_path):
+    """The fixture with every face written again the other way (a
+    double-sided export): with `--repair` one copy of each goes and the
+    scan is cleaned to the bytes of the fixture's own cleanup."""
+    v, f = poisson.load_mesh(ROOT / "fixtures" / "meshes" / "blade_jagged.stl")
+    double = tmp_path / "double.ply"
+    synthetic.write_mesh_ply(double, v, np.vstack([f, f[:, [0, 2, 1]]]), double=True)
+    single = tmp_path / "single.ply"
+    synthetic.write_mesh_ply(single, v, f, double=True)
+    outs = [tmp_path / "double_out.ply", tmp_path / "single_out.ply"]
+    run_meshtrim("clean", double, outs[0], "--repair", "--report", tmp_path / "r.json")
+    run_meshtrim("clean", single, outs[1])
+    assert outs[0].read_bytes() == outs[1].read_bytes()
+    rep = json.loads((tmp_path / "r.json").read_text())
+    assert rep["double_sided_faces_removed"] == len(f) and rep["crowded_faces_removed"] == 0, rep
 
 
 def test_fan_boundary_loops_split_pinched_vertices():

@@ -10,17 +10,23 @@
 //! wrong way; the cleanup needs every edge used at most twice and run
 //! opposite ways by its two faces.
 //!
-//! 1. **Edges of more than two faces.** The faces on such edges are taken
+//! 1. **Surfaces written twice.** A face with the corners of an earlier
+//!    one in the opposite turn (an exporter that wrote a patch once each
+//!    way, or a double-sided shell) goes, the first copy staying: the
+//!    turn is settled in step 3. Left in, each such edge has four faces,
+//!    and taking them smallest first leaves faces of both copies, then
+//!    pockets of no volume (a double-sided scan loses every face).
+//! 2. **Edges of more than two faces.** The faces on such edges are taken
 //!    smallest first (by area, then index) and each is removed while one
 //!    of its edges still has more than two faces: MeshLab's rule (vcglib's
 //!    `RemoveNonManifoldFace`), which keeps the larger faces, usually the
 //!    surface's own, and drops what was stitched onto them.
-//! 2. **Orientation.** Each piece (faces joined through edges of two faces)
+//! 3. **Orientation.** Each piece (faces joined through edges of two faces)
 //!    is walked from its lowest face, breadth first, and every face is
 //!    turned to agree with the face it was reached from. A piece then keeps
 //!    the turn most of its area had: where a few faces were wound the wrong
 //!    way, those are the ones turned.
-//! 3. **One-sided pieces.** Where a face reached another way still
+//! 4. **One-sided pieces.** Where a face reached another way still
 //!    disagrees (a piece with one side, as a Möbius strip), the smaller face
 //!    of that edge is removed, which leaves every other edge agreeing.
 //!
@@ -30,12 +36,15 @@
 use std::collections::VecDeque;
 
 use super::Mesh;
-use crate::hash::HashMap;
+use crate::hash::{HashMap, HashSet};
 
 /// What [`CleanOptions::repair`](crate::CleanOptions::repair) changed to
 /// make a mesh edge-manifold and consistently oriented.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct ManifoldRepair {
+    /// Faces removed for repeating an earlier face's corners in the
+    /// opposite turn (a surface written twice, once each way).
+    pub double_sided_faces_removed: usize,
     /// Faces removed from edges shared by more than two faces.
     pub crowded_faces_removed: usize,
     /// Faces turned over to agree with their neighbours.
@@ -47,16 +56,22 @@ pub struct ManifoldRepair {
 impl ManifoldRepair {
     /// Faces removed or turned in all.
     pub fn changed(&self) -> usize {
-        self.crowded_faces_removed + self.faces_flipped + self.one_sided_faces_removed
+        self.double_sided_faces_removed
+            + self.crowded_faces_removed
+            + self.faces_flipped
+            + self.one_sided_faces_removed
     }
 }
 
 /// `mesh` (whose faces each name three vertices) made edge-manifold and
 /// consistently oriented: see the module doc.
 pub(crate) fn make_manifold(mesh: &Mesh) -> (Mesh, ManifoldRepair) {
-    let mut keep = vec![true; mesh.faces.len()];
-    let crowded = remove_faces_on_crowded_edges(mesh, &mut keep);
     let mut out = mesh.clone();
+    let mut keep = vec![true; out.faces.len()];
+    let double_sided = remove_second_copies(&out, &mut keep);
+    out.retain_faces(&keep);
+    let mut keep = vec![true; out.faces.len()];
+    let crowded = remove_faces_on_crowded_edges(&out, &mut keep);
     out.retain_faces(&keep);
     let orientation = orient(&out);
     let mut keep = vec![true; out.faces.len()];
@@ -72,6 +87,7 @@ pub(crate) fn make_manifold(mesh: &Mesh) -> (Mesh, ManifoldRepair) {
     }
     out.retain_faces(&keep);
     let repair = ManifoldRepair {
+        double_sided_faces_removed: double_sided,
         crowded_faces_removed: crowded,
         faces_flipped: flipped,
         one_sided_faces_removed: orientation.one_sided.len(),
@@ -79,7 +95,23 @@ pub(crate) fn make_manifold(mesh: &Mesh) -> (Mesh, ManifoldRepair) {
     (out, repair)
 }
 
-/// Step 1: clears `keep` for faces taken off edges of more than two faces,
+/// Step 1: clears `keep` for every face with the corners of an earlier
+/// one (in either turn); returns how many.
+fn remove_second_copies(mesh: &Mesh, keep: &mut [bool]) -> usize {
+    let mut seen = HashSet::default();
+    let mut removed = 0;
+    for (f, face) in mesh.faces.iter().enumerate() {
+        let mut corners = *face;
+        corners.sort_unstable();
+        if !seen.insert(corners) {
+            keep[f] = false;
+            removed += 1;
+        }
+    }
+    removed
+}
+
+/// Step 2: clears `keep` for faces taken off edges of more than two faces,
 /// smallest first; returns how many.
 fn remove_faces_on_crowded_edges(mesh: &Mesh, keep: &mut [bool]) -> usize {
     let mut uses: HashMap<(u32, u32), usize> = HashMap::default();
@@ -123,7 +155,7 @@ fn undirected_edges(face: [u32; 3]) -> [(u32, u32); 3] {
     })
 }
 
-/// Steps 2 and 3: which faces to turn, and which to remove.
+/// Steps 3 and 4: which faces to turn, and which to remove.
 struct Orientation {
     turn: Vec<bool>,
     one_sided: Vec<u32>,
@@ -258,6 +290,20 @@ mod tests {
     }
 
     #[test]
+    fn a_surface_written_twice_keeps_one_copy() {
+        // Every face of a grid again the other way: a double-sided shell.
+        let original = grid(6);
+        let mut mesh = original.clone();
+        mesh.faces
+            .extend(original.faces.iter().map(|f| [f[0], f[2], f[1]]));
+        assert!(mesh.check_manifold().is_err());
+        let (out, repair) = make_manifold(&mesh);
+        assert_eq!(repair.double_sided_faces_removed, original.faces.len());
+        assert_eq!(repair.changed(), original.faces.len(), "{repair:?}");
+        assert_eq!(out.faces, original.faces);
+    }
+
+    #[test]
     fn faces_wound_the_wrong_way_are_turned_back() {
         let mut rng = ChaCha8Rng::seed_from_u64(3);
         for case in 0..50 {
@@ -343,7 +389,9 @@ mod tests {
                 out.faces.iter().all(|&f| faces_in.contains(&sorted(f))),
                 "{case}"
             );
-            let removed = repair.crowded_faces_removed + repair.one_sided_faces_removed;
+            let removed = repair.double_sided_faces_removed
+                + repair.crowded_faces_removed
+                + repair.one_sided_faces_removed;
             assert_eq!(out.faces.len() + removed, mesh.faces.len(), "{case}");
             repaired += usize::from(repair.changed() > 0);
         }
