@@ -213,6 +213,38 @@ fn faces_wound_the_wrong_way_are_turned_back_with_repair() {
     assert_eq!(json["crowded_faces_removed"], 0);
 }
 
+/// A mesh of nothing but triangles written once each way (each pair a
+/// pocket of no volume, which the output's repair removes): a clear error,
+/// not an empty file written with success.
+#[test]
+fn a_mesh_the_repairs_empty_is_a_clear_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("pockets.obj");
+    let mut text = String::new();
+    for t in 0..40u32 {
+        // Scattered triangles, far enough apart to give every vertex a
+        // neighbourhood of its own.
+        let (x, y) = (f64::from(t % 8) * 3.0, f64::from(t / 8) * 3.0);
+        text += &format!(
+            "v {x} {y} 0\nv {} {y} 0.3\nv {x} {} 0.6\n",
+            x + 1.0,
+            y + 1.0
+        );
+    }
+    for t in 0..40u32 {
+        let a = 3 * t + 1;
+        text += &format!("f {a} {} {}\nf {a} {} {}\n", a + 1, a + 2, a + 2, a + 1);
+    }
+    std::fs::write(&input, text).unwrap();
+    let output = dir.path().join("o.obj");
+    let run = meshtrim(&["clean", s(&input), s(&output)], None);
+    assert_clean_failure(
+        &run,
+        "no face would be left: the repairs remove all 80 faces",
+    );
+    assert!(!output.exists());
+}
+
 #[test]
 fn a_truncated_file_is_a_clear_error() {
     let dir = tempfile::tempdir().unwrap();

@@ -227,4 +227,12 @@ pub enum CleanError {
         /// Vertices of the mesh.
         vertices: usize,
     },
+    /// Every face of the mesh is one the cleanup's repairs remove (pairs of
+    /// one triangle wound both ways, which enclose no volume; faces of no
+    /// area), so nothing would be written.
+    #[error("no face would be left: the repairs remove all {faces} faces (triangles written once each way, pockets of no volume, or faces of no area)")]
+    NothingLeft {
+        /// Faces of the mesh.
+        faces: usize,
+    },
 }

@@ -703,6 +703,11 @@ fn finish(
     report.pinch_faces_dropped = open_new_pinches(input, &out, &mut keep);
     out.retain_faces(&keep);
     report.repaired = repair_degenerate_faces(&mut out);
+    if out.faces.is_empty() {
+        return Err(CleanError::NothingLeft {
+            faces: report.faces_in,
+        });
+    }
     out.remove_unused_vertices();
     check_manifold(&out)?;
     report.faces_out = out.faces.len();
