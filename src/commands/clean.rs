@@ -30,9 +30,10 @@ pub struct Args {
     #[arg(long, value_name = "FILE.json")]
     pub report: Option<PathBuf>,
     /// Repair a mesh that is not edge-manifold or consistently oriented
-    /// instead of refusing it: faces on edges of more than two faces are
-    /// removed (smallest first, as MeshLab's "Repair non Manifold Edges"),
-    /// faces wound against their neighbours turned over.
+    /// instead of refusing it: a face written again the other way goes
+    /// (one side kept), then faces on edges of more than two faces
+    /// (smallest first, as MeshLab's "Repair non Manifold Edges"), and
+    /// faces wound against their neighbours are turned over.
     #[arg(long)]
     pub repair: bool,
     /// Detection and edge options.
@@ -188,10 +189,7 @@ pub fn clean_file(
         clean_ms: ((r.resolution_ms + r.clean_ms) * 10.0).round() / 10.0,
         write_ms: r.write_ms,
         area_facing_one_way: r.area_facing_one_way,
-        repaired: r.double_sided_faces_removed
-            + r.crowded_faces_removed
-            + r.faces_flipped
-            + r.one_sided_faces_removed,
+        repaired: r.repaired(),
     })
 }
 
@@ -333,6 +331,14 @@ impl Report {
         })
     }
 
+    /// Faces `--repair` removed or turned.
+    fn repaired(&self) -> usize {
+        self.double_sided_faces_removed
+            + self.crowded_faces_removed
+            + self.faces_flipped
+            + self.one_sided_faces_removed
+    }
+
     /// The smallest angle of the new faces, or "none" when there are none
     /// (the number is then 0, which would read as a degenerate face).
     fn smallest_new_angle(&self) -> String {
@@ -402,11 +408,7 @@ impl crate::report::Table for Report {
                 ),
             );
         }
-        let repaired = self.double_sided_faces_removed
-            + self.crowded_faces_removed
-            + self.faces_flipped
-            + self.one_sided_faces_removed;
-        if repaired > 0 {
+        if self.repaired() > 0 {
             rows.insert(
                 3,
                 (
