@@ -58,16 +58,50 @@ fn cleans_the_fixture_and_reports() {
 #[test]
 fn same_bytes_whatever_the_threads() {
     let dir = tempfile::tempdir().unwrap();
-    let (a, b) = (dir.path().join("a.stl"), dir.path().join("b.stl"));
-    for (out, threads) in [(&a, "1"), (&b, "2")] {
-        let run = meshtrim(&["clean", JAGGED, s(out), "--json"], Some(threads));
-        assert!(
-            run.status.success(),
-            "{}",
-            String::from_utf8_lossy(&run.stderr)
-        );
+    // The fixture, and the fixture with a fin stood on one of its edges,
+    // repaired.
+    let stl = std::fs::read(JAGGED).unwrap();
+    let damaged = fixture_with(dir.path(), "damaged.stl", &[fin_on_first_edge(&stl)]).0;
+    for (input, repair) in [
+        (Path::new(JAGGED), None),
+        (damaged.as_path(), Some("--repair")),
+    ] {
+        let (a, b) = (dir.path().join("a.stl"), dir.path().join("b.stl"));
+        for (out, threads) in [(&a, "1"), (&b, "2")] {
+            let mut args = vec!["clean", s(input), s(out), "--json"];
+            args.extend(repair);
+            let run = meshtrim(&args, Some(threads));
+            assert!(
+                run.status.success(),
+                "{}",
+                String::from_utf8_lossy(&run.stderr)
+            );
+            let json: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+            let repaired = json["crowded_faces_removed"].as_u64().unwrap()
+                + json["faces_flipped"].as_u64().unwrap();
+            assert_eq!(repaired > 0, repair.is_some(), "{json}");
+        }
+        assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
     }
-    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+}
+
+/// A binary STL triangle standing on the first triangle's first edge,
+/// its tip a little off the edge's middle.
+fn fin_on_first_edge(stl: &[u8]) -> Vec<u8> {
+    let corner = |k: usize| -> [f32; 3] {
+        let at = 84 + 12 + 12 * k;
+        [0, 4, 8].map(|o| f32::from_le_bytes(stl[at + o..at + o + 4].try_into().unwrap()))
+    };
+    let (a, b) = (corner(0), corner(1));
+    let tip = [0, 1, 2].map(|c| (a[c] + b[c]) / 2.0 + if c == 2 { 0.05 } else { 0.0 });
+    let mut triangle = vec![0u8; 50];
+    for (k, p) in [a, b, tip].iter().enumerate() {
+        for (c, x) in p.iter().enumerate() {
+            let at = 12 + 12 * k + 4 * c;
+            triangle[at..at + 4].copy_from_slice(&x.to_le_bytes());
+        }
+    }
+    triangle
 }
 
 #[test]
