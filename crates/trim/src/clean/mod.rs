@@ -96,7 +96,9 @@ use crate::mesh::boundary_loops_of;
 use crate::mesh::manifold::{make_manifold, ManifoldRepair};
 use crate::mesh::pinches::open_new_pinches;
 use crate::mesh::repair::{repair_degenerate_faces, FaceRepair};
-use crate::mesh::topology::{check_manifold, check_manifold_with, distinct, EdgeRows, Topology};
+use crate::mesh::topology::{
+    check_manifold, check_manifold_with, distinct, manifold_at_a_glance, EdgeRows, Topology,
+};
 use crate::mesh::{lowest_first, Mesh};
 use crate::planar::{
     inside_faces, kept_apart, obstacle, untwist, Cdt, Node, Ring, SegmentGrid, Tangle, STEINER,
@@ -914,7 +916,7 @@ fn without_empty_faces(mesh: &Mesh) -> (Cow<'_, Mesh>, DroppedFaces, EdgeRows) {
     // A face repeated in the same turn runs its edges twice: where no edge
     // is run twice and every face has three vertices, none goes (the usual
     // case, without hashing every face).
-    if edges.no_edge_run_twice() && mesh.faces.iter().all(|&f| distinct(f)) {
+    if manifold_at_a_glance(mesh, &edges) {
         return (Cow::Borrowed(mesh), DroppedFaces::default(), edges);
     }
     let mut seen = HashSet::with_capacity_and_hasher(mesh.faces.len(), Default::default());

@@ -9,7 +9,7 @@ mod vec3;
 pub(crate) use predicates::{orient, orientation, segments_meet};
 pub(crate) use union_find::UnionFind;
 pub(crate) use vec3::{
-    add, cross, dist2, dot, norm2, scale, segment_dist2, segment_param, sub, unit,
+    add, cross, dist2, dot, lerp, lerp2, norm2, scale, segment_dist2, segment_param, sub, unit,
 };
 pub use vec3::{rotation_from_quaternion, Point3};
 

@@ -31,6 +31,16 @@ pub(crate) fn add(a: Point3, b: Point3) -> Point3 {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
 
+/// a + t (b − a).
+pub(crate) fn lerp(a: Point3, b: Point3, t: f64) -> Point3 {
+    [0, 1, 2].map(|c| a[c] + t * (b[c] - a[c]))
+}
+
+/// a + t (b − a), in the plane.
+pub(crate) fn lerp2(a: [f64; 2], b: [f64; 2], t: f64) -> [f64; 2] {
+    [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]
+}
+
 pub(crate) fn scale(a: Point3, s: f64) -> Point3 {
     a.map(|c| c * s)
 }

@@ -11,13 +11,12 @@ pub(crate) fn check_manifold(mesh: &Mesh) -> Result<(), MeshError> {
     check_manifold_with(mesh, &EdgeRows::new(&mesh.faces))
 }
 
-/// [`check_manifold`] with the mesh's edge rows already built. Where
-/// every face has three distinct vertices and no directed edge repeats,
-/// an undirected edge is run at most once each way, so at most twice: the
-/// mesh passes without counting each edge's uses, the costly part on a
-/// large mesh. Otherwise the defects are counted to say how many.
+/// [`check_manifold`] with the mesh's edge rows already built: a mesh
+/// [`manifold_at_a_glance`] passes without counting each edge's uses, the
+/// costly part on a large mesh; otherwise the defects are counted to say
+/// how many.
 pub(crate) fn check_manifold_with(mesh: &Mesh, edges: &EdgeRows) -> Result<(), MeshError> {
-    if edges.no_edge_run_twice() && mesh.faces.iter().all(|&f| distinct(f)) {
+    if manifold_at_a_glance(mesh, edges) {
         return Ok(());
     }
     let (over, misoriented) = edge_defects(mesh);
@@ -66,6 +65,14 @@ pub(crate) fn for_each_edge(mesh: &Mesh, mut visit: impl FnMut(&[(u32, u32, u32)
         }
         visit(run, forward, backward);
     }
+}
+
+/// Whether every face has three distinct vertices and no edge is run
+/// twice the same way: each edge is then run at most once each way, so
+/// used at most twice, consistently (and no face repeats another in the
+/// same turn).
+pub(crate) fn manifold_at_a_glance(mesh: &Mesh, edges: &EdgeRows) -> bool {
+    edges.no_edge_run_twice() && mesh.faces.iter().all(|&f| distinct(f))
 }
 
 /// Whether a face names three different vertices.

@@ -1,11 +1,10 @@
 //! Smoothed loops as closed polylines, and their repair where they cross
 //! themselves in a projection.
 
-use super::segment_grid::point_at;
 use super::SegmentGrid;
 use crate::edges::cluster::MIN_LOOP_POINTS;
 use crate::edges::Loop;
-use crate::geom::Point3;
+use crate::geom::{lerp, lerp2, Point3};
 
 /// Consecutive vertices of a ring closer than this many β in the
 /// projection are merged: they would make zero-length constraints.
@@ -229,7 +228,7 @@ pub(crate) fn kept_apart(rings: &[Ring], grid: &SegmentGrid, gap: f64) -> Option
             let (k, j) = grid.owner[s as usize];
             let other = &rings[k as usize];
             let next = (j as usize + 1) % other.len();
-            let q2 = point_at(other.p2[j as usize], other.p2[next], t);
+            let q2 = lerp2(other.p2[j as usize], other.p2[next], t);
             let distance = dist2d(p2, q2);
             if distance == 0.0 {
                 continue;
@@ -242,10 +241,6 @@ pub(crate) fn kept_apart(rings: &[Ring], grid: &SegmentGrid, gap: f64) -> Option
         }
     }
     any.then_some(moved)
-}
-
-fn lerp(a: Point3, b: Point3, t: f64) -> Point3 {
-    [0, 1, 2].map(|c| a[c] + t * (b[c] - a[c]))
 }
 
 /// A ring through `p2` in the plane z = 0, β 1 (for tests).

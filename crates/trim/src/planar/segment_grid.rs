@@ -1,7 +1,7 @@
 //! The loops' segments in a uniform grid.
 
 use super::ring::{dist2d, Ring};
-use crate::geom::{orientation, segments_meet};
+use crate::geom::{lerp2, orientation, segments_meet};
 
 /// Where two loop segments meet ([`SegmentGrid::contacts`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
@@ -185,7 +185,7 @@ impl SegmentGrid {
                 for &s in &self.cells[r * self.nx + c] {
                     let (a, b) = (self.a[s as usize], self.b[s as usize]);
                     let t = parameter_on(a, b, p);
-                    let d = dist2d(p, point_at(a, b, t));
+                    let d = dist2d(p, lerp2(a, b, t));
                     let better = best.is_none_or(|(bd, bs, _)| d < bd || (d == bd && s < bs));
                     if d < radius && better && accept(s) {
                         best = Some((d, s, t));
@@ -358,7 +358,7 @@ impl SegmentGrid {
 
 /// The point of segment ab nearest to `p`.
 fn closest_on(a: [f64; 2], b: [f64; 2], p: [f64; 2]) -> [f64; 2] {
-    point_at(a, b, parameter_on(a, b, p))
+    lerp2(a, b, parameter_on(a, b, p))
 }
 
 /// The parameter of the point of segment a–b nearest to `p`.
@@ -370,9 +370,4 @@ fn parameter_on(a: [f64; 2], b: [f64; 2], p: [f64; 2]) -> f64 {
     } else {
         0.0
     }
-}
-
-/// The point at parameter `t` of segment a–b.
-pub(crate) fn point_at(a: [f64; 2], b: [f64; 2], t: f64) -> [f64; 2] {
-    [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]
 }

@@ -41,7 +41,7 @@
 
 use super::ring::Ring;
 use super::{Contact, SegmentGrid};
-use crate::geom::{orient, UnionFind};
+use crate::geom::{lerp, lerp2, orient, UnionFind};
 use crate::hash::{HashMap, HashSet};
 use crate::mesh::pinches::fan_labels;
 
@@ -370,20 +370,12 @@ pub(crate) fn pinched_faces(faces: &[[u32; 3]], ids: usize, points: usize) -> Ve
     pinched
 }
 
-fn lerp2(a: [f64; 2], b: [f64; 2], t: f64) -> [f64; 2] {
-    [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1])]
-}
-
-fn lerp3(a: crate::geom::Point3, b: crate::geom::Point3, t: f64) -> crate::geom::Point3 {
-    [0, 1, 2].map(|c| a[c] + t * (b[c] - a[c]))
-}
-
 /// The 3D position, β and reference point at parameter `t` of segment
 /// ab: the reference is the nearer end's.
 fn on_segment(a: Vertex, b: Vertex, t: f64) -> (crate::geom::Point3, f64, u32) {
     let reference = if t <= 0.5 { a.reference } else { b.reference };
     (
-        lerp3(a.p3, b.p3, t),
+        lerp(a.p3, b.p3, t),
         a.beta + t * (b.beta - a.beta),
         reference,
     )

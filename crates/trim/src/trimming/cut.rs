@@ -90,11 +90,6 @@ pub(super) fn cut_both_sides(mesh: &Mesh, field: &[f64]) -> Cut {
     cut
 }
 
-/// a + t (b − a).
-pub(super) fn lerp(a: Point3, b: Point3, t: f64) -> Point3 {
-    [0, 1, 2].map(|c| a[c] + t * (b[c] - a[c]))
-}
-
 /// What the cut along the cloud's reach removed.
 pub(super) struct OutOfReach {
     /// Faces of the cut mesh dropped.

@@ -85,7 +85,7 @@ use crate::edges::offset::{edge_sides, outward};
 use crate::edges::Edges;
 use crate::error::TrimError;
 use crate::geom::UnionFind;
-use crate::geom::{dist2, dot, norm2, sub, Point3};
+use crate::geom::{dist2, dot, lerp, norm2, sub, Point3};
 use crate::mesh::{sorted_edges_of, Mesh};
 use crate::spatial::closest_face::FaceIndex;
 use crate::spatial::neighbours::NeighbourIndex;
