@@ -13,6 +13,7 @@
 //! file starting with `solid` is ASCII, else it is binary and too short.
 
 use crate::io::hash::HashMap;
+use std::collections::hash_map::Entry;
 use std::io::Write;
 
 use anyhow::{anyhow, bail, Result};
@@ -86,14 +87,16 @@ impl Merger {
     fn vertex(&mut self, p: Point3) -> Result<u32> {
         // Adding +0 turns -0 into +0, so the two (equal as f64) share a key.
         let key = p.map(|c| (c + 0.0).to_bits());
-        if let Some(&i) = self.index.get(&key) {
-            return Ok(i);
+        match self.index.entry(key) {
+            Entry::Occupied(known) => Ok(*known.get()),
+            Entry::Vacant(new) => {
+                let i = u32::try_from(self.mesh.vertices.len())
+                    .map_err(|_| anyhow!("more than {} distinct vertices", u32::MAX))?;
+                self.mesh.vertices.push(p);
+                new.insert(i);
+                Ok(i)
+            }
         }
-        let i = u32::try_from(self.mesh.vertices.len())
-            .map_err(|_| anyhow!("more than {} distinct vertices", u32::MAX))?;
-        self.mesh.vertices.push(p);
-        self.index.insert(key, i);
-        Ok(i)
     }
 
     fn triangle(&mut self, corners: [Point3; 3]) -> Result<()> {
@@ -128,23 +131,83 @@ fn read_binary(bytes: &[u8]) -> Result<Mesh> {
         );
     }
     // Bytes after the last triangle (padding some exporters add) are ignored.
-    let mut merger = Merger::new(n as usize);
-    for (t, record) in bytes[HEADER..]
-        .chunks_exact(RECORD)
-        .take(n as usize)
+    let records = &bytes[HEADER..HEADER + n as usize * RECORD];
+    let per_piece = (n as usize)
+        .div_ceil(rayon::current_num_threads())
+        .max(MIN_PIECE_TRIANGLES);
+    read_records_in_pieces(records, per_piece)
+}
+
+/// Reads the triangle records in pieces of `per_piece` triangles, each
+/// merged on its own thread, then joined.
+fn read_records_in_pieces(records: &[u8], per_piece: usize) -> Result<Mesh> {
+    let pieces: Vec<Result<Merger>> = records
+        .par_chunks(per_piece * RECORD)
         .enumerate()
-    {
+        .map(|(j, piece)| merge_binary_piece(piece, j * per_piece))
+        .collect();
+    // The first bad triangle's message, whichever piece was read first.
+    join_pieces(pieces.into_iter().collect::<Result<_>>()?)
+}
+
+/// Triangles below which a binary STL is read in one piece.
+const MIN_PIECE_TRIANGLES: usize = 1 << 16;
+
+/// The triangle records of one piece, the first being triangle `first`,
+/// with their corners merged within the piece.
+fn merge_binary_piece(records: &[u8], first: usize) -> Result<Merger> {
+    let mut merger = Merger::new(records.len() / RECORD);
+    for (t, record) in records.chunks_exact(RECORD).enumerate() {
         let corner = |k: usize| -> Point3 {
             let at = 12 + 12 * k;
             [0, 4, 8].map(|o| f64::from(LittleEndian::read_f32(&record[at + o..])))
         };
         let corners = [corner(0), corner(1), corner(2)];
         if let Some(p) = corners.iter().find(|p| p.iter().any(|c| !c.is_finite())) {
-            bail!("triangle {t} has a non-finite coordinate {}", show(p));
+            bail!(
+                "triangle {} has a non-finite coordinate {}",
+                first + t,
+                show(p)
+            );
         }
         merger.triangle(corners)?;
     }
-    Ok(merger.mesh)
+    Ok(merger)
+}
+
+/// Pieces merged each within itself, joined in order: a piece's vertices,
+/// in its own order of first appearance, take the number of an equal
+/// vertex of an earlier piece or the next new one. That is the numbering
+/// one merger over all the triangles gives, however the triangles were
+/// cut into pieces.
+fn join_pieces(pieces: Vec<Merger>) -> Result<Mesh> {
+    let mut pieces = pieces.into_iter();
+    let Some(mut all) = pieces.next() else {
+        return Ok(Merger::new(0).mesh);
+    };
+    let pieces: Vec<Merger> = pieces.collect();
+    let more: usize = pieces.iter().map(|p| p.mesh.vertices.len()).sum();
+    all.index.reserve(more);
+    all.mesh.vertices.reserve(more);
+    let faces: usize = pieces
+        .iter()
+        .map(|p| p.mesh.faces.as_ref().map_or(0, Vec::len))
+        .sum();
+    if let Some(all_faces) = all.mesh.faces.as_mut() {
+        all_faces.reserve(faces);
+    }
+    for piece in pieces {
+        let numbers = piece
+            .mesh
+            .vertices
+            .iter()
+            .map(|&p| all.vertex(p))
+            .collect::<Result<Vec<u32>>>()?;
+        if let (Some(faces), Some(new)) = (all.mesh.faces.as_mut(), &piece.mesh.faces) {
+            faces.extend(new.iter().map(|f| f.map(|v| numbers[v as usize])));
+        }
+    }
+    Ok(all.mesh)
 }
 
 /// Where the ASCII reader is in the `solid` grammar.

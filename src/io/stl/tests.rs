@@ -211,3 +211,60 @@ fn ascii_errors_name_the_line() {
 fn degenerate_normal_is_zero() {
     assert_eq!(unit_normal([0.; 3], [1., 0., 0.], [2., 0., 0.]), [0.; 3]);
 }
+
+/// Binary records read in pieces of 1–9 triangles number the vertices as
+/// one merger over all of them does, and name the same bad triangle, on
+/// random triangle soups drawn from a few positions (so that corners
+/// repeat within and across pieces, `-0` among them).
+#[test]
+fn binary_pieces_read_as_one_merger() {
+    let mut rng = testkit::synthetic::SplitMix64::new(61);
+    let mut below = |n: u64| (rng.next_u64() % n) as usize;
+    let pool: [[f32; 3]; 7] = [
+        [0., 0., 0.],
+        [-0., 0., 0.],
+        [1., 0., 0.],
+        [0., 1., 2.5],
+        [1., 1., -1.],
+        [3., 0., 0.25],
+        [0., 0., -0.],
+    ];
+    let mut errors = 0;
+    for _ in 0..2000 {
+        let triangles = below(40);
+        let mut records = Vec::with_capacity(triangles * RECORD);
+        for _ in 0..triangles {
+            records.extend([0u8; 12]);
+            for _ in 0..3 {
+                let mut p = pool[below(pool.len() as u64)];
+                if below(300) == 0 {
+                    p[below(3)] = f32::NAN;
+                }
+                p.iter().for_each(|c| records.extend(c.to_le_bytes()));
+            }
+            records.extend([0u8; 2]);
+        }
+        let one = merge_binary_piece(&records, 0).map(|m| (m.mesh.vertices, m.mesh.faces));
+        let one = one.map_err(|e| e.to_string());
+        for per_piece in 1..10 {
+            let pieces = read_records_in_pieces(&records, per_piece)
+                .map(|m| (m.vertices, m.faces))
+                .map_err(|e| e.to_string());
+            match (&pieces, &one) {
+                (Ok((v, f)), Ok((w, g))) => {
+                    assert_eq!(f, g, "faces, pieces of {per_piece}");
+                    let bits = |v: &Vec<Point3>| -> Vec<[u64; 3]> {
+                        v.iter().map(|p| p.map(f64::to_bits)).collect()
+                    };
+                    assert_eq!(bits(v), bits(w), "vertices, pieces of {per_piece}");
+                }
+                _ => assert_eq!(pieces, one, "pieces of {per_piece}"),
+            }
+        }
+        errors += usize::from(one.is_err());
+    }
+    assert!(
+        (100..1000).contains(&errors),
+        "{errors} errors in 2000 cases"
+    );
+}
