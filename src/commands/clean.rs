@@ -228,8 +228,9 @@ pub fn clean_in_memory(
 ) -> Result<(trim::Mesh, Report)> {
     let started = Instant::now();
     // Only β is needed: the mesh knows its border (BPD's labels would be
-    // thrown away), and β alone takes about half the time.
-    let beta = trim::local_resolution(&mesh.vertices, &stages.detection)
+    // thrown away). On a large mesh it is found only where the cleanup
+    // reads it, near the borders.
+    let beta = trim::LocalResolution::new(&mesh.vertices, &stages.detection)
         .with_context(|| format!("{name}: the mesh's vertices"))?;
     let resolution_time = started.elapsed();
     let started = Instant::now();

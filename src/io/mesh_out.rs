@@ -17,11 +17,10 @@ use std::io::Write;
 use std::path::Path;
 
 use anyhow::{anyhow, bail, Context, Result};
-use byteorder::{LittleEndian, WriteBytesExt};
 
 use super::atomic::write_atomic;
 use super::float_text::push_f64_debug;
-use super::{gltf_io, show, stl, Point3};
+use super::{gltf_io, show, stl, write_formatted, Point3};
 
 /// The mesh formats meshtrim writes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -217,19 +216,21 @@ pub fn write_ply(
         vertices.len(),
         faces.len()
     )?;
-    for p in vertices {
-        for &c in p {
-            w.write_f64::<LittleEndian>(c)?;
-        }
+    // Face indices are written as int: every vertex index must fit.
+    if let Some(last) = vertices.len().checked_sub(1) {
+        i32::try_from(last).map_err(std::io::Error::other)?;
     }
-    for f in faces {
-        w.write_u8(3)?;
-        for &v in f {
-            let v = i32::try_from(v).map_err(std::io::Error::other)?;
-            w.write_i32::<LittleEndian>(v)?;
+    write_formatted(w, vertices.len(), |out, i| {
+        for c in vertices[i] {
+            out.extend(c.to_le_bytes());
         }
-    }
-    Ok(())
+    })?;
+    write_formatted(w, faces.len(), |out, i| {
+        out.push(3);
+        for v in faces[i] {
+            out.extend((v as i32).to_le_bytes());
+        }
+    })
 }
 
 #[cfg(test)]

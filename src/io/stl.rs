@@ -13,14 +13,15 @@
 //! file starting with `solid` is ASCII, else it is binary and too short.
 
 use crate::io::hash::HashMap;
-use std::collections::hash_map::Entry;
 use std::io::Write;
 
 use anyhow::{anyhow, bail, Result};
 use byteorder::{ByteOrder, LittleEndian, WriteBytesExt};
 use rayon::prelude::*;
 
-use super::{capacity, cut_after_newlines, lines, show, words, Mesh, Point3, PIECE_BYTES};
+use super::{
+    capacity, cut_after_newlines, lines, show, words, write_formatted, Mesh, Point3, PIECE_BYTES,
+};
 
 /// Size of a binary STL's header: 80 bytes of text, a u32 triangle count.
 const HEADER: usize = 84;
@@ -66,10 +67,24 @@ fn binary_size(triangles: u32) -> Option<usize> {
         .and_then(|b| b.checked_add(HEADER))
 }
 
+/// A position's coordinates as bits, hashed as three words (an array's
+/// own `Hash` adds its length and goes through the byte-slice path, a
+/// tenth of reading a large file).
+#[derive(PartialEq, Eq)]
+struct PositionKey([u64; 3]);
+
+impl std::hash::Hash for PositionKey {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        for word in self.0 {
+            state.write_u64(word);
+        }
+    }
+}
+
 /// Shares vertices between corners with equal positions.
 struct Merger {
     mesh: Mesh,
-    index: HashMap<[u64; 3], u32>,
+    index: HashMap<PositionKey, u32>,
 }
 
 impl Merger {
@@ -86,17 +101,15 @@ impl Merger {
 
     fn vertex(&mut self, p: Point3) -> Result<u32> {
         // Adding +0 turns -0 into +0, so the two (equal as f64) share a key.
-        let key = p.map(|c| (c + 0.0).to_bits());
-        match self.index.entry(key) {
-            Entry::Occupied(known) => Ok(*known.get()),
-            Entry::Vacant(new) => {
-                let i = u32::try_from(self.mesh.vertices.len())
-                    .map_err(|_| anyhow!("more than {} distinct vertices", u32::MAX))?;
-                self.mesh.vertices.push(p);
-                new.insert(i);
-                Ok(i)
-            }
+        let key = PositionKey(p.map(|c| (c + 0.0).to_bits()));
+        if let Some(&i) = self.index.get(&key) {
+            return Ok(i);
         }
+        let i = u32::try_from(self.mesh.vertices.len())
+            .map_err(|_| anyhow!("more than {} distinct vertices", u32::MAX))?;
+        self.mesh.vertices.push(p);
+        self.index.insert(key, i);
+        Ok(i)
     }
 
     fn triangle(&mut self, corners: [Point3; 3]) -> Result<()> {
@@ -431,19 +444,18 @@ pub fn write_stl(
     w.write_all(&header)?;
     let count = u32::try_from(faces.len()).map_err(std::io::Error::other)?;
     w.write_u32::<LittleEndian>(count)?;
-    for face in faces {
-        let [a, b, c] = face.map(|v| vertices[v as usize]);
+    write_formatted(w, faces.len(), |out, f| {
+        let [a, b, c] = faces[f].map(|v| vertices[v as usize]);
         for n in unit_normal(a, b, c) {
-            w.write_f32::<LittleEndian>(n as f32)?;
+            out.extend((n as f32).to_le_bytes());
         }
         for p in [a, b, c] {
             for coordinate in p {
-                w.write_f32::<LittleEndian>(coordinate as f32)?;
+                out.extend((coordinate as f32).to_le_bytes());
             }
         }
-        w.write_u16::<LittleEndian>(0)?;
-    }
-    Ok(())
+        out.extend([0, 0]);
+    })
 }
 
 fn unit_normal(a: Point3, b: Point3, c: Point3) -> Point3 {

@@ -75,7 +75,7 @@ mod trimming;
 pub use bpd::detect_boundary_reference;
 pub use bpd::{
     detect_boundary, detect_boundary_with_progress, local_resolution, BpdOptions, Decision,
-    Detection, View,
+    Detection, LocalResolution, View,
 };
 pub use bspline::{interpolate as interpolate_bspline, BSpline};
 pub use clean::{clean_mesh, CleanOptions, CleanReport, LeftLoops, LeftReason, SEEN_FROM_ONE_SIDE};
@@ -88,6 +88,7 @@ pub use geom::rotation_from_quaternion;
 pub use mesh::manifold::ManifoldRepair;
 pub use mesh::repair::FaceRepair;
 pub use mesh::{check_vertex_range, Mesh};
+pub use resolution::PointResolution;
 pub use spatial::neighbours::NeighbourIndex;
 pub use trimming::{trim_mesh, LoopFit, TrimOptions, TrimReport};
 

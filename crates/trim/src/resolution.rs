@@ -151,6 +151,74 @@ pub(crate) fn dist2(a: Point2, b: Point2) -> f64 {
     dx * dx + dy * dy
 }
 
+/// β of each point of a cloud, however it was found: a slice with every
+/// point's ([`crate::local_resolution`]), or a [`crate::LocalResolution`]
+/// that finds each where it is first asked for.
+pub trait PointResolution: Sync {
+    /// How many points it has β for.
+    fn len(&self) -> usize;
+    /// Whether it has β for no point.
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+    /// β of point `i` (`i < len()`).
+    fn beta(&self, i: usize) -> f64;
+    /// The median β, the scale of the cloud's spacing.
+    fn median(&self) -> f64;
+}
+
+impl PointResolution for [f64] {
+    fn len(&self) -> usize {
+        <[f64]>::len(self)
+    }
+    fn beta(&self, i: usize) -> f64 {
+        self[i]
+    }
+    fn median(&self) -> f64 {
+        crate::geom::median(self)
+    }
+}
+
+impl PointResolution for Vec<f64> {
+    fn len(&self) -> usize {
+        self.as_slice().len()
+    }
+    fn beta(&self, i: usize) -> f64 {
+        self.as_slice().beta(i)
+    }
+    fn median(&self) -> f64 {
+        self.as_slice().median()
+    }
+}
+
+impl<const N: usize> PointResolution for [f64; N] {
+    fn len(&self) -> usize {
+        N
+    }
+    fn beta(&self, i: usize) -> f64 {
+        self.as_slice().beta(i)
+    }
+    fn median(&self) -> f64 {
+        self.as_slice().median()
+    }
+}
+
+/// A reference to any [`PointResolution`] (a slice included) as a sized
+/// one, which a `&dyn PointResolution` can point to.
+pub(crate) struct ByRef<'a, R: PointResolution + ?Sized>(pub(crate) &'a R);
+
+impl<R: PointResolution + ?Sized> PointResolution for ByRef<'_, R> {
+    fn len(&self) -> usize {
+        self.0.len()
+    }
+    fn beta(&self, i: usize) -> f64 {
+        self.0.beta(i)
+    }
+    fn median(&self) -> f64 {
+        self.0.median()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

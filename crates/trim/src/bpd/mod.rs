@@ -15,7 +15,10 @@
 //! time, and exists to check the fast one.
 
 pub mod circle;
+mod on_demand;
 pub mod polar;
+
+pub use on_demand::LocalResolution;
 
 use std::ops::Range;
 
@@ -392,6 +395,7 @@ struct Prepared {
 
 /// Sites copied in spatial order ([`spatial_order`]): position p holds
 /// site `order[p]`, whose Morton key is `keys[p]`.
+#[derive(Clone)]
 struct SpatialOrder {
     points: Vec<Point3>,
     order: Vec<u32>,
@@ -833,7 +837,6 @@ struct Scratch {
     polar: polar::PolarScratch,
 }
 
-/// Runs steps 2–5 on the point at spatial position `p`.
 /// Steps 1–2 at one position: the neighbourhood projected onto its plane
 /// (and mapped by its sampling tensor) into `s.projected`, and its local
 /// resolution β = μ + 2σ.
@@ -849,18 +852,32 @@ fn projected_beta(
         || fit_plane_normal(&hoods.points, members),
         |v| v[p].frame(),
     );
-    let shear = shear_towards(
-        hoods.view.as_ref(),
+    let moments = vectors.map(|v| members.iter().map(|&m| &v[m as usize].moment));
+    beta_in_plane(
+        &hoods.points,
+        members,
         &frame,
-        hoods.points[members[0] as usize],
-    );
-    project_sheared(&hoods.points, members, &frame, shear, &mut s.projected);
-    if let Some(vectors) = vectors {
-        let tensor = sampling_tensor_of_moments(
-            &frame,
-            members.iter().map(|&m| &vectors[m as usize].moment),
-        );
-        let map = whitening_map(tensor);
+        hoods.view.as_ref(),
+        moments,
+        s,
+    )
+}
+
+/// β of the neighbourhood `members` (the point first) in `frame`'s plane,
+/// mapped by the members' sampling moments when given; the projection is
+/// left in `s.projected`.
+fn beta_in_plane<'m>(
+    points: &[Point3],
+    members: &[u32],
+    frame: &Frame,
+    view: Option<&View>,
+    moments: Option<impl Iterator<Item = &'m SamplingMoment>>,
+    s: &mut Scratch,
+) -> f64 {
+    let shear = shear_towards(view, frame, points[members[0] as usize]);
+    project_sheared(points, members, frame, shear, &mut s.projected);
+    if let Some(moments) = moments {
+        let map = whitening_map(sampling_tensor_of_moments(frame, moments));
         for q in s.projected.iter_mut() {
             *q = apply(&map, *q);
         }

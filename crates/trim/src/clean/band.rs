@@ -115,7 +115,7 @@ impl Band {
             let p = projection.vertex_to2(mesh, v);
             !old_border.contains(&v)
                 && grid.parity(p) == has_outer
-                && !grid.near(p, MARGIN * cx.beta[v as usize])
+                && !grid.near(p, MARGIN * cx.beta.beta(v as usize))
         };
         self.faces
             .iter()
@@ -479,7 +479,7 @@ fn removes_far_vertices(cx: &Context, rings: &[Ring], removed: &[u32]) -> bool {
     candidates.sort_unstable();
     candidates.dedup();
     let far = candidates.into_iter().filter(|&v| {
-        let reach = REACH * cx.beta[v as usize];
+        let reach = REACH * cx.beta.beta(v as usize);
         cx.topology.faces_of(v).iter().all(is_removed)
             && distance2(cx.mesh.vertices[v as usize]) > reach * reach
     });

@@ -87,11 +87,11 @@ use spade::{
 };
 
 use crate::edges::cluster::MIN_LOOP_POINTS;
-use crate::edges::loop_from_tour;
+use crate::edges::loop_with_beta;
 use crate::error::{CleanError, MeshError};
 use crate::frame::fit_plane;
 use crate::geom::{add, cross, dist2, dot, norm2, sub, Point3};
-use crate::geom::{median, orient, orientation};
+use crate::geom::{orient, orientation};
 use crate::mesh::boundary_loops_of;
 use crate::mesh::manifold::{make_manifold, ManifoldRepair};
 use crate::mesh::pinches::open_new_pinches;
@@ -103,6 +103,7 @@ use crate::mesh::{lowest_first, Mesh};
 use crate::planar::{
     inside_faces, kept_apart, obstacle, untwist, Cdt, Node, Ring, SegmentGrid, Tangle, STEINER,
 };
+use crate::resolution::{ByRef, PointResolution};
 use crate::spatial::neighbours::NeighbourIndex;
 
 /// The segment grid's cells are no smaller than this many β.
@@ -318,7 +319,16 @@ pub struct CleanReport {
 /// the vertices).
 pub fn clean_mesh(
     mesh: &Mesh,
-    beta: &[f64],
+    beta: &(impl PointResolution + ?Sized),
+    options: &CleanOptions,
+) -> Result<(Mesh, CleanReport), CleanError> {
+    clean_with(mesh, &ByRef(beta), options)
+}
+
+/// [`clean_mesh`] over any [`PointResolution`], compiled once.
+fn clean_with(
+    mesh: &Mesh,
+    beta: &dyn PointResolution,
     options: &CleanOptions,
 ) -> Result<(Mesh, CleanReport), CleanError> {
     mesh.validate()?;
@@ -366,7 +376,11 @@ pub fn clean_mesh(
 /// What the cleanup needs of the mesh left once its empty faces are dropped:
 /// faces, one β per vertex, every edge used at most twice and never twice
 /// the same way.
-fn check_cleanable(mesh: &Mesh, beta: &[f64], edges: &EdgeRows) -> Result<(), CleanError> {
+fn check_cleanable(
+    mesh: &Mesh,
+    beta: &dyn PointResolution,
+    edges: &EdgeRows,
+) -> Result<(), CleanError> {
     if mesh.faces.is_empty() {
         return Err(MeshError::NoFaces.into());
     }
@@ -385,7 +399,7 @@ fn check_cleanable(mesh: &Mesh, beta: &[f64], edges: &EdgeRows) -> Result<(), Cl
 /// to smooth.
 fn smoothed_loops(
     mesh: &Mesh,
-    beta: &[f64],
+    beta: &dyn PointResolution,
     borders: &[Vec<u32>],
     options: &CleanOptions,
 ) -> Vec<Option<Ring>> {
@@ -394,7 +408,8 @@ fn smoothed_loops(
         .par_iter()
         .map(|border| {
             (border.len() >= MIN_LOOP_POINTS).then(|| {
-                let lp = loop_from_tour(&mesh.vertices, beta, border.clone(), index.as_ref());
+                let loop_beta = border.iter().map(|&v| beta.beta(v as usize)).collect();
+                let lp = loop_with_beta(&mesh.vertices, loop_beta, border.clone(), index.as_ref());
                 even_out(Ring::from_loop(&lp, beta))
             })
         })
@@ -406,7 +421,7 @@ fn smoothed_loops(
 /// with every patch applied.
 fn replace_bands(
     mesh: &Mesh,
-    beta: &[f64],
+    beta: &dyn PointResolution,
     borders: &[Vec<u32>],
     rings: &[Option<Ring>],
     view: Option<Point3>,
@@ -720,7 +735,7 @@ fn finish(
 /// Everything the band replacement reads.
 struct Context<'a> {
     mesh: &'a Mesh,
-    beta: &'a [f64],
+    beta: &'a dyn PointResolution,
     borders: &'a [Vec<u32>],
     rings: &'a [Option<Ring>],
     topology: &'a Topology,

@@ -44,12 +44,12 @@ pub(super) struct Replaced {
 /// Steps 3 to 5 for every smoothed loop, in rounds (see the module doc).
 pub(super) fn replace_in_rounds(
     mesh: &Mesh,
-    beta: &[f64],
+    beta: &dyn PointResolution,
     borders: &[Vec<u32>],
     rings: &[Option<Ring>],
     view: Option<Point3>,
 ) -> Replaced {
-    let beta_median = median(beta);
+    let beta_median = beta.median();
     let (outcomes, out) = replace_bands(mesh, beta, borders, rings, view, beta_median);
     let mut done = Replaced {
         kept_input_faces: kept_below(mesh.faces.len(), &outcomes),
@@ -70,7 +70,7 @@ impl Replaced {
     fn round(
         &mut self,
         input: &Mesh,
-        beta: &[f64],
+        beta: &dyn PointResolution,
         borders: &[Vec<u32>],
         rings: &[Option<Ring>],
         view: Option<Point3>,
@@ -155,16 +155,42 @@ fn as_input_loops(input: &[Vec<u32>], here: &[Vec<u32>]) -> Vec<Option<usize>> {
         .collect()
 }
 
-/// β for every vertex of `mesh`, whose first vertices are the input's:
+/// β of every vertex of a mesh whose first vertices are the input's:
 /// theirs, and for the new ones that of the nearest input vertex.
-fn beta_of_new_vertices(input: &Mesh, beta: &[f64], mesh: &Mesh) -> Vec<f64> {
-    let n = input.vertices.len();
-    let mut all = beta.to_vec();
-    if let Some(tree) = PointTree::new(&input.vertices) {
-        all.extend(mesh.vertices[n..].iter().map(|p| beta[tree.nearest(p).0]));
+struct WithNewVertices<'a> {
+    input: &'a dyn PointResolution,
+    new: Vec<f64>,
+}
+
+impl PointResolution for WithNewVertices<'_> {
+    fn len(&self) -> usize {
+        self.input.len() + self.new.len()
     }
-    all.resize(mesh.vertices.len(), median(beta));
-    all
+    fn beta(&self, i: usize) -> f64 {
+        match i.checked_sub(self.input.len()) {
+            Some(new) => self.new[new],
+            None => self.input.beta(i),
+        }
+    }
+    fn median(&self) -> f64 {
+        self.input.median()
+    }
+}
+
+fn beta_of_new_vertices<'a>(
+    input: &Mesh,
+    beta: &'a dyn PointResolution,
+    mesh: &Mesh,
+) -> WithNewVertices<'a> {
+    let new_vertices = &mesh.vertices[input.vertices.len()..];
+    let new = match PointTree::new(&input.vertices) {
+        Some(tree) => new_vertices
+            .iter()
+            .map(|p| beta.beta(tree.nearest(p).0))
+            .collect(),
+        None => vec![beta.median(); new_vertices.len()],
+    };
+    WithNewVertices { input: beta, new }
 }
 
 /// How many of a mesh's first `count` faces no patch removes.

@@ -436,7 +436,7 @@ impl Cut {
                 }
             }
         }
-        let goes = |v: u32| guide.goes(cx.mesh.vertices[v as usize], cx.beta[v as usize]);
+        let goes = |v: u32| guide.goes(cx.mesh.vertices[v as usize], cx.beta.beta(v as usize));
         for _ in 0..MAX_DEPTH {
             let mut next = Vec::new();
             for &v in &frontier {
@@ -491,7 +491,7 @@ impl Cut {
         let border = &cx.borders[other];
         let beyond = border
             .iter()
-            .filter(|&&v| guide.goes(cx.mesh.vertices[v as usize], cx.beta[v as usize]))
+            .filter(|&&v| guide.goes(cx.mesh.vertices[v as usize], cx.beta.beta(v as usize)))
             .count();
         // A border one face from this one cannot keep the faces between.
         let own: HashSet<u32> = cx.borders[l].iter().copied().collect();

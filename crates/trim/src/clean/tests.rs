@@ -72,7 +72,7 @@ fn edge_defects_match_the_reference() {
         );
     }
 }
-use crate::bpd::{detect_boundary, BpdOptions};
+use crate::bpd::{detect_boundary, BpdOptions, LocalResolution};
 use spade::{DelaunayTriangulation, Point2 as SpadePoint};
 use testkit::SplitMix64;
 
@@ -415,4 +415,38 @@ fn a_border_wrapping_round_a_cylinder(mesh: Mesh, r: f64, reach: f64, height: f6
     });
     assert!(far.clone().count() > 100);
     assert!(far.into_iter().all(|p| kept.contains(&p.map(f64::to_bits))));
+}
+
+/// β found on demand, only where the cleanup reads it, cleans as β found
+/// for every vertex does, bit for bit: on the jagged annulus and on the
+/// cylinder whose border wraps round it (rounds and strips included),
+/// with and without anisotropy. (Below 16,384 points the on-demand median
+/// is taken over every point, so it is the same median.)
+#[test]
+fn beta_found_on_demand_cleans_the_same() {
+    let meshes = [
+        jagged_annulus(20.0, 6.0, 3),
+        jagged_cylinder(12.0, 110f64.to_radians(), 16.0, 2),
+    ];
+    for (mesh, anisotropy) in meshes.iter().flat_map(|m| [(m, true), (m, false)]) {
+        let detection = BpdOptions {
+            anisotropy,
+            ..BpdOptions::default()
+        };
+        let everywhere = crate::local_resolution(&mesh.vertices, &detection).unwrap();
+        let mut on_demand =
+            LocalResolution::all_at_once_up_to(&mesh.vertices, &detection, 0).unwrap();
+        // Found by the median: forgotten, to be found where clean reads β.
+        on_demand.forget();
+        let options = CleanOptions::default();
+        let (want, want_report) = clean_mesh(mesh, &everywhere, &options).unwrap();
+        let (got, got_report) = clean_mesh(mesh, &on_demand, &options).unwrap();
+        assert!(want_report.faces_added > 0, "{want_report:?}");
+        assert_eq!(got.faces, want.faces);
+        let bits = |m: &Mesh| -> Vec<[u64; 3]> {
+            m.vertices.iter().map(|p| p.map(f64::to_bits)).collect()
+        };
+        assert_eq!(bits(&got), bits(&want));
+        assert_eq!(format!("{got_report:?}"), format!("{want_report:?}"));
+    }
 }

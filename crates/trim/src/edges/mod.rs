@@ -307,7 +307,7 @@ fn in_geometric_order(points: &[Point3], loops: Vec<Vec<u32>>) -> (Vec<Vec<u32>>
 }
 
 /// Each closed tour (input indices, in loop order) made a loop by
-/// [`loop_from_tour`], with the outward offset when `options` asks for it,
+/// [`loop_with_beta`], with the outward offset when `options` asks for it,
 /// held back at the points `occluding` marks (per input point; empty for
 /// none).
 fn loops_of_tours(
@@ -326,7 +326,8 @@ fn loops_of_tours(
             } else {
                 tour.iter().map(|&i| occluding[i as usize]).collect()
             };
-            loop_held_at_occlusions(points, beta, tour, index.as_ref(), held)
+            let loop_beta = tour.iter().map(|&i| beta[i as usize]).collect();
+            loop_held_at_occlusions(points, loop_beta, tour, index.as_ref(), held)
         })
         .collect()
 }
@@ -466,29 +467,29 @@ fn drop_tours_made_by_fillers(tours: &mut Vec<Vec<u32>>, detected: impl Fn(u32) 
 
 /// Corners, smoothed edges and (with `index`, the cloud's neighbour index)
 /// the outward offset of one closed tour of boundary points (indices into
-/// `points`, in loop order). Used on BPD's tours and on the border loops of
-/// a mesh, whose order the mesh itself gives.
-pub fn loop_from_tour(
+/// `points`, in loop order), given β of the tour's points (`loop_beta`, in
+/// its order). Used on the border loops of a mesh, whose order the mesh
+/// itself gives.
+pub(crate) fn loop_with_beta(
     points: &[Point3],
-    beta: &[f64],
+    loop_beta: Vec<f64>,
     tour: Vec<u32>,
     index: Option<&NeighbourIndex>,
 ) -> Loop {
-    loop_held_at_occlusions(points, beta, tour, index, Vec::new())
+    loop_held_at_occlusions(points, loop_beta, tour, index, Vec::new())
 }
 
-/// [`loop_from_tour`], the offset held back where `occluding` (per tour
+/// [`loop_with_beta`], the offset held back where `occluding` (per tour
 /// point; empty for none) says the loop runs along an occlusion
 /// ([`offset::hold_at_occlusions`]).
 fn loop_held_at_occlusions(
     points: &[Point3],
-    beta: &[f64],
+    loop_beta: Vec<f64>,
     tour: Vec<u32>,
     index: Option<&NeighbourIndex>,
     occluding: Vec<bool>,
 ) -> Loop {
     let loop_points: Vec<Point3> = tour.iter().map(|&i| points[i as usize]).collect();
-    let loop_beta: Vec<f64> = tour.iter().map(|&i| beta[i as usize]).collect();
     let corners = corners::find_corners(&loop_points, &loop_beta);
     let mut edges = smoothed_edges(&loop_points, &loop_beta, &corners);
     let mut sides = index.map_or_else(Vec::new, |index| offset::edge_sides(index, &tour));

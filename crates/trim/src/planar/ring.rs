@@ -5,6 +5,7 @@ use super::SegmentGrid;
 use crate::edges::cluster::MIN_LOOP_POINTS;
 use crate::edges::Loop;
 use crate::geom::{lerp, lerp2, Point3};
+use crate::resolution::PointResolution;
 
 /// Consecutive vertices of a ring closer than this many β in the
 /// projection are merged: they would make zero-length constraints.
@@ -35,7 +36,7 @@ pub(crate) struct Ring {
 }
 
 impl Ring {
-    pub(crate) fn from_loop(lp: &Loop, beta: &[f64]) -> Self {
+    pub(crate) fn from_loop(lp: &Loop, beta: &(impl PointResolution + ?Sized)) -> Self {
         let mut ring = Ring {
             p3: Vec::new(),
             p2: Vec::new(),
@@ -46,7 +47,9 @@ impl Ring {
             let r = lp.boundary_points.get(position).copied().unwrap_or(0);
             ring.p3.push(p);
             ring.reference.push(r);
-            ring.beta.push(beta.get(r as usize).copied().unwrap_or(0.0));
+            let r = r as usize;
+            ring.beta
+                .push(if r < beta.len() { beta.beta(r) } else { 0.0 });
         }
         ring
     }

@@ -90,6 +90,28 @@ impl<'a> NeighbourIndex<'a> {
         self.nearest_holding(i, k, None, out);
     }
 
+    /// [`Self::nearest`] for an index in Morton order, asked about one point
+    /// alone (not a run): the search starts from the radius holding the k
+    /// nearest of the 2k points beside `i` in that order, which are near
+    /// it in space. (The radius from the cells, [`Self::nearest`]'s start,
+    /// holds a whole cell of k points or more, often hundreds of points.)
+    pub(crate) fn nearest_alone(&self, i: usize, k: usize, out: &mut Vec<u32>) {
+        let n = self.points.len();
+        let k = k.min(n);
+        if k == 0 || !matches!(self.search, Search::Morton(_)) {
+            return self.nearest(i, k, out);
+        }
+        let from = i.saturating_sub(k).min(n.saturating_sub(2 * k));
+        let p = self.points[i];
+        let mut d2: Vec<f64> = (from..(from + 2 * k).min(n))
+            .map(|j| crate::geom::dist2(p, self.points[j]))
+            .collect();
+        let (_, kth, _) = d2.select_nth_unstable_by(k - 1, f64::total_cmp);
+        // A hair wider, so that rounding in r² cannot leave the k-th out.
+        let radius = kth.sqrt() * (1.0 + 1e-9);
+        self.nearest_holding(i, k, Some(radius), out);
+    }
+
     /// [`Self::nearest`], given when known a radius round point `i` that
     /// holds at least k points: with Morton cells the search starts there
     /// (else at a radius found from the cells); the tree does not need it.
