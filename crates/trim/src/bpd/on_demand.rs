@@ -27,7 +27,7 @@ use crate::hash::HashMap;
 const MEDIAN_RUNS: usize = 16;
 /// … and the points in each.
 const MEDIAN_RUN: usize = 1024;
-/// Locks the kept sampling moments are spread over, so that threads asking
+/// Locks the kept neighbourhoods are spread over, so that threads asking
 /// for β at once seldom wait for each other.
 const SHARDS: usize = 64;
 /// The bits of a β not found yet (no β is NaN).
@@ -108,7 +108,7 @@ impl LocalResolution {
         Ok(resolution)
     }
 
-    /// β of input point `i`.
+    /// β of input point `i` (`i` below the number of points given).
     pub fn beta(&self, i: usize) -> f64 {
         self.at_position(self.position_of_input[i] as usize)
     }
