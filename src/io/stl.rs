@@ -73,6 +73,13 @@ fn binary_size(triangles: u32) -> Option<usize> {
 #[derive(PartialEq, Eq)]
 struct PositionKey([u64; 3]);
 
+impl PositionKey {
+    fn of(p: Point3) -> Self {
+        // Adding +0 turns -0 into +0, so the two (equal as f64) share a key.
+        Self(p.map(|c| (c + 0.0).to_bits()))
+    }
+}
+
 impl std::hash::Hash for PositionKey {
     fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
         for word in self.0 {
@@ -100,15 +107,20 @@ impl Merger {
     }
 
     fn vertex(&mut self, p: Point3) -> Result<u32> {
-        // Adding +0 turns -0 into +0, so the two (equal as f64) share a key.
-        let key = PositionKey(p.map(|c| (c + 0.0).to_bits()));
-        if let Some(&i) = self.index.get(&key) {
-            return Ok(i);
+        match self.index.get(&PositionKey::of(p)) {
+            Some(&i) => Ok(i),
+            None => self.push_new(p, true),
         }
+    }
+
+    /// Adds `p` as the next vertex, to the map too when `remember`.
+    fn push_new(&mut self, p: Point3, remember: bool) -> Result<u32> {
         let i = u32::try_from(self.mesh.vertices.len())
             .map_err(|_| anyhow!("more than {} distinct vertices", u32::MAX))?;
         self.mesh.vertices.push(p);
-        self.index.insert(key, i);
+        if remember {
+            self.index.insert(PositionKey::of(p), i);
+        }
         Ok(i)
     }
 
@@ -199,9 +211,11 @@ fn join_pieces(pieces: Vec<Merger>) -> Result<Mesh> {
         return Ok(Merger::new(0).mesh);
     };
     let pieces: Vec<Merger> = pieces.collect();
-    let more: usize = pieces.iter().map(|p| p.mesh.vertices.len()).sum();
-    all.index.reserve(more);
-    all.mesh.vertices.reserve(more);
+    let vertices = |p: &Merger| p.mesh.vertices.len();
+    all.mesh.vertices.reserve(pieces.iter().map(vertices).sum());
+    // All but the last piece's new vertices go into the map.
+    all.index
+        .reserve(pieces.iter().rev().skip(1).map(vertices).sum());
     let faces: usize = pieces
         .iter()
         .map(|p| p.mesh.faces.as_ref().map_or(0, Vec::len))
@@ -209,19 +223,32 @@ fn join_pieces(pieces: Vec<Merger>) -> Result<Mesh> {
     if let Some(all_faces) = all.mesh.faces.as_mut() {
         all_faces.reserve(faces);
     }
-    for piece in pieces {
-        let numbers = piece
+    let count = pieces.len();
+    for (j, piece) in pieces.into_iter().enumerate() {
+        // Looked up on every thread: the map only grows between pieces.
+        let found: Vec<Option<u32>> = piece
             .mesh
             .vertices
-            .iter()
-            .map(|&p| all.vertex(p))
+            .par_iter()
+            .with_min_len(PIECE_LOOKUPS)
+            .map(|&p| all.index.get(&PositionKey::of(p)).copied())
+            .collect();
+        // The last piece's new vertices need no place in the map.
+        let remember = j + 1 < count;
+        let numbers = found
+            .into_iter()
+            .zip(&piece.mesh.vertices)
+            .map(|(found, &p)| found.map_or_else(|| all.push_new(p, remember), Ok))
             .collect::<Result<Vec<u32>>>()?;
         if let (Some(faces), Some(new)) = (all.mesh.faces.as_mut(), &piece.mesh.faces) {
-            faces.extend(new.iter().map(|f| f.map(|v| numbers[v as usize])));
+            faces.par_extend(new.par_iter().map(|f| f.map(|v| numbers[v as usize])));
         }
     }
     Ok(all.mesh)
 }
+
+/// Vertices a thread looks up at a time when pieces are joined.
+const PIECE_LOOKUPS: usize = 4096;
 
 /// Where the ASCII reader is in the `solid` grammar.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

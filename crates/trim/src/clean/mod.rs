@@ -104,7 +104,7 @@ use crate::planar::{
     inside_faces, kept_apart, obstacle, untwist, Cdt, Node, Ring, SegmentGrid, Tangle, STEINER,
 };
 use crate::resolution::{ByRef, PointResolution};
-use crate::spatial::neighbours::NeighbourIndex;
+use crate::spatial::neighbours::{KNearest, MortonIndex};
 
 /// The segment grid's cells are no smaller than this many β.
 const GRID_CELL: f64 = 0.1;
@@ -403,13 +403,14 @@ fn smoothed_loops(
     borders: &[Vec<u32>],
     options: &CleanOptions,
 ) -> Vec<Option<Ring>> {
-    let index = options.offset.then(|| NeighbourIndex::new(&mesh.vertices));
+    let index = options.offset.then(|| MortonIndex::new(&mesh.vertices));
     borders
         .par_iter()
         .map(|border| {
             (border.len() >= MIN_LOOP_POINTS).then(|| {
                 let loop_beta = border.iter().map(|&v| beta.beta(v as usize)).collect();
-                let lp = loop_with_beta(&mesh.vertices, loop_beta, border.clone(), index.as_ref());
+                let index = index.as_ref().map(|i| i as &dyn KNearest);
+                let lp = loop_with_beta(&mesh.vertices, loop_beta, border.clone(), index);
                 even_out(Ring::from_loop(&lp, beta))
             })
         })

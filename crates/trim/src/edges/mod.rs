@@ -27,7 +27,7 @@ use rayon::prelude::*;
 
 use crate::bpd::Detection;
 use crate::geom::{dist2, sub, Point3};
-use crate::spatial::neighbours::{tie_key, NeighbourIndex};
+use crate::spatial::neighbours::{tie_key, KNearest, NeighbourIndex};
 
 /// Options of edge reconstruction.
 #[derive(Debug, Clone, PartialEq)]
@@ -327,7 +327,8 @@ fn loops_of_tours(
                 tour.iter().map(|&i| occluding[i as usize]).collect()
             };
             let loop_beta = tour.iter().map(|&i| beta[i as usize]).collect();
-            loop_held_at_occlusions(points, loop_beta, tour, index.as_ref(), held)
+            let index = index.as_ref().map(|i| i as &dyn KNearest);
+            loop_held_at_occlusions(points, loop_beta, tour, index, held)
         })
         .collect()
 }
@@ -474,7 +475,7 @@ pub(crate) fn loop_with_beta(
     points: &[Point3],
     loop_beta: Vec<f64>,
     tour: Vec<u32>,
-    index: Option<&NeighbourIndex>,
+    index: Option<&dyn KNearest>,
 ) -> Loop {
     loop_held_at_occlusions(points, loop_beta, tour, index, Vec::new())
 }
@@ -486,7 +487,7 @@ fn loop_held_at_occlusions(
     points: &[Point3],
     loop_beta: Vec<f64>,
     tour: Vec<u32>,
-    index: Option<&NeighbourIndex>,
+    index: Option<&dyn KNearest>,
     occluding: Vec<bool>,
 ) -> Loop {
     let loop_points: Vec<Point3> = tour.iter().map(|&i| points[i as usize]).collect();

@@ -25,7 +25,7 @@
 
 use crate::frame::fit_plane;
 use crate::geom::{cross, dot, norm2, sub, Point3};
-use crate::spatial::neighbours::NeighbourIndex;
+use crate::spatial::neighbours::KNearest;
 
 /// Loop points on each side averaged into each estimate.
 pub(crate) const WINDOW: usize = 5;
@@ -46,7 +46,7 @@ pub struct EdgeSide {
 
 /// The [`EdgeSide`] of each loop point. `loop_points` are indices into the
 /// cloud behind `index`, in loop order.
-pub fn edge_sides(index: &NeighbourIndex, loop_points: &[u32]) -> Vec<EdgeSide> {
+pub fn edge_sides(index: &dyn KNearest, loop_points: &[u32]) -> Vec<EdgeSide> {
     let points = index.points();
     let n = loop_points.len();
     let mut members = Vec::new();
@@ -249,6 +249,7 @@ pub fn corner_shift(offset: f64, n_in: Point3, n_out: Point3) -> Point3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::spatial::neighbours::NeighbourIndex;
 
     /// Along an occlusion the offset is held back to nothing, ramping over
     /// the window where it begins and ends; elsewhere it stays.

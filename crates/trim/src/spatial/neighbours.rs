@@ -18,7 +18,9 @@ use std::ops::Range;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 
 use crate::geom::Point3;
-use crate::spatial::morton::MortonCells;
+use rayon::prelude::*;
+
+use crate::spatial::morton::{spatial_order, MortonCells, MortonGrid};
 
 /// A k-NN index over a slice of distinct points.
 pub struct NeighbourIndex<'a> {
@@ -536,6 +538,79 @@ fn magnitude(p: Point3) -> f64 {
     p.iter().fold(0.0, |m, c| m.max(c.abs()))
 }
 
+/// The k nearest points of a cloud's point, by index: the point itself
+/// first, then by increasing distance, ties by index ([`NeighbourIndex`]'s
+/// answers, whichever index gives them).
+pub trait KNearest: Sync {
+    /// The cloud.
+    fn points(&self) -> &[Point3];
+    /// Writes the indices of the `k` points nearest to point `i` into `out`.
+    fn nearest(&self, i: usize, k: usize, out: &mut Vec<u32>);
+}
+
+impl KNearest for NeighbourIndex<'_> {
+    fn points(&self) -> &[Point3] {
+        NeighbourIndex::points(self)
+    }
+    fn nearest(&self, i: usize, k: usize, out: &mut Vec<u32>) {
+        NeighbourIndex::nearest(self, i, k, out);
+    }
+}
+
+/// A k-NN index over points in any order, searched through a copy of them
+/// in Morton order: [`NeighbourIndex::new`]'s answers with nothing to
+/// build but the sort, for a few queries over a large cloud (a mesh's
+/// border vertices among all its vertices: building the k-d tree over 2.5
+/// million vertices cost more than all the queries). Each query starts
+/// from the point's neighbours in the order
+/// ([`NeighbourIndex::nearest_alone`]).
+pub struct MortonIndex<'a> {
+    points: &'a [Point3],
+    in_order: Vec<Point3>,
+    /// The point at each position of the order, and its Morton key.
+    order: Vec<u32>,
+    keys: Vec<u64>,
+    /// Each point's position in the order.
+    position_of: Vec<u32>,
+    grid: MortonGrid,
+}
+
+impl<'a> MortonIndex<'a> {
+    /// Sorts the points. `points` must be finite and have fewer than 2^32
+    /// entries.
+    pub fn new(points: &'a [Point3]) -> Self {
+        let grid = MortonGrid::of(points);
+        let (order, keys) = spatial_order(points, &grid);
+        let in_order = order.par_iter().map(|&i| points[i as usize]).collect();
+        let mut position_of = vec![0u32; points.len()];
+        for (position, &i) in order.iter().enumerate() {
+            position_of[i as usize] = position as u32;
+        }
+        Self {
+            points,
+            in_order,
+            order,
+            keys,
+            position_of,
+            grid,
+        }
+    }
+}
+
+impl KNearest for MortonIndex<'_> {
+    fn points(&self) -> &[Point3] {
+        self.points
+    }
+    fn nearest(&self, i: usize, k: usize, out: &mut Vec<u32>) {
+        let cells = MortonCells::new(self.grid, &self.keys);
+        let index = NeighbourIndex::in_morton_order(&self.in_order, cells).with_ranks(&self.order);
+        index.nearest_alone(self.position_of[i] as usize, k, out);
+        for found in out.iter_mut() {
+            *found = self.order[*found as usize];
+        }
+    }
+}
+
 #[cfg(test)]
 /// Reference k-NN by sorting all distances; for tests.
 pub fn nearest_brute_force(points: &[Point3], i: usize, k: usize) -> Vec<u32> {
@@ -641,8 +716,9 @@ mod tests {
 
     /// The index over points in Morton order ([`crate::spatial::morton`]) gives the
     /// brute force's answers on the original points, ties cut by input
-    /// index: by runs (gathers, and the fallbacks given a radius) and by
-    /// single queries (which find their own radius).
+    /// index: by runs (gathers, and the fallbacks given a radius), by
+    /// single queries (which find their own radius) and by queries alone
+    /// (which start from their neighbours in the order).
     fn assert_morton_matches_brute_force(raw: &[Point3]) {
         use crate::spatial::morton::{spatial_order, MortonCells, MortonGrid};
         let grid = MortonGrid::of(raw);
@@ -667,6 +743,26 @@ mod tests {
         for p in (0..points.len()).step_by(13) {
             index.nearest(p, 30, &mut single);
             assert_eq!(single, reference(p), "single query at {p}");
+            index.nearest_alone(p, 30, &mut single);
+            assert_eq!(single, reference(p), "query alone at {p}");
+        }
+    }
+
+    /// [`MortonIndex`] answers as the k-d tree does, in the points' own
+    /// indices, on a sheet, a grid full of ties and points repeated.
+    #[test]
+    fn morton_index_by_input_index_matches_the_tree() {
+        let mut pts = sheet_and_grid(15, 1500);
+        let copies: Vec<Point3> = pts.iter().step_by(7).copied().collect();
+        pts.extend(copies);
+        let (tree, morton) = (NeighbourIndex::new(&pts), MortonIndex::new(&pts));
+        let (mut want, mut got) = (Vec::new(), Vec::new());
+        for i in (0..pts.len()).step_by(5) {
+            for k in [1, 12, 30] {
+                tree.nearest(i, k, &mut want);
+                KNearest::nearest(&morton, i, k, &mut got);
+                assert_eq!(got, want, "point {i}, k {k}");
+            }
         }
     }
 
