@@ -68,8 +68,7 @@ fn binary_size(triangles: u32) -> Option<usize> {
 }
 
 /// A position's coordinates as bits, hashed as three words (an array's
-/// own `Hash` adds its length and goes through the byte-slice path, a
-/// tenth of reading a large file).
+/// own `Hash` also writes its length, and hands the words over as bytes).
 #[derive(PartialEq, Eq)]
 struct PositionKey([u64; 3]);
 

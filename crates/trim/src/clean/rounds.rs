@@ -182,7 +182,8 @@ fn beta_of_new_vertices<'a>(
     beta: &'a dyn PointResolution,
     mesh: &Mesh,
 ) -> WithNewVertices<'a> {
-    let new_vertices = &mesh.vertices[input.vertices.len()..];
+    // The mesh keeps every input vertex first ([`assemble`]).
+    let new_vertices = mesh.vertices.get(input.vertices.len()..).unwrap_or(&[]);
     let new = match PointTree::new(&input.vertices) {
         Some(tree) => new_vertices
             .iter()
