@@ -351,6 +351,23 @@ mod tests {
         }
     }
 
+    /// Over a cloud larger than the runs, the median of 16 runs of 1,024
+    /// consecutive points is close to the median of all (the wavy sheet's
+    /// β varies with its jitter and its hole).
+    #[test]
+    fn the_median_of_runs_is_close_to_the_median() {
+        let points = sheet(4, 40_000);
+        let options = BpdOptions::default();
+        let all = median(&local_resolution(&points, &options).unwrap());
+        let runs = LocalResolution::all_at_once_up_to(&points, &options, 0)
+            .unwrap()
+            .median();
+        assert!(
+            (runs - all).abs() < 0.01 * all,
+            "median of runs {runs}, of all {all}"
+        );
+    }
+
     #[test]
     fn bad_clouds_get_the_full_pass_errors() {
         let line: Vec<Point3> = (0..100).map(|i| [i as f64, 0.0, 0.0]).collect();
