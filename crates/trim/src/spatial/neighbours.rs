@@ -16,10 +16,9 @@ use std::num::NonZeroUsize;
 use std::ops::Range;
 
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
-
-use crate::geom::Point3;
 use rayon::prelude::*;
 
+use crate::geom::Point3;
 use crate::spatial::morton::{spatial_order, MortonCells, MortonGrid};
 
 /// A k-NN index over a slice of distinct points.
