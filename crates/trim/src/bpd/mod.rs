@@ -33,7 +33,9 @@ use crate::error::CloudError;
 use crate::frame::{fit_plane_normal, project_sheared, ray_shear, spread, Frame, Point2};
 use crate::geom::{add, dist2, sub, unit, Point3};
 use crate::resolution::{beta_of, nearest_distances, Columns};
-use crate::spatial::morton::{octree_runs, spatial_order, split_by_runs, MortonCells, MortonGrid};
+use crate::spatial::morton::{
+    octree_runs, positions_in_order, spatial_order, split_by_runs, MortonCells, MortonGrid,
+};
 use crate::spatial::neighbours::{NeighbourIndex, RunScratch};
 
 /// Options of boundary point detection.
@@ -280,21 +282,12 @@ fn neighbourhood_reach(hoods: &Neighbourhoods, site_of: &[u32]) -> Vec<f64> {
                 .sqrt()
         })
         .collect();
-    let position_of = positions_of_sites(&hoods.order);
+    let position_of = positions_in_order(&hoods.order);
     site_of
         .par_iter()
         .with_min_len(PASS_PIECE)
         .map(|&site| radius[position_of[site as usize] as usize])
         .collect()
-}
-
-/// Site → position, from `order` (each position's site).
-fn positions_of_sites(order: &[u32]) -> Vec<u32> {
-    let mut position_of = vec![0u32; order.len()];
-    for (position, &site) in order.iter().enumerate() {
-        position_of[site as usize] = position as u32;
-    }
-    position_of
 }
 
 /// Neighbourhoods sampled to judge whether the cloud has a second
@@ -404,6 +397,14 @@ struct SpatialOrder {
 }
 
 impl SpatialOrder {
+    /// The k-NN index over the points in this order (nothing to build),
+    /// ties cut by site index, which unlike the spatial order does not
+    /// change when the cloud is moved.
+    fn index(&self) -> NeighbourIndex<'_> {
+        let cells = MortonCells::new(self.grid, &self.keys);
+        NeighbourIndex::in_morton_order(&self.points, cells).with_ranks(&self.order)
+    }
+
     /// True when two sites share a Morton key, as copies of a point do.
     fn keys_repeat(&self) -> bool {
         self.keys
@@ -505,16 +506,8 @@ fn neighbourhoods(
 ) -> Neighbourhoods {
     let k = options.k;
     let view = options.view.as_ref();
-    let SpatialOrder {
-        points,
-        order,
-        keys,
-        grid,
-    } = spatial;
-    // Ties are broken by site index (input order), which, unlike the
-    // spatial order, does not change when the cloud is moved.
-    let index =
-        NeighbourIndex::in_morton_order(&points, MortonCells::new(grid, &keys)).with_ranks(&order);
+    let index = spatial.index();
+    let (points, keys) = (&spatial.points, &spatial.keys);
     let mut lists = vec![0u32; points.len() * k];
     let mut sampling = options.anisotropy.then(|| {
         let unset = Sampling::default();
@@ -524,7 +517,7 @@ fn neighbourhoods(
     });
     match how {
         TestImpl::Fast => {
-            let runs = octree_runs(&keys, RUN);
+            let runs = octree_runs(keys, RUN);
             let sampled = usize::from(sampling.is_some());
             let sampling_pieces =
                 split_by_runs(&runs, sampling.as_deref_mut().unwrap_or_default(), sampled);
@@ -541,7 +534,7 @@ fn neighbourhoods(
                     |(scratch, projected), (run, out, out_sampling)| {
                         index.nearest_of_run(run.clone(), k, out, scratch);
                         for (members, o) in out.chunks_exact(k).zip(out_sampling.iter_mut()) {
-                            *o = sampling_at(&points, members, view, projected);
+                            *o = sampling_at(points, members, view, projected);
                         }
                     },
                 );
@@ -561,11 +554,12 @@ fn neighbourhoods(
             }
             let mut projected = Vec::new();
             for (members, o) in lists.chunks_exact(k).zip(sampling.iter_mut().flatten()) {
-                *o = sampling_at(&points, members, view, &mut projected);
+                *o = sampling_at(points, members, view, &mut projected);
             }
         }
     }
     drop(index);
+    let SpatialOrder { points, order, .. } = spatial;
     Neighbourhoods {
         points,
         order,
@@ -732,7 +726,7 @@ fn spread_to_input<T: Sync>(
     // Site → position, so that each input point reads its verdict in one
     // gather (one pass: at 12k points the verdicts no longer sit in the
     // cache, and each pass over them cost some 30 µs).
-    let position_of = positions_of_sites(order);
+    let position_of = positions_in_order(order);
     let (decision, beta): (Vec<Decision>, Vec<f64>) = site_of
         .par_iter()
         .with_min_len(PASS_PIECE)

@@ -83,7 +83,7 @@ impl LocalResolution {
         limit: usize,
     ) -> Result<Self, CloudError> {
         let Prepared { site_of, spatial } = prepare(points, options)?;
-        let position_of_site = positions_of_sites(&spatial.order);
+        let position_of_site = positions_in_order(&spatial.order);
         let position_of_input = site_of
             .par_iter()
             .with_min_len(PASS_PIECE)
@@ -172,13 +172,13 @@ impl LocalResolution {
 
     /// β at position `p`, as [`projected_beta`] finds it.
     fn find(&self, p: usize) -> f64 {
-        let index = self.index();
+        let index = self.spatial.index();
         let mut s = Scratch::default();
         let points = &self.spatial.points;
         let view = self.view.as_ref();
         if !self.anisotropy {
             let mut members = Vec::with_capacity(self.k);
-            index.nearest_alone(p, self.k, &mut members);
+            index.nearest(p, self.k, &mut members);
             let frame = fit_plane_normal(points, &members);
             let none: Option<std::iter::Empty<&SamplingMoment>> = None;
             return beta_in_plane(points, &members, &frame, view, none, &mut s);
@@ -208,7 +208,7 @@ impl LocalResolution {
             return read(known);
         }
         let mut members = Vec::with_capacity(self.k);
-        index.nearest_alone(p as usize, self.k, &mut members);
+        index.nearest(p as usize, self.k, &mut members);
         let sampling = sampling_at(
             &self.spatial.points,
             &members,
@@ -231,13 +231,6 @@ impl LocalResolution {
             .iter()
             .for_each(|b| b.store(NOT_FOUND, Ordering::Relaxed));
         self.known.iter_mut().for_each(|shard| lock(shard).clear());
-    }
-
-    /// The index BPD queries (nothing to build: the points are in Morton
-    /// order, ties cut by input order).
-    fn index(&self) -> NeighbourIndex<'_> {
-        let cells = MortonCells::new(self.spatial.grid, &self.spatial.keys);
-        NeighbourIndex::in_morton_order(&self.spatial.points, cells).with_ranks(&self.spatial.order)
     }
 }
 

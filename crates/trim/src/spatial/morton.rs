@@ -72,6 +72,15 @@ impl MortonGrid {
     }
 }
 
+/// Each point's position in `order` (the point at each position).
+pub(crate) fn positions_in_order(order: &[u32]) -> Vec<u32> {
+    let mut position_of = vec![0u32; order.len()];
+    for (position, &i) in order.iter().enumerate() {
+        position_of[i as usize] = position as u32;
+    }
+    position_of
+}
+
 /// Indices of `points` sorted by Morton key, and the keys in that order.
 pub fn spatial_order(points: &[Point3], grid: &MortonGrid) -> (Vec<u32>, Vec<u64>) {
     // The key above the index in one integer: sorted, they are in the

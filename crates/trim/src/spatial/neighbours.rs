@@ -19,7 +19,7 @@ use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use rayon::prelude::*;
 
 use crate::geom::Point3;
-use crate::spatial::morton::{spatial_order, MortonCells, MortonGrid};
+use crate::spatial::morton::{positions_in_order, spatial_order, MortonCells, MortonGrid};
 
 /// A k-NN index over a slice of distinct points.
 pub struct NeighbourIndex<'a> {
@@ -91,17 +91,13 @@ impl<'a> NeighbourIndex<'a> {
         self.nearest_holding(i, k, None, out);
     }
 
-    /// [`Self::nearest`] for an index in Morton order, asked about one point
-    /// alone (not a run): the search starts from the radius holding the k
-    /// nearest of the 2k points beside `i` in that order, which are near
-    /// it in space. (The radius from the cells, [`Self::nearest`]'s start,
-    /// holds a whole cell of k points or more, often hundreds of points.)
-    pub(crate) fn nearest_alone(&self, i: usize, k: usize, out: &mut Vec<u32>) {
+    /// A radius round point `i` of an index in Morton order that holds at
+    /// least k points: that of the k nearest of the 2k points beside `i`
+    /// in the order, which are near it in space (the smallest cell with k
+    /// points, [`MortonCells::radius_holding`], often holds hundreds). 0
+    /// when k copies of the point sit there.
+    fn radius_from_order(&self, i: usize, k: usize) -> f64 {
         let n = self.points.len();
-        let k = k.min(n);
-        if k == 0 || !matches!(self.search, Search::Morton(_)) {
-            return self.nearest(i, k, out);
-        }
         let from = i.saturating_sub(k).min(n.saturating_sub(2 * k));
         let p = self.points[i];
         let mut d2: Vec<f64> = (from..(from + 2 * k).min(n))
@@ -109,8 +105,7 @@ impl<'a> NeighbourIndex<'a> {
             .collect();
         let (_, kth, _) = d2.select_nth_unstable_by(k - 1, f64::total_cmp);
         // A hair wider, so that rounding in r² cannot leave the k-th out.
-        let radius = kth.sqrt() * (1.0 + 1e-9);
-        self.nearest_holding(i, k, Some(radius), out);
+        kth.sqrt() * (1.0 + 1e-9)
     }
 
     /// [`Self::nearest`], given when known a radius round point `i` that
@@ -127,8 +122,13 @@ impl<'a> NeighbourIndex<'a> {
             Search::Morton(cells) => {
                 // A radius of 0 would never grow (k = 1 at a run's centre).
                 let radius = holding
-                    .filter(|&r| r > 0.0)
-                    .unwrap_or_else(|| cells.radius_holding(i, k));
+                    .unwrap_or_else(|| self.radius_from_order(i, k))
+                    .max(0.0);
+                let radius = if radius > 0.0 {
+                    radius
+                } else {
+                    cells.radius_holding(i, k)
+                };
                 self.nearest_in_cells(cells, i, k, radius, out);
             }
         }
@@ -561,8 +561,7 @@ impl KNearest for NeighbourIndex<'_> {
 /// build but the sort, for a few queries over a large cloud (a mesh's
 /// border vertices among all its vertices: building the k-d tree over 2.5
 /// million vertices cost more than all the queries). Each query starts
-/// from the point's neighbours in the order
-/// ([`NeighbourIndex::nearest_alone`]).
+/// from the radius of the point's neighbours in the order.
 pub struct MortonIndex<'a> {
     points: &'a [Point3],
     in_order: Vec<Point3>,
@@ -581,10 +580,7 @@ impl<'a> MortonIndex<'a> {
         let grid = MortonGrid::of(points);
         let (order, keys) = spatial_order(points, &grid);
         let in_order = order.par_iter().map(|&i| points[i as usize]).collect();
-        let mut position_of = vec![0u32; points.len()];
-        for (position, &i) in order.iter().enumerate() {
-            position_of[i as usize] = position as u32;
-        }
+        let position_of = positions_in_order(&order);
         Self {
             points,
             in_order,
@@ -603,7 +599,7 @@ impl KNearest for MortonIndex<'_> {
     fn nearest(&self, i: usize, k: usize, out: &mut Vec<u32>) {
         let cells = MortonCells::new(self.grid, &self.keys);
         let index = NeighbourIndex::in_morton_order(&self.in_order, cells).with_ranks(&self.order);
-        index.nearest_alone(self.position_of[i] as usize, k, out);
+        index.nearest(self.position_of[i] as usize, k, out);
         for found in out.iter_mut() {
             *found = self.order[*found as usize];
         }
@@ -715,18 +711,14 @@ mod tests {
 
     /// The index over points in Morton order ([`crate::spatial::morton`]) gives the
     /// brute force's answers on the original points, ties cut by input
-    /// index: by runs (gathers, and the fallbacks given a radius), by
-    /// single queries (which find their own radius) and by queries alone
-    /// (which start from their neighbours in the order).
+    /// index: by runs (gathers, and the fallbacks given a radius) and by
+    /// single queries (which start from their neighbours in the order).
     fn assert_morton_matches_brute_force(raw: &[Point3]) {
         use crate::spatial::morton::{spatial_order, MortonCells, MortonGrid};
         let grid = MortonGrid::of(raw);
         let (order, keys) = spatial_order(raw, &grid);
         let points: Vec<Point3> = order.iter().map(|&i| raw[i as usize]).collect();
-        let mut position_of = vec![0u32; raw.len()];
-        for (position, &i) in order.iter().enumerate() {
-            position_of[i as usize] = position as u32;
-        }
+        let position_of = crate::spatial::morton::positions_in_order(&order);
         let index = NeighbourIndex::in_morton_order(&points, MortonCells::new(grid, &keys))
             .with_ranks(&order);
         let reference = |p: usize| -> Vec<u32> {
@@ -742,8 +734,6 @@ mod tests {
         for p in (0..points.len()).step_by(13) {
             index.nearest(p, 30, &mut single);
             assert_eq!(single, reference(p), "single query at {p}");
-            index.nearest_alone(p, 30, &mut single);
-            assert_eq!(single, reference(p), "query alone at {p}");
         }
     }
 
