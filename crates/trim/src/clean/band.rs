@@ -117,11 +117,16 @@ impl Band {
                 && grid.parity(p) == has_outer
                 && !grid.near(p, MARGIN * cx.beta.beta(v as usize))
         };
-        self.faces
+        let mut vertices: Vec<u32> = self
+            .faces
             .iter()
             .flat_map(|&f| mesh.faces[f as usize])
-            .map(|v| (v, stays(v)))
-            .collect()
+            .collect();
+        vertices.sort_unstable();
+        vertices.dedup();
+        // β is found here for most of the band's vertices: on every thread.
+        let stay: Vec<bool> = vertices.par_iter().map(|&v| stays(v)).collect();
+        vertices.into_iter().zip(stay).collect()
     }
 
     /// The band's faces with a vertex that goes, or crossed by a smoothed

@@ -11,6 +11,7 @@ use crate::error::MeshError;
 pub(crate) mod manifold;
 pub(crate) mod pinches;
 pub(crate) mod repair;
+pub(crate) mod rows;
 pub(crate) mod topology;
 use crate::geom::{add, cross, dot, norm2, sub, Point3};
 use topology::EdgeRows;
@@ -325,44 +326,35 @@ fn cube_map_direction(bin: usize) -> Point3 {
     d.map(|c| c / length)
 }
 
-/// Where each vertex's row starts when every edge of `faces` is filed
-/// under its smaller vertex (row v is `start[v]..start[v + 1]`): a
-/// counting sort's offsets. Sized by the largest index the faces name, so
-/// a face that names a vertex past the end (an invalid mesh, which
-/// `validate` reports) still gets its edges instead of a panic.
-pub(crate) fn rows_by_smaller_vertex(faces: &[[u32; 3]]) -> Vec<u32> {
-    let vertices = faces.iter().flatten().max().map_or(0, |&v| v as usize + 1);
-    let mut start = vec![0u32; vertices + 1];
-    for face in faces {
-        for k in 0..3 {
-            start[face[k].min(face[(k + 1) % 3]) as usize + 1] += 1;
-        }
-    }
-    for v in 1..start.len() {
-        start[v] += start[v - 1];
-    }
-    start
+/// How many rows filing the edges of `faces` under their smaller vertex
+/// takes: sized by the largest index the faces name, so a face that names
+/// a vertex past the end (an invalid mesh, which `validate` reports)
+/// still gets its edges instead of a panic.
+pub(crate) fn rows_for_vertices_of(faces: &[[u32; 3]]) -> usize {
+    faces.iter().flatten().max().map_or(0, |&v| v as usize + 1)
+}
+
+/// The edge `k` of `face` filed under its smaller vertex: (smaller,
+/// larger, whether the face runs it from the larger).
+pub(crate) fn edge_by_smaller_vertex(face: &[u32; 3], k: usize) -> (u32, u32, bool) {
+    let (a, b) = (face[k], face[(k + 1) % 3]);
+    (a.min(b), a.max(b), a > b)
 }
 
 /// [`Mesh::sorted_edges`] of a list of faces (which need not be a whole
 /// mesh's: the faces of one part of it, say).
 pub fn sorted_edges_of(faces: &[[u32; 3]]) -> Vec<(u32, u32, u32)> {
-    let start = rows_by_smaller_vertex(faces);
-    let vertices = start.len() - 1;
-    let mut edges = vec![(0u32, 0u32, 0u32); 3 * faces.len()];
-    let mut fill = start.clone();
-    for (f, face) in faces.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (face[k], face[(k + 1) % 3]);
-            let slot = &mut fill[a.min(b) as usize];
-            edges[*slot as usize] = (a.min(b), a.max(b), f as u32);
-            *slot += 1;
-        }
-    }
-    // Faces were visited in order, so each vertex's edges are sorted by
-    // face already; a stable sort by the larger vertex finishes.
-    for v in 0..vertices {
-        edges[start[v] as usize..start[v + 1] as usize].sort_by_key(|e| e.1);
+    let mut rows = rows::file_by_row(rows_for_vertices_of(faces), faces, |f, face, k| {
+        let (low, high, _) = edge_by_smaller_vertex(face, k);
+        Some((low, (high, f)))
+    });
+    // Filed in face order, so each vertex's edges are sorted by face
+    // already; a stable sort by the larger vertex finishes.
+    rows.sort_each_by_key(|&(high, _)| high);
+    let mut edges = Vec::with_capacity(rows.values.len());
+    for (low, w) in rows.start.windows(2).enumerate() {
+        let row = &rows.values[w[0] as usize..w[1] as usize];
+        edges.extend(row.iter().map(|&(high, f)| (low as u32, high, f)));
     }
     edges
 }

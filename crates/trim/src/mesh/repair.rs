@@ -26,6 +26,7 @@
 //! left. Faces that are not degenerate are never touched, apart from the
 //! one vertex a collapse renames.
 
+use super::rows::file_by_row;
 use super::Mesh;
 use crate::geom::{cross, dist2, norm2, sub, Point3};
 use rayon::prelude::*;
@@ -104,58 +105,50 @@ fn degenerate_faces(mesh: &Mesh, min_area: f64) -> Vec<usize> {
 /// several times faster than hashing every face of a large mesh) and
 /// comparing within each bucket, in face order.
 fn drop_repeated_faces(mesh: &mut Mesh) -> usize {
-    let mut keep: Vec<bool> = mesh
-        .faces
-        .iter()
-        .map(|f| f[0] != f[1] && f[1] != f[2] && f[0] != f[2])
-        .collect();
-    let mut start = vec![0u32; mesh.vertices.len() + 1];
-    for (f, &k) in mesh.faces.iter().zip(&keep) {
-        if k {
-            start[f.iter().min().map_or(0, |&v| v as usize + 1)] += 1;
-        }
-    }
-    for i in 1..start.len() {
-        start[i] += start[i - 1];
-    }
-    let mut fill = start.clone();
-    let mut bucketed = vec![0u32; start[mesh.vertices.len()] as usize];
-    for (i, (f, &k)) in mesh.faces.iter().zip(&keep).enumerate() {
-        if k {
-            let lowest = f.iter().min().map_or(0, |&v| v as usize);
-            bucketed[fill[lowest] as usize] = i as u32;
-            fill[lowest] += 1;
-        }
-    }
-    let sorted = |f: [u32; 3]| {
+    let names_three = |f: &[u32; 3]| f[0] != f[1] && f[1] != f[2] && f[0] != f[2];
+    let corners = |f: [u32; 3]| {
         let mut key = f;
         key.sort_unstable();
         key
     };
-    for bucket in start.windows(2) {
-        let faces = &mut bucketed[bucket[0] as usize..bucket[1] as usize];
-        if faces.len() < 2 {
-            continue;
-        }
-        // Face order within equal corners: the first copy is the kept one.
-        faces.sort_unstable_by_key(|&i| (sorted(mesh.faces[i as usize]), i));
-        for group in faces
-            .chunk_by(|&a, &b| sorted(mesh.faces[a as usize]) == sorted(mesh.faces[b as usize]))
-        {
-            let first = group[0] as usize;
-            for &later in &group[1..] {
-                keep[later as usize] = false;
-                if super::lowest_first(mesh.faces[later as usize])
-                    != super::lowest_first(mesh.faces[first])
-                {
-                    keep[first] = false;
-                }
-            }
-        }
+    let mut buckets = file_by_row(mesh.vertices.len(), &mesh.faces, |i, f, k| {
+        (k == 0 && names_three(f)).then(|| (corners(*f)[0], i))
+    });
+    // Filed in face order, and sorted stably: within equal corners the
+    // first copy, the kept one, comes first.
+    buckets.sort_each_by_key(|&i| corners(mesh.faces[i as usize]));
+    let faces = &mesh.faces;
+    let dropped: Vec<u32> = buckets
+        .start
+        .par_windows(2)
+        .flat_map_iter(|bucket| {
+            let bucket = &buckets.values[bucket[0] as usize..bucket[1] as usize];
+            bucket
+                .chunk_by(|&a, &b| corners(faces[a as usize]) == corners(faces[b as usize]))
+                .flat_map(|group| repeats_dropped(faces, group))
+                .collect::<Vec<u32>>()
+        })
+        .collect();
+    let mut keep: Vec<bool> = faces.par_iter().map(names_three).collect();
+    for &f in &dropped {
+        keep[f as usize] = false;
     }
     let dropped = keep.iter().filter(|&&k| !k).count();
     if dropped > 0 {
         mesh.retain_faces(&keep);
+    }
+    dropped
+}
+
+/// Of faces with the same corners, in face order, those that go: every
+/// later copy, and the first too when a copy runs the other way.
+fn repeats_dropped(faces: &[[u32; 3]], group: &[u32]) -> Vec<u32> {
+    let first = group[0] as usize;
+    let later = &group[1..];
+    let turn = |f: usize| super::lowest_first(faces[f]);
+    let mut dropped = later.to_vec();
+    if later.iter().any(|&f| turn(f as usize) != turn(first)) {
+        dropped.push(first as u32);
     }
     dropped
 }
@@ -488,6 +481,40 @@ mod tests {
                 "case {case}: {mesh:?}"
             );
             assert_eq!(fast.faces, plain.faces, "case {case}: {mesh:?}");
+        }
+    }
+
+    /// The same on a mesh large enough to be bucketed on every thread:
+    /// copies, reverses and rotations of random faces among 90,000.
+    #[test]
+    fn repeated_faces_match_the_reference_on_every_thread() {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(12);
+        let vertices = 5_000u32;
+        let mut faces: Vec<[u32; 3]> = (0..80_000)
+            .map(|_| [0; 3].map(|_| rng.random_range(0..vertices)))
+            .collect();
+        for _ in 0..10_000 {
+            let [a, b, c] = faces[rng.random_range(0..faces.len())];
+            let again = [[a, b, c], [c, b, a], [b, c, a], [a, c, b]];
+            let at = rng.random_range(0..=faces.len());
+            faces.insert(at, again[rng.random_range(0..4)]);
+        }
+        let mesh = Mesh {
+            vertices: vec![[0.0; 3]; vertices as usize],
+            faces,
+        };
+        let mut plain = mesh.clone();
+        let dropped = drop_repeated_faces_reference(&mut plain);
+        assert!(dropped > 10_000, "{dropped}");
+        for threads in [1, 2, 3] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let mut fast = mesh.clone();
+            assert_eq!(pool.install(|| drop_repeated_faces(&mut fast)), dropped);
+            assert_eq!(fast.faces, plain.faces, "{threads} threads");
         }
     }
 

@@ -1,7 +1,8 @@
 //! Mesh topology: edge uses counted by sorting, the manifold and
 //! orientation check, and the faces round each vertex.
 
-use super::{rows_by_smaller_vertex, Mesh};
+use super::rows::file_by_row;
+use super::{edge_by_smaller_vertex, rows_for_vertices_of, Mesh};
 use crate::error::MeshError;
 use crate::hash::HashMap;
 
@@ -92,24 +93,17 @@ pub(crate) struct EdgeRows {
 }
 
 impl EdgeRows {
-    /// The edges of `faces` (rows as [`rows_by_smaller_vertex`]).
+    /// The edges of `faces`, each filed under its smaller vertex.
     pub(crate) fn new(faces: &[[u32; 3]]) -> Self {
-        let start = rows_by_smaller_vertex(faces);
-        let vertices = start.len() - 1;
-        let mut entries = vec![0u64; 3 * faces.len()];
-        let mut fill = start.clone();
-        for face in faces {
-            for k in 0..3 {
-                let (a, b) = (face[k], face[(k + 1) % 3]);
-                let slot = &mut fill[a.min(b) as usize];
-                entries[*slot as usize] = (u64::from(a.max(b)) << 1) | u64::from(a > b);
-                *slot += 1;
-            }
+        let mut rows = file_by_row(rows_for_vertices_of(faces), faces, |_, face, k| {
+            let (low, high, backwards) = edge_by_smaller_vertex(face, k);
+            Some((low, (u64::from(high) << 1) | u64::from(backwards)))
+        });
+        rows.sort_each_by_key(|&entry| entry);
+        EdgeRows {
+            start: rows.start,
+            entries: rows.values,
         }
-        for v in 0..vertices {
-            entries[start[v] as usize..start[v + 1] as usize].sort_unstable();
-        }
-        EdgeRows { start, entries }
     }
 
     /// Each row: its smaller vertex and its entries.
@@ -170,26 +164,12 @@ pub(crate) struct Topology {
 
 impl Topology {
     pub(crate) fn new(mesh: &Mesh) -> Self {
-        let mut count = vec![0u32; mesh.vertices.len() + 1];
-        for f in &mesh.faces {
-            for &v in f {
-                count[v as usize + 1] += 1;
-            }
-        }
-        for i in 1..count.len() {
-            count[i] += count[i - 1];
-        }
-        let mut fill = count.clone();
-        let mut faces = vec![0; count[mesh.vertices.len()] as usize];
-        for (i, f) in mesh.faces.iter().enumerate() {
-            for &v in f {
-                faces[fill[v as usize] as usize] = i as u32;
-                fill[v as usize] += 1;
-            }
-        }
+        let rows = file_by_row(mesh.vertices.len(), &mesh.faces, |f, face, k| {
+            Some((face[k], f))
+        });
         Topology {
-            start: count,
-            faces,
+            start: rows.start,
+            faces: rows.values,
         }
     }
 
