@@ -223,10 +223,18 @@ impl<'a> MortonCells<'a> {
             .min(BITS);
         let (low, high) = (low.map(|c| c >> shift), high.map(|c| c >> shift));
         let r2 = radius * radius;
+        // Morton keys grow with each coordinate, so every cell of the box
+        // lies between its lowest and highest corners' keys: the cells are
+        // searched for in that stretch of the keys alone.
+        let level = 3 * shift;
+        let from = self.keys.partition_point(|&k| k >> level < interleave(low));
+        let to = from + self.keys[from..].partition_point(|&k| k >> level <= interleave(high));
+        let stretch = &self.keys[from..to];
         for z in low[2]..=high[2] {
             for y in low[1]..=high[1] {
                 for x in low[0]..=high[0] {
-                    for position in self.cell_range(interleave([x, y, z]), shift) {
+                    let cell = cell_range_in(stretch, interleave([x, y, z]), shift);
+                    for position in from + cell.start..from + cell.end {
                         if dist2(points[position], centre) <= r2 {
                             visit(position as u32);
                         }
@@ -239,12 +247,7 @@ impl<'a> MortonCells<'a> {
     /// Positions of the points in the cell with Morton key `cell` at the
     /// level of cells of side 2^shift.
     fn cell_range(&self, cell: u64, shift: u32) -> std::ops::Range<usize> {
-        let level = 3 * shift;
-        // At the top level (shift = BITS) the only cell is the whole grid;
-        // keys have 3·BITS = 63 bits, so the shifts stay below 64.
-        let start = self.keys.partition_point(|&k| k >> level < cell);
-        let len = self.keys[start..].partition_point(|&k| k >> level == cell);
-        start..start + len
+        cell_range_in(&self.keys, cell, shift)
     }
 
     /// A radius around the point at `position` that holds at least `k`
@@ -260,6 +263,17 @@ impl<'a> MortonCells<'a> {
         // the rounding of (x − lo)·scale.
         side * 3f64.sqrt() * (1.0 + 1e-6) + 1e-12 * (side + magnitude(self.grid.lo))
     }
+}
+
+/// Positions in `keys` (sorted) of the points in the cell with Morton key
+/// `cell` at the level of cells of side 2^shift.
+fn cell_range_in(keys: &[u64], cell: u64, shift: u32) -> std::ops::Range<usize> {
+    let level = 3 * shift;
+    // At the top level (shift = BITS) the only cell is the whole grid;
+    // keys have 3·BITS = 63 bits, so the shifts stay below 64.
+    let start = keys.partition_point(|&k| k >> level < cell);
+    let len = keys[start..].partition_point(|&k| k >> level == cell);
+    start..start + len
 }
 
 fn magnitude(p: Point3) -> f64 {
