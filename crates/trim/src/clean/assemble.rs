@@ -7,11 +7,12 @@ use crate::mesh::topology::for_each_edge;
 
 /// The input with every patch applied, and for each output face the
 /// outcome whose patch made it (`None` for input faces).
-pub(super) fn assemble(mesh: &Mesh, outcomes: &[Outcome]) -> (Mesh, Vec<Option<usize>>) {
+pub(super) fn assemble(mesh: &Mesh, outcomes: &[Outcome]) -> (Mesh, Origins) {
     let n = mesh.vertices.len() as u32;
     let mut removed = vec![false; mesh.faces.len()];
     let mut vertices = mesh.vertices.clone();
     let mut new_faces = Vec::new();
+    let mut origins = Origins::default();
     for (g, outcome) in outcomes.iter().enumerate() {
         let Some(patch) = &outcome.patch else {
             continue;
@@ -22,25 +23,42 @@ pub(super) fn assemble(mesh: &Mesh, outcomes: &[Outcome]) -> (Mesh, Vec<Option<u
         let base = vertices.len() as u32;
         vertices.extend_from_slice(&patch.vertices);
         for face in &patch.faces {
-            new_faces.push((g, face.map(|id| if id < n { id } else { base + id - n })));
+            new_faces.push(face.map(|id| if id < n { id } else { base + id - n }));
+            origins.of_new_faces.push(g);
         }
     }
     let mut faces: Vec<[u32; 3]> = Vec::with_capacity(mesh.faces.len() + new_faces.len());
-    let mut origin = Vec::with_capacity(faces.capacity());
-    for (f, _) in mesh.faces.iter().zip(&removed).filter(|(_, &r)| !r) {
-        faces.push(*f);
-        origin.push(None);
+    faces.extend(
+        mesh.faces
+            .iter()
+            .zip(&removed)
+            .filter(|(_, &r)| !r)
+            .map(|(f, _)| *f),
+    );
+    origins.input_faces = faces.len();
+    faces.extend(new_faces);
+    (Mesh { vertices, faces }, origins)
+}
+
+/// Which outcome each face of an assembled mesh comes from: the input's
+/// kept faces come first, from none; then each patch's new faces.
+#[derive(Default)]
+pub(super) struct Origins {
+    pub(super) input_faces: usize,
+    pub(super) of_new_faces: Vec<usize>,
+}
+
+impl Origins {
+    /// The outcome face `f` comes from; `None` for an input face.
+    pub(super) fn of(&self, f: usize) -> Option<usize> {
+        f.checked_sub(self.input_faces)
+            .and_then(|k| self.of_new_faces.get(k).copied())
     }
-    for (g, f) in new_faces {
-        faces.push(f);
-        origin.push(Some(g));
-    }
-    (Mesh { vertices, faces }, origin)
 }
 
 /// The outcomes whose new faces use an edge more than twice or twice the
 /// same way.
-pub(super) fn patches_breaking_manifold(mesh: &Mesh, origin: &[Option<usize>]) -> BTreeSet<usize> {
+pub(super) fn patches_breaking_manifold(mesh: &Mesh, origins: &Origins) -> BTreeSet<usize> {
     let mut bad = BTreeSet::new();
     // The usual case, told without counting each edge's uses.
     if EdgeRows::new(&mesh.faces).no_edge_run_twice() {
@@ -48,7 +66,7 @@ pub(super) fn patches_breaking_manifold(mesh: &Mesh, origin: &[Option<usize>]) -
     }
     for_each_edge(mesh, |faces, forward, backward| {
         if forward > 1 || backward > 1 {
-            bad.extend(faces.iter().filter_map(|e| origin[e.2 as usize]));
+            bad.extend(faces.iter().filter_map(|e| origins.of(e.2 as usize)));
         }
     });
     bad

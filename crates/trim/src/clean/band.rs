@@ -139,17 +139,17 @@ impl Band {
         stay: &HashMap<u32, bool>,
     ) -> Vec<u32> {
         let p2 = |v: u32| projection.vertex_to2(mesh, v);
-        let mut removed = Vec::new();
-        for &f in &self.faces {
-            let face = mesh.faces[f as usize];
-            let all_stay = face.iter().all(|v| stay[v]);
-            let crossed =
-                all_stay && (0..3).any(|k| grid.crosses(p2(face[k]), p2(face[(k + 1) % 3])));
-            if !all_stay || crossed {
-                removed.push(f);
-            }
-        }
-        removed
+        self.faces
+            .par_iter()
+            .copied()
+            .filter(|&f| {
+                let face = mesh.faces[f as usize];
+                let all_stay = face.iter().all(|v| stay[v]);
+                let crossed =
+                    all_stay && (0..3).any(|k| grid.crosses(p2(face[k]), p2(face[(k + 1) % 3])));
+                !all_stay || crossed
+            })
+            .collect()
     }
 
     /// The band's faces that turn over in the projection (a range scan's

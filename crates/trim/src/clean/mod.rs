@@ -408,7 +408,9 @@ fn smoothed_loops(
         .par_iter()
         .map(|border| {
             (border.len() >= MIN_LOOP_POINTS).then(|| {
-                let loop_beta = border.iter().map(|&v| beta.beta(v as usize)).collect();
+                // β is found here for the border's vertices: on every
+                // thread, as one loop is often most of the border.
+                let loop_beta = border.par_iter().map(|&v| beta.beta(v as usize)).collect();
                 let index = index.as_ref().map(|i| i as &dyn KNearest);
                 let lp = loop_with_beta(&mesh.vertices, loop_beta, border.clone(), index);
                 even_out(Ring::from_loop(&lp, beta))

@@ -62,11 +62,17 @@ fn edge_defects_match_the_reference() {
             edge_defects_reference(&mesh),
             "case {case}: {mesh:?}"
         );
-        let origin: Vec<Option<usize>> = (0..mesh.faces.len())
-            .map(|_| rng.random_bool(0.7).then(|| rng.random_range(0..4)))
-            .collect();
+        // The input's faces first, then the patches' new faces.
+        let input_faces = rng.random_range(0..=mesh.faces.len());
+        let origins = Origins {
+            input_faces,
+            of_new_faces: (input_faces..mesh.faces.len())
+                .map(|_| rng.random_range(0..4))
+                .collect(),
+        };
+        let origin: Vec<Option<usize>> = (0..mesh.faces.len()).map(|f| origins.of(f)).collect();
         assert_eq!(
-            patches_breaking_manifold(&mesh, &origin),
+            patches_breaking_manifold(&mesh, &origins),
             patches_breaking_manifold_reference(&mesh, &origin),
             "case {case}: {mesh:?}"
         );

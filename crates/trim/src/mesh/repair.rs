@@ -111,12 +111,17 @@ fn drop_repeated_faces(mesh: &mut Mesh) -> usize {
         key.sort_unstable();
         key
     };
+    // Each face filed under its lowest vertex with its sorted corners, so
+    // that the buckets sort without reading the faces again.
     let mut buckets = file_by_row(mesh.vertices.len(), &mesh.faces, |i, f, k| {
-        (k == 0 && names_three(f)).then(|| (corners(*f)[0], i))
+        (k == 0 && names_three(f)).then(|| {
+            let key = corners(*f);
+            (key[0], (key, i))
+        })
     });
     // Filed in face order, and sorted stably: within equal corners the
     // first copy, the kept one, comes first.
-    buckets.sort_each_by_key(|&i| corners(mesh.faces[i as usize]));
+    buckets.sort_each_by_key(|&(key, _)| key);
     let faces = &mesh.faces;
     let dropped: Vec<u32> = buckets
         .start
@@ -124,7 +129,7 @@ fn drop_repeated_faces(mesh: &mut Mesh) -> usize {
         .flat_map_iter(|bucket| {
             let bucket = &buckets.values[bucket[0] as usize..bucket[1] as usize];
             bucket
-                .chunk_by(|&a, &b| corners(faces[a as usize]) == corners(faces[b as usize]))
+                .chunk_by(|a, b| a.0 == b.0)
                 .flat_map(|group| repeats_dropped(faces, group))
                 .collect::<Vec<u32>>()
         })
@@ -142,13 +147,13 @@ fn drop_repeated_faces(mesh: &mut Mesh) -> usize {
 
 /// Of faces with the same corners, in face order, those that go: every
 /// later copy, and the first too when a copy runs the other way.
-fn repeats_dropped(faces: &[[u32; 3]], group: &[u32]) -> Vec<u32> {
-    let first = group[0] as usize;
-    let later = &group[1..];
-    let turn = |f: usize| super::lowest_first(faces[f]);
-    let mut dropped = later.to_vec();
-    if later.iter().any(|&f| turn(f as usize) != turn(first)) {
-        dropped.push(first as u32);
+fn repeats_dropped(faces: &[[u32; 3]], group: &[([u32; 3], u32)]) -> Vec<u32> {
+    let first = group[0].1;
+    let later: Vec<u32> = group[1..].iter().map(|&(_, f)| f).collect();
+    let turn = |f: u32| super::lowest_first(faces[f as usize]);
+    let mut dropped = later.clone();
+    if later.iter().any(|&f| turn(f) != turn(first)) {
+        dropped.push(first);
     }
     dropped
 }
