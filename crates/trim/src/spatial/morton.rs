@@ -234,8 +234,9 @@ impl<'a> MortonCells<'a> {
             for y in low[1]..=high[1] {
                 for x in low[0]..=high[0] {
                     let cell = cell_range_in(stretch, interleave([x, y, z]), shift);
-                    for position in from + cell.start..from + cell.end {
-                        if dist2(points[position], centre) <= r2 {
+                    let first = from + cell.start;
+                    for (position, &p) in (first..).zip(&points[first..from + cell.end]) {
+                        if dist2(p, centre) <= r2 {
                             visit(position as u32);
                         }
                     }
@@ -247,7 +248,7 @@ impl<'a> MortonCells<'a> {
     /// Positions of the points in the cell with Morton key `cell` at the
     /// level of cells of side 2^shift.
     fn cell_range(&self, cell: u64, shift: u32) -> std::ops::Range<usize> {
-        cell_range_in(&self.keys, cell, shift)
+        cell_range_in(self.keys, cell, shift)
     }
 
     /// A radius around the point at `position` that holds at least `k`
