@@ -295,7 +295,26 @@ fn read_ascii_in_pieces(bytes: &[u8], piece_bytes: usize) -> Result<Mesh> {
                 (kind == Kind::Vertex).then(|| vertices.next()).flatten(),
             )
         });
-    walk(text, lines_read)
+    let triangles = walk(text, lines_read)?;
+    let per_piece = triangles
+        .len()
+        .div_ceil(rayon::current_num_threads())
+        .max(MIN_PIECE_TRIANGLES);
+    merge_in_pieces(&triangles, per_piece)
+}
+
+/// Triangles merged in pieces of `per_piece`, each on its own thread,
+/// then joined: the mesh one merger over all of them gives.
+fn merge_in_pieces(triangles: &[[Point3; 3]], per_piece: usize) -> Result<Mesh> {
+    let pieces: Vec<Result<Merger>> = triangles
+        .par_chunks(per_piece.max(1))
+        .map(|piece| {
+            let mut merger = Merger::new(piece.len());
+            piece.iter().try_for_each(|&t| merger.triangle(t))?;
+            Ok(merger)
+        })
+        .collect();
+    join_pieces(pieces.into_iter().collect::<Result<_>>()?)
 }
 
 /// What the grammar needs of a piece's lines, read once: each line's first
@@ -376,12 +395,12 @@ impl Kind {
 
 /// The `solid` grammar over the file's lines, in order: each line's kind,
 /// with its point (or what is wrong with it) for a `vertex` line; messages
-/// quote a wrong line from `text`.
+/// quote a wrong line from `text`. Gives the facets' corners in order.
 fn walk(
     text: &str,
     lines_read: impl Iterator<Item = (Kind, Option<Result<Point3, String>>)>,
-) -> Result<Mesh> {
-    let mut merger = Merger::new(text.len() / 200);
+) -> Result<Vec<[Point3; 3]>> {
+    let mut triangles = Vec::with_capacity(text.len() / 250);
     let mut state = State::Outside;
     let mut corners: Vec<Point3> = Vec::with_capacity(3);
     let mut facets = 0usize;
@@ -416,7 +435,7 @@ fn walk(
                         corners.len()
                     )));
                 }
-                merger.triangle([corners[0], corners[1], corners[2]])?;
+                triangles.push([corners[0], corners[1], corners[2]]);
                 corners.clear();
                 facets += 1;
                 State::EndLoop
@@ -427,7 +446,7 @@ fn walk(
         };
     }
     match state {
-        State::Outside => Ok(merger.mesh),
+        State::Outside => Ok(triangles),
         _ => bail!("line {last}: the file ends inside a solid (no 'endsolid' line)"),
     }
 }

@@ -268,3 +268,40 @@ fn binary_pieces_read_as_one_merger() {
         "{errors} errors in 2000 cases"
     );
 }
+
+/// Triangles merged in pieces of 1–9 number the vertices as one merger
+/// over all of them does, on random triangle soups drawn from a few
+/// positions (`-0` among them), as the ASCII reader merges its facets.
+#[test]
+fn triangles_merged_in_pieces_as_one_merger() {
+    let mut rng = testkit::synthetic::SplitMix64::new(62);
+    let mut below = |n: u64| (rng.next_u64() % n) as usize;
+    let pool: [Point3; 6] = [
+        [0., 0., 0.],
+        [-0., 0., 0.],
+        [1., 0., 0.],
+        [0., 1., 2.5],
+        [1e-300, 1., -1.],
+        [0., 0., -0.],
+    ];
+    for _ in 0..2000 {
+        let triangles: Vec<[Point3; 3]> = (0..below(40))
+            .map(|_| [0; 3].map(|_| pool[below(pool.len() as u64)]))
+            .collect();
+        let mut one = Merger::new(0);
+        for &t in &triangles {
+            one.triangle(t).unwrap();
+        }
+        let bits =
+            |v: &[Point3]| -> Vec<[u64; 3]> { v.iter().map(|p| p.map(f64::to_bits)).collect() };
+        for per_piece in 1..10 {
+            let pieces = merge_in_pieces(&triangles, per_piece).unwrap();
+            assert_eq!(pieces.faces, one.mesh.faces, "faces, pieces of {per_piece}");
+            assert_eq!(
+                bits(&pieces.vertices),
+                bits(&one.mesh.vertices),
+                "vertices, pieces of {per_piece}"
+            );
+        }
+    }
+}
