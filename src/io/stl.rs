@@ -156,10 +156,7 @@ fn read_binary(bytes: &[u8]) -> Result<Mesh> {
     }
     // Bytes after the last triangle (padding some exporters add) are ignored.
     let records = &bytes[HEADER..HEADER + n as usize * RECORD];
-    let per_piece = (n as usize)
-        .div_ceil(rayon::current_num_threads())
-        .max(MIN_PIECE_TRIANGLES);
-    read_records_in_pieces(records, per_piece)
+    read_records_in_pieces(records, triangles_per_piece(n as usize))
 }
 
 /// Reads the triangle records in pieces of `per_piece` triangles, each
@@ -174,8 +171,16 @@ fn read_records_in_pieces(records: &[u8], per_piece: usize) -> Result<Mesh> {
     join_pieces(pieces.into_iter().collect::<Result<_>>()?)
 }
 
-/// Triangles below which a binary STL is read in one piece.
+/// Triangles below which an STL is merged in one piece.
 const MIN_PIECE_TRIANGLES: usize = 1 << 16;
+
+/// How many of `triangles` each thread merges: one piece per thread,
+/// one piece for few triangles.
+fn triangles_per_piece(triangles: usize) -> usize {
+    triangles
+        .div_ceil(rayon::current_num_threads())
+        .max(MIN_PIECE_TRIANGLES)
+}
 
 /// The triangle records of one piece, the first being triangle `first`,
 /// with their corners merged within the piece.
@@ -296,11 +301,7 @@ fn read_ascii_in_pieces(bytes: &[u8], piece_bytes: usize) -> Result<Mesh> {
             )
         });
     let triangles = walk(text, lines_read)?;
-    let per_piece = triangles
-        .len()
-        .div_ceil(rayon::current_num_threads())
-        .max(MIN_PIECE_TRIANGLES);
-    merge_in_pieces(&triangles, per_piece)
+    merge_in_pieces(&triangles, triangles_per_piece(triangles.len()))
 }
 
 /// Triangles merged in pieces of `per_piece`, each on its own thread,

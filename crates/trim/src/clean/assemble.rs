@@ -5,8 +5,8 @@
 use super::*;
 use crate::mesh::topology::for_each_edge;
 
-/// The input with every patch applied, and for each output face the
-/// outcome whose patch made it (`None` for input faces).
+/// The input with every patch applied, and which outcome's patch made
+/// each output face ([`Origins`]).
 pub(super) fn assemble(mesh: &Mesh, outcomes: &[Outcome]) -> (Mesh, Origins) {
     let n = mesh.vertices.len() as u32;
     let mut removed = vec![false; mesh.faces.len()];

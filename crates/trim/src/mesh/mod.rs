@@ -346,17 +346,12 @@ pub(crate) fn edge_by_smaller_vertex(face: &[u32; 3], k: usize) -> (u32, u32, bo
 pub fn sorted_edges_of(faces: &[[u32; 3]]) -> Vec<(u32, u32, u32)> {
     let mut rows = rows::file_by_row(rows_for_vertices_of(faces), faces, |f, face, k| {
         let (low, high, _) = edge_by_smaller_vertex(face, k);
-        Some((low, (high, f)))
+        Some((low, (low, high, f)))
     });
     // Filed in face order, so each vertex's edges are sorted by face
     // already; a stable sort by the larger vertex finishes.
-    rows.sort_each_by_key(|&(high, _)| high);
-    let mut edges = Vec::with_capacity(rows.values.len());
-    for (low, w) in rows.start.windows(2).enumerate() {
-        let row = &rows.values[w[0] as usize..w[1] as usize];
-        edges.extend(row.iter().map(|&(high, f)| (low as u32, high, f)));
-    }
-    edges
+    rows.sort_each_by_key(|&(_, high, _)| high);
+    rows.values
 }
 
 #[cfg(test)]

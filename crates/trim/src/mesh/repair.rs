@@ -148,11 +148,10 @@ fn drop_repeated_faces(mesh: &mut Mesh) -> usize {
 /// Of faces with the same corners, in face order, those that go: every
 /// later copy, and the first too when a copy runs the other way.
 fn repeats_dropped(faces: &[[u32; 3]], group: &[([u32; 3], u32)]) -> Vec<u32> {
-    let first = group[0].1;
-    let later: Vec<u32> = group[1..].iter().map(|&(_, f)| f).collect();
     let turn = |f: u32| super::lowest_first(faces[f as usize]);
-    let mut dropped = later.clone();
-    if later.iter().any(|&f| turn(f) != turn(first)) {
+    let first = group[0].1;
+    let mut dropped: Vec<u32> = group[1..].iter().map(|&(_, f)| f).collect();
+    if dropped.iter().any(|&f| turn(f) != turn(first)) {
         dropped.push(first);
     }
     dropped

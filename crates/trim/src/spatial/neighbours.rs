@@ -121,9 +121,7 @@ impl<'a> NeighbourIndex<'a> {
             Search::Tree(tree) => self.nearest_in_tree(tree, i, k, out),
             Search::Morton(cells) => {
                 // A radius of 0 would never grow (k = 1 at a run's centre).
-                let radius = holding
-                    .unwrap_or_else(|| self.radius_from_order(i, k))
-                    .max(0.0);
+                let radius = holding.unwrap_or_else(|| self.radius_from_order(i, k));
                 let radius = if radius > 0.0 {
                     radius
                 } else {
