@@ -13,6 +13,16 @@
 //! triangle is parry's exact point-triangle projection; the answer is the
 //! face at the smallest distance, the lower index on a tie, tested against
 //! parry's `TriMesh` on random meshes.
+//!
+//! The support test needs only the *piece* of the closest face, not the
+//! face: [`FaceIndex::nearest_label`] takes a label per face, and each node
+//! of the hierarchy knows whether all its faces share one. Once a face
+//! within reach is found, a node whose faces all carry its label is set
+//! aside unsearched: whatever face it holds, nearer or not, the answer's
+//! label stays. Only if a face with another label becomes the nearest are
+//! the set-aside nodes it could lose to searched after all. Most points
+//! lie inside one piece, so most queries end at their first leaf instead
+//! of searching every box within the nearest face's distance.
 
 use parry3d_f64::math::Vector;
 use parry3d_f64::query::PointQuery;
@@ -90,7 +100,10 @@ impl FaceIndex {
         }
     }
 
-    /// The face closest to `p` within `max_dist` (the lower index on a tie).
+    /// The face closest to `p` within `max_dist` (the lower index on a
+    /// tie), searched box by box: the reference for
+    /// [`FaceIndex::nearest_label`].
+    #[cfg(test)]
     pub fn nearest_face(&self, p: Point3, max_dist: f64) -> Option<u32> {
         let query = Vector::new(p[0], p[1], p[2]);
         let mut best: Option<(f64, u32)> = None;
@@ -100,36 +113,199 @@ impl FaceIndex {
         let mut stack: Vec<(usize, usize)> = Vec::with_capacity(2 * self.levels.len());
         stack.push((top, 0));
         while let Some((level, i)) = stack.pop() {
-            if box_distance(p, self.levels[level][i]) > limit {
+            if farther_than(p, self.levels[level][i], limit) {
                 continue;
             }
             if level == 0 {
-                for t in i * LEAF..((i + 1) * LEAF).min(self.triangles.len()) {
-                    let d = (self.triangles[t].project_local_point(query, false).point - query)
-                        .length();
-                    let face = self.faces[t];
-                    if d <= limit && best.is_none_or(|(bd, bf)| d < bd || (d == bd && face < bf)) {
-                        best = Some((d, face));
-                        limit = d;
-                    }
-                }
+                self.search_leaf(query, i, &mut best, &mut limit);
                 continue;
             }
-            let below = &self.levels[level - 1];
-            let (left, right) = (2 * i, 2 * i + 1);
-            if right < below.len() {
-                // Push the farther child first so the nearer is searched first.
-                let (dl, dr) = (box_distance(p, below[left]), box_distance(p, below[right]));
-                if dl <= dr {
-                    stack.extend([(level - 1, right), (level - 1, left)]);
-                } else {
-                    stack.extend([(level - 1, left), (level - 1, right)]);
-                }
-            } else {
-                stack.push((level - 1, left));
-            }
+            self.push_children(p, level, i, &mut stack);
         }
         best.map(|b| b.1)
+    }
+}
+
+/// A label per face (its piece, say), and per node of a [`FaceIndex`]
+/// the label all its faces share, or [`MIXED`].
+pub struct FaceLabels<'a> {
+    /// The label of each face, by the mesh's face index.
+    of_face: &'a [u32],
+    /// Node labels, level by level as the index's boxes.
+    levels: Vec<Vec<u32>>,
+}
+
+/// The search's stacks, kept from one query to the next (a query's few
+/// dozen nodes cost less than allocating them).
+#[derive(Default)]
+pub struct Scratch {
+    stack: Vec<(usize, usize)>,
+    set_aside: Vec<(usize, usize)>,
+    /// The leaf of the last answer.
+    last_leaf: Option<usize>,
+}
+
+/// The label of a node whose faces carry more than one.
+const MIXED: u32 = u32::MAX;
+
+impl FaceLabels<'_> {
+    fn common(a: u32, b: u32) -> u32 {
+        if a == b {
+            a
+        } else {
+            MIXED
+        }
+    }
+}
+
+impl FaceIndex {
+    /// The node labels of `labels`, one per face of the indexed mesh (no
+    /// label may be `u32::MAX`).
+    pub fn labels<'a>(&self, labels: &'a [u32]) -> FaceLabels<'a> {
+        let leaves: Vec<u32> = self
+            .faces
+            .par_chunks(LEAF)
+            .map(|group| {
+                group
+                    .iter()
+                    .map(|&f| labels[f as usize])
+                    .reduce(FaceLabels::common)
+                    .unwrap_or(MIXED)
+            })
+            .collect();
+        let mut levels = vec![leaves];
+        for level in 1..self.levels.len() {
+            let above = levels[level - 1]
+                .chunks(2)
+                .map(|pair| {
+                    pair.iter()
+                        .copied()
+                        .reduce(FaceLabels::common)
+                        .unwrap_or(MIXED)
+                })
+                .collect();
+            levels.push(above);
+        }
+        FaceLabels {
+            of_face: labels,
+            levels,
+        }
+    }
+
+    /// The label of the face closest to `p` within `max_dist` (the lower
+    /// index on a tie): `labels.of_face[nearest_face(p, max_dist)]`, found
+    /// with nodes of the nearest face's label set aside (see the module
+    /// doc).
+    pub fn nearest_label(
+        &self,
+        p: Point3,
+        max_dist: f64,
+        labels: &FaceLabels,
+        scratch: &mut Scratch,
+    ) -> Option<u32> {
+        let query = Vector::new(p[0], p[1], p[2]);
+        let top = self.levels.len().checked_sub(1)?;
+        let mut best: Option<(f64, u32)> = None;
+        let mut limit = max_dist;
+        let Scratch {
+            stack,
+            set_aside,
+            last_leaf,
+        } = scratch;
+        stack.clear();
+        set_aside.clear();
+        // The leaf of the last query's answer first: queries in spatial
+        // order land near each other, and a face found at once lets whole
+        // subtrees of its label be set aside from the root down.
+        let mut best_leaf = None;
+        if let Some(leaf) = last_leaf.filter(|&leaf| leaf < self.levels[0].len()) {
+            if self.search_leaf(query, leaf, &mut best, &mut limit) {
+                best_leaf = Some(leaf);
+            }
+        }
+        stack.push((top, 0));
+        loop {
+            while let Some((level, i)) = stack.pop() {
+                let node_label = labels.levels[level][i];
+                if best.is_some_and(|(_, face)| node_label == labels.of_face[face as usize]) {
+                    set_aside.push((level, i));
+                    continue;
+                }
+                if farther_than(p, self.levels[level][i], limit) {
+                    continue;
+                }
+                if level == 0 {
+                    if self.search_leaf(query, i, &mut best, &mut limit) {
+                        best_leaf = Some(i);
+                    }
+                    continue;
+                }
+                self.push_children(p, level, i, stack);
+            }
+            // The nodes set aside under another label than the nearest
+            // face's now, and near enough to hold a face at least as near,
+            // are searched after all.
+            let Some((_, face)) = best else { break };
+            let label = labels.of_face[face as usize];
+            set_aside.retain(|&(level, i)| {
+                let reopen = labels.levels[level][i] != label
+                    && !farther_than(p, self.levels[level][i], limit);
+                if reopen {
+                    stack.push((level, i));
+                }
+                !reopen
+            });
+            if stack.is_empty() {
+                break;
+            }
+        }
+        if best_leaf.is_some() {
+            *last_leaf = best_leaf;
+        }
+        best.map(|(_, face)| labels.of_face[face as usize])
+    }
+
+    /// Weighs the faces of leaf `i`: a face within `limit` nearer than
+    /// `best` (or as near, with a lower index) becomes `best`, and its
+    /// distance the limit. Whether one did.
+    fn search_leaf(
+        &self,
+        query: Vector,
+        i: usize,
+        best: &mut Option<(f64, u32)>,
+        limit: &mut f64,
+    ) -> bool {
+        let mut improved = false;
+        for t in i * LEAF..((i + 1) * LEAF).min(self.triangles.len()) {
+            let d = (self.triangles[t].project_local_point(query, false).point - query).length();
+            let face = self.faces[t];
+            if d <= *limit && best.is_none_or(|(bd, bf)| d < bd || (d == bd && face < bf)) {
+                *best = Some((d, face));
+                *limit = d;
+                improved = true;
+            }
+        }
+        improved
+    }
+
+    /// Pushes the children of node `i` of `level` onto `stack`, the nearer
+    /// last so that it is searched first.
+    fn push_children(&self, p: Point3, level: usize, i: usize, stack: &mut Vec<(usize, usize)>) {
+        let below = &self.levels[level - 1];
+        let (left, right) = (2 * i, 2 * i + 1);
+        if right < below.len() {
+            let (dl, dr) = (
+                box_distance2(p, below[left]),
+                box_distance2(p, below[right]),
+            );
+            if dl <= dr {
+                stack.extend([(level - 1, right), (level - 1, left)]);
+            } else {
+                stack.extend([(level - 1, left), (level - 1, right)]);
+            }
+        } else {
+            stack.push((level - 1, left));
+        }
     }
 }
 
@@ -176,10 +352,19 @@ fn bounds(points: impl Iterator<Item = Point3>) -> Aabb {
     points.fold(EMPTY, |acc, p| union(acc, (p, p)))
 }
 
-/// Distance from `p` to the box (0 inside).
-fn box_distance(p: Point3, (low, high): Aabb) -> f64 {
+/// Squared distance from `p` to the box (0 inside).
+fn box_distance2(p: Point3, (low, high): Aabb) -> f64 {
     let gap = [0, 1, 2].map(|a| (low[a] - p[a]).max(p[a] - high[a]).max(0.0));
-    norm2(gap).sqrt()
+    norm2(gap)
+}
+
+/// Whether the box lies farther than `limit` from `p`. Squares are
+/// compared (a square root per box was a fifth of a query), with the
+/// limit's square widened by a few units in the last place, so that a box
+/// whose rounded distance is within the limit is never left out: a box
+/// searched in vain costs little, one left out could change the answer.
+fn farther_than(p: Point3, b: Aabb, limit: f64) -> bool {
+    box_distance2(p, b) > limit * limit * (1.0 + 1e-12)
 }
 
 #[cfg(test)]
@@ -266,6 +451,55 @@ mod tests {
                             "{p:?}: {other:?}, {d} vs {max_dist}"
                         );
                     }
+                }
+            }
+        }
+    }
+
+    /// The label search gives the label of the reference's face, for
+    /// labels in patches (pieces) and labels at random, points anywhere and
+    /// on vertices and edges (ties), with one scratch over queries in
+    /// random order (so the last answer's leaf is rarely the right one).
+    #[test]
+    fn nearest_label_is_the_label_of_the_nearest_face() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
+        for seed in 0..4 {
+            let mesh = two_sheets(seed, 20);
+            let index = FaceIndex::new(&mesh);
+            let patches: Vec<u32> = mesh
+                .faces
+                .iter()
+                .map(|f| {
+                    let c = mesh.vertices[f[0] as usize];
+                    (c[0] / 7.0) as u32 + 3 * (c[2] > 1.0) as u32
+                })
+                .collect();
+            let at_random: Vec<u32> = (0..mesh.faces.len())
+                .map(|_| rng.random_range(0..3))
+                .collect();
+            let mut points: Vec<(Point3, f64)> = Vec::new();
+            for _ in 0..1500 {
+                let p = [
+                    rng.random_range(-2.0..22.0),
+                    rng.random_range(-2.0..22.0),
+                    rng.random_range(-1.5..3.0),
+                ];
+                points.push((p, rng.random_range(0.05..1.5)));
+            }
+            for v in mesh.vertices.iter().step_by(3) {
+                points.push((*v, 0.5));
+            }
+            for f in mesh.faces.iter().step_by(5) {
+                let (a, b) = (mesh.vertices[f[0] as usize], mesh.vertices[f[1] as usize]);
+                points.push(([0, 1, 2].map(|k| 0.5 * (a[k] + b[k])), 0.5));
+            }
+            for labels in [&patches, &at_random] {
+                let tagged = index.labels(labels);
+                let mut scratch = Scratch::default();
+                for &(p, max_dist) in &points {
+                    let expected = index.nearest_face(p, max_dist).map(|f| labels[f as usize]);
+                    let found = index.nearest_label(p, max_dist, &tagged, &mut scratch);
+                    assert_eq!(found, expected, "{p:?} within {max_dist}");
                 }
             }
         }

@@ -107,6 +107,35 @@ pub fn spatial_order(points: &[Point3], grid: &MortonGrid) -> (Vec<u32>, Vec<u64
         .unzip()
 }
 
+/// `query(scratch, i)` for every point `i` of `points`, evaluated in Morton
+/// order on every thread (each with its own `scratch`, made by `init`) and
+/// returned in the points' own order. Queries of an index
+/// (a k-d tree, a face hierarchy) from points near each other in space
+/// walk the same nodes, which stay in the cache; in the order of a cloud
+/// shuffled by its writer every query misses it from the root down. The
+/// answers do not depend on the order they are computed in.
+pub fn query_in_spatial_order<T, S, Q>(
+    points: &[Point3],
+    init: impl Fn() -> S + Sync + Send,
+    query: Q,
+) -> Vec<T>
+where
+    T: Send + Copy + Default,
+    Q: Fn(&mut S, usize) -> T + Sync + Send,
+{
+    let (order, _) = spatial_order(points, &MortonGrid::of(points));
+    let answers: Vec<T> = order
+        .par_iter()
+        .with_min_len(PASS_PIECE)
+        .map_init(&init, |scratch, &i| query(scratch, i as usize))
+        .collect();
+    let mut in_point_order = vec![T::default(); points.len()];
+    for (&i, answer) in order.iter().zip(answers) {
+        in_point_order[i as usize] = answer;
+    }
+    in_point_order
+}
+
 /// Point count below which [`spatial_order`] sorts with a (serial) radix
 /// sort rather than rayon's parallel sort.
 const RADIX_SORT_BELOW: usize = 65536;
@@ -413,6 +442,26 @@ mod tests {
             let (order, keys) = spatial_order(&points, &grid);
             let got: Vec<(u64, u32)> = keys.into_iter().zip(order).collect();
             assert_eq!(got, want, "{n} points");
+        }
+    }
+
+    /// Each point gets its own query's answer, in its own place, whatever
+    /// the order of evaluation; the scratch is each thread's own.
+    #[test]
+    fn queries_in_spatial_order_answer_in_point_order() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(8);
+        for n in [0, 1, 7, 20_000] {
+            let points: Vec<Point3> = (0..n).map(|_| [rng.random(), rng.random(), 0.0]).collect();
+            let answers = query_in_spatial_order(&points, Vec::new, |seen: &mut Vec<usize>, i| {
+                seen.push(i);
+                (i, points[i][0].to_bits())
+            });
+            let expected: Vec<(usize, u64)> = points
+                .iter()
+                .enumerate()
+                .map(|(i, p)| (i, p[0].to_bits()))
+                .collect();
+            assert_eq!(answers, expected, "{n} points");
         }
     }
 

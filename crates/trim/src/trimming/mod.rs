@@ -87,7 +87,8 @@ use crate::error::TrimError;
 use crate::geom::UnionFind;
 use crate::geom::{dist2, dot, lerp, norm2, sub, Point3};
 use crate::mesh::{sorted_edges_of, Mesh};
-use crate::spatial::closest_face::FaceIndex;
+use crate::spatial::closest_face::{FaceIndex, Scratch};
+use crate::spatial::morton::query_in_spatial_order;
 use crate::spatial::neighbours::NeighbourIndex;
 
 /// Options of trimming. The defaults are the measured ones of

@@ -30,18 +30,18 @@ pub(super) fn supported_faces(
     let piece = face_pieces(&cut.faces, beyond);
     let pieces = piece.iter().map(|&p| p as usize + 1).max().unwrap_or(0);
     let projector = FaceIndex::new(cut);
+    let of_piece = projector.labels(&piece);
     let mut hits = vec![0usize; pieces];
     let mut cell_area = vec![0.0f64; pieces];
     // Each projection is independent: parallel, then summed in cloud order
-    // so the sums do not depend on the thread count.
-    let landed: Vec<Option<u32>> = cloud
-        .par_iter()
-        .zip(beta)
-        .map(|(p, &b)| projector.nearest_face(*p, 2.0 * b))
-        .collect();
-    for (face, &b) in landed.iter().zip(beta) {
-        if let Some(face) = face {
-            let k = piece[*face as usize] as usize;
+    // so the sums do not depend on the thread count. Only the piece a
+    // point lands on counts, not the face.
+    let landed: Vec<Option<u32>> = query_in_spatial_order(cloud, Scratch::default, |s, i| {
+        projector.nearest_label(cloud[i], 2.0 * beta[i], &of_piece, s)
+    });
+    for (landed_on, &b) in landed.iter().zip(beta) {
+        if let Some(k) = landed_on {
+            let k = *k as usize;
             hits[k] += 1;
             cell_area[k] += 0.75f64.sqrt() * b * b;
         }
