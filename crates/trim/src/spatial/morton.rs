@@ -109,11 +109,13 @@ pub fn spatial_order(points: &[Point3], grid: &MortonGrid) -> (Vec<u32>, Vec<u64
 
 /// `query(scratch, i)` for every point `i` of `points`, evaluated in Morton
 /// order on every thread (each with its own `scratch`, made by `init`) and
-/// returned in the points' own order. Queries of an index
-/// (a k-d tree, a face hierarchy) from points near each other in space
-/// walk the same nodes, which stay in the cache; in the order of a cloud
-/// shuffled by its writer every query misses it from the root down. The
-/// answers do not depend on the order they are computed in.
+/// returned in the points' own order. For queries that start from the
+/// last one's answer (the face hierarchy's label search): in a cloud
+/// shuffled by its writer the last answer is anywhere. The answers do not
+/// depend on the order they are computed in. (kiddo's nearest-point
+/// queries gain nothing from it: on 2.5M points they took 0.26 s in the
+/// cloud's shuffled order and 0.54 s in Morton order, the ordering
+/// included.)
 pub fn query_in_spatial_order<T, S, Q>(
     points: &[Point3],
     init: impl Fn() -> S + Sync + Send,

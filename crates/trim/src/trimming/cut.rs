@@ -105,9 +105,12 @@ pub(super) struct OutOfReach {
 /// in little domes over a scan's crevices. Faces and their origins are
 /// those of `cut`'s input mesh.
 pub(super) fn within_reach(cut: Cut, reach: &Reach, snap: f64) -> (Cut, OutOfReach) {
-    let vertices = &cut.mesh.vertices;
-    let excess: Vec<(f64, f64)> =
-        query_in_spatial_order(vertices, || (), |_, v| reach.excess(vertices[v]));
+    let excess: Vec<(f64, f64)> = cut
+        .mesh
+        .vertices
+        .par_iter()
+        .map(|&v| reach.excess(v))
+        .collect();
     let (field, snapped_count) = snapped_field(&excess, snap);
     // Where every loop closed, nothing is out of reach and the cut below
     // would copy `cut` face for face: skip it.
