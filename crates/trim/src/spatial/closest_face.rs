@@ -76,9 +76,17 @@ impl FaceIndex {
                 Triangle::new(a, b, c)
             })
             .collect();
-        let leaves: Vec<Aabb> = faces
+        // From the triangles, which lie in leaf order: the mesh's faces
+        // and vertices would be read at random once more.
+        let leaves: Vec<Aabb> = triangles
             .par_chunks(LEAF)
-            .map(|group| bounds(group.iter().flat_map(|&f| corners(&mesh.faces[f as usize]))))
+            .map(|group| {
+                bounds(
+                    group
+                        .iter()
+                        .flat_map(|t| [t.a, t.b, t.c].map(|v| [v.x, v.y, v.z])),
+                )
+            })
             .collect();
         let mut levels = if leaves.is_empty() {
             Vec::new()
