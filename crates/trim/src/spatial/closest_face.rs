@@ -21,8 +21,10 @@
 //! aside unsearched: whatever face it holds, nearer or not, the answer's
 //! label stays. Only if a face with another label becomes the nearest are
 //! the set-aside nodes it could lose to searched after all. Most points
-//! lie inside one piece, so most queries end at their first leaf instead
-//! of searching every box within the nearest face's distance.
+//! lie inside one piece, whose subtrees then go unsearched. The search
+//! starts at the leaf of the last answer, and the support test asks in
+//! Morton order, so that leaf is usually near: on a 5M-face mesh a query
+//! weighs 15 boxes where the face search weighed 42.
 
 use parry3d_f64::math::Vector;
 use parry3d_f64::query::PointQuery;
@@ -143,8 +145,8 @@ pub struct FaceLabels<'a> {
     levels: Vec<Vec<u32>>,
 }
 
-/// The search's stacks, kept from one query to the next (a query's few
-/// dozen nodes cost less than allocating them).
+/// A label search's state, kept from one query to the next: its stacks,
+/// rather than allocated for each query, and the last answer's leaf.
 #[derive(Default)]
 pub struct Scratch {
     stack: Vec<(usize, usize)>,
@@ -367,7 +369,7 @@ fn box_distance2(p: Point3, (low, high): Aabb) -> f64 {
 }
 
 /// Whether the box lies farther than `limit` from `p`. Squares are
-/// compared (a square root per box was a fifth of a query), with the
+/// compared (a square root per box was a sixth of a query), with the
 /// limit's square widened by a few units in the last place, so that a box
 /// whose rounded distance is within the limit is never left out: a box
 /// searched in vain costs little, one left out could change the answer.

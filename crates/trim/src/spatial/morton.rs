@@ -448,7 +448,8 @@ mod tests {
     }
 
     /// Each point gets its own query's answer, in its own place, whatever
-    /// the order of evaluation; the scratch is each thread's own.
+    /// the order of evaluation (a scratch that grows with every query
+    /// changes nothing).
     #[test]
     fn queries_in_spatial_order_answer_in_point_order() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(8);
