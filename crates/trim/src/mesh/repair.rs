@@ -719,6 +719,18 @@ mod tests {
         assert_eq!(pocket.faces.len(), grid(2).faces.len() - 1);
     }
 
+    /// The unit grid of `n` × `n` squares, its vertices moved by up to 0.2
+    /// in x and y.
+    fn jittered_grid(n: u32, rng: &mut impl rand::Rng) -> Mesh {
+        use rand::RngExt;
+        let mut mesh = grid(n);
+        for p in mesh.vertices.iter_mut() {
+            p[0] += rng.random_range(-0.2..0.2);
+            p[1] += rng.random_range(-0.2..0.2);
+        }
+        mesh
+    }
+
     /// Faces listed round the degenerate faces' vertices only give the
     /// repairs of faces listed round every vertex, on jittered grids with
     /// needles and caps made at random, borders included.
@@ -728,12 +740,7 @@ mod tests {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(12);
         let mut repaired = 0;
         for case in 0..300 {
-            let n = 7;
-            let mut mesh = grid(n);
-            for p in mesh.vertices.iter_mut() {
-                p[0] += rng.random_range(-0.2..0.2);
-                p[1] += rng.random_range(-0.2..0.2);
-            }
+            let mut mesh = jittered_grid(7, &mut rng);
             for _ in 0..rng.random_range(1..6) {
                 let f = mesh.faces[rng.random_range(0..mesh.faces.len())];
                 let (u, v, w) = (f[0] as usize, f[1] as usize, f[2] as usize);
@@ -772,11 +779,7 @@ mod tests {
         let mut interior_cases = 0;
         for case in 0..200 {
             let n = 8;
-            let mut mesh = grid(n);
-            for p in mesh.vertices.iter_mut() {
-                p[0] += rng.random_range(-0.2..0.2);
-                p[1] += rng.random_range(-0.2..0.2);
-            }
+            let mut mesh = jittered_grid(n, &mut rng);
             let interior = |v: u32| {
                 let (i, j) = (v % (n + 1), v / (n + 1));
                 i > 0 && i < n && j > 0 && j < n
