@@ -332,7 +332,7 @@ fn median_split_order(items: &mut [([f32; 3], u32)]) {
     }
     let capacity = n.div_ceil(LEAF).next_power_of_two() * LEAF;
     let mid = capacity / 2;
-    let (low, high) = bounds(items.iter().map(|i| i.0.map(f64::from)));
+    let (low, high) = centroid_bounds(items);
     let axis = (0..3)
         .max_by(|&a, &b| (high[a] - low[a]).total_cmp(&(high[b] - low[b])))
         .unwrap_or(0);
@@ -346,6 +346,27 @@ fn median_split_order(items: &mut [([f32; 3], u32)]) {
         median_split_order(left);
         median_split_order(right);
     }
+}
+
+/// The bounding box of the centroids, widened to f64 (exactly: the
+/// comparisons pick values, and f32 widens without rounding). A plain
+/// loop of comparisons in f32: this pass runs on every node of every
+/// level, and folding f64 boxes made the median splits of 5M faces take
+/// 0.48–0.54 s (now 0.27–0.32 s).
+fn centroid_bounds(items: &[([f32; 3], u32)]) -> Aabb {
+    let mut low = [f32::INFINITY; 3];
+    let mut high = [f32::NEG_INFINITY; 3];
+    for (c, _) in items {
+        for a in 0..3 {
+            if c[a] < low[a] {
+                low[a] = c[a];
+            }
+            if c[a] > high[a] {
+                high[a] = c[a];
+            }
+        }
+    }
+    (low.map(f64::from), high.map(f64::from))
 }
 
 const EMPTY: Aabb = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
