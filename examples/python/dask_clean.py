@@ -5,12 +5,15 @@ given its scheduler's address. The same code runs in both places.
     python examples/python/dask_clean.py SCANS/ OUT/
     python examples/python/dask_clean.py SCANS/ OUT/ --scheduler tcp://host:8786
 
-The files pair as ``meshtrim batch`` pairs them: a mesh ``S.EXT`` (.stl,
-.ply, .obj, .gltf, .glb) with a cloud ``S.cloud.EXT`` beside it is trimmed
-with that cloud; any other mesh is cleaned. Each output is ``OUT/`` plus the
-mesh's file name, the same bytes ``meshtrim batch SCANS/ --out-dir OUT/``
-writes. The workers need the ``meshtrim`` package (``pip install ./python``)
-and to see the folders (a shared file system on a cluster).
+The work is ``meshtrim batch``'s own list (:func:`meshtrim.batch_plan`):
+the folder walked recursively, each mesh (.stl, .ply, .obj, .gltf, .glb)
+paired with its cloud by name (``S.cloud.EXT`` beside ``S.EXT``, or a
+scanner's ``S.e57`` / ``S.laz`` / ``S.xyz`` …) and trimmed with it, any
+other mesh cleaned, two clouds for one mesh a failure. Each output is
+``OUT/`` plus the mesh's path below the folder, the same bytes ``meshtrim
+batch SCANS/ --out-dir OUT/`` writes. The workers need the ``meshtrim``
+package (``pip install ./python``) and to see the folders (a shared file
+system on a cluster).
 """
 
 from __future__ import annotations
@@ -21,38 +24,23 @@ from pathlib import Path
 
 import meshtrim
 
-MESH_EXTENSIONS = {".stl", ".ply", ".obj", ".gltf", ".glb"}
-CLOUD_EXTENSIONS = [".ply", ".obj", ".pcd", ".xyz", ".txt", ".csv", ".asc", ".pts"]
 
-
-def jobs(folder: Path) -> list[tuple[str, str | None]]:
-    """(mesh, cloud or None) for every mesh directly in ``folder``, sorted."""
-    found = []
-    for path in sorted(folder.iterdir()):
-        is_cloud = path.suffixes[-2:-1] == [".cloud"]
-        if path.suffix.lower() not in MESH_EXTENSIONS or is_cloud:
-            continue
-        stem = path.name[: -len(path.suffix)]
-        clouds = [folder / f"{stem}.cloud{ext}" for ext in CLOUD_EXTENSIONS]
-        cloud = next((str(c) for c in clouds if c.is_file()), None)
-        found.append((str(path), cloud))
-    return found
-
-
-def process(job: tuple[str, str | None], out_dir: str) -> dict:
+def process(job: meshtrim.BatchJob) -> dict:
     """Trims or cleans one mesh and writes its output; runs on a worker.
     Returns a row for the summary (an error does not stop the others)."""
-    mesh_path, cloud_path = job
-    output = Path(out_dir) / Path(mesh_path).name
-    row = {"input": mesh_path, "output": str(output), "mode": "trim" if cloud_path else "clean"}
+    mode = "clean" if not job.clouds else "trim"
+    row = {"input": str(job.input), "output": str(job.output), "mode": mode}
     try:
-        vertices, faces = meshtrim.read_mesh(mesh_path)
-        if cloud_path:
-            points = meshtrim.read_cloud(cloud_path)
+        if len(job.clouds) > 1:
+            names = ", ".join(str(c) for c in job.clouds)
+            raise meshtrim.MeshtrimError(f"several clouds match this mesh ({names}): keep one")
+        vertices, faces = meshtrim.read_mesh(job.input)
+        if job.clouds:
+            points = meshtrim.read_cloud(job.clouds[0])
             vertices, faces, report = meshtrim.trim(vertices, faces, points)
         else:
             vertices, faces, report = meshtrim.clean(vertices, faces)
-        meshtrim.write_mesh(output, vertices, faces)
+        meshtrim.write_mesh(job.output, vertices, faces)
         row.update(status="ok", faces_in=report["faces_in"], faces_out=report["faces_out"])
     except meshtrim.MeshtrimError as e:
         row.update(status="failed", error=str(e))
@@ -62,8 +50,8 @@ def process(job: tuple[str, str | None], out_dir: str) -> dict:
 def run(folder: str, out_dir: str, client) -> list[dict]:
     """Every mesh of ``folder`` through meshtrim on the Dask ``client``'s
     workers, one task per file; the rows in file order."""
-    work = jobs(Path(folder))
-    futures = client.map(process, work, out_dir=out_dir, pure=False)
+    work = meshtrim.batch_plan(folder, out_dir)
+    futures = client.map(process, work, pure=False)
     return client.gather(futures)
 
 

@@ -11,7 +11,10 @@ same Rust library, with the same results bit for bit:
 - :func:`clean`: a triangulated scan's jagged border replaced by its
   smoothed edge;
 - :func:`read_cloud`, :func:`read_mesh`, :func:`write_mesh`: the CLI's
-  readers and writers.
+  readers and writers;
+- :func:`batch_plan`: which meshes ``meshtrim batch`` would take, where
+  each output goes and which cloud trims it, for running a batch on
+  another scheduler (Dask, say).
 
 Points and vertices are ``(n, 3)`` arrays (float64, or anything numpy
 converts to it, e.g. float32), faces ``(m, 3)`` integer arrays; any memory
@@ -30,7 +33,8 @@ from __future__ import annotations
 import json
 import os
 from dataclasses import dataclass, field
-from typing import Any, Optional, Sequence, Union
+from pathlib import Path
+from typing import Any, NamedTuple, Optional, Sequence, Union
 
 import numpy as np
 
@@ -52,6 +56,8 @@ __all__ = [
     "read_mesh",
     "write_mesh",
     "write_edges",
+    "BatchJob",
+    "batch_plan",
 ]
 
 __version__ = "0.1.0"
@@ -397,3 +403,36 @@ def write_mesh(path: PathLike, vertices: Any, faces: Any) -> None:
     v = _float_rows(vertices, "vertices")
     f = _face_rows(faces, len(v))
     _meshtrim.write_mesh(os.fspath(path), v, f)
+
+
+class BatchJob(NamedTuple):
+    """One mesh of a batch: the mesh, its output, and the clouds paired
+    with it (none: it is cleaned; one: trimmed with it; several: the
+    batch fails it, as the choice would be a guess)."""
+
+    input: Path
+    output: Path
+    clouds: tuple
+
+
+def batch_plan(
+    inputs: Union[PathLike, Sequence[PathLike]], out_dir: PathLike, *, cloud_dir: Optional[PathLike] = None
+) -> list:
+    """The work ``meshtrim batch INPUTS --out-dir OUT_DIR [--cloud-dir
+    CLOUD_DIR]`` would do, decided as it decides it before processing
+    anything: ``inputs`` (files, directories walked recursively, glob
+    patterns) expanded, sorted and de-duplicated, each mesh paired with
+    its clouds by name (``S.cloud.EXT``, or ``S.EXT`` with a cloud-only
+    extension such as ``.e57``, ``.laz`` or ``.xyz``), outputs mirrored
+    below ``out_dir`` and checked (two meshes with one output, or an
+    output that is an input, raise :class:`MeshtrimError`). A list of
+    :class:`BatchJob`, sorted by input path; nothing is read but
+    directory listings and PLY/OBJ headers, nothing written."""
+    if isinstance(inputs, (str, os.PathLike)):
+        inputs = [inputs]
+    args = [os.fspath(p) for p in inputs]
+    cloud = None if cloud_dir is None else os.fspath(cloud_dir)
+    return [
+        BatchJob(Path(i), Path(o), tuple(Path(c) for c in clouds))
+        for i, o, clouds in _meshtrim.batch_plan(args, os.fspath(out_dir), cloud)
+    ]

@@ -60,3 +60,6 @@ def write_edges(
     units: str,
     dxf_splines: bool,
 ) -> None: ...
+def batch_plan(
+    inputs: list[str], out_dir: str, cloud_dir: Optional[str] = None
+) -> list[Tuple[PathLike[str], PathLike[str], list[PathLike[str]]]]: ...

@@ -386,6 +386,39 @@ fn write_mesh(
     })
 }
 
+/// The batch's list of work, as `meshtrim batch INPUTS --out-dir OUT_DIR
+/// [--cloud-dir CLOUD_DIR]` makes it before processing anything: per mesh
+/// (sorted by path), its output and the clouds paired with it (none:
+/// cleaned; one: trimmed with it; several: the batch fails that mesh).
+#[pyfunction]
+#[pyo3(signature = (inputs, out_dir, cloud_dir=None))]
+fn batch_plan(
+    py: Python<'_>,
+    inputs: Vec<PathBuf>,
+    out_dir: PathBuf,
+    cloud_dir: Option<PathBuf>,
+) -> PyResult<Vec<(PathBuf, PathBuf, Vec<PathBuf>)>> {
+    let jobs = without_gil(py, || {
+        commands::batch::plan(&commands::batch::Inputs {
+            args: &inputs,
+            out_dir: &out_dir,
+            cloud_dir: cloud_dir.as_deref(),
+            report: None,
+        })
+    })?;
+    Ok(jobs
+        .into_iter()
+        .map(|job| {
+            let clouds = match job.cloud {
+                commands::batch::CloudMatch::None => Vec::new(),
+                commands::batch::CloudMatch::One(cloud) => vec![cloud],
+                commands::batch::CloudMatch::Several(clouds) => clouds,
+            };
+            (job.input, job.output, clouds)
+        })
+        .collect())
+}
+
 /// A loop as Python passes it back: boundary point indices, corner
 /// positions, edges (closed, points).
 type LoopIn<'py> = (
@@ -502,5 +535,6 @@ fn _meshtrim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(write_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(write_edges_py, m)?)?;
+    m.add_function(wrap_pyfunction!(batch_plan, m)?)?;
     Ok(())
 }

@@ -18,7 +18,7 @@ use crate::stages::{detect, millis};
 /// Arguments of `meshtrim detect`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct Args {
-    /// Input point cloud: .ply, .pcd, .obj, .las/.laz, .xyz/.txt/.csv/.asc/.pts, or a
+    /// Input point cloud: .ply, .pcd, .obj, .las/.laz, .e57, .xyz/.txt/.csv/.asc/.pts, or a
     /// mesh (.stl, .gltf, .glb) whose vertices are the cloud.
     pub cloud: PathBuf,
     /// Write the points with their labels: OUT.ply (binary), OUT.csv, or

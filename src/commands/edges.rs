@@ -19,7 +19,7 @@ use crate::stages::{detect_and_reconstruct, millis, Stages};
 /// Arguments of `meshtrim edges`.
 #[derive(Debug, Clone, clap::Args)]
 pub struct Args {
-    /// Input point cloud: .ply, .pcd, .obj, .las/.laz, .xyz/.txt/.csv/.asc/.pts, or a
+    /// Input point cloud: .ply, .pcd, .obj, .las/.laz, .e57, .xyz/.txt/.csv/.asc/.pts, or a
     /// mesh (.stl, .gltf, .glb) whose vertices are the cloud.
     pub cloud: PathBuf,
     /// Write the loops and edges: OUT.json (everything), OUT.obj (the

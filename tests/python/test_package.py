@@ -407,11 +407,20 @@ def test_adapters_are_imported_on_demand():
 
 
 def test_dask_example_matches_meshtrim_batch(tmp_path):
+    """The example runs `meshtrim batch`'s own list of work: a cloud beside
+    its mesh or under a cloud-only extension (`sub/part.xyz`) trims it,
+    sub-directories are mirrored, two clouds for one mesh fail it, and each
+    output is the batch's bytes."""
     scans = tmp_path / "scans"
-    scans.mkdir()
+    (scans / "sub").mkdir(parents=True)
     shutil.copy(JAGGED, scans / "jagged.stl")
     shutil.copy(POISSON, scans / "blade.ply")
     shutil.copy(CLOUD, scans / "blade.cloud.ply")
+    shutil.copy(POISSON, scans / "sub" / "part.ply")
+    np.savetxt(scans / "sub" / "part.xyz", meshtrim.read_cloud(CLOUD))
+    shutil.copy(POISSON, scans / "two.ply")
+    shutil.copy(CLOUD, scans / "two.cloud.ply")
+    shutil.copy(scans / "sub" / "part.xyz", scans / "two.xyz")
     (scans / "empty.stl").write_bytes(b"solid empty\nendsolid empty\n")
     dask_out, batch_out = tmp_path / "dask", tmp_path / "batch"
     # As a user runs it: a LocalCluster of worker processes.
@@ -419,13 +428,19 @@ def test_dask_example_matches_meshtrim_batch(tmp_path):
     r = subprocess.run(
         [sys.executable, str(example), str(scans), str(dask_out)], capture_output=True, text=True, timeout=300
     )
-    assert r.returncode == 1, r.stderr  # the empty file fails, the others not
-    lines = [line.split()[:3] for line in r.stdout.splitlines()]
-    assert [(mode, status, Path(name.rstrip(":")).name) for mode, status, name in lines] == [
+    assert r.returncode == 1, r.stderr  # the empty file and two.ply fail, the others not
+    lines = [line.split(maxsplit=3) for line in r.stdout.splitlines()]
+    assert [(mode, status, Path(name.rstrip(":")).relative_to(scans).as_posix()) for mode, status, name, _ in lines] == [
         ("trim", "ok", "blade.ply"),
         ("clean", "failed", "empty.stl"),
         ("clean", "ok", "jagged.stl"),
+        ("trim", "ok", "sub/part.ply"),
+        ("trim", "failed", "two.ply"),
     ], r.stdout
-    subprocess.run([str(MESHTRIM), "batch", str(scans), "--out-dir", str(batch_out)], capture_output=True, timeout=300)
-    for name in ("blade.ply", "jagged.stl"):
+    assert "several clouds match this mesh" in lines[-1][3], r.stdout
+    batch = subprocess.run(
+        [str(MESHTRIM), "batch", str(scans), "--out-dir", str(batch_out)], capture_output=True, text=True, timeout=300
+    )
+    assert batch.returncode == 1, batch.stderr
+    for name in ("blade.ply", "jagged.stl", "sub/part.ply"):
         assert (dask_out / name).read_bytes() == (batch_out / name).read_bytes(), name

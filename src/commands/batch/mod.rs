@@ -12,7 +12,7 @@
 mod plan;
 mod report;
 
-pub use plan::{CloudMatch, Job, Shard};
+pub use plan::{plan, CloudMatch, Inputs, Job, Shard};
 pub use report::{Mode, Outcome, ReportFormat, Row, Status};
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -36,8 +36,8 @@ pub struct Args {
     /// Meshes (.stl, .ply, .obj, .gltf, .glb): files, directories (walked
     /// recursively) and glob patterns (quote them: 'scans/*.ply'). A mesh
     /// S.ext is trimmed when a cloud S.cloud.EXT or S.EXT with EXT one of
-    /// pcd xyz txt csv asc pts sits beside it, and cleaned otherwise;
-    /// clouds are never inputs themselves.
+    /// e57 las laz pcd xyz txt csv asc pts sits beside it, and cleaned
+    /// otherwise; clouds are never inputs themselves.
     #[arg(required = true, value_name = "INPUTS")]
     pub inputs: Vec<PathBuf>,
     /// Where the outputs go: the input's path below the directory argument
@@ -77,7 +77,7 @@ pub fn run(args: &Args) -> Result<()> {
         .as_deref()
         .map(ReportFormat::from_path)
         .transpose()?;
-    let jobs = plan::plan(&plan::Inputs {
+    let jobs = plan(&Inputs {
         args: &args.inputs,
         out_dir: &args.out_dir,
         cloud_dir: args.cloud_dir.as_deref(),
@@ -205,7 +205,7 @@ fn process(job: &Job, skip_existing: bool, repair: bool, stages: &Stages) -> Row
 
 /// A file without faces among the meshes is most likely a cloud misnamed.
 const NO_FACES: &str = "it looks like a point cloud: to trim the mesh S.EXT with it, name it \
-     S.cloud.EXT beside the mesh (or S.EXT with EXT one of pcd xyz txt csv asc pts)";
+     S.cloud.EXT beside the mesh (or S.EXT with EXT one of e57 las laz pcd xyz txt csv asc pts)";
 
 /// A cleaned mesh without a border: nothing was smoothed.
 const CLOSED: &str = "no border: a closed mesh has nothing to clean; to trim a Poisson \

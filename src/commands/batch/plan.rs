@@ -16,9 +16,15 @@ use anyhow::{bail, Context, Result};
 const MESH_EXTENSIONS: [&str; 5] = ["stl", "ply", "obj", "gltf", "glb"];
 /// Extensions a cloud can have; `STEM.cloud.EXT` with any of them is a
 /// cloud.
-const CLOUD_EXTENSIONS: [&str; 8] = ["ply", "obj", "pcd", "xyz", "txt", "csv", "asc", "pts"];
+const CLOUD_EXTENSIONS: [&str; 11] = [
+    "ply", "obj", "pcd", "xyz", "txt", "csv", "asc", "pts", "las", "laz", "e57",
+];
 /// Extensions only clouds have: `STEM.EXT` with one of them is a cloud.
-const CLOUD_ONLY_EXTENSIONS: [&str; 6] = ["pcd", "xyz", "txt", "csv", "asc", "pts"];
+/// The scanners' own formats are among them, so that `part.stl` beside
+/// the `part.e57` or `part.laz` it was made from is trimmed with it.
+const CLOUD_ONLY_EXTENSIONS: [&str; 9] = [
+    "pcd", "xyz", "txt", "csv", "asc", "pts", "las", "laz", "e57",
+];
 
 /// One mesh of the batch.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -476,6 +482,9 @@ mod tests {
         assert_eq!(stem("blade.CLOUD.PCD"), Some("blade".into()));
         assert_eq!(stem("blade.xyz"), Some("blade".into()));
         assert_eq!(stem("b.pcd"), Some("b".into()));
+        assert_eq!(stem("part.e57"), Some("part".into()));
+        assert_eq!(stem("part.LAZ"), Some("part".into()));
+        assert_eq!(stem("part.cloud.las"), Some("part".into()));
         assert_eq!(stem("blade.ply"), None);
         assert_eq!(stem("blade.cloud.stl"), None);
         assert_eq!(stem(".cloud.ply"), None);

@@ -1,0 +1,121 @@
+"""`meshtrim batch` pairs a mesh with the scanner's own file beside it
+(`S.e57` written by pye57, `S.laz` and `S.cloud.las` by laspy): each such
+mesh is trimmed, the bytes `meshtrim trim MESH CLOUD OUT` writes. The
+package's `batch_plan` is the batch's own list of work."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+from pathlib import Path
+
+import laspy
+import numpy as np
+import pye57
+import pymeshlab
+import pytest
+
+import meshtrim
+from meshtrim_cli import MESHTRIM, run_meshtrim
+
+FIXTURES = Path(__file__).resolve().parents[2] / "fixtures" / "meshes"
+CLOUD = FIXTURES / "blade_small.ply"
+POISSON = FIXTURES / "blade_small_poisson.ply"
+JAGGED = FIXTURES / "blade_jagged.stl"
+
+
+def cloud_points() -> np.ndarray:
+    """The fixture cloud's points, as PyMeshLab reads them."""
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(str(CLOUD))
+    return ms.current_mesh().vertex_matrix()
+
+
+def write_e57(path: Path, points: np.ndarray) -> None:
+    e = pye57.E57(str(path), mode="w")
+    e.write_scan_raw({"cartesianX": points[:, 0], "cartesianY": points[:, 1], "cartesianZ": points[:, 2]})
+    e.close()
+
+
+def write_las(path: Path, points: np.ndarray) -> None:
+    """LAS or LAZ by the extension (laspy compresses .laz with lazrs)."""
+    header = laspy.LasHeader(point_format=0, version="1.4")
+    header.offsets = points.min(0)
+    header.scales = [1e-4, 1e-4, 1e-4]
+    las = laspy.LasData(header)
+    las.x, las.y, las.z = points[:, 0], points[:, 1], points[:, 2]
+    las.write(str(path))
+
+
+@pytest.fixture(scope="module")
+def scans(tmp_path_factory) -> Path:
+    """A folder as a scanning shop keeps it: Poisson meshes beside the
+    scanner's clouds, a jagged scan without one, and a mesh with two."""
+    root = tmp_path_factory.mktemp("shop")
+    d = root / "scans"
+    (d / "sub").mkdir(parents=True)
+    points = cloud_points()
+    for mesh in ["a.ply", "b.ply", "e.ply", "sub/c.ply"]:
+        (d / mesh).write_bytes(POISSON.read_bytes())
+    (d / "d.stl").write_bytes(JAGGED.read_bytes())
+    write_e57(d / "a.e57", points)
+    write_las(d / "b.laz", points)
+    write_las(d / "sub" / "c.cloud.las", points)
+    write_e57(d / "e.e57", points)
+    np.savetxt(d / "e.xyz", points)
+    return root
+
+
+def test_batch_plan_pairs_the_scanners_files(scans):
+    d, out = scans / "scans", scans / "out"
+    plan = meshtrim.batch_plan(d, out)
+    assert plan == [
+        meshtrim.BatchJob(d / "a.ply", out / "a.ply", (d / "a.e57",)),
+        meshtrim.BatchJob(d / "b.ply", out / "b.ply", (d / "b.laz",)),
+        meshtrim.BatchJob(d / "d.stl", out / "d.stl", ()),
+        meshtrim.BatchJob(d / "e.ply", out / "e.ply", (d / "e.e57", d / "e.xyz")),
+        meshtrim.BatchJob(d / "sub" / "c.ply", out / "sub" / "c.ply", (d / "sub" / "c.cloud.las",)),
+    ]
+    # A glob pattern and a file argument, as the CLI takes them.
+    assert [j.input for j in meshtrim.batch_plan([str(d / "*.ply"), d / "d.stl"], out)] == [
+        d / "a.ply",
+        d / "b.ply",
+        d / "d.stl",
+        d / "e.ply",
+    ]
+
+
+def test_batch_plan_refuses_what_the_batch_refuses(scans):
+    d = scans / "scans"
+    with pytest.raises(meshtrim.MeshtrimError, match="matches no mesh"):
+        meshtrim.batch_plan(d / "nothing*.stl", scans / "out")
+    with pytest.raises(meshtrim.MeshtrimError, match="not a mesh input"):
+        meshtrim.batch_plan(d / "a.e57", scans / "out")
+    # Outputs into the inputs' own folder would overwrite them.
+    with pytest.raises(meshtrim.MeshtrimError, match="overwrite"):
+        meshtrim.batch_plan(d, d)
+
+
+def test_batch_trims_with_the_scanners_files(scans, tmp_path):
+    d, out, report = scans / "scans", tmp_path / "out", tmp_path / "report.json"
+    r = subprocess.run(
+        [str(MESHTRIM), "batch", str(d), "--out-dir", str(out), "--report", str(report)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert r.returncode == 1, r.stderr  # e.ply has two clouds
+    rows = {Path(row["input"]).relative_to(d).as_posix(): row for row in json.loads(report.read_text())["files"]}
+    assert {k: (v["mode"], v["status"]) for k, v in rows.items()} == {
+        "a.ply": ("trim", "ok"),
+        "b.ply": ("trim", "ok"),
+        "d.stl": ("clean", "ok"),
+        "e.ply": ("trim", "failed"),
+        "sub/c.ply": ("trim", "ok"),
+    }
+    assert "several clouds match this mesh" in rows["e.ply"]["error"], rows["e.ply"]
+    for mesh, cloud in [("a.ply", "a.e57"), ("b.ply", "b.laz"), ("sub/c.ply", "sub/c.cloud.las")]:
+        alone = tmp_path / "alone.ply"
+        run_meshtrim("trim", d / mesh, d / cloud, alone)
+        assert (out / mesh).read_bytes() == alone.read_bytes(), mesh
+        assert rows[mesh]["faces_out"] < rows[mesh]["faces_in"], rows[mesh]
