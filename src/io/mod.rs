@@ -78,8 +78,8 @@ impl Format {
         }
     }
 
-    /// The format an extension names, if any.
-    fn from_extension(ext: &str) -> Option<Format> {
+    /// The format an extension names, if any (any case).
+    pub(crate) fn from_extension(ext: &str) -> Option<Format> {
         match ext.to_ascii_lowercase().as_str() {
             "ply" => Some(Format::Ply),
             "pcd" => Some(Format::Pcd),

@@ -12,20 +12,10 @@ use std::str::FromStr;
 
 use anyhow::{bail, Context, Result};
 
+use crate::io::Format;
+
 /// Extensions of mesh inputs (any case).
 const MESH_EXTENSIONS: [&str; 5] = ["stl", "ply", "obj", "gltf", "glb"];
-/// Extensions a cloud can have; `STEM.cloud.EXT` with any of them is a
-/// cloud.
-const CLOUD_EXTENSIONS: [&str; 11] = [
-    "ply", "obj", "pcd", "xyz", "txt", "csv", "asc", "pts", "las", "laz", "e57",
-];
-/// Extensions only clouds have: `STEM.EXT` with one of them is a cloud.
-/// The scanners' own formats are among them, so that `part.stl` beside
-/// the `part.e57` or `part.laz` it was made from is trimmed with it.
-const CLOUD_ONLY_EXTENSIONS: [&str; 9] = [
-    "pcd", "xyz", "txt", "csv", "asc", "pts", "las", "laz", "e57",
-];
-
 /// One mesh of the batch.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Job {
@@ -267,15 +257,15 @@ fn is_mesh_input(path: &Path) -> bool {
 /// `STEM.cloud.EXT` (EXT any cloud format) or `STEM.EXT` (EXT a format
 /// only clouds have); `.cloud` and EXT in any case.
 fn cloud_stem(path: &Path) -> Option<&str> {
-    let ext = extension(path);
-    if !CLOUD_EXTENSIONS.contains(&ext.as_str()) {
-        return None;
-    }
+    // The cloud reader's own extensions, so that every format it reads
+    // pairs; PLY and OBJ name meshes too.
+    let format = Format::from_extension(&extension(path))?;
+    let cloud_only = !matches!(format, Format::Ply | Format::Obj);
     let stem = path.file_stem()?.to_str()?;
     let cut = stem.len().saturating_sub(".cloud".len());
     match stem.get(cut..) {
         Some(tail) if tail.eq_ignore_ascii_case(".cloud") && cut > 0 => Some(&stem[..cut]),
-        _ if CLOUD_ONLY_EXTENSIONS.contains(&ext.as_str()) => Some(stem),
+        _ if cloud_only => Some(stem),
         _ => None,
     }
 }
