@@ -1,7 +1,8 @@
 """`meshtrim batch` pairs a mesh with the scanner's own file beside it
 (`S.e57` written by pye57, `S.laz` and `S.cloud.las` by laspy): each such
-mesh is trimmed, the bytes `meshtrim trim MESH CLOUD OUT` writes. The
-package's `batch_plan` is the batch's own list of work."""
+mesh is trimmed, the bytes `meshtrim trim MESH CLOUD OUT` writes, and an
+E57 file in metres beside a mesh in millimetres fails with the units
+named. The package's `batch_plan` is the batch's own list of work."""
 
 from __future__ import annotations
 
@@ -50,12 +51,13 @@ def write_las(path: Path, points: np.ndarray) -> None:
 @pytest.fixture(scope="module")
 def scans(tmp_path_factory) -> Path:
     """A folder as a scanning shop keeps it: Poisson meshes beside the
-    scanner's clouds, a jagged scan without one, and a mesh with two."""
+    scanner's clouds, a jagged scan without one, a mesh with two, and a
+    mesh in millimetres beside its scan in metres (as E57 holds them)."""
     root = tmp_path_factory.mktemp("shop")
     d = root / "scans"
     (d / "sub").mkdir(parents=True)
     points = cloud_points()
-    for mesh in ["a.ply", "b.ply", "e.ply", "sub/c.ply"]:
+    for mesh in ["a.ply", "b.ply", "e.ply", "m.ply", "sub/c.ply"]:
         (d / mesh).write_bytes(POISSON.read_bytes())
     (d / "d.stl").write_bytes(JAGGED.read_bytes())
     write_e57(d / "a.e57", points)
@@ -63,6 +65,7 @@ def scans(tmp_path_factory) -> Path:
     write_las(d / "sub" / "c.cloud.las", points)
     write_e57(d / "e.e57", points)
     np.savetxt(d / "e.xyz", points)
+    write_e57(d / "m.e57", points / 1000.0)
     return root
 
 
@@ -74,6 +77,7 @@ def test_batch_plan_pairs_the_scanners_files(scans):
         meshtrim.BatchJob(d / "b.ply", out / "b.ply", (d / "b.laz",)),
         meshtrim.BatchJob(d / "d.stl", out / "d.stl", ()),
         meshtrim.BatchJob(d / "e.ply", out / "e.ply", (d / "e.e57", d / "e.xyz")),
+        meshtrim.BatchJob(d / "m.ply", out / "m.ply", (d / "m.e57",)),
         meshtrim.BatchJob(d / "sub" / "c.ply", out / "sub" / "c.ply", (d / "sub" / "c.cloud.las",)),
     ]
     # A glob pattern and a file argument, as the CLI takes them.
@@ -82,6 +86,7 @@ def test_batch_plan_pairs_the_scanners_files(scans):
         d / "b.ply",
         d / "d.stl",
         d / "e.ply",
+        d / "m.ply",
     ]
 
 
@@ -104,16 +109,20 @@ def test_batch_trims_with_the_scanners_files(scans, tmp_path):
         text=True,
         timeout=300,
     )
-    assert r.returncode == 1, r.stderr  # e.ply has two clouds
+    assert r.returncode == 1, r.stderr  # e.ply has two clouds, m.ply's is in metres
     rows = {Path(row["input"]).relative_to(d).as_posix(): row for row in json.loads(report.read_text())["files"]}
     assert {k: (v["mode"], v["status"]) for k, v in rows.items()} == {
         "a.ply": ("trim", "ok"),
         "b.ply": ("trim", "ok"),
         "d.stl": ("clean", "ok"),
         "e.ply": ("trim", "failed"),
+        "m.ply": ("trim", "failed"),
         "sub/c.ply": ("trim", "ok"),
     }
     assert "several clouds match this mesh" in rows["e.ply"]["error"], rows["e.ply"]
+    units = "scaled by 1000: the cloud looks to be in metres and the mesh in millimetres"
+    assert units in rows["m.ply"]["error"], rows["m.ply"]
+    assert not (out / "m.ply").exists()
     for mesh, cloud in [("a.ply", "a.e57"), ("b.ply", "b.laz"), ("sub/c.ply", "sub/c.cloud.las")]:
         alone = tmp_path / "alone.ply"
         run_meshtrim("trim", d / mesh, d / cloud, alone)

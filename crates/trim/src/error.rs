@@ -152,9 +152,96 @@ pub enum TrimError {
     /// The mesh is not one trimming can cut.
     #[error(transparent)]
     Mesh(#[from] MeshError),
-    /// Nothing of the mesh lies where the cloud is.
-    #[error("no part of the mesh is supported by the cloud: is the cloud the one the mesh was reconstructed from, in the same units and pose?")]
-    Unsupported,
+    /// Nothing of the mesh lies where the cloud is; where the cloud lies
+    /// against the mesh says what to check.
+    #[error("no part of the mesh is supported by the cloud: {0}")]
+    Unsupported(Placement),
+}
+
+/// Where a cloud lies against a mesh: what a trim that found nothing of
+/// the mesh supported tells the user to check. A cloud in other units than
+/// its mesh (a scanner's E57 file holds metres, the STL made from it often
+/// millimetres) or in another frame is the usual cause.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Placement {
+    /// Scaled by a unit ratio, the cloud lies on the mesh: the cloud's
+    /// coordinates times `factor` are the mesh's units.
+    Units {
+        /// The factor, a ratio of two units (1000, 1/1000, 25.4, …).
+        factor: f64,
+        /// The two units, the cloud's first.
+        units: (&'static str, &'static str),
+    },
+    /// The cloud's bounding-box diagonal is `ratio` times the mesh's, more
+    /// than three times larger or smaller, and no unit ratio explains it.
+    Scaled {
+        /// Cloud diagonal over mesh diagonal.
+        ratio: f64,
+    },
+    /// Of similar size, but the bounding boxes do not meet.
+    Apart {
+        /// Distance between the boxes' centres.
+        distance: f64,
+        /// The mesh's bounding-box diagonal.
+        mesh_diagonal: f64,
+    },
+    /// The bounding boxes overlap.
+    Overlapping,
+}
+
+/// A ratio to four decimals without trailing zeros, a fraction below 1
+/// written 1/x: 1000, 1/1000, 39.3701.
+fn ratio_text(ratio: f64) -> String {
+    let (r, inverse) = if ratio >= 1.0 {
+        (ratio, false)
+    } else {
+        (1.0 / ratio, true)
+    };
+    let digits = format!("{r:.4}");
+    let text = digits.trim_end_matches('0').trim_end_matches('.');
+    if inverse {
+        format!("1/{text}")
+    } else {
+        text.to_string()
+    }
+}
+
+impl std::fmt::Display for Placement {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            Placement::Units { factor, units } => write!(
+                f,
+                "the cloud lies on the mesh once scaled by {}: the cloud looks to be in {} and \
+                 the mesh in {}; give both in the same units",
+                ratio_text(factor),
+                units.0,
+                units.1
+            ),
+            Placement::Scaled { ratio } => {
+                let (factor, size) = if ratio < 1.0 {
+                    (1.0 / ratio, "smaller")
+                } else {
+                    (ratio, "larger")
+                };
+                write!(
+                    f,
+                    "the cloud's bounding box is {factor:.3} times {size} than the mesh's: is \
+                     the cloud the one the mesh was reconstructed from, in the same units?"
+                )
+            }
+            Placement::Apart {
+                distance,
+                mesh_diagonal,
+            } => write!(
+                f,
+                "the cloud's bounding box does not meet the mesh's (their centres {distance:.4} \
+                 apart, the mesh's diagonal {mesh_diagonal:.4}): give the cloud in the mesh's frame"
+            ),
+            Placement::Overlapping => f.write_str(
+                "is the cloud the one the mesh was reconstructed from, in the same units and pose?",
+            ),
+        }
+    }
 }
 
 /// Why the Delaunay path could not mesh a cloud. All but [`Self::Input`]

@@ -82,7 +82,7 @@ pub use clean::{clean_mesh, CleanOptions, CleanReport, LeftLoops, LeftReason, SE
 pub use cloud::Point3;
 pub use delaunay::{delaunay_mesh, delaunay_mesh_with_report, DelaunayOptions, DelaunayReport};
 pub use edges::{reconstruct_edges, Edge, EdgeOptions, Edges, Loop, LoopSource};
-pub use error::{CleanError, CloudError, DelaunayError, MeshError, TrimError};
+pub use error::{CleanError, CloudError, DelaunayError, MeshError, Placement, TrimError};
 pub use frame::{fit_plane, Frame};
 pub use geom::rotation_from_quaternion;
 pub use mesh::manifold::ManifoldRepair;

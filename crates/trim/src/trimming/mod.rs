@@ -67,10 +67,12 @@
 
 mod cut;
 mod field;
+mod placement;
 mod support;
 
 use cut::*;
 use field::*;
+use placement::placement;
 use support::*;
 
 use crate::hash::HashMap;
@@ -210,7 +212,11 @@ pub fn trim_mesh(
         out_of_reach,
     ) = within_reach(first_cut, &reach, options.snap);
     snapped_count += out_of_reach.snapped;
-    let support = supported_faces(&cut, &beyond, cloud, &detection.beta, options.support)?;
+    let support = supported_faces(&cut, &beyond, cloud, &detection.beta, options.support)
+        .ok_or_else(|| {
+            let placement = placement(mesh, cloud, &detection.beta, options.reach);
+            TrimError::Unsupported(placement)
+        })?;
     let mut keep = support.keep;
     let pinch_faces_dropped = open_new_pinches(mesh, &cut, &mut keep);
     let mut survived = vec![false; mesh.faces.len()];

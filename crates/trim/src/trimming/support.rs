@@ -16,16 +16,17 @@ pub(super) struct Support {
 }
 
 /// Which faces of `cut` lie in a piece the cloud supports (see the module
-/// doc). Pieces never cross the walls: `beyond` says each face's side.
+/// doc), or `None` when no piece is. Pieces never cross the walls:
+/// `beyond` says each face's side.
 pub(super) fn supported_faces(
     cut: &Mesh,
     beyond: &[bool],
     cloud: &[Point3],
     beta: &[f64],
     support: f64,
-) -> Result<Support, TrimError> {
+) -> Option<Support> {
     if cut.faces.is_empty() {
-        return Err(TrimError::Unsupported);
+        return None;
     }
     let piece = face_pieces(&cut.faces, beyond);
     let pieces = piece.iter().map(|&p| p as usize + 1).max().unwrap_or(0);
@@ -58,13 +59,13 @@ pub(super) fn supported_faces(
         })
         .collect();
     if !keep.iter().any(|&k| k) {
-        return Err(TrimError::Unsupported);
+        return None;
     }
     let mut piece_beyond = vec![false; pieces];
     for (&p, &b) in piece.iter().zip(beyond) {
         piece_beyond[p as usize] = b;
     }
-    Ok(Support {
+    Some(Support {
         keep: piece.iter().map(|&p| keep[p as usize]).collect(),
         dropped: keep.iter().filter(|&&k| !k).count(),
         restored: (0..pieces).filter(|&k| keep[k] && piece_beyond[k]).count(),

@@ -2,6 +2,7 @@
 //! references on random inputs.
 
 use super::*;
+use crate::error::Placement;
 use rand::{RngExt, SeedableRng};
 
 /// Walls along a regular `n`-gon of radius `r` in the plane z = 0,
@@ -172,4 +173,83 @@ fn sorted_edges_give_the_border_of_the_hash_map() {
         assert!(loops.len() > 3, "seed {seed}");
         assert_eq!(loops, mesh.boundary_loops_reference(), "seed {seed}");
     }
+}
+
+/// A cap of a sphere of radius 10 centred well away from the origin, so
+/// that scaling a cloud about the origin by a wrong ratio moves it off:
+/// `side` × `side` quads of about 0.4, split into triangles.
+fn sphere_cap(side: u32) -> Mesh {
+    let centre = [60.0, 25.0, 10.0];
+    let at = |i: u32, j: u32| i * (side + 1) + j;
+    let vertices = (0..=side)
+        .flat_map(|i| {
+            (0..=side).map(move |j| {
+                let (u, v) = (i as f64 / side as f64 - 0.5, j as f64 / side as f64 - 0.5);
+                let (theta, phi) = (1.6 * u, 1.6 * v);
+                let direction = [theta.sin() * phi.cos(), phi.sin(), theta.cos() * phi.cos()];
+                [0, 1, 2].map(|a| centre[a] + 10.0 * direction[a])
+            })
+        })
+        .collect();
+    let faces = (0..side)
+        .flat_map(|i| {
+            (0..side).flat_map(move |j| {
+                [
+                    [at(i, j), at(i + 1, j), at(i + 1, j + 1)],
+                    [at(i, j), at(i + 1, j + 1), at(i, j + 1)],
+                ]
+            })
+        })
+        .collect();
+    Mesh { vertices, faces }
+}
+
+/// A trim that finds nothing supported says where the cloud lies: in
+/// other units (scaled by their ratio, it lies on the mesh), scaled by no
+/// ratio of units, elsewhere, or in place.
+#[test]
+fn an_unsupported_cloud_is_placed_against_the_mesh() {
+    let mesh = sphere_cap(40);
+    let spacing = 0.4;
+    let place = |factor: f64, shift: Point3| {
+        let cloud: Vec<Point3> = mesh
+            .vertices
+            .iter()
+            .map(|p| [0, 1, 2].map(|a| p[a] * factor + shift[a]))
+            .collect();
+        placement(&mesh, &cloud, &vec![spacing * factor; cloud.len()], 2.0)
+    };
+    let metres = place(0.001, [0.0; 3]);
+    assert_eq!(
+        metres,
+        Placement::Units {
+            factor: 1000.0,
+            units: ("metres", "millimetres")
+        }
+    );
+    let message = TrimError::Unsupported(metres).to_string();
+    assert!(
+        message.contains("scaled by 1000: the cloud looks to be in metres"),
+        "{message}"
+    );
+    let inches = place(25.4, [0.0; 3]);
+    assert_eq!(
+        inches,
+        Placement::Units {
+            factor: 1.0 / 25.4,
+            units: ("millimetres", "inches")
+        }
+    );
+    let message = TrimError::Unsupported(inches).to_string();
+    assert!(message.contains("scaled by 1/25.4:"), "{message}");
+    // A ratio no two units have.
+    match place(1.0 / 7.0, [0.0; 3]) {
+        Placement::Scaled { ratio } => assert!((ratio * 7.0 - 1.0).abs() < 1e-9, "{ratio}"),
+        other => panic!("{other:?}"),
+    }
+    assert!(matches!(
+        place(1.0, [500.0, 0.0, 0.0]),
+        Placement::Apart { distance, .. } if (distance - 500.0).abs() < 1e-9
+    ));
+    assert_eq!(place(1.0, [0.0, 0.0, 1.0]), Placement::Overlapping);
 }
