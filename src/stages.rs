@@ -98,6 +98,7 @@ pub fn in_cli_words(message: &str) -> String {
         )
         .replace("check the view's position", "check --view-from")
         .replace("clean with repair on", "clean with --repair")
+        .replace("scale the cloud by ", "scale the cloud with --cloud-scale ")
 }
 
 #[cfg(test)]
@@ -117,6 +118,12 @@ mod tests {
         assert!(in_cli_words(&few.to_string()).ends_with("; lower --k or use a denser cloud"));
         let behind = DelaunayError::NotInView { index: 3 };
         assert!(in_cli_words(&behind.to_string()).ends_with("; check --view-from"));
+        let metres = trim::TrimError::Unsupported(trim::Placement::Units {
+            factor: 1000.0,
+            units: ("metres", "millimetres"),
+        });
+        assert!(in_cli_words(&metres.to_string())
+            .ends_with("): scale the cloud with --cloud-scale 1000"));
         let folds = [
             DelaunayError::NotAHeightField {
                 onto: "the best-fit plane",

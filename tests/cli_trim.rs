@@ -493,8 +493,9 @@ fn scaled_cloud(dir: &Path, factor: f64) -> PathBuf {
 
 /// A cloud in other units than its mesh (metres against the Poisson
 /// mesh's millimetres, as a scanner's E57 file holds them) supports
-/// nothing: the error names the ratio and the units, and nothing is
-/// written. A ratio no two units have is not taken for one, though the
+/// nothing: the error names the units and the flag that scales the cloud,
+/// and nothing is written; with the flag, the trim is the cloud's in the
+/// mesh's units. A ratio no two units have is not taken for one, though the
 /// Poisson envelope, larger than its cloud, spans ten times the cloud
 /// scaled by 1/7, and 70 % of those points scaled by 10 pass within reach
 /// of it.
@@ -507,9 +508,46 @@ fn a_cloud_in_other_units_is_named_so() {
     let run = meshtrim(&[MESH, metres.to_str().unwrap(), o], None);
     assert_clean_failure(
         &run,
-        "no part of the mesh is supported by the cloud: the cloud lies on the mesh once scaled \
-         by 1000: the cloud looks to be in metres and the mesh in millimetres",
+        "no part of the mesh is supported by the cloud: the cloud looks to be in metres and the \
+         mesh in millimetres (scaled by 1000, the cloud lies on the mesh): scale the cloud with \
+         --cloud-scale 1000",
     );
+    // Scaled back, the cloud trims as in the mesh's units: the same bytes
+    // (halved and doubled, so that no rounding enters).
+    let halved = scaled_cloud(dir.path(), 0.5);
+    let scaled = path(dir.path(), "scaled.ply");
+    let report = path(dir.path(), "scaled.json");
+    let run = meshtrim(
+        &[
+            MESH,
+            halved.to_str().unwrap(),
+            scaled.to_str().unwrap(),
+            "--cloud-scale",
+            "2",
+            "--report",
+            report.to_str().unwrap(),
+        ],
+        None,
+    );
+    assert!(run.status.success(), "{}", stderr(&run));
+    let same = scaled_cloud(dir.path(), 1.0);
+    let direct = path(dir.path(), "direct.ply");
+    let run = meshtrim(
+        &[MESH, same.to_str().unwrap(), direct.to_str().unwrap()],
+        None,
+    );
+    assert!(run.status.success(), "{}", stderr(&run));
+    let (a, b) = (
+        std::fs::read(&scaled).unwrap(),
+        std::fs::read(&direct).unwrap(),
+    );
+    assert!(
+        a == b,
+        "the scaled cloud's trim differs from the cloud's own"
+    );
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&report).unwrap()).unwrap();
+    assert_eq!(report["cloud_scale"], 2.0);
     let sevenths = scaled_cloud(dir.path(), 1.0 / 7.0);
     let run = meshtrim(&[MESH, sevenths.to_str().unwrap(), o], None);
     assert_clean_failure(
@@ -517,5 +555,25 @@ fn a_cloud_in_other_units_is_named_so() {
         "the cloud's bounding box is 10.133 times smaller than the mesh's",
     );
     assert!(!stderr(&run).contains("scaled by"), "{}", stderr(&run));
+    assert!(!out.exists());
+}
+
+/// A scale factor must be a number above zero.
+#[test]
+fn a_cloud_scale_must_be_above_zero() {
+    let dir = temp_dir();
+    let out = path(dir.path(), "out.ply");
+    for bad in ["0", "-1000", "nan", "inf", "mm"] {
+        let run = meshtrim(
+            &[MESH, CLOUD, out.to_str().unwrap(), "--cloud-scale", bad],
+            None,
+        );
+        assert_eq!(run.status.code(), Some(2), "{bad}: {}", stderr(&run));
+        assert!(
+            stderr(&run).contains("give a number above zero, e.g. 1000"),
+            "{bad}: {}",
+            stderr(&run)
+        );
+    }
     assert!(!out.exists());
 }

@@ -283,6 +283,7 @@ fn trim_py<'py>(
         .stages()?,
         progress: false,
         cloud: Default::default(),
+        cloud_scale: None,
     };
     let mesh = mesh_of(&vertices, &faces)?;
     let points = rows(&points, "points")?;

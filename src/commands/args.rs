@@ -165,6 +165,17 @@ pub(crate) fn parse_k(text: &str) -> Result<usize, String> {
     Ok(k)
 }
 
+/// A finite factor above zero, to scale a cloud by.
+pub(crate) fn parse_scale(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(factor) if factor.is_finite() && factor > 0.0 => Ok(factor),
+        _ => Err(format!(
+            "'{text}' is not a factor: give a number above zero, e.g. 1000 for a cloud in \
+             metres and a mesh in millimetres"
+        )),
+    }
+}
+
 /// Three finite numbers separated by commas.
 pub(crate) fn parse_vector(text: &str) -> Result<[f64; 3], String> {
     let parts: Vec<&str> = text.split(',').map(str::trim).collect();

@@ -12,8 +12,9 @@ use serde::Serialize;
 use trim::{trim_mesh, Detection, Edges, LoopFit, TrimOptions, TrimReport};
 
 use crate::commands::args::{
-    parse_direction, parse_k, parse_vector, EdgeFileArgs, StageArgs, ViewArgs, DXF_SPLINES_HELP,
-    UNITS_HELP, VIEW_ALONG_HELP, VIEW_ALONG_LONG_HELP, VIEW_FROM_HELP, VIEW_FROM_LONG_HELP,
+    parse_direction, parse_k, parse_scale, parse_vector, EdgeFileArgs, StageArgs, ViewArgs,
+    DXF_SPLINES_HELP, UNITS_HELP, VIEW_ALONG_HELP, VIEW_ALONG_LONG_HELP, VIEW_FROM_HELP,
+    VIEW_FROM_LONG_HELP,
 };
 use crate::io::edges_out::step::LengthUnit;
 use crate::io::edges_out::EdgeFileOptions;
@@ -67,6 +68,11 @@ pub struct Args {
     /// frame.
     #[arg(long, value_name = "N")]
     pub scan: Option<usize>,
+    /// Multiply the cloud's coordinates by this factor before trimming,
+    /// for a cloud in other units than the mesh: 1000 for a cloud in
+    /// metres (as E57 files hold them) and a mesh in millimetres.
+    #[arg(long, value_name = "FACTOR", value_parser = parse_scale, allow_hyphen_values = true)]
+    pub cloud_scale: Option<f64>,
     /// The length unit declared (as `EdgeFileArgs`'s, same help).
     #[arg(long, value_enum, default_value_t = LengthUnit::Mm, help = UNITS_HELP)]
     pub units: LengthUnit,
@@ -112,6 +118,9 @@ pub struct Report {
     pub cloud: Option<String>,
     /// The output.
     pub output: Option<String>,
+    /// The factor the cloud was scaled by (`--cloud-scale`), if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cloud_scale: Option<f64>,
     /// Cloud points read.
     pub points: usize,
     /// Boundary points found by BPD.
@@ -187,6 +196,9 @@ pub struct TrimSettings {
     pub progress: bool,
     /// How the cloud is read (which scan of an E57 file).
     pub cloud: CloudOptions,
+    /// The factor the cloud's coordinates are multiplied by once read, to
+    /// the mesh's units.
+    pub cloud_scale: Option<f64>,
 }
 
 /// Runs the trimming.
@@ -196,6 +208,7 @@ pub fn run(args: &Args) -> Result<()> {
         stages: args.stage_args().stages(),
         progress: true,
         cloud: CloudOptions { scan: args.scan },
+        cloud_scale: args.cloud_scale,
     };
     let report = trim_file(
         &args.mesh,
@@ -230,7 +243,12 @@ pub fn trim_file(
         || read_cloud_with(cloud_path, &settings.cloud),
     );
     let mesh = mesh?;
-    let cloud = cloud?;
+    let mut cloud = cloud?;
+    if let Some(factor) = settings.cloud_scale {
+        for p in &mut cloud.points {
+            *p = p.map(|c| c * factor);
+        }
+    }
     let read_time = started.elapsed();
     let names = [mesh_path, cloud_path].map(|p| p.display().to_string());
     let Trimmed {
@@ -248,6 +266,7 @@ pub fn trim_file(
     report.write_ms = millis(started.elapsed());
     report.mesh = Some(names[0].clone());
     report.cloud = Some(names[1].clone());
+    report.cloud_scale = settings.cloud_scale;
     report.output = Some(output.display().to_string());
     Ok(report)
 }
@@ -327,6 +346,7 @@ impl Report {
         Report {
             mesh: None,
             cloud: None,
+            cloud_scale: None,
             output: None,
             points,
             boundary_points,
@@ -367,10 +387,13 @@ impl crate::report::Table for Report {
             (
                 "cloud",
                 format!(
-                    "{} ({} points, {} boundary)",
+                    "{} ({} points, {} boundary){}",
                     shown(&self.cloud),
                     self.points,
-                    self.boundary_points
+                    self.boundary_points,
+                    self.cloud_scale
+                        .map(|f| format!(", scaled by {f}"))
+                        .unwrap_or_default()
                 ),
             ),
             ("loops", self.loops.to_string()),

@@ -120,11 +120,30 @@ def test_batch_trims_with_the_scanners_files(scans, tmp_path):
         "sub/c.ply": ("trim", "ok"),
     }
     assert "several clouds match this mesh" in rows["e.ply"]["error"], rows["e.ply"]
-    units = "scaled by 1000: the cloud looks to be in metres and the mesh in millimetres"
+    units = "the cloud looks to be in metres and the mesh in millimetres"
     assert units in rows["m.ply"]["error"], rows["m.ply"]
+    assert rows["m.ply"]["error"].endswith("scale the cloud with --cloud-scale 1000"), rows["m.ply"]
     assert not (out / "m.ply").exists()
     for mesh, cloud in [("a.ply", "a.e57"), ("b.ply", "b.laz"), ("sub/c.ply", "sub/c.cloud.las")]:
         alone = tmp_path / "alone.ply"
         run_meshtrim("trim", d / mesh, d / cloud, alone)
         assert (out / mesh).read_bytes() == alone.read_bytes(), mesh
         assert rows[mesh]["faces_out"] < rows[mesh]["faces_in"], rows[mesh]
+
+
+def test_batch_scales_clouds_in_metres(scans, tmp_path):
+    """`--cloud-scale 1000`, as the error advises: the E57 file in metres
+    trims its mesh in millimetres, the bytes `meshtrim trim` writes with
+    the same flag, and the report says the factor."""
+    d = scans / "scans"
+    folder = tmp_path / "m"
+    folder.mkdir()
+    for name in ("m.ply", "m.e57"):
+        (folder / name).write_bytes((d / name).read_bytes())
+    out = tmp_path / "out"
+    run_meshtrim("batch", folder, "--out-dir", out, "--cloud-scale", "1000")
+    alone, report = tmp_path / "alone.ply", tmp_path / "report.json"
+    run_meshtrim("trim", folder / "m.ply", folder / "m.e57", alone, "--cloud-scale", "1000", "--report", report)
+    assert (out / "m.ply").read_bytes() == alone.read_bytes()
+    rep = json.loads(report.read_text())
+    assert rep["cloud_scale"] == 1000.0 and rep["faces_out"] < rep["faces_in"], rep

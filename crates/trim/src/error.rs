@@ -209,14 +209,15 @@ fn ratio_text(ratio: f64) -> String {
 impl std::fmt::Display for Placement {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match *self {
-            Placement::Units { factor, units } => write!(
-                f,
-                "the cloud lies on the mesh once scaled by {}: the cloud looks to be in {} and \
-                 the mesh in {}; give both in the same units",
-                ratio_text(factor),
-                units.0,
-                units.1
-            ),
+            Placement::Units { factor, units } => {
+                let factor = ratio_text(factor);
+                write!(
+                    f,
+                    "the cloud looks to be in {} and the mesh in {} (scaled by {factor}, the \
+                     cloud lies on the mesh): scale the cloud by {factor}",
+                    units.0, units.1
+                )
+            }
             Placement::Scaled { ratio } => {
                 let (factor, size) = if ratio < 1.0 {
                     (1.0 / ratio, "smaller")

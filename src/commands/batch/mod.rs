@@ -48,6 +48,11 @@ pub struct Args {
     /// instead of beside the meshes.
     #[arg(long, value_name = "DIR")]
     pub cloud_dir: Option<PathBuf>,
+    /// Multiply the clouds' coordinates by this factor before trimming,
+    /// for clouds in other units than the meshes: 1000 for clouds in
+    /// metres (as E57 files hold them) and meshes in millimetres.
+    #[arg(long, value_name = "FACTOR", value_parser = crate::commands::args::parse_scale, allow_hyphen_values = true)]
+    pub cloud_scale: Option<f64>,
     /// Files processed at once, and threads in all [default: all cores].
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u16).range(1..))]
     pub jobs: Option<u16>,
@@ -120,12 +125,17 @@ fn process_all(jobs: &[Job], args: &Args) -> Result<Vec<Row>> {
         .num_threads(args.jobs.map_or(0, usize::from))
         .build()
         .context("cannot start the worker threads")?;
-    let stages = args.stages.stages();
+    let settings = FileSettings {
+        skip_existing: args.skip_existing,
+        repair: args.repair,
+        stages: args.stages.stages(),
+        cloud_scale: args.cloud_scale,
+    };
     let bar = batch_bar(jobs.len());
     let rows = pool.install(|| {
         jobs.par_iter()
             .map(|job| {
-                let row = process(job, args.skip_existing, args.repair, &stages);
+                let row = process(job, &settings);
                 // Printed above the bar, which is redrawn below it.
                 // Best effort: a failing stdout must not stop the files;
                 // the summary below reports it.
@@ -150,9 +160,21 @@ fn batch_bar(files: usize) -> ProgressBar {
     bar
 }
 
+/// What every file of the batch is told.
+struct FileSettings {
+    /// Skip a file whose output exists.
+    skip_existing: bool,
+    /// Repair meshes before cleaning them (`--repair`).
+    repair: bool,
+    /// Detection's and edge reconstruction's options.
+    stages: Stages,
+    /// The clouds' scale factor (`--cloud-scale`).
+    cloud_scale: Option<f64>,
+}
+
 /// One file, whatever happens: skipped, done, failed, or panicked (the
 /// panic is caught and reported as the file's failure).
-fn process(job: &Job, skip_existing: bool, repair: bool, stages: &Stages) -> Row {
+fn process(job: &Job, settings: &FileSettings) -> Row {
     let started = Instant::now();
     let mode = match job.cloud {
         CloudMatch::None => Mode::Clean,
@@ -174,10 +196,10 @@ fn process(job: &Job, skip_existing: bool, repair: bool, stages: &Stages) -> Row
         repaired: None,
         note: None,
     };
-    if skip_existing && job.output.exists() {
+    if settings.skip_existing && job.output.exists() {
         return row;
     }
-    let result = catch_unwind(AssertUnwindSafe(|| work(job, repair, stages)))
+    let result = catch_unwind(AssertUnwindSafe(|| work(job, settings)))
         .unwrap_or_else(|panic| Err(anyhow!("internal error: {}", panic_text(&*panic))));
     match result {
         Ok(o) => {
@@ -215,9 +237,15 @@ const CLOSED: &str = "no border: a closed mesh has nothing to clean; to trim a P
 const WRAPS: &str = "it wraps round an object, as an envelope cut open does: to trim a \
      reconstruction's envelope instead, put its cloud S.cloud.EXT beside it";
 
-/// Cleans (repairing it first if `repair`) or trims one file, writing its
-/// output atomically.
-fn work(job: &Job, repair: bool, stages: &Stages) -> Result<Outcome> {
+/// Cleans (repairing it first with `--repair`) or trims one file, writing
+/// its output atomically.
+fn work(job: &Job, settings: &FileSettings) -> Result<Outcome> {
+    let FileSettings {
+        repair,
+        ref stages,
+        cloud_scale,
+        ..
+    } = *settings;
     match &job.cloud {
         CloudMatch::None => {
             let o = clean_file(&job.input, &job.output, stages, repair, NO_FACES)?;
@@ -241,6 +269,7 @@ fn work(job: &Job, repair: bool, stages: &Stages) -> Result<Outcome> {
                 stages: stages.clone(),
                 progress: false,
                 cloud: CloudOptions::default(),
+                cloud_scale,
             };
             let r = trim_file(&job.input, cloud, &job.output, None, &settings)?;
             Ok(Outcome {
