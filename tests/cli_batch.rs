@@ -380,10 +380,22 @@ fn bad_files_fail_alone_and_the_reports_say_why() {
             "algorithm_ms",
             "write_ms",
             "total_ms",
-            "repaired"
+            "repaired",
+            "cloud"
         ]
     );
     assert_eq!(rows.len(), 5, "{rows:?}");
+    // The cloud each trimmed file was paired with; none for a clean.
+    let clouds: Vec<&str> = rows[1..].iter().map(|r| r[13].as_str()).collect();
+    assert_eq!(
+        clouds,
+        [
+            "scans/a.cloud.ply",
+            "",
+            "scans/worse.cloud.ply",
+            "scans/z.cloud.ply"
+        ]
+    );
     let order: Vec<&str> = rows[1..].iter().map(|r| r[0].as_str()).collect();
     assert_eq!(
         order,

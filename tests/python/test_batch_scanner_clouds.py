@@ -120,6 +120,14 @@ def test_batch_trims_with_the_scanners_files(scans, tmp_path):
         "sub/c.ply": ("trim", "ok"),
     }
     assert "several clouds match this mesh" in rows["e.ply"]["error"], rows["e.ply"]
+    # The report names the cloud each mesh was trimmed with.
+    assert [rows[m]["cloud"] for m in ("a.ply", "b.ply", "d.stl", "e.ply", "sub/c.ply")] == [
+        str(d / "a.e57"),
+        str(d / "b.laz"),
+        None,
+        None,
+        str(d / "sub" / "c.cloud.las"),
+    ]
     units = "the cloud looks to be in metres and the mesh in millimetres"
     assert units in rows["m.ply"]["error"], rows["m.ply"]
     assert rows["m.ply"]["error"].endswith("scale the cloud with --cloud-scale 1000"), rows["m.ply"]

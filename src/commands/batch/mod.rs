@@ -194,6 +194,10 @@ fn process(job: &Job, settings: &FileSettings) -> Row {
         write_ms: None,
         total_ms: 0.0,
         repaired: None,
+        cloud: match &job.cloud {
+            CloudMatch::One(cloud) => Some(cloud.display().to_string()),
+            _ => None,
+        },
         note: None,
     };
     if settings.skip_existing && job.output.exists() {

@@ -103,6 +103,9 @@ pub struct Row {
     /// Faces `--repair` removed or turned to make the mesh manifold and
     /// oriented (cleaned files only).
     pub repaired: Option<usize>,
+    /// The cloud a trimmed file was paired with (none for a clean, or
+    /// when several clouds matched: the error names them).
+    pub cloud: Option<String>,
     /// What the user should know about the file, when anything.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub note: Option<&'static str>,
@@ -136,7 +139,7 @@ impl Row {
     }
 
     /// The row's CSV fields, in [`CSV_HEADER`] order.
-    fn csv_fields(&self) -> [String; 13] {
+    fn csv_fields(&self) -> [String; 14] {
         let opt = |v: Option<String>| v.unwrap_or_default();
         [
             self.input.clone(),
@@ -152,12 +155,14 @@ impl Row {
             opt(self.write_ms.map(|v| v.to_string())),
             self.total_ms.to_string(),
             opt(self.repaired.map(|v| v.to_string())),
+            opt(self.cloud.clone()),
         ]
     }
 }
 
-/// The CSV columns.
-pub const CSV_HEADER: [&str; 13] = [
+/// The CSV columns (new ones go last, so that columns read by position
+/// keep theirs).
+pub const CSV_HEADER: [&str; 14] = [
     "input",
     "output",
     "mode",
@@ -171,6 +176,7 @@ pub const CSV_HEADER: [&str; 13] = [
     "write_ms",
     "total_ms",
     "repaired",
+    "cloud",
 ];
 
 /// The report formats, by the file's extension.
