@@ -161,7 +161,7 @@ pub struct Report {
     /// Area of the output mesh.
     pub area_out: f64,
     /// Per smoothed loop: mean and largest distance from the output border
-    /// to it, in the cloud's units.
+    /// to it, in the cloud's units (once scaled by `cloud_scale`).
     pub border_to_edge: Vec<BorderFit>,
     /// Time of each stage, in milliseconds.
     pub read_ms: f64,
@@ -451,7 +451,14 @@ impl crate::report::Table for Report {
             ),
             (
                 "border to edge, max",
-                format!("{} (the cloud's units)", significant(worst, 4)),
+                format!(
+                    "{} ({})",
+                    significant(worst, 4),
+                    match self.cloud_scale {
+                        Some(_) => "the mesh's units: the cloud's, scaled",
+                        None => "the cloud's units",
+                    }
+                ),
             ),
             ("read time", format!("{:.1} ms", self.read_ms)),
             ("detect time", format!("{:.1} ms", self.detect_ms)),
