@@ -38,7 +38,7 @@ use crate::mesh::Mesh;
 const LEAF: usize = 4;
 
 /// An axis-aligned box: lower and upper corners.
-type Aabb = (Point3, Point3);
+pub(crate) type Aabb = (Point3, Point3);
 
 /// Closest-face queries on one mesh.
 pub struct FaceIndex {
@@ -378,8 +378,9 @@ fn union(a: Aabb, b: Aabb) -> Aabb {
     )
 }
 
-/// The bounding box of `points`.
-fn bounds(points: impl Iterator<Item = Point3>) -> Aabb {
+/// The bounding box of `points` (inside out, lower corner +∞, when there
+/// are none).
+pub(crate) fn bounds(points: impl Iterator<Item = Point3>) -> Aabb {
     points.fold(EMPTY, |acc, p| union(acc, (p, p)))
 }
 

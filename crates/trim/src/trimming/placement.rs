@@ -6,6 +6,7 @@
 
 use super::*;
 use crate::error::Placement;
+use crate::spatial::closest_face::{bounds, Aabb};
 
 /// Unit pairs a cloud and its mesh may be given in: how many of the
 /// second make one of the first.
@@ -34,18 +35,20 @@ pub(super) fn placement(mesh: &Mesh, cloud: &[Point3], beta: &[f64], reach: f64)
     if let Some(units) = unit_ratio(mesh, cloud, beta, reach) {
         return units;
     }
-    let (Some(mesh_box), Some(cloud_box)) = (Bounds::of(&mesh.vertices), Bounds::of(cloud)) else {
+    if mesh.vertices.is_empty() || cloud.is_empty() {
         return Placement::Overlapping;
-    };
-    let (mesh_diagonal, cloud_diagonal) = (mesh_box.diagonal(), cloud_box.diagonal());
+    }
+    let mesh_box = bounds(mesh.vertices.iter().copied());
+    let cloud_box = bounds(cloud.iter().copied());
+    let (mesh_diagonal, cloud_diagonal) = (diagonal(mesh_box), diagonal(cloud_box));
     let ratio = cloud_diagonal / mesh_diagonal;
     if mesh_diagonal > 0.0 && cloud_diagonal > 0.0 && !(1.0 / 3.0..=3.0).contains(&ratio) {
         Placement::Scaled { ratio }
-    } else if mesh_box.meets(&cloud_box) {
+    } else if meet(mesh_box, cloud_box) {
         Placement::Overlapping
     } else {
         Placement::Apart {
-            distance: mesh_box.centre_distance(&cloud_box),
+            distance: centre_distance(mesh_box, cloud_box),
             mesh_diagonal,
         }
     }
@@ -89,36 +92,15 @@ fn unit_ratio(mesh: &Mesh, cloud: &[Point3], beta: &[f64], reach: f64) -> Option
         .then_some(Placement::Units { factor, units })
 }
 
-/// An axis-aligned bounding box.
-struct Bounds {
-    low: Point3,
-    high: Point3,
+fn diagonal((low, high): Aabb) -> f64 {
+    dist2(low, high).sqrt()
 }
 
-impl Bounds {
-    fn of(points: &[Point3]) -> Option<Bounds> {
-        let first = *points.first()?;
-        let mut b = Bounds {
-            low: first,
-            high: first,
-        };
-        for p in points {
-            b.low = [0, 1, 2].map(|a| b.low[a].min(p[a]));
-            b.high = [0, 1, 2].map(|a| b.high[a].max(p[a]));
-        }
-        Some(b)
-    }
+fn meet(a: Aabb, b: Aabb) -> bool {
+    (0..3).all(|k| a.0[k] <= b.1[k] && b.0[k] <= a.1[k])
+}
 
-    fn diagonal(&self) -> f64 {
-        dist2(self.low, self.high).sqrt()
-    }
-
-    fn meets(&self, other: &Bounds) -> bool {
-        (0..3).all(|a| self.low[a] <= other.high[a] && other.low[a] <= self.high[a])
-    }
-
-    fn centre_distance(&self, other: &Bounds) -> f64 {
-        let centre = |b: &Bounds| lerp(b.low, b.high, 0.5);
-        dist2(centre(self), centre(other)).sqrt()
-    }
+fn centre_distance(a: Aabb, b: Aabb) -> f64 {
+    let centre = |(low, high): Aabb| lerp(low, high, 0.5);
+    dist2(centre(a), centre(b)).sqrt()
 }
