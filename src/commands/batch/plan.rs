@@ -16,6 +16,7 @@ use crate::io::Format;
 
 /// Extensions of mesh inputs (any case).
 const MESH_EXTENSIONS: [&str; 5] = ["stl", "ply", "obj", "gltf", "glb"];
+
 /// One mesh of the batch.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Job {
