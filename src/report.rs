@@ -61,6 +61,23 @@ pub fn emit<R: Serialize + Table>(report: &R, file: Option<&Path>, json: bool) -
     }
 }
 
+/// The report's row on the mesh's vertex attributes: those written
+/// (carried to the new vertices) and those the output's format cannot
+/// hold; `None` when the mesh had none.
+pub fn attributes_row(written: &[&str], not_written: &[&str]) -> Option<String> {
+    match (written, not_written) {
+        ([], []) => None,
+        (written, []) => Some(format!(
+            "{} (kept vertices' as read, the new ones' from the mesh's surface)",
+            written.join(", ")
+        )),
+        (_, not_written) => Some(format!(
+            "{} not written: the output's format holds none",
+            not_written.join(", ")
+        )),
+    }
+}
+
 /// Lays out (label, value) rows as the commands print them.
 pub fn rows(rows: &[(&str, String)]) -> String {
     rows.iter()

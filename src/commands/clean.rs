@@ -13,8 +13,8 @@ use serde::Serialize;
 use trim::{clean_mesh, CleanOptions, CleanReport};
 
 use crate::commands::args::StageArgs;
-use crate::io::mesh_out::write_mesh;
-use crate::io::read_mesh_with_faces;
+use crate::io::mesh_out::write_mesh_carrying;
+use crate::io::read_mesh_with_attributes;
 use crate::report::shown;
 use crate::stages::{millis, Stages};
 
@@ -135,6 +135,13 @@ pub struct Report {
     /// for a scan seen from one side, lower for a surface wrapping round
     /// an object (see [`WRAPS_BELOW`]).
     pub area_facing_one_way: f64,
+    /// The input's vertex attributes written to the output ("normals",
+    /// "colours"), carried to the new vertices from the input's surface.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub vertex_attributes: Vec<&'static str>,
+    /// The input's vertex attributes the output's format cannot hold (STL).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub vertex_attributes_not_written: Vec<&'static str>,
     /// Reading time, ms.
     pub read_ms: f64,
     /// Local resolution (β of every vertex) time, ms.
@@ -202,12 +209,14 @@ fn clean(
     no_faces: &str,
 ) -> Result<Report> {
     let started = Instant::now();
-    let mesh = read_mesh_with_faces(input, no_faces)?;
+    let (mesh, attributes) = read_mesh_with_attributes(input, no_faces)?;
     let read_time = started.elapsed();
     let name = input.display().to_string();
     let (out, mut report) = clean_in_memory(&mesh, stages, repair, &name)?;
     let started = Instant::now();
-    write_mesh(output, &out.vertices, &out.faces)?;
+    let carried = write_mesh_carrying(output, &out, &mesh, &attributes)?;
+    report.vertex_attributes = carried.written;
+    report.vertex_attributes_not_written = carried.not_written;
     report.read_ms = millis(read_time);
     report.write_ms = millis(started.elapsed());
     report.input = Some(name);
@@ -303,6 +312,8 @@ impl Report {
             area_in: r.area_in,
             area_out: r.area_out,
             area_facing_one_way: r.area_facing_one_way,
+            vertex_attributes: Vec::new(),
+            vertex_attributes_not_written: Vec::new(),
             read_ms: 0.0,
             resolution_ms: millis(resolution),
             clean_ms: millis(clean),
@@ -385,6 +396,12 @@ impl crate::report::Table for Report {
             ("write time", format!("{:.1} ms", self.write_ms)),
             ("output", shown(&self.output)),
         ];
+        if let Some(row) =
+            crate::report::attributes_row(&self.vertex_attributes, &self.vertex_attributes_not_written)
+        {
+            let before_times = rows.len() - 5;
+            rows.insert(before_times, ("vertex attributes", row));
+        }
         if self.zero_area_faces_repaired + self.zero_area_faces_left > 0 {
             rows.insert(
                 3,

@@ -18,8 +18,8 @@ use crate::commands::args::{
 };
 use crate::io::edges_out::step::LengthUnit;
 use crate::io::edges_out::EdgeFileOptions;
-use crate::io::mesh_out::write_mesh;
-use crate::io::{read_cloud_with, read_mesh_with_faces, CloudOptions, Point3};
+use crate::io::mesh_out::write_mesh_carrying;
+use crate::io::{read_cloud_with, read_mesh_with_attributes, CloudOptions, Point3};
 use crate::report::{shown, significant, write_edges, LoopsFrom};
 use crate::stages::{detect_and_reconstruct, millis, Stages};
 
@@ -163,6 +163,13 @@ pub struct Report {
     /// Per smoothed loop: mean and largest distance from the output border
     /// to it, in the cloud's units (once scaled by `cloud_scale`).
     pub border_to_edge: Vec<BorderFit>,
+    /// The mesh's vertex attributes written to the output ("normals",
+    /// "colours"), carried to the new vertices from the mesh's surface.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub vertex_attributes: Vec<&'static str>,
+    /// The mesh's vertex attributes the output's format cannot hold (STL).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub vertex_attributes_not_written: Vec<&'static str>,
     /// Time of each stage, in milliseconds.
     pub read_ms: f64,
     /// Boundary detection time.
@@ -239,10 +246,10 @@ pub fn trim_file(
     // read first.
     let started = Instant::now();
     let (mesh, cloud) = rayon::join(
-        || read_mesh_with_faces(mesh_path, "give a mesh (the cloud goes second)"),
+        || read_mesh_with_attributes(mesh_path, "give a mesh (the cloud goes second)"),
         || read_cloud_with(cloud_path, &settings.cloud),
     );
-    let mesh = mesh?;
+    let (mesh, attributes) = mesh?;
     let mut cloud = cloud?;
     if let Some(factor) = settings.cloud_scale {
         for p in &mut cloud.points {
@@ -258,7 +265,7 @@ pub fn trim_file(
         edges,
     } = trim_in_memory(&mesh, &cloud.points, settings, &names)?;
     let started = Instant::now();
-    write_mesh(output, &out.vertices, &out.faces)?;
+    let carried = write_mesh_carrying(output, &out, &mesh, &attributes)?;
     if let Some((path, options)) = edges_output {
         write_edges(path, &cloud.points, &detection, &edges, options)?;
     }
@@ -268,6 +275,8 @@ pub fn trim_file(
     report.cloud = Some(names[1].clone());
     report.cloud_scale = settings.cloud_scale;
     report.output = Some(output.display().to_string());
+    report.vertex_attributes = carried.written;
+    report.vertex_attributes_not_written = carried.not_written;
     Ok(report)
 }
 
@@ -366,6 +375,8 @@ impl Report {
             area_in: r.area_in,
             area_out: r.area_out,
             border_to_edge: r.loops.iter().map(fit).collect(),
+            vertex_attributes: Vec::new(),
+            vertex_attributes_not_written: Vec::new(),
             read_ms: 0.0,
             detect_ms: millis(detect),
             edges_ms: millis(edges),
@@ -382,7 +393,7 @@ impl crate::report::Table for Report {
             .iter()
             .map(|f| f.max)
             .fold(0.0, f64::max);
-        let rows = [
+        let mut rows = vec![
             ("mesh", shown(&self.mesh)),
             (
                 "cloud",
@@ -467,6 +478,12 @@ impl crate::report::Table for Report {
             ("write time", format!("{:.1} ms", self.write_ms)),
             ("output", shown(&self.output)),
         ];
+        if let Some(row) =
+            crate::report::attributes_row(&self.vertex_attributes, &self.vertex_attributes_not_written)
+        {
+            let before_times = rows.len() - 6;
+            rows.insert(before_times, ("vertex attributes", row));
+        }
         crate::report::rows(&rows)
     }
 }

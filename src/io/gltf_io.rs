@@ -32,7 +32,7 @@ use byteorder::{ByteOrder, LittleEndian};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 
-use super::{show, Mesh, Point3};
+use super::{show, Mesh, Point3, VertexAttributes};
 
 /// Whether the bytes are a GLB container (the `glTF` magic).
 pub fn is_glb(bytes: &[u8]) -> bool {
@@ -663,10 +663,13 @@ fn accessor_data<'b>(
 }
 
 /// The glTF JSON document and binary buffer of one mesh; `uri` is the
-/// buffer's URI (`None` for the GLB binary chunk).
+/// buffer's URI (`None` for the GLB binary chunk). Normals, when given,
+/// are written as unit `f32` vectors (as the spec requires: a zero one as
+/// +z); colours as `COLOR_0`, normalised unsigned bytes RGBA.
 fn document(
     vertices: &[Point3],
     faces: &[[u32; 3]],
+    attributes: &VertexAttributes,
     uri: Option<String>,
 ) -> (serde_json::Value, Vec<u8>) {
     let mut bin = Vec::with_capacity(12 * (vertices.len() + faces.len()));
@@ -680,10 +683,54 @@ fn document(
             bin.extend_from_slice(&c.to_le_bytes());
         }
     }
-    let positions_len = bin.len();
+    let mut accessors = vec![serde_json::json!({
+        "bufferView": 0, "componentType": 5126, "count": vertices.len(), "type": "VEC3",
+        "min": min.map(f64::from), "max": max.map(f64::from)
+    })];
+    let mut views = vec![serde_json::json!({
+        "buffer": 0, "byteOffset": 0, "byteLength": bin.len(), "target": 34962
+    })];
+    let mut primitive_attributes = serde_json::json!({ "POSITION": 0 });
+    let mut add_view = |bin: &Vec<u8>, start: usize, target: u32| {
+        views.push(serde_json::json!({
+            "buffer": 0, "byteOffset": start, "byteLength": bin.len() - start, "target": target
+        }));
+        views.len() - 1
+    };
+    if let Some(normals) = &attributes.normals {
+        let start = bin.len();
+        for n in normals {
+            for c in unit_normal(*n) {
+                bin.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        let view = add_view(&bin, start, 34962);
+        primitive_attributes["NORMAL"] = accessors.len().into();
+        accessors.push(serde_json::json!({
+            "bufferView": view, "componentType": 5126, "count": vertices.len(), "type": "VEC3"
+        }));
+    }
+    if let Some(colours) = &attributes.colours {
+        let start = bin.len();
+        for rgba in &colours.rgba {
+            bin.extend(rgba.iter().map(|&c| super::mesh_out::channel_byte(c)));
+        }
+        let view = add_view(&bin, start, 34962);
+        primitive_attributes["COLOR_0"] = accessors.len().into();
+        accessors.push(serde_json::json!({
+            "bufferView": view, "componentType": 5121, "normalized": true,
+            "count": vertices.len(), "type": "VEC4"
+        }));
+    }
+    let start = bin.len();
     for v in faces.iter().flatten() {
         bin.extend_from_slice(&v.to_le_bytes());
     }
+    let indices_view = add_view(&bin, start, 34963);
+    let indices = accessors.len();
+    accessors.push(serde_json::json!({
+        "bufferView": indices_view, "componentType": 5125, "count": 3 * faces.len(), "type": "SCALAR"
+    }));
     let mut buffer = serde_json::json!({ "byteLength": bin.len() });
     if let Some(uri) = uri {
         buffer["uri"] = uri.into();
@@ -693,24 +740,24 @@ fn document(
         "scene": 0,
         "scenes": [{ "nodes": [0] }],
         "nodes": [{ "mesh": 0 }],
-        "meshes": [{ "primitives": [{ "attributes": { "POSITION": 0 }, "indices": 1, "mode": 4 }] }],
-        "accessors": [
-            {
-                "bufferView": 0, "componentType": 5126, "count": vertices.len(), "type": "VEC3",
-                "min": min.map(f64::from), "max": max.map(f64::from)
-            },
-            { "bufferView": 1, "componentType": 5125, "count": 3 * faces.len(), "type": "SCALAR" }
-        ],
-        "bufferViews": [
-            { "buffer": 0, "byteOffset": 0, "byteLength": positions_len, "target": 34962 },
-            {
-                "buffer": 0, "byteOffset": positions_len,
-                "byteLength": bin.len() - positions_len, "target": 34963
-            }
-        ],
+        "meshes": [{ "primitives": [{
+            "attributes": primitive_attributes, "indices": indices, "mode": 4
+        }] }],
+        "accessors": accessors,
+        "bufferViews": views,
         "buffers": [buffer]
     });
     (json, bin)
+}
+
+/// A normal as the unit `f32` vector glTF requires (+z for a zero one).
+fn unit_normal(n: Point3) -> [f32; 3] {
+    let length = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    if length > 0.0 && length.is_finite() {
+        n.map(|c| (c / length) as f32)
+    } else {
+        [0.0, 0.0, 1.0]
+    }
 }
 
 fn empty_error(vertices: &[Point3], faces: &[[u32; 3]]) -> std::io::Result<()> {
@@ -729,12 +776,14 @@ pub fn write_glb(
     w: &mut dyn Write,
     vertices: &[Point3],
     faces: &[[u32; 3]],
+    attributes: &VertexAttributes,
 ) -> std::io::Result<()> {
     empty_error(vertices, faces)?;
-    let (json, bin) = document(vertices, faces, None);
+    let (json, bin) = document(vertices, faces, attributes, None);
     let mut json = serde_json::to_vec(&json).map_err(std::io::Error::other)?;
     json.resize(json.len().next_multiple_of(4), b' ');
-    // The binary data is a multiple of 4 bytes already (f32 and u32).
+    // The binary data is a multiple of 4 bytes already (f32, u32 and
+    // four bytes of colour per vertex).
     let total = 12 + 8 + json.len() + 8 + bin.len();
     let total = u32::try_from(total).map_err(|_| std::io::Error::other("GLB larger than 4 GiB"))?;
     w.write_all(b"glTF")?;
@@ -755,14 +804,15 @@ pub fn write_gltf(
     w: &mut dyn Write,
     vertices: &[Point3],
     faces: &[[u32; 3]],
+    attributes: &VertexAttributes,
 ) -> std::io::Result<()> {
     empty_error(vertices, faces)?;
-    let (_, bin) = document(vertices, faces, None);
+    let (_, bin) = document(vertices, faces, attributes, None);
     let uri = format!(
         "data:application/octet-stream;base64,{}",
         base64::engine::general_purpose::STANDARD.encode(&bin)
     );
-    let (json, _) = document(vertices, faces, Some(uri));
+    let (json, _) = document(vertices, faces, attributes, Some(uri));
     serde_json::to_writer_pretty(&mut *w, &json).map_err(std::io::Error::other)?;
     w.write_all(b"\n")
 }
@@ -784,11 +834,11 @@ mod tests {
         for glb in [true, false] {
             let mut bytes = Vec::new();
             if glb {
-                write_glb(&mut bytes, &v, &f).unwrap();
+                write_glb(&mut bytes, &v, &f, &VertexAttributes::default()).unwrap();
                 assert!(is_glb(&bytes));
                 assert_eq!(bytes.len() % 4, 0);
             } else {
-                write_gltf(&mut bytes, &v, &f).unwrap();
+                write_gltf(&mut bytes, &v, &f, &VertexAttributes::default()).unwrap();
                 assert!(looks_like_json(&bytes));
             }
             let mesh = read_gltf(&bytes, Path::new(".")).unwrap();
@@ -819,6 +869,6 @@ mod tests {
     #[test]
     fn empty_meshes_are_refused() {
         let mut out = Vec::new();
-        assert!(write_glb(&mut out, &[], &[]).is_err());
+        assert!(write_glb(&mut out, &[], &[], &VertexAttributes::default()).is_err());
     }
 }

@@ -20,7 +20,7 @@ use anyhow::{anyhow, bail, Context, Result};
 
 use super::atomic::write_atomic;
 use super::float_text::push_f64_debug;
-use super::{gltf_io, show, stl, write_formatted, Point3};
+use super::{gltf_io, show, stl, write_formatted, Point3, VertexAttributes};
 
 /// The mesh formats meshtrim writes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -56,20 +56,28 @@ impl MeshFormat {
         matches!(self, MeshFormat::Stl | MeshFormat::Glb | MeshFormat::Gltf)
     }
 
-    /// Writes the mesh in this format; the mesh must pass [`check_mesh`].
+    /// Writes the mesh in this format, with the vertex attributes it can
+    /// hold (all but STL hold normals and colours); the mesh must pass
+    /// [`check_mesh`].
     pub fn write(
         self,
         w: &mut dyn Write,
         vertices: &[Point3],
         faces: &[[u32; 3]],
+        attributes: &VertexAttributes,
     ) -> std::io::Result<()> {
         match self {
-            MeshFormat::Obj => write_obj(w, vertices, faces),
-            MeshFormat::Ply => write_ply(w, vertices, faces),
+            MeshFormat::Obj => write_obj(w, vertices, faces, attributes),
+            MeshFormat::Ply => write_ply(w, vertices, faces, attributes),
             MeshFormat::Stl => stl::write_stl(w, vertices, faces),
-            MeshFormat::Glb => gltf_io::write_glb(w, vertices, faces),
-            MeshFormat::Gltf => gltf_io::write_gltf(w, vertices, faces),
+            MeshFormat::Glb => gltf_io::write_glb(w, vertices, faces, attributes),
+            MeshFormat::Gltf => gltf_io::write_gltf(w, vertices, faces, attributes),
         }
+    }
+
+    /// Whether the format stores vertex normals and colours.
+    pub fn holds_attributes(self) -> bool {
+        self != MeshFormat::Stl
     }
 }
 
@@ -83,6 +91,17 @@ impl MeshFormat {
 /// the mesh (PLY's `int` indices, STL's `u32` triangle count, glTF's
 /// non-empty accessors).
 pub fn write_mesh(path: &Path, vertices: &[Point3], faces: &[[u32; 3]]) -> Result<()> {
+    write_mesh_with(path, vertices, faces, &VertexAttributes::default())
+}
+
+/// [`write_mesh`] with per-vertex normals and colours (one per vertex),
+/// which every format but STL holds.
+pub fn write_mesh_with(
+    path: &Path,
+    vertices: &[Point3],
+    faces: &[[u32; 3]],
+    attributes: &VertexAttributes,
+) -> Result<()> {
     let format = MeshFormat::from_path(path)
         .ok_or_else(|| {
             let ext = path.extension().map(|e| e.to_string_lossy().into_owned());
@@ -93,7 +112,8 @@ pub fn write_mesh(path: &Path, vertices: &[Point3], faces: &[[u32; 3]]) -> Resul
         })
         .with_context(|| path.display().to_string())?;
     check_mesh(format, vertices, faces).with_context(|| path.display().to_string())?;
-    write_atomic(path, |w| format.write(w, vertices, faces))
+    check_attributes(vertices.len(), attributes).with_context(|| path.display().to_string())?;
+    write_atomic(path, |w| format.write(w, vertices, faces, attributes))
 }
 
 /// Checks that `format` can hold the mesh, with a message naming the
@@ -136,6 +156,61 @@ pub fn check_mesh(format: MeshFormat, vertices: &[Point3], faces: &[[u32; 3]]) -
     }
 }
 
+/// What [`write_mesh_carrying`] did with the input's vertex attributes.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct AttributesWritten {
+    /// Written to the output ("normals", "colours").
+    pub written: Vec<&'static str>,
+    /// Read but not written, the output's format holding none (STL).
+    pub not_written: Vec<&'static str>,
+}
+
+/// Writes `out`, made from `from` (whose vertices carry `attributes`), to
+/// `path` as [`write_mesh_with`] does, its vertices' normals and colours
+/// carried from `from` ([`VertexAttributes::carried`]) when the format
+/// holds them.
+pub fn write_mesh_carrying(
+    path: &Path,
+    out: &trim::Mesh,
+    from: &trim::Mesh,
+    attributes: &VertexAttributes,
+) -> Result<AttributesWritten> {
+    let holds = MeshFormat::from_path(path).is_some_and(MeshFormat::holds_attributes);
+    let carried = if holds {
+        attributes.carried(from, &out.vertices)
+    } else {
+        VertexAttributes::default()
+    };
+    write_mesh_with(path, &out.vertices, &out.faces, &carried)?;
+    Ok(AttributesWritten {
+        written: carried.names(),
+        not_written: if holds { Vec::new() } else { attributes.names() },
+    })
+}
+
+/// Checks that there is one normal and one colour per vertex, all finite.
+fn check_attributes(vertices: usize, attributes: &VertexAttributes) -> Result<()> {
+    if let Some(normals) = &attributes.normals {
+        if normals.len() != vertices {
+            bail!("{} normals for {vertices} vertices", normals.len());
+        }
+        if let Some(i) = normals.iter().position(|n| n.iter().any(|c| !c.is_finite())) {
+            bail!("vertex {i} has a non-finite normal {}", show(&normals[i]));
+        }
+    }
+    if let Some(colours) = &attributes.colours {
+        if colours.rgba.len() != vertices {
+            bail!("{} colours for {vertices} vertices", colours.rgba.len());
+        }
+    }
+    Ok(())
+}
+
+/// A colour channel in 0..1 as a byte (NaN as 0).
+pub(crate) fn channel_byte(c: f64) -> u8 {
+    (c.clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
 /// Refuses a mesh too small for `f32`: when its largest |coordinate| is
 /// below f32's smallest normal number, every coordinate becomes 0 or a
 /// subnormal with a few bits, so the file would hold a point or a
@@ -174,11 +249,15 @@ fn format_name(format: MeshFormat) -> &'static str {
 }
 
 /// OBJ: a comment, `v` lines (Rust's shortest round-trip decimals, with an
-/// exponent for very large or small values), `f` lines 1-based.
+/// exponent for very large or small values; with colours, `v x y z r g b`
+/// as MeshLab and trimesh write them, each channel a multiple of 1/255),
+/// with normals `vn` lines, one per vertex, and `f a//a b//b c//c`;
+/// otherwise `f` lines 1-based.
 pub fn write_obj(
     w: &mut dyn Write,
     vertices: &[Point3],
     faces: &[[u32; 3]],
+    attributes: &VertexAttributes,
 ) -> std::io::Result<()> {
     writeln!(
         w,
@@ -186,18 +265,40 @@ pub fn write_obj(
         vertices.len(),
         faces.len()
     )?;
+    let colours = attributes.colours.as_ref();
     super::write_formatted(w, vertices.len(), |out, i| {
         out.push(b'v');
         for c in vertices[i] {
             out.push(b' ');
             push_f64_debug(out, c);
         }
+        if let Some(colours) = colours {
+            for c in &colours.rgba[i][..3] {
+                out.push(b' ');
+                push_f64_debug(out, f64::from(channel_byte(*c)) / 255.0);
+            }
+        }
         out.push(b'\n');
     })?;
+    if let Some(normals) = &attributes.normals {
+        super::write_formatted(w, normals.len(), |out, i| {
+            out.extend_from_slice(b"vn");
+            for c in normals[i] {
+                out.push(b' ');
+                push_f64_debug(out, c);
+            }
+            out.push(b'\n');
+        })?;
+    }
+    let with_normals = attributes.normals.is_some();
     super::write_formatted(w, faces.len(), |out, i| {
         let [a, b, c] = faces[i].map(|v| u64::from(v) + 1);
         // Writing into a Vec cannot fail.
-        let _ = writeln!(out, "f {a} {b} {c}");
+        let _ = if with_normals {
+            writeln!(out, "f {a}//{a} {b}//{b} {c}//{c}")
+        } else {
+            writeln!(out, "f {a} {b} {c}")
+        };
     })
 }
 
@@ -207,11 +308,22 @@ pub fn write_ply(
     w: &mut dyn Write,
     vertices: &[Point3],
     faces: &[[u32; 3]],
+    attributes: &VertexAttributes,
 ) -> std::io::Result<()> {
+    let mut properties = String::from("property double x\nproperty double y\nproperty double z\n");
+    if attributes.normals.is_some() {
+        properties.push_str("property float nx\nproperty float ny\nproperty float nz\n");
+    }
+    if let Some(colours) = &attributes.colours {
+        properties.push_str("property uchar red\nproperty uchar green\nproperty uchar blue\n");
+        if colours.alpha {
+            properties.push_str("property uchar alpha\n");
+        }
+    }
     write!(
         w,
         "ply\nformat binary_little_endian 1.0\ncomment written by meshtrim\n\
-         element vertex {}\nproperty double x\nproperty double y\nproperty double z\n\
+         element vertex {}\n{properties}\
          element face {}\nproperty list uchar int vertex_indices\nend_header\n",
         vertices.len(),
         faces.len()
@@ -223,6 +335,15 @@ pub fn write_ply(
     write_formatted(w, vertices.len(), |out, i| {
         for c in vertices[i] {
             out.extend(c.to_le_bytes());
+        }
+        if let Some(normals) = &attributes.normals {
+            for c in normals[i] {
+                out.extend((c as f32).to_le_bytes());
+            }
+        }
+        if let Some(colours) = &attributes.colours {
+            let channels = if colours.alpha { 4 } else { 3 };
+            out.extend(colours.rgba[i][..channels].iter().map(|&c| channel_byte(c)));
         }
     })?;
     write_formatted(w, faces.len(), |out, i| {
@@ -253,7 +374,7 @@ mod tests {
     fn obj_text_is_shortest_round_trip() {
         let mut out = Vec::new();
         let v = [[0.1, -2.0, 1e300], [1.0 / 3.0, -0.0, 5e-324]];
-        write_obj(&mut out, &v, &[[0, 1, 0]]).unwrap();
+        write_obj(&mut out, &v, &[[0, 1, 0]], &VertexAttributes::default()).unwrap();
         assert_eq!(
             String::from_utf8(out).unwrap(),
             "# meshtrim mesh: 2 vertices, 1 triangles\nv 0.1 -2.0 1e300\n\
@@ -266,7 +387,7 @@ mod tests {
         let v = vec![[0.1, -2.0, 1e300], [1.0 / 3.0, -0.0, 5e-324], [1., 2., 3.]];
         let f = vec![[0, 1, 2], [2, 1, 0]];
         let mut out = Vec::new();
-        write_ply(&mut out, &v, &f).unwrap();
+        write_ply(&mut out, &v, &f, &VertexAttributes::default()).unwrap();
         let mesh = super::super::ply::read_ply(&out).unwrap();
         assert_eq!(mesh.vertices, v);
         assert_eq!(mesh.faces.unwrap(), f);

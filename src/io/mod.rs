@@ -35,7 +35,7 @@ pub(crate) use text_lines::{
     strip_bom, text_of, truncated, words, write_formatted, HeaderEol, PIECE_BYTES,
 };
 
-pub use mesh_out::{write_mesh, MeshFormat};
+pub use mesh_out::{write_mesh, write_mesh_with, MeshFormat};
 
 use std::path::Path;
 
@@ -132,9 +132,73 @@ pub struct Mesh {
     pub vertices: Vec<Point3>,
     /// Per-vertex normals, when the file has them.
     pub normals: Option<Vec<Point3>>,
+    /// Per-vertex colours, when the file has them.
+    pub colours: Option<Colours>,
     /// Triangles as vertex indices, polygons split into fans; `None` when
     /// the file has no face element or `f` lines at all.
     pub faces: Option<Vec<[u32; 3]>>,
+}
+
+/// Vertex colours as read: red, green, blue and alpha in 0..1.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Colours {
+    /// One per vertex; alpha 1 where the file has none.
+    pub rgba: Vec<[f64; 4]>,
+    /// Whether the file had an alpha channel (written back only then).
+    pub alpha: bool,
+}
+
+/// The per-vertex attributes a mesh file holds besides positions, which
+/// the commands that write a mesh carry to it
+/// ([`trim::vertex_sources`]).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct VertexAttributes {
+    /// Unit (or as read) normals, one per vertex.
+    pub normals: Option<Vec<Point3>>,
+    /// Colours, one per vertex.
+    pub colours: Option<Colours>,
+}
+
+impl VertexAttributes {
+    /// Whether there is nothing to carry.
+    pub fn is_empty(&self) -> bool {
+        self.normals.is_none() && self.colours.is_none()
+    }
+
+    /// These attributes, of `from`'s vertices, at the vertices `to` of a
+    /// mesh made from it: copied where a vertex was kept, blended from the
+    /// closest point of `from` elsewhere (see [`trim::vertex_sources`]).
+    /// Empty when there is nothing to carry or `from` has no vertex.
+    pub fn carried(&self, from: &trim::Mesh, to: &[Point3]) -> VertexAttributes {
+        if self.is_empty() {
+            return VertexAttributes::default();
+        }
+        let Some(sources) = trim::vertex_sources(from, to) else {
+            return VertexAttributes::default();
+        };
+        VertexAttributes {
+            normals: self
+                .normals
+                .as_ref()
+                .map(|normals| trim::carry_normals(from, &sources, normals)),
+            colours: self.colours.as_ref().map(|colours| Colours {
+                rgba: trim::carry(from, &sources, &colours.rgba),
+                alpha: colours.alpha,
+            }),
+        }
+    }
+
+    /// The names of what there is, for reports: "normals", "colours".
+    pub fn names(&self) -> Vec<&'static str> {
+        let mut names = Vec::new();
+        if self.normals.is_some() {
+            names.push("normals");
+        }
+        if self.colours.is_some() {
+            names.push("colours");
+        }
+        names
+    }
 }
 
 /// Reads a point cloud, choosing the reader by content and extension.
@@ -171,14 +235,27 @@ pub fn read_mesh(path: &Path) -> Result<Mesh> {
 /// Reads a mesh that must have faces (for the commands that cut or clean
 /// one); a file without faces is an error naming the file and `hint`.
 pub fn read_mesh_with_faces(path: &Path, hint: &str) -> Result<trim::Mesh> {
+    Ok(read_mesh_with_attributes(path, hint)?.0)
+}
+
+/// [`read_mesh_with_faces`], with the vertices' normals and colours.
+pub fn read_mesh_with_attributes(
+    path: &Path,
+    hint: &str,
+) -> Result<(trim::Mesh, VertexAttributes)> {
     let read = read_mesh(path)?;
     let Some(faces) = read.faces else {
         bail!("{}: the file has no faces: {hint}", path.display());
     };
-    Ok(trim::Mesh {
+    let attributes = VertexAttributes {
+        normals: read.normals,
+        colours: read.colours,
+    };
+    let mesh = trim::Mesh {
         vertices: read.vertices,
         faces,
-    })
+    };
+    Ok((mesh, attributes))
 }
 
 fn read_cloud_inner(path: &Path, options: &CloudOptions) -> Result<Cloud> {

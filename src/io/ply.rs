@@ -54,7 +54,7 @@ use rayon::prelude::*;
 
 use super::{
     capacity, cut_after_newlines, mixed_line_ending, next_line, show, strip_bom, truncated,
-    HeaderEol, Mesh, Point3, PIECE_BYTES,
+    Colours, HeaderEol, Mesh, Point3, PIECE_BYTES,
 };
 
 /// A PLY scalar type.
@@ -782,6 +782,7 @@ enum Role {
     Vertex {
         xyz: [usize; 3],
         normal: Option<[usize; 3]>,
+        colour: Option<ColourColumns>,
     },
     /// Index of the vertex index list property.
     Face {
@@ -800,12 +801,21 @@ fn read_body(header: &Header, values: &mut dyn Values, grid: bool) -> Result<Mes
     let mut range_grid = None;
     for element in &header.elements {
         match role_of(element, grid)? {
-            Role::Vertex { xyz, normal } => {
+            Role::Vertex {
+                xyz,
+                normal,
+                colour,
+            } => {
                 if vertex_count.is_some() {
                     bail!("the file has two vertex elements");
                 }
                 vertex_count = Some(element.count);
-                read_vertices(element, values, xyz, normal, &mut mesh)?;
+                let columns = VertexColumns {
+                    xyz,
+                    normal,
+                    colour,
+                };
+                read_vertices(element, values, &columns, &mut mesh)?;
             }
             Role::Face { list } => {
                 let faces = mesh.faces.get_or_insert_with(Vec::new);
@@ -859,7 +869,12 @@ fn role_of(element: &Element, grid: bool) -> Result<Role> {
                 (Some(x), Some(y), Some(z)) => Some([x, y, z]),
                 _ => None,
             };
-            Ok(Role::Vertex { xyz, normal })
+            let colour = colour_columns(element, &find);
+            Ok(Role::Vertex {
+                xyz,
+                normal,
+                colour,
+            })
         }
         "face" => {
             let list = element.properties.iter().position(|p| {
@@ -879,25 +894,89 @@ fn role_of(element: &Element, grid: bool) -> Result<Role> {
     }
 }
 
+/// The vertex element's columns the reader keeps.
+struct VertexColumns {
+    xyz: [usize; 3],
+    normal: Option<[usize; 3]>,
+    colour: Option<ColourColumns>,
+}
+
+/// A vertex colour's columns: red, green, blue, and alpha if there is
+/// one, with the factor that brings the properties' type to 0..1.
+#[derive(Clone, Copy)]
+struct ColourColumns {
+    rgb: [usize; 3],
+    alpha: Option<usize>,
+    scale: f64,
+}
+
+impl ColourColumns {
+    /// Red, green, blue and alpha in 0..1 (alpha 1 where there is none).
+    fn rgba(&self, rgb: Point3, alpha: Option<f64>) -> [f64; 4] {
+        let [r, g, b] = rgb.map(|c| (c * self.scale).clamp(0.0, 1.0));
+        let a = alpha.map_or(1.0, |a| (a * self.scale).clamp(0.0, 1.0));
+        [r, g, b, a]
+    }
+}
+
+/// The colour properties of a vertex element, `red green blue [alpha]`
+/// (or `diffuse_red …`), all of one type: 8-bit integers are read as
+/// 0..255, 16-bit ones as 0..65535, 32-bit ones as 0..255 (as some
+/// writers use `int` for bytes), floats as 0..1.
+fn colour_columns(element: &Element, find: &dyn Fn(&str) -> Option<usize>) -> Option<ColourColumns> {
+    let named = |prefix: &str| {
+        let rgb = ["red", "green", "blue"].map(|c| find(&format!("{prefix}{c}")));
+        let [Some(r), Some(g), Some(b)] = rgb else {
+            return None;
+        };
+        Some(([r, g, b], find(&format!("{prefix}alpha"))))
+    };
+    let (rgb, alpha) = named("").or_else(|| named("diffuse_"))?;
+    let ty = |k: usize| match element.properties[k] {
+        Property::Scalar { ty, .. } => ty,
+        Property::List { item, .. } => item,
+    };
+    let first = ty(rgb[0]);
+    if rgb.iter().chain(&alpha).any(|&k| ty(k) != first) {
+        return None;
+    }
+    let scale = match first {
+        Scalar::F32 | Scalar::F64 => 1.0,
+        Scalar::I16 | Scalar::U16 => 1.0 / 65535.0,
+        _ => 1.0 / 255.0,
+    };
+    Some(ColourColumns { rgb, alpha, scale })
+}
+
 fn read_vertices(
     element: &Element,
     values: &mut dyn Values,
-    xyz: [usize; 3],
-    normal: Option<[usize; 3]>,
+    columns: &VertexColumns,
     mesh: &mut Mesh,
 ) -> Result<()> {
+    let VertexColumns {
+        xyz,
+        normal,
+        colour,
+    } = *columns;
     if element
         .properties
         .iter()
         .all(|p| matches!(p, Property::Scalar { .. }))
     {
-        let columns: Vec<[usize; 3]> = std::iter::once(xyz).chain(normal).collect();
-        if let Some(rows) = values.read_rows(element, &columns) {
-            return vertices_from_rows(rows, mesh);
+        let alpha = colour.and_then(|c| c.alpha).map(|a| [a; 3]);
+        let triples: Vec<[usize; 3]> = std::iter::once(xyz)
+            .chain(normal)
+            .chain(colour.map(|c| c.rgb))
+            .chain(alpha)
+            .collect();
+        if let Some(rows) = values.read_rows(element, &triples) {
+            return vertices_from_rows(rows, columns, mesh);
         }
     }
     mesh.vertices.reserve(capacity(element.count));
     let mut normals = normal.map(|_| Vec::with_capacity(capacity(element.count)));
+    let mut colours = colour.map(|_| Vec::with_capacity(capacity(element.count)));
     read_element(element, values, None, |i, record| {
         let p = xyz.map(|k| record.scalars[k]);
         if p.iter().any(|c| !c.is_finite()) {
@@ -907,18 +986,44 @@ fn read_vertices(
         if let (Some(n), Some(out)) = (normal, normals.as_mut()) {
             out.push(n.map(|k| record.scalars[k]));
         }
+        if let (Some(c), Some(out)) = (colour, colours.as_mut()) {
+            let rgb = c.rgb.map(|k| record.scalars[k]);
+            out.push(c.rgba(rgb, c.alpha.map(|k| record.scalars[k])));
+        }
         Ok(())
     })?;
     mesh.normals = normals;
+    mesh.colours = colours.map(|rgba| Colours {
+        rgba,
+        alpha: colour.is_some_and(|c| c.alpha.is_some()),
+    });
     Ok(())
 }
 
-/// The vertices (and normals) of records read at once; the same checks
-/// and messages as [`read_vertices`]'s.
-fn vertices_from_rows(rows: Rows, mesh: &mut Mesh) -> Result<()> {
+/// The vertices (and normals and colours) of records read at once; the
+/// same checks and messages as [`read_vertices`]'s.
+fn vertices_from_rows(rows: Rows, columns: &VertexColumns, mesh: &mut Mesh) -> Result<()> {
     let mut triples = rows.triples.into_iter();
     mesh.vertices = triples.next().unwrap_or_default();
-    mesh.normals = triples.next();
+    if columns.normal.is_some() {
+        mesh.normals = triples.next();
+    }
+    if let Some(colour) = columns.colour {
+        let rgb = triples.next().unwrap_or_default();
+        let alpha = colour.alpha.and_then(|_| triples.next());
+        let rgba = match alpha {
+            Some(alpha) => rgb
+                .iter()
+                .zip(&alpha)
+                .map(|(&c, a)| colour.rgba(c, Some(a[0])))
+                .collect(),
+            None => rgb.iter().map(|&c| colour.rgba(c, None)).collect(),
+        };
+        mesh.colours = Some(Colours {
+            rgba,
+            alpha: colour.alpha.is_some(),
+        });
+    }
     let non_finite = |p: &Point3| p.iter().any(|c| !c.is_finite());
     if let Some(i) = mesh.vertices.iter().position(non_finite) {
         let line = rows

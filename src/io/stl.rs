@@ -99,6 +99,7 @@ impl Merger {
             mesh: Mesh {
                 vertices: Vec::with_capacity(capacity(triangles / 2)),
                 normals: None,
+                colours: None,
                 faces: Some(Vec::with_capacity(capacity(triangles))),
             },
             index: HashMap::with_capacity_and_hasher(capacity(triangles / 2), Default::default()),

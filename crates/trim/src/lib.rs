@@ -53,6 +53,7 @@
 //! no FMA is emitted.
 
 mod anisotropy;
+mod attributes;
 mod bpd;
 mod bspline;
 mod clean;
@@ -77,6 +78,9 @@ pub use bpd::{
     detect_boundary, detect_boundary_with_progress, local_resolution, BpdOptions, Decision,
     Detection, LocalResolution, View,
 };
+#[doc(hidden)]
+pub use attributes::vertex_sources_reference;
+pub use attributes::{carry, carry_normals, vertex_sources, VertexSource};
 pub use bspline::{interpolate as interpolate_bspline, BSpline};
 pub use clean::{clean_mesh, CleanOptions, CleanReport, LeftLoops, LeftReason, SEEN_FROM_ONE_SIDE};
 pub use cloud::Point3;
