@@ -61,16 +61,13 @@ pub fn emit<R: Serialize + Table>(report: &R, file: Option<&Path>, json: bool) -
     }
 }
 
-/// The report's row on the mesh's vertex attributes: those written
-/// (carried to the new vertices) and those the output's format cannot
-/// hold; `None` when the mesh had none.
-pub fn attributes_row(written: &[&str], not_written: &[&str]) -> Option<String> {
+/// The report's row on the input's vertex attributes: those written
+/// (carried as `how` says) and those the output's format cannot hold;
+/// `None` when the input had none.
+pub fn attributes_row(written: &[&str], not_written: &[&str], how: &str) -> Option<String> {
     match (written, not_written) {
         ([], []) => None,
-        (written, []) => Some(format!(
-            "{} (kept vertices' as read, the new ones' from the mesh's surface)",
-            written.join(", ")
-        )),
+        (written, []) => Some(format!("{} ({how})", written.join(", "))),
         (_, not_written) => Some(format!(
             "{} not written: the output's format holds none",
             not_written.join(", ")

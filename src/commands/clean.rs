@@ -396,9 +396,11 @@ impl crate::report::Table for Report {
             ("write time", format!("{:.1} ms", self.write_ms)),
             ("output", shown(&self.output)),
         ];
-        if let Some(row) =
-            crate::report::attributes_row(&self.vertex_attributes, &self.vertex_attributes_not_written)
-        {
+        if let Some(row) = crate::report::attributes_row(
+            &self.vertex_attributes,
+            &self.vertex_attributes_not_written,
+            "kept vertices' as read, new ones' from the input's surface",
+        ) {
             let before_times = rows.len() - 5;
             rows.insert(before_times, ("vertex attributes", row));
         }

@@ -10,8 +10,8 @@ use serde::Serialize;
 use trim::{delaunay_mesh_with_report, DelaunayOptions, DelaunayReport, Detection, Edges};
 
 use crate::commands::args::{EdgeFileArgs, StageArgs};
-use crate::io::mesh_out::write_mesh;
-use crate::io::{read_cloud_with, CloudOptions, Point3};
+use crate::io::mesh_out::write_mesh_carrying;
+use crate::io::{read_cloud_with, CloudOptions, Point3, VertexAttributes};
 use crate::report::{shown, write_edges, LoopsFrom};
 use crate::stages::{detect_and_reconstruct, millis, Stages};
 
@@ -85,6 +85,13 @@ pub struct Report {
     pub faces: usize,
     /// Output area.
     pub area: f64,
+    /// The cloud's point attributes written to the output ("normals",
+    /// "colours"), each vertex's from the nearest point.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub vertex_attributes: Vec<&'static str>,
+    /// The cloud's point attributes the output's format cannot hold (STL).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub vertex_attributes_not_written: Vec<&'static str>,
     /// Time of each stage, in milliseconds.
     pub read_ms: f64,
     /// Boundary detection time.
@@ -117,7 +124,23 @@ pub fn run(args: &Args) -> Result<()> {
         edges,
     } = mesh_in_memory(&cloud.points, &args.stages.stages(), true, &name)?;
     let started = Instant::now();
-    write_mesh(&args.output, &mesh.vertices, &mesh.faces)?;
+    // The cloud's normals and colours, carried to the vertices from the
+    // nearest point (the cloud's own points are the mesh's vertices).
+    let attributes = VertexAttributes {
+        normals: cloud.normals.clone(),
+        colours: cloud.colours.clone(),
+    };
+    let points = trim::Mesh {
+        // Copied only when there is something to carry.
+        vertices: match attributes.is_empty() {
+            true => Vec::new(),
+            false => cloud.points.clone(),
+        },
+        faces: Vec::new(),
+    };
+    let carried = write_mesh_carrying(&args.output, &mesh, &points, &attributes)?;
+    report.vertex_attributes = carried.written;
+    report.vertex_attributes_not_written = carried.not_written;
     if let Some(path) = &args.edges {
         write_edges(path, &cloud.points, &detection, &edges, args.file.options())?;
     }
@@ -194,6 +217,8 @@ impl Report {
             diagonals_flipped: made.diagonals_flipped,
             faces,
             area: made.area,
+            vertex_attributes: Vec::new(),
+            vertex_attributes_not_written: Vec::new(),
             read_ms: 0.0,
             detect_ms: millis(detect),
             edges_ms: millis(edges),
@@ -205,7 +230,7 @@ impl Report {
 
 impl crate::report::Table for Report {
     fn table(&self) -> String {
-        let rows = [
+        let mut rows = vec![
             (
                 "cloud",
                 format!("{} ({} points)", shown(&self.cloud), self.points),
@@ -230,6 +255,14 @@ impl crate::report::Table for Report {
             ("write time", format!("{:.1} ms", self.write_ms)),
             ("output", shown(&self.output)),
         ];
+        if let Some(row) = crate::report::attributes_row(
+            &self.vertex_attributes,
+            &self.vertex_attributes_not_written,
+            "each vertex's from the nearest cloud point",
+        ) {
+            let before_times = rows.len() - 6;
+            rows.insert(before_times, ("vertex attributes", row));
+        }
         crate::report::rows(&rows)
     }
 }

@@ -78,6 +78,7 @@ pub fn read_e57(bytes: Vec<u8>, scan: Option<usize>) -> Result<Cloud> {
         dropped_non_finite: dropped,
         format: Format::E57,
         scale_offset: None,
+        colours: None,
         grid: with_grid.then_some(grid),
     })
 }

@@ -18,8 +18,16 @@
 //! would make more than [`MAX_INSTANCED_VERTICES`] or
 //! [`MAX_INSTANCED_TRIANGLES`] (beyond what it stores) is refused.
 //!
+//! Vertex attributes: `NORMAL` (float VEC3, turned by the world matrix's
+//! inverse transpose and scaled to unit length) and `COLOR_0` (float, or
+//! normalised unsigned byte or short, RGB or RGBA) are read when every
+//! primitive has them; the other attributes (texture coordinates,
+//! tangents, joints) are not.
+//!
 //! Writing: one mesh with one primitive, `f32` positions with the `min` and
-//! `max` bounds the spec requires, and `u32` indices.
+//! `max` bounds the spec requires, `u32` indices, and with the vertex
+//! attributes given, unit `f32` `NORMAL`s and `COLOR_0` as normalised
+//! unsigned bytes RGBA.
 
 use std::borrow::Cow;
 use std::collections::HashSet;
@@ -32,7 +40,7 @@ use byteorder::{ByteOrder, LittleEndian};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 
-use super::{show, Mesh, Point3, VertexAttributes};
+use super::{show, Colours, Mesh, Point3, VertexAttributes};
 
 /// Whether the bytes are a GLB container (the `glTF` magic).
 pub fn is_glb(bytes: &[u8]) -> bool {
@@ -60,6 +68,9 @@ pub fn read_gltf(bytes: &[u8], dir: &Path) -> Result<Mesh> {
         faces: Some(Vec::new()),
         ..Mesh::default()
     };
+    // Each attribute is kept only if every primitive has it.
+    let mut normals = Some(Vec::new());
+    let mut colours = Some(Colours::default());
     for Instance {
         node,
         mesh: m,
@@ -77,9 +88,137 @@ pub fn read_gltf(bytes: &[u8], dir: &Path) -> Result<Mesh> {
                 )
             };
             add_primitive(&primitive, &buffers, world, &mut mesh).with_context(at)?;
+            add_normals(&primitive, &buffers, world, &mut normals).with_context(at)?;
+            add_colours(&primitive, &buffers, &mut colours).with_context(at)?;
         }
     }
+    mesh.normals = normals;
+    mesh.colours = colours;
     Ok(mesh)
+}
+
+/// Appends the primitive's `NORMAL`s, turned into world coordinates by
+/// the inverse transpose of the world matrix and scaled to unit length,
+/// to `normals`; without them, `normals` becomes `None`.
+fn add_normals(
+    primitive: &gltf::Primitive,
+    buffers: &[Cow<[u8]>],
+    world: &Matrix,
+    normals: &mut Option<Vec<Point3>>,
+) -> Result<()> {
+    let (Some(list), Some(accessor)) = (normals.as_mut(), primitive.get(&gltf::Semantic::Normals))
+    else {
+        *normals = None;
+        return Ok(());
+    };
+    if accessor.data_type() != DataType::F32 || accessor.dimensions() != Dimensions::Vec3 {
+        bail!(
+            "accessor {} (NORMAL) is {:?} {:?}, only float VEC3 normals are supported",
+            accessor.index(),
+            accessor.data_type(),
+            accessor.dimensions()
+        );
+    }
+    check_count(&accessor, primitive, "NORMAL")?;
+    let (data, stride) = accessor_data(&accessor, buffers, 12, "NORMAL")?;
+    let turn = normal_matrix(world);
+    for i in 0..accessor.count() {
+        let record = &data[i * stride..];
+        let local = [0, 4, 8].map(|o| f64::from(LittleEndian::read_f32(&record[o..])));
+        let n = turn.map(|row| row[0] * local[0] + row[1] * local[1] + row[2] * local[2]);
+        let length = n.iter().map(|c| c * c).sum::<f64>().sqrt();
+        if !length.is_finite() {
+            bail!("NORMAL {i} is non-finite: {}", show(&local));
+        }
+        list.push(if length > 0.0 {
+            n.map(|c| c / length)
+        } else {
+            n
+        });
+    }
+    Ok(())
+}
+
+/// The rows of the matrix that turns normals as the world matrix turns
+/// surfaces: its 3×3 part's inverse transpose, up to a positive factor
+/// (the cofactor matrix, its sign the determinant's).
+fn normal_matrix(m: &Matrix) -> [[f64; 3]; 3] {
+    // a[row][col] of the 3×3 part (glTF matrices are column-major).
+    let a = |row: usize, col: usize| m[col][row];
+    let sign = if determinant3(m) < 0.0 { -1.0 } else { 1.0 };
+    let cofactor = |row: usize, col: usize| {
+        let (r0, r1) = ((row + 1) % 3, (row + 2) % 3);
+        let (c0, c1) = ((col + 1) % 3, (col + 2) % 3);
+        sign * (a(r0, c0) * a(r1, c1) - a(r0, c1) * a(r1, c0))
+    };
+    [0, 1, 2].map(|row| [0, 1, 2].map(|col| cofactor(row, col)))
+}
+
+/// Appends the primitive's `COLOR_0` (float, or normalised unsigned byte
+/// or short, RGB or RGBA) to `colours`; without it, `colours` becomes
+/// `None`.
+fn add_colours(
+    primitive: &gltf::Primitive,
+    buffers: &[Cow<[u8]>],
+    colours: &mut Option<Colours>,
+) -> Result<()> {
+    let (Some(list), Some(accessor)) =
+        (colours.as_mut(), primitive.get(&gltf::Semantic::Colors(0)))
+    else {
+        *colours = None;
+        return Ok(());
+    };
+    let channels = match accessor.dimensions() {
+        Dimensions::Vec3 => 3,
+        Dimensions::Vec4 => 4,
+        other => bail!(
+            "accessor {} (COLOR_0) is {other:?}, not VEC3 or VEC4",
+            accessor.index()
+        ),
+    };
+    let (bytes, scale) = match (accessor.data_type(), accessor.normalized()) {
+        (DataType::F32, _) => (4, 1.0),
+        (DataType::U8, true) => (1, 1.0 / 255.0),
+        (DataType::U16, true) => (2, 1.0 / 65535.0),
+        (other, _) => bail!(
+            "accessor {} (COLOR_0) is {other:?}, not float or normalised unsigned byte or short",
+            accessor.index()
+        ),
+    };
+    check_count(&accessor, primitive, "COLOR_0")?;
+    let (data, stride) = accessor_data(&accessor, buffers, channels * bytes, "COLOR_0")?;
+    let value = |b: &[u8]| match bytes {
+        4 => f64::from(LittleEndian::read_f32(b)),
+        2 => f64::from(LittleEndian::read_u16(b)),
+        _ => f64::from(b[0]),
+    };
+    list.alpha |= channels == 4;
+    for i in 0..accessor.count() {
+        let record = &data[i * stride..];
+        let mut rgba = [1.0; 4];
+        for (c, slot) in rgba.iter_mut().enumerate().take(channels) {
+            let v = value(&record[c * bytes..]) * scale;
+            // NaN too becomes 0, so a colour is always in 0..1.
+            *slot = if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
+        }
+        list.rgba.push(rgba);
+    }
+    Ok(())
+}
+
+/// An attribute's accessor must have one element per position.
+fn check_count(accessor: &gltf::Accessor, primitive: &gltf::Primitive, what: &str) -> Result<()> {
+    let positions = primitive
+        .get(&gltf::Semantic::Positions)
+        .map_or(0, |p| p.count());
+    if accessor.count() != positions {
+        bail!(
+            "accessor {} ({what}) has {} elements for {positions} positions",
+            accessor.index(),
+            accessor.count()
+        );
+    }
+    Ok(())
 }
 
 /// Why a file without mesh instances has no vertices. Meshes that no node

@@ -76,6 +76,7 @@ pub fn read_las(bytes: Vec<u8>) -> Result<Cloud> {
         dropped_non_finite: 0,
         format: Format::Las,
         scale_offset: Some(frame),
+        colours: None,
         grid: None,
     })
 }

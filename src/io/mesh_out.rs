@@ -184,7 +184,11 @@ pub fn write_mesh_carrying(
     write_mesh_with(path, &out.vertices, &out.faces, &carried)?;
     Ok(AttributesWritten {
         written: carried.names(),
-        not_written: if holds { Vec::new() } else { attributes.names() },
+        not_written: if holds {
+            Vec::new()
+        } else {
+            attributes.names()
+        },
     })
 }
 
@@ -194,7 +198,10 @@ fn check_attributes(vertices: usize, attributes: &VertexAttributes) -> Result<()
         if normals.len() != vertices {
             bail!("{} normals for {vertices} vertices", normals.len());
         }
-        if let Some(i) = normals.iter().position(|n| n.iter().any(|c| !c.is_finite())) {
+        if let Some(i) = normals
+            .iter()
+            .position(|n| n.iter().any(|c| !c.is_finite()))
+        {
             bail!("vertex {i} has a non-finite normal {}", show(&normals[i]));
         }
     }

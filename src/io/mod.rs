@@ -100,6 +100,9 @@ pub struct Cloud {
     /// Per-point normals, when the file has them (PLY nx/ny/nz, PCD
     /// normal_x/normal_y/normal_z).
     pub normals: Option<Vec<Point3>>,
+    /// Per-point colours, when the file has them (PLY, OBJ and glTF
+    /// vertex colours).
+    pub colours: Option<Colours>,
     /// Points dropped by the reader: a NaN or infinite coordinate (PCD), or
     /// no position (E57's invalid states).
     pub dropped_non_finite: usize,
@@ -389,6 +392,7 @@ fn from_mesh(mesh: Mesh, format: Format) -> Cloud {
     Cloud {
         points: mesh.vertices,
         normals: mesh.normals,
+        colours: mesh.colours,
         dropped_non_finite: 0,
         format,
         scale_offset: None,

@@ -4,14 +4,16 @@
 //! that some face uses (re-indexed per object), so a face-less OBJ point
 //! cloud comes back empty, and its errors carry no line numbers. Here every
 //! `v` line is a vertex, in file order; `f` lines become triangle fans.
-//! Texture coordinates, normals (`vn`, indexed per face corner), groups and
+//! Vertex colours, `v x y z r g b` (MeshLab's and trimesh's extension,
+//! channels in 0..1), are kept when every `v` line has them. Texture
+//! coordinates, normals (`vn`, indexed per face corner), groups and
 //! materials are ignored.
 
 use anyhow::{anyhow, bail, Result};
 
 use rayon::prelude::*;
 
-use super::{cut_after_newlines, lines, show, text_of, Mesh, Point3, PIECE_BYTES};
+use super::{cut_after_newlines, lines, show, text_of, Colours, Mesh, Point3, PIECE_BYTES};
 
 /// Reads the vertices and faces of an OBJ file.
 ///
@@ -42,12 +44,17 @@ fn read_obj_in_pieces(bytes: &[u8], piece_bytes: usize) -> Result<Mesh> {
         .map(|(piece, before)| parse_piece(piece, before))
         .collect();
     let mut mesh = Mesh::default();
+    let mut colours = Some(Vec::new());
     let mut line0 = 0;
     for piece in parsed {
         if let Some((i, e)) = piece.error {
             bail!("line {}: {e}", line0 + i);
         }
         mesh.vertices.extend_from_slice(&piece.vertices);
+        colours = colours.zip(piece.colours).map(|(mut all, more)| {
+            all.extend(more);
+            all
+        });
         if let Some(faces) = piece.faces {
             mesh.faces
                 .get_or_insert_with(Vec::new)
@@ -56,7 +63,15 @@ fn read_obj_in_pieces(bytes: &[u8], piece_bytes: usize) -> Result<Mesh> {
         line0 += piece.lines;
     }
     check_indices(&mesh, text)?;
+    mesh.colours = coloured(colours, mesh.vertices.len());
     Ok(mesh)
+}
+
+/// The vertices' colours, when there are vertices and every one has one.
+fn coloured(colours: Option<Vec<[f64; 4]>>, vertices: usize) -> Option<Colours> {
+    colours
+        .filter(|c| vertices > 0 && c.len() == vertices)
+        .map(|rgba| Colours { rgba, alpha: false })
 }
 
 /// The `v` lines of a piece of text.
@@ -70,6 +85,8 @@ fn vertex_lines(text: &str) -> usize {
 #[derive(Default)]
 struct ObjPiece {
     vertices: Vec<Point3>,
+    /// The vertices' colours, until a vertex without one.
+    colours: Option<Vec<[f64; 4]>>,
     /// `Some` once an `f` line is seen, even one that makes no triangle.
     faces: Option<Vec<[u32; 3]>>,
     lines: usize,
@@ -79,12 +96,18 @@ struct ObjPiece {
 
 /// Parses a piece that follows `before` vertices.
 fn parse_piece(text: &str, before: usize) -> ObjPiece {
-    let mut piece = ObjPiece::default();
+    let mut piece = ObjPiece {
+        colours: Some(Vec::new()),
+        ..ObjPiece::default()
+    };
     for line in lines(text) {
         piece.lines += 1;
         let mut words = line.split_whitespace();
         let parsed = match words.next() {
-            Some("v") => parse_vertex(words).map(|p| piece.vertices.push(p)),
+            Some("v") => parse_vertex(words).map(|(p, colour)| {
+                piece.vertices.push(p);
+                push_colour(&mut piece.colours, colour);
+            }),
             Some("f") => {
                 let faces = piece.faces.get_or_insert_with(Vec::new);
                 parse_face(words, before + piece.vertices.len(), faces)
@@ -129,10 +152,20 @@ fn line_of_triangle(text: &str, t: usize) -> Option<usize> {
     None
 }
 
-/// `v x y z [w | r g b]`: the first three numbers.
-fn parse_vertex<'a>(words: impl Iterator<Item = &'a str>) -> Result<Point3> {
+/// Keeps a vertex's colour, or drops them all at the first vertex
+/// without one.
+fn push_colour(colours: &mut Option<Vec<[f64; 4]>>, colour: Option<[f64; 4]>) {
+    match (colours.as_mut(), colour) {
+        (Some(list), Some(c)) => list.push(c),
+        _ => *colours = None,
+    }
+}
+
+/// `v x y z [w | r g b]`: the first three numbers, and the colour when
+/// exactly three more numbers follow (clamped to 0..1).
+fn parse_vertex<'a>(words: impl Iterator<Item = &'a str>) -> Result<(Point3, Option<[f64; 4]>)> {
+    let mut words = words.peekable();
     let mut p: Point3 = [0.0; 3];
-    let mut words = words.take(3);
     for (k, c) in p.iter_mut().enumerate() {
         let word = words
             .next()
@@ -144,7 +177,14 @@ fn parse_vertex<'a>(words: impl Iterator<Item = &'a str>) -> Result<Point3> {
     if p.iter().any(|c| !c.is_finite()) {
         bail!("non-finite coordinate {}", show(&p));
     }
-    Ok(p)
+    let rest: Vec<f64> = words.take(4).map_while(|w| w.parse().ok()).collect();
+    let colour = match rest[..] {
+        [r, g, b] if [r, g, b].iter().all(|c| c.is_finite()) => {
+            Some([r.clamp(0.0, 1.0), g.clamp(0.0, 1.0), b.clamp(0.0, 1.0), 1.0])
+        }
+        _ => None,
+    };
+    Ok((p, colour))
 }
 
 /// `f a b c ...`, each corner `v`, `v/vt`, `v//vn` or `v/vt/vn`, 1-based or
@@ -183,11 +223,16 @@ mod tests {
     fn read_obj_serial(bytes: &[u8]) -> Result<Mesh> {
         let text = text_of(bytes)?;
         let mut mesh = Mesh::default();
+        let mut colours = Some(Vec::new());
         for (i, line) in lines(text).enumerate() {
             let mut words = line.split_whitespace();
             let at = |e: anyhow::Error| anyhow!("line {}: {e}", i + 1);
             match words.next() {
-                Some("v") => mesh.vertices.push(parse_vertex(words).map_err(at)?),
+                Some("v") => {
+                    let (p, colour) = parse_vertex(words).map_err(at)?;
+                    mesh.vertices.push(p);
+                    push_colour(&mut colours, colour);
+                }
                 Some("f") => {
                     let faces = mesh.faces.get_or_insert_with(Vec::new);
                     parse_face(words, mesh.vertices.len(), faces).map_err(at)?;
@@ -196,6 +241,7 @@ mod tests {
             }
         }
         check_indices(&mesh, text)?;
+        mesh.colours = coloured(colours, mesh.vertices.len());
         Ok(mesh)
     }
 

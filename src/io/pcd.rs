@@ -542,6 +542,7 @@ fn keep_finite(raw: Raw) -> Cloud {
             dropped_non_finite: 0,
             format: Format::Pcd,
             scale_offset: None,
+            colours: None,
             grid: None,
         };
     }
@@ -559,6 +560,7 @@ fn keep_finite(raw: Raw) -> Cloud {
         dropped_non_finite: dropped,
         format: Format::Pcd,
         scale_offset: None,
+        colours: None,
         grid: None,
     }
 }

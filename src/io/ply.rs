@@ -923,7 +923,10 @@ impl ColourColumns {
 /// (or `diffuse_red …`), all of one type: 8-bit integers are read as
 /// 0..255, 16-bit ones as 0..65535, 32-bit ones as 0..255 (as some
 /// writers use `int` for bytes), floats as 0..1.
-fn colour_columns(element: &Element, find: &dyn Fn(&str) -> Option<usize>) -> Option<ColourColumns> {
+fn colour_columns(
+    element: &Element,
+    find: &dyn Fn(&str) -> Option<usize>,
+) -> Option<ColourColumns> {
     let named = |prefix: &str| {
         let rgb = ["red", "green", "blue"].map(|c| find(&format!("{prefix}{c}")));
         let [Some(r), Some(g), Some(b)] = rgb else {

@@ -57,7 +57,13 @@ pub fn vertex_sources(from: &Mesh, to: &[Point3]) -> Option<Vec<VertexSource>> {
         .map(|p| same_position.get(&bits(p)).copied())
         .collect();
     if exact.iter().all(Option::is_some) {
-        return Some(exact.into_iter().flatten().map(VertexSource::Vertex).collect());
+        return Some(
+            exact
+                .into_iter()
+                .flatten()
+                .map(VertexSource::Vertex)
+                .collect(),
+        );
     }
     if from.faces.is_empty() {
         return nearest_points(&from.vertices, to, &exact);
@@ -332,7 +338,10 @@ mod tests {
         assert_eq!(carried[1], up, "a kept vertex keeps its normal as it was");
         let cancelling = [[0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [0.0, 0.0, 0.0]];
         let midpoint = vertex_sources(&mesh, &[[0.5, 0.0, 0.0]]).unwrap();
-        assert_eq!(carry_normals(&mesh, &midpoint, &cancelling)[0], [0.0, 0.0, 1.0]);
+        assert_eq!(
+            carry_normals(&mesh, &midpoint, &cancelling)[0],
+            [0.0, 0.0, 1.0]
+        );
     }
 
     #[test]

@@ -71,6 +71,9 @@ mod spatial;
 
 mod trimming;
 
+#[doc(hidden)]
+pub use attributes::vertex_sources_reference;
+pub use attributes::{carry, carry_normals, vertex_sources, VertexSource};
 /// The plain detector the fast one is tested against (same labels).
 #[doc(hidden)]
 pub use bpd::detect_boundary_reference;
@@ -78,9 +81,6 @@ pub use bpd::{
     detect_boundary, detect_boundary_with_progress, local_resolution, BpdOptions, Decision,
     Detection, LocalResolution, View,
 };
-#[doc(hidden)]
-pub use attributes::vertex_sources_reference;
-pub use attributes::{carry, carry_normals, vertex_sources, VertexSource};
 pub use bspline::{interpolate as interpolate_bspline, BSpline};
 pub use clean::{clean_mesh, CleanOptions, CleanReport, LeftLoops, LeftReason, SEEN_FROM_ONE_SIDE};
 pub use cloud::Point3;
