@@ -987,6 +987,58 @@ mod tests {
     }
 
     #[test]
+    fn normals_and_colours_round_trip() {
+        let (v, f) = square();
+        let attributes = VertexAttributes {
+            normals: Some(vec![[0.0, 0.0, 2.0], [0.0, 0.0, 0.0], [0.6, 0.0, 0.8], [0.0, -1.0, 0.0]]),
+            colours: Some(Colours {
+                rgba: vec![[1.0, 0.0, 0.2, 1.0]; 4],
+                alpha: true,
+            }),
+        };
+        for glb in [true, false] {
+            let mut bytes = Vec::new();
+            if glb {
+                write_glb(&mut bytes, &v, &f, &attributes).unwrap();
+                assert_eq!(bytes.len() % 4, 0);
+            } else {
+                write_gltf(&mut bytes, &v, &f, &attributes).unwrap();
+            }
+            let mesh = read_gltf(&bytes, Path::new(".")).unwrap();
+            let normals = mesh.normals.unwrap();
+            // Written as unit f32 vectors; a zero normal as +z.
+            let want = [[0.0, 0.0, 1.0], [0.0, 0.0, 1.0], [0.6, 0.0, 0.8], [0.0, -1.0, 0.0]];
+            for (got, want) in normals.iter().zip(want) {
+                assert!((0..3).all(|k| (got[k] - want[k]).abs() < 1e-7), "{got:?}");
+            }
+            assert_eq!(mesh.colours, attributes.colours);
+        }
+    }
+
+    /// A node's matrix turns normals by its inverse transpose: under a
+    /// non-uniform scale a slanted normal tilts the other way from the
+    /// surface, and a mirror keeps it on the face's front.
+    #[test]
+    fn normals_follow_the_node_matrix() {
+        let stretch: Matrix = [
+            [2.0, 0.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0, 0.0],
+            [0.0, 0.0, 1.0, 0.0],
+            [0.0, 0.0, 0.0, 1.0],
+        ];
+        let n = normal_matrix(&stretch);
+        let slanted = [1.0, 0.0, 1.0];
+        let turned = n.map(|row| row[0] * slanted[0] + row[1] * slanted[1] + row[2] * slanted[2]);
+        // The plane x + z = 0 becomes x/2 + z = 0: its normal (1/2, 0, 1).
+        assert!((turned[0] / turned[2] - 0.5).abs() < 1e-12, "{turned:?}");
+        let mut mirror = IDENTITY;
+        mirror[2][2] = -1.0;
+        let n = normal_matrix(&mirror);
+        let up = n.map(|row| row[2]);
+        assert_eq!(up, [0.0, 0.0, -1.0], "a mirrored +z normal points down");
+    }
+
+    #[test]
     fn matrix_product_is_column_major() {
         let mut translate = IDENTITY;
         translate[3] = [1.0, 2.0, 3.0, 1.0];

@@ -250,13 +250,20 @@ mod tests {
     /// bytes give what the one-pass reading gives.
     #[test]
     fn pieces_read_as_one_pass_does() {
-        let outcome = |m: Result<Mesh>| m.map(|m| (m.vertices, m.faces)).map_err(|e| e.to_string());
+        let outcome = |m: Result<Mesh>| {
+            m.map(|m| (m.vertices, m.faces, m.colours))
+                .map_err(|e| e.to_string())
+        };
         let errors = crate::io::piece_tests::compare_with_one_pass(
             41,
             2000,
             25,
             |_, _| String::new(),
             |below, l, case| match below(16) {
+                // Coloured in most texts, so that some keep their colours.
+                _ if case % 3 > 0 && below(40) > 0 => {
+                    format!("v {l} {case} {} 0.{} 1 0", below(9), below(10))
+                }
                 0 => "# comment".to_string(),
                 1 => "vn 0 0 1".to_string(),
                 2 => "v 1 x 3".to_string(),
@@ -274,6 +281,21 @@ mod tests {
             (400..1600).contains(&errors),
             "{errors} errors in 2000 cases"
         );
+    }
+
+    #[test]
+    fn colours_kept_when_every_vertex_has_one() {
+        let coloured = read_obj(b"v 0 0 0 1 0.5 0\nv 1 0 0 2 -1 0.25\nf 1 2 1\n").unwrap();
+        assert_eq!(
+            coloured.colours,
+            Some(Colours {
+                rgba: vec![[1.0, 0.5, 0.0, 1.0], [1.0, 0.0, 0.25, 1.0]],
+                alpha: false
+            })
+        );
+        for partly in ["v 0 0 0 1 0.5 0\nv 1 0 0\n", "v 0 0 0 1 0.5 0\nv 1 0 0 1\n"] {
+            assert_eq!(read_obj(partly.as_bytes()).unwrap().colours, None, "{partly}");
+        }
     }
 
     #[test]

@@ -1,6 +1,7 @@
 //! Tests of the PLY reader and writer.
 
 use super::*;
+use crate::io::Colours;
 
 fn err(bytes: &[u8]) -> String {
     format!("{:#}", read_ply(bytes).unwrap_err())
@@ -386,8 +387,9 @@ fn ascii_vertices_in_pieces_read_as_in_one_pass() {
 /// Binary vertices decoded in parallel give what one value at a time
 /// gives, on random headers and bytes: every scalar type in both byte
 /// orders, x, y, z anywhere among the properties, sometimes a list
-/// property (which the parallel decoding declines), normals, faces
-/// after, truncated data and non-finite floats (random bit patterns).
+/// property (which the parallel decoding declines), normals, colours
+/// (RGB or RGBA, of one type or, now and then, mixed), faces after,
+/// truncated data and non-finite floats (random bit patterns).
 #[test]
 fn binary_vertices_decoded_in_parallel_as_one_at_a_time() {
     let types = [
@@ -398,6 +400,11 @@ fn binary_vertices_decoded_in_parallel_as_one_at_a_time() {
         let mut names: Vec<String> = ["x", "y", "z"].map(String::from).to_vec();
         if below(2) == 0 {
             names.extend(["nx", "ny", "nz"].map(String::from));
+        }
+        let colour_ty = types[below(8)];
+        if below(2) == 0 {
+            let channels = 3 + below(2);
+            names.extend(["red", "green", "blue", "alpha"][..channels].iter().map(|c| c.to_string()));
         }
         for extra in 0..below(4) {
             let at = below(names.len() as u64 + 1);
@@ -411,8 +418,12 @@ fn binary_vertices_decoded_in_parallel_as_one_at_a_time() {
                 size += 5;
                 continue;
             }
-            // Coordinates and normals are floats in 3 of 4 cases.
-            let ty = if name.starts_with("extra") || below(4) == 0 {
+            // Colours share a type in 7 of 8 cases; coordinates and
+            // normals are floats in 3 of 4.
+            let colour = ["red", "green", "blue", "alpha"].contains(&name.as_str());
+            let ty = if colour && below(8) != 0 {
+                colour_ty
+            } else if name.starts_with("extra") || below(4) == 0 {
                 types[below(8)]
             } else {
                 ["float", "double"][below(2)]
@@ -647,4 +658,92 @@ fn rows_in_pieces_reads_exactly_the_elements_lines() {
 fn crlf_header() {
     let text = ASCII.replace('\n', "\r\n");
     assert_eq!(read_ply(text.as_bytes()).unwrap().vertices.len(), 4);
+}
+
+/// ASCII vertices with colours, read in pieces, give what one pass gives:
+/// RGB or RGBA of every type, values out of range and bad lines.
+#[test]
+fn ascii_colours_in_pieces_read_as_in_one_pass() {
+    let types = ["uchar", "ushort", "float", "int"];
+    let errors = compare_readings(41, false, |below, case| {
+        let channels = 3 + case % 2;
+        let ty = types[below(4)];
+        let mut text = format!("ply\nformat ascii 1.0\nelement vertex {}\n", below(20));
+        text += "property float x\nproperty float y\nproperty float z\n";
+        for name in &["red", "green", "blue", "alpha"][..channels] {
+            text += &format!("property {ty} {name}\n");
+        }
+        text += "end_header\n";
+        for v in 0..below(22) {
+            let values: Vec<String> = (0..3 + channels)
+                .map(|k| match below(60) {
+                    0 => "x".to_string(),
+                    1 => "-7".to_string(),
+                    2 => "1e9".to_string(),
+                    _ if k >= 3 => below(256).to_string(),
+                    _ => format!("{v}.5"),
+                })
+                .collect();
+            text += &values.join(" ");
+            text += "\n";
+        }
+        text.into_bytes()
+    });
+    assert!((300..2700).contains(&errors), "{errors} errors in 3000 cases");
+}
+
+#[test]
+fn colours_are_read_by_their_type() {
+    let file = |props: &str, row: &str| {
+        format!(
+            "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n\
+             property float z\n{props}end_header\n0 0 0 {row}\n"
+        )
+    };
+    let colours = |props: &str, row: &str| read_ply(file(props, row).as_bytes()).unwrap().colours;
+    let uchar = "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+    assert_eq!(
+        colours(uchar, "255 0 51"),
+        Some(Colours {
+            rgba: vec![[1.0, 0.0, 0.2, 1.0]],
+            alpha: false
+        })
+    );
+    let ushort_rgba = "property ushort red\nproperty ushort green\nproperty ushort blue\n\
+                       property ushort alpha\n";
+    let read = colours(ushort_rgba, "65535 0 0 0").unwrap();
+    assert_eq!((read.rgba[0], read.alpha), ([1.0, 0.0, 0.0, 0.0], true));
+    let float = "property float diffuse_red\nproperty float diffuse_green\n\
+                 property float diffuse_blue\n";
+    assert_eq!(colours(float, "0.5 2 -1").unwrap().rgba[0], [0.5, 1.0, 0.0, 1.0]);
+    let mixed = "property uchar red\nproperty float green\nproperty uchar blue\n";
+    assert_eq!(colours(mixed, "1 0.5 1"), None, "channels of mixed types");
+    assert_eq!(colours("property uchar red\n", "255"), None, "red alone");
+}
+
+#[test]
+fn normals_and_colours_written_read_back() {
+    let vertices = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+    let faces = vec![[0, 1, 2]];
+    for alpha in [false, true] {
+        let attributes = crate::io::VertexAttributes {
+            normals: Some(vec![[0.0, 0.0, 1.0], [0.0, 0.5, 0.75], [0.25, 0.0, -1.0]]),
+            colours: Some(Colours {
+                rgba: vec![[1.0, 0.0, 0.2, 1.0], [0.0, 1.0, 0.4, 0.6], [0.2, 0.4, 0.6, 0.0]],
+                alpha,
+            }),
+        };
+        let mut bytes = Vec::new();
+        crate::io::mesh_out::write_ply(&mut bytes, &vertices, &faces, &attributes).unwrap();
+        let read = read_ply_mesh(&bytes).unwrap();
+        assert_eq!(read.vertices, vertices);
+        assert_eq!(read.normals, attributes.normals);
+        let colours = read.colours.unwrap();
+        assert_eq!(colours.alpha, alpha);
+        let want = attributes.colours.unwrap().rgba;
+        for (got, want) in colours.rgba.iter().zip(&want) {
+            let channels = if alpha { 4 } else { 3 };
+            assert_eq!(got[..channels], want[..channels]);
+        }
+    }
 }
