@@ -17,7 +17,8 @@
 //!   vertex on an edge blends that edge's two ends;
 //! - from an input without faces (a cloud), the nearest input point.
 //!
-//! Normals are blended and then scaled to unit length; colours blended.
+//! Normals are blended in direction and in length (unit ones stay unit);
+//! colours blended.
 //! Positions decide everything, so the result does not depend on how a
 //! stage numbered its vertices, nor on the number of threads.
 
@@ -139,21 +140,28 @@ pub fn carry<const N: usize>(
 }
 
 /// Normals (one per input vertex) at each source: copied from a vertex;
-/// blended by a face's weights and scaled to unit length, or, where the
-/// corners' normals cancel, the face's own normal turned to their side.
+/// from a face, the direction of the corners' normals blended by the
+/// weights, at the length their lengths blend to (so unit normals give
+/// unit ones, and a file's unnormalised normals, such as screened
+/// Poisson's gradients, keep lengths of their kind). Where the corners'
+/// normals cancel, the face's own normal turned to their side.
 pub fn carry_normals(from: &Mesh, sources: &[VertexSource], normals: &[Point3]) -> Vec<Point3> {
     let blended = carry(from, sources, normals);
+    let lengths: Vec<[f64; 1]> = normals.iter().map(|n| [norm2(*n).sqrt()]).collect();
+    let blended_lengths = carry(from, sources, &lengths);
     blended
         .into_par_iter()
+        .zip(blended_lengths)
         .zip(sources)
-        .map(|(n, source)| match *source {
+        .map(|((n, [length]), source)| match *source {
             VertexSource::Vertex(_) => n,
             VertexSource::Face { face, .. } => {
-                if norm2(n) > 1e-12 {
+                let direction = if norm2(n) > 1e-12 * length * length {
                     unit(n)
                 } else {
                     face_normal(from, face, normals)
-                }
+                };
+                direction.map(|c| c * length)
             }
         })
         .collect()
@@ -323,25 +331,25 @@ mod tests {
     }
 
     #[test]
-    fn normals_are_unit_and_cancelling_ones_take_the_face_normal() {
+    fn normals_keep_their_lengths_and_cancelling_ones_take_the_face_normal() {
         let mesh = Mesh {
             vertices: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
             faces: vec![[0, 1, 2]],
         };
-        let up = [0.0, 0.0, 2.0];
-        let carried = carry_normals(
-            &mesh,
-            &vertex_sources(&mesh, &[[0.25, 0.25, 0.0], [0.0, 0.0, 0.0]]).unwrap(),
-            &[up, up, up],
-        );
-        assert_eq!(carried[0], [0.0, 0.0, 1.0]);
-        assert_eq!(carried[1], up, "a kept vertex keeps its normal as it was");
+        let sources = vertex_sources(&mesh, &[[0.25, 0.25, 0.0], [0.0, 0.0, 0.0]]).unwrap();
+        let tilted = [0.6, 0.0, 0.8];
+        let unit_normals = carry_normals(&mesh, &sources, &[[0.0, 0.0, 1.0], tilted, tilted]);
+        let length = norm2(unit_normals[0]).sqrt();
+        assert!((length - 1.0).abs() < 1e-15, "unit normals blend to a unit one: {length}");
+        assert_eq!(unit_normals[1], [0.0, 0.0, 1.0]);
+        let long = [[0.0, 0.0, 2.0], [0.0, 0.0, 6.0], [0.0, 0.0, 6.0]];
+        let carried = carry_normals(&mesh, &sources, &long);
+        // Weights 0.5, 0.25, 0.25: the lengths blend to 4.
+        assert_eq!(carried[0], [0.0, 0.0, 4.0]);
+        assert_eq!(carried[1], long[0], "a kept vertex keeps its normal as it was");
         let cancelling = [[0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [0.0, 0.0, 0.0]];
         let midpoint = vertex_sources(&mesh, &[[0.5, 0.0, 0.0]]).unwrap();
-        assert_eq!(
-            carry_normals(&mesh, &midpoint, &cancelling)[0],
-            [0.0, 0.0, 1.0]
-        );
+        assert_eq!(carry_normals(&mesh, &midpoint, &cancelling)[0], [0.0, 0.0, 1.0]);
     }
 
     #[test]

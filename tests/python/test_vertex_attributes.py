@@ -1,0 +1,203 @@
+"""Vertex normals and colours carried from the input to the output, read
+back by PyMeshLab and trimesh, and checked against an independent
+carrying: Open3D's closest point on the input surface and its
+barycentric coordinates there.
+
+The inputs are PyMeshLab's own: a cloud whose colours vary along the
+blade, meshed by PyMeshLab's screened Poisson (which gives the mesh
+normals and colours of its own), and the jagged blade scan coloured
+the same way."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+
+import numpy as np
+import pymeshlab
+import pytest
+import trimesh
+
+from meshtrim_cli import MESHTRIM, ROOT, run_meshtrim
+
+FIXTURES = ROOT / "fixtures" / "meshes"
+
+
+def colour_by_position(v):
+    """RGBA in 0..1: red along x, blue along y, a fixed green."""
+    c = np.ones((len(v), 4))
+    c[:, 0] = (v[:, 0] - v[:, 0].min()) / np.ptp(v[:, 0])
+    c[:, 1] = 0.5
+    c[:, 2] = (v[:, 1] - v[:, 1].min()) / np.ptp(v[:, 1])
+    return c
+
+
+@pytest.fixture(scope="module")
+def coloured(tmp_path_factory):
+    """A coloured cloud and its screened-Poisson mesh (normals and colours
+    from PyMeshLab), and the jagged blade scan coloured by position."""
+    d = tmp_path_factory.mktemp("coloured")
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(str(FIXTURES / "blade_small.ply"))
+    m = ms.current_mesh()
+    v = m.vertex_matrix()
+    ms.add_mesh(
+        pymeshlab.Mesh(vertex_matrix=v, v_normals_matrix=m.vertex_normal_matrix(), v_color_matrix=colour_by_position(v)),
+        "cloud",
+    )
+    ms.save_current_mesh(str(d / "cloud.ply"), save_vertex_color=True, save_vertex_normal=True)
+    ms.generate_surface_reconstruction_screened_poisson(depth=8)
+    assert ms.current_mesh().has_vertex_color()
+    ms.save_current_mesh(str(d / "poisson.ply"), save_vertex_color=True, save_vertex_normal=True)
+
+    scan = pymeshlab.MeshSet()
+    scan.load_new_mesh(str(FIXTURES / "blade_jagged.stl"))
+    s = scan.current_mesh()
+    sv = s.vertex_matrix()
+    scan.add_mesh(pymeshlab.Mesh(vertex_matrix=sv, face_matrix=s.face_matrix(), v_color_matrix=colour_by_position(sv)), "scan")
+    scan.compute_normal_per_vertex()
+    scan.save_current_mesh(str(d / "scan.ply"), save_vertex_color=True, save_vertex_normal=True)
+    return d
+
+
+def load(path):
+    """Vertices, faces, normals and colours (RGBA bytes) as PyMeshLab
+    reads them."""
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(str(path))
+    m = ms.current_mesh()
+    colours = np.rint(m.vertex_color_matrix() * 255).astype(int) if m.has_vertex_color() else None
+    return m.vertex_matrix(), m.face_matrix(), m.vertex_normal_matrix(), colours
+
+
+def expected_at(vertices, faces, values, points):
+    """`values` (per input vertex) at `points`, by Open3D: blended with
+    the barycentric coordinates of each point's closest point on the
+    input surface (its ray-casting scene, in float32)."""
+    import open3d as o3d
+
+    scene = o3d.t.geometry.RaycastingScene()
+    scene.add_triangles(
+        o3d.core.Tensor(vertices.astype(np.float32)), o3d.core.Tensor(faces.astype(np.uint32))
+    )
+    found = scene.compute_closest_points(o3d.core.Tensor(points.astype(np.float32)))
+    corners = faces[found["primitive_ids"].numpy()]
+    u, v = found["primitive_uvs"].numpy().T
+    weights = np.stack([1 - u - v, u, v], axis=1)
+    return np.einsum("ij,ijk->ik", weights, values[corners])
+
+
+def kept_and_new(v_in, v_out):
+    """Output vertex indices at an input vertex's exact position (and
+    those input vertices), and the others."""
+    at = {tuple(p): i for i, p in reversed(list(enumerate(v_in)))}
+    kept = [(o, at[tuple(p)]) for o, p in enumerate(v_out) if tuple(p) in at]
+    new = [o for o, p in enumerate(v_out) if tuple(p) not in at]
+    out_kept, in_kept = (np.array(x, dtype=int) for x in zip(*kept))
+    return out_kept, in_kept, np.array(new, dtype=int)
+
+
+def check_carried(src, out):
+    """Kept vertices keep their normals (at float32) and colours exactly;
+    new ones have the colours and normal directions trimesh's carrying
+    gives, within a colour step and 1e-4 radians."""
+    v_in, f_in, n_in, c_in = load(src)
+    v_out, f_out, n_out, c_out = load(out)
+    assert c_out is not None, "the output has no colours"
+    out_kept, in_kept, new = kept_and_new(v_in, v_out)
+    assert len(new) > 50 and len(out_kept) > 500, (len(new), len(out_kept))
+    assert np.array_equal(c_out[out_kept], c_in[in_kept])
+    assert np.array_equal(n_out[out_kept], n_in[in_kept].astype(np.float32))
+
+    want = expected_at(v_in, f_in, c_in.astype(float), v_out[new])
+    assert np.abs(c_out[new] - want).max() <= 1.0, np.abs(c_out[new] - want).max()
+    # Not a copy of the nearest vertex's: most new colours are blends.
+    assert (np.abs(c_out[new] - want) <= 0.5 + 1e-9).mean() > 0.95
+    want_n = expected_at(v_in, f_in, n_in, v_out[new])
+    unit = lambda a: a / np.linalg.norm(a, axis=1, keepdims=True)
+    cosines = np.einsum("ij,ij->i", unit(want_n), unit(n_out[new]))
+    assert cosines.min() > np.cos(1e-4), cosines.min()
+    return v_in, n_in, v_out, n_out, new
+
+
+def test_trim_carries_poisson_normals_and_colours(coloured, tmp_path):
+    out, report = tmp_path / "out.ply", tmp_path / "r.json"
+    run_meshtrim(coloured / "poisson.ply", coloured / "cloud.ply", out, "--report", report)
+    assert json.loads(report.read_text())["vertex_attributes"] == ["normals", "colours"]
+    _, n_in, _, n_out, new = check_carried(coloured / "poisson.ply", out)
+    # Screened Poisson's normals are not unit; the new ones are of the
+    # same kind (their lengths blended), not unit vectors among them.
+    lengths_in, lengths_new = np.linalg.norm(n_in, axis=1), np.linalg.norm(n_out[new], axis=1)
+    assert lengths_in.min() > 1.5 and lengths_new.min() > 0.8 * lengths_in.min(), (lengths_in.min(), lengths_new.min())
+
+
+def test_clean_carries_a_scans_normals_and_colours(coloured, tmp_path):
+    out = tmp_path / "out.ply"
+    run_meshtrim("clean", coloured / "scan.ply", out)
+    check_carried(coloured / "scan.ply", out)
+
+
+def test_mesh_takes_each_vertexs_from_the_nearest_point(coloured, tmp_path):
+    from scipy.spatial import cKDTree
+
+    out = tmp_path / "out.ply"
+    run_meshtrim("mesh", coloured / "cloud.ply", out)
+    v_in, _, n_in, c_in = load(coloured / "cloud.ply")
+    v_out, _, n_out, c_out = load(out)
+    _, nearest = cKDTree(v_in).query(v_out)
+    assert np.array_equal(c_out, c_in[nearest])
+    assert np.array_equal(n_out, n_in[nearest].astype(np.float32))
+
+
+def load_gltf_with_trimesh(path):
+    """Vertices, normals and colours (RGBA bytes) as trimesh's glTF
+    reader reads them (its raw output: a `Trimesh` built from it replaces
+    some normals by its own)."""
+    from trimesh.exchange import gltf
+
+    with open(path, "rb") as f:
+        read = gltf.load_glb(f) if path.suffix == ".glb" else gltf.load_gltf(f)
+    (geometry,) = read["geometry"].values()
+    colours = np.asarray(geometry["vertex_colors"]).astype(int)
+    return np.asarray(geometry["vertices"]), np.asarray(geometry["vertex_normals"]), colours
+
+
+@pytest.mark.parametrize("ext", ["obj", "glb", "gltf"])
+def test_other_formats_hold_the_same_attributes(coloured, tmp_path, ext):
+    """OBJ (`v x y z r g b`, `vn`) read by PyMeshLab, glTF (COLOR_0,
+    NORMAL) by trimesh: the PLY output's colours, and its normals'
+    directions (glTF holds unit normals)."""
+    ply, other = tmp_path / "out.ply", tmp_path / f"out.{ext}"
+    for out in (ply, other):
+        run_meshtrim(coloured / "poisson.ply", coloured / "cloud.ply", out)
+    v_ply, _, n_ply, c_ply = load(ply)
+    if ext == "obj":
+        vertices, _, normals, colours = load(other)
+    else:
+        vertices, normals, colours = load_gltf_with_trimesh(other)
+    assert len(vertices) == len(v_ply)
+    assert np.allclose(vertices, v_ply, rtol=0, atol=1e-4)
+    assert np.abs(colours[:, :3] - c_ply[:, :3]).max() <= 1, np.abs(colours[:, :3] - c_ply[:, :3]).max()
+    unit = lambda a: a / np.linalg.norm(a, axis=1, keepdims=True)
+    assert np.einsum("ij,ij->i", unit(normals), unit(n_ply)).min() > 1 - 1e-6
+
+
+def test_stl_output_says_what_it_could_not_hold(coloured, tmp_path):
+    out, report = tmp_path / "out.stl", tmp_path / "r.json"
+    result = run_meshtrim(coloured / "poisson.ply", coloured / "cloud.ply", out, "--report", report)
+    assert "normals, colours not written" in result.stdout, result.stdout
+    r = json.loads(report.read_text())
+    assert r["vertex_attributes_not_written"] == ["normals", "colours"] and "vertex_attributes" not in r
+
+
+def test_carried_attributes_do_not_depend_on_threads(coloured, tmp_path):
+    outputs = []
+    for threads in ["1", "2"]:
+        out = tmp_path / f"out{threads}.ply"
+        env = dict(os.environ, RAYON_NUM_THREADS=threads)
+        subprocess.run(
+            [str(MESHTRIM), "clean", str(coloured / "scan.ply"), str(out)], check=True, env=env, capture_output=True
+        )
+        outputs.append(out.read_bytes())
+    assert outputs[0] == outputs[1]
