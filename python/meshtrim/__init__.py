@@ -11,7 +11,10 @@ same Rust library, with the same results bit for bit:
 - :func:`clean`: a triangulated scan's jagged border replaced by its
   smoothed edge;
 - :func:`read_cloud`, :func:`read_mesh`, :func:`write_mesh`: the CLI's
-  readers and writers;
+  readers and writers, vertex normals and colours included;
+- :func:`carry`: per-vertex values (normals, colours, anything) carried
+  from a mesh to the mesh :func:`trim`, :func:`clean` or :func:`mesh`
+  made from it, as the CLI carries normals and colours;
 - :func:`batch_plan`: which meshes ``meshtrim batch`` would take, where
   each output goes and which cloud trims it, for running a batch on
   another scheduler (Dask, say).
@@ -56,6 +59,8 @@ __all__ = [
     "read_mesh",
     "write_mesh",
     "write_edges",
+    "VertexAttributes",
+    "carry",
     "BatchJob",
     "batch_plan",
 ]
@@ -390,19 +395,82 @@ def read_cloud(path: PathLike, *, scan: Optional[int] = None) -> np.ndarray:
     return _meshtrim.read_cloud(os.fspath(path), scan)
 
 
-def read_mesh(path: PathLike) -> tuple:
+class VertexAttributes(NamedTuple):
+    """A mesh file's per-vertex attributes: ``normals`` ``(n, 3)``
+    float64 and ``colours`` ``(n, 4)`` float64 RGBA in 0..1 (alpha 1 where
+    the file has none, and then ``colours[:, :3]`` is what it held), each
+    ``None`` when the file has none."""
+
+    normals: Optional[np.ndarray]
+    colours: Optional[np.ndarray]
+
+
+def read_mesh(path: PathLike, *, attributes: bool = False) -> tuple:
     """``(vertices, faces)`` of a mesh file (OBJ, PLY, STL, glTF/GLB),
-    polygons split into fans, as ``trim`` and ``clean`` read it."""
-    return _meshtrim.read_mesh(os.fspath(path))
+    polygons split into fans, as ``trim`` and ``clean`` read it; with
+    ``attributes=True``, ``(vertices, faces, VertexAttributes)``: the
+    vertex normals (PLY, glTF) and colours (PLY, OBJ, glTF) the CLI
+    carries to its outputs."""
+    vertices, faces, normals, colours, alpha = _meshtrim.read_mesh(os.fspath(path))
+    if not attributes:
+        return vertices, faces
+    if colours is not None and not alpha:
+        colours = np.ascontiguousarray(colours[:, :3])
+    return vertices, faces, VertexAttributes(normals, colours)
 
 
-def write_mesh(path: PathLike, vertices: Any, faces: Any) -> None:
+def write_mesh(
+    path: PathLike, vertices: Any, faces: Any, *, normals: Any = None, colours: Any = None
+) -> None:
     """Writes a mesh as the CLI writes its outputs: the format from the
     extension (.obj, .ply and .stl binary, .gltf, .glb), missing parent
-    directories created, the file replaced atomically."""
+    directories created, the file replaced atomically. ``normals``
+    ``(n, 3)`` and ``colours`` ``(n, 3)`` or ``(n, 4)`` (RGB or RGBA in
+    0..1) are written with the vertices by every format but STL, as the
+    CLI writes them: PLY ``float nx ny nz`` and ``uchar red green blue
+    [alpha]``, OBJ ``v x y z r g b`` and ``vn``, glTF ``NORMAL`` (unit) and
+    ``COLOR_0``."""
     v = _float_rows(vertices, "vertices")
     f = _face_rows(faces, len(v))
-    _meshtrim.write_mesh(os.fspath(path), v, f)
+    n = None if normals is None else _per_vertex(normals, "normals", len(v), (3,))
+    c = None if colours is None else _per_vertex(colours, "colours", len(v), (3, 4))
+    _meshtrim.write_mesh(os.fspath(path), v, f, n, c)
+
+
+def _per_vertex(array: Any, name: str, vertices: int, widths: tuple) -> np.ndarray:
+    """A C-order float64 ``(vertices, w)`` array, ``w`` one of ``widths``."""
+    a = np.ascontiguousarray(array, dtype=np.float64)
+    if a.ndim != 2 or a.shape[0] != vertices or a.shape[1] not in widths:
+        shape = " or ".join(f"({vertices}, {w})" for w in widths)
+        raise MeshtrimError(f"{name}: expected an array of shape {shape}, got {a.shape}")
+    return a
+
+
+def carry(vertices: Any, faces: Any, values: Any, to: Any, *, normals: bool = False) -> np.ndarray:
+    """Per-vertex ``values`` of the mesh ``vertices``, ``faces`` (or of a
+    cloud: ``faces`` ``None`` or empty) at the vertices ``to`` of a mesh
+    made from it by :func:`trim`, :func:`clean` or :func:`mesh`, as the
+    CLI carries normals and colours to its outputs: a vertex at an input
+    vertex's exact position takes its row, any other the row blended by
+    the barycentric weights of its closest point on the input surface
+    (from a cloud, the nearest point's row). ``values`` is ``(n,)`` or
+    ``(n, k)``: colours, a quality, texture coordinates. With
+    ``normals=True`` (``k`` = 3) rows blend as normals do: the direction,
+    at the blended length.
+
+    >>> v, f, attrs = meshtrim.read_mesh("poisson.ply", attributes=True)
+    >>> out_v, out_f, _ = meshtrim.trim(v, f, points)
+    >>> colours = meshtrim.carry(v, f, attrs.colours, out_v)
+    """
+    v = _float_rows(vertices, "vertices")
+    f = np.empty((0, 3), dtype=np.uint32) if faces is None or np.size(faces) == 0 else _face_rows(faces, len(v))
+    values = np.asarray(values, dtype=np.float64)
+    flat = values.ndim == 1
+    table = np.ascontiguousarray(values.reshape(-1, 1) if flat else values)
+    if table.ndim != 2 or table.shape[0] != len(v):
+        raise MeshtrimError(f"values: expected an array of shape ({len(v)},) or ({len(v)}, k), got {values.shape}")
+    out = _meshtrim.carry(v, f, table, _float_rows(to, "to"), bool(normals))
+    return out[:, 0] if flat else out
 
 
 class BatchJob(NamedTuple):

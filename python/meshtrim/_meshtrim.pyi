@@ -50,8 +50,23 @@ def clean(
     repair: bool,
 ) -> Tuple[Points, Faces, str]: ...
 def read_cloud(path: str | PathLike[str], scan: Optional[int] = None) -> Points: ...
-def read_mesh(path: str | PathLike[str]) -> Tuple[Points, Faces]: ...
-def write_mesh(path: str | PathLike[str], vertices: Points, faces: npt.NDArray[np.uint32]) -> None: ...
+def read_mesh(
+    path: str | PathLike[str],
+) -> Tuple[Points, Faces, Optional[Points], Optional[npt.NDArray[np.float64]], bool]: ...
+def write_mesh(
+    path: str | PathLike[str],
+    vertices: Points,
+    faces: npt.NDArray[np.uint32],
+    normals: Optional[Points],
+    colours: Optional[npt.NDArray[np.float64]],
+) -> None: ...
+def carry(
+    vertices: Points,
+    faces: npt.NDArray[np.uint32],
+    values: npt.NDArray[np.float64],
+    to: Points,
+    normals: bool,
+) -> npt.NDArray[np.float64]: ...
 def write_edges(
     path: str | PathLike[str],
     points: Points,

@@ -5,7 +5,9 @@ new ``TriangleMesh`` out (the inputs are not changed).
 >>> trimmed = meshtrim.open3d.trim(poisson, pcd)
 
 Each mesh function takes :func:`meshtrim.trim`'s options as keywords, and
-with ``report=True`` returns ``(mesh, report)``.
+with ``report=True`` returns ``(mesh, report)``. The input's vertex normals
+and colours, when it has them, are carried to the new mesh
+(:func:`meshtrim.carry`; from a cloud, each vertex's nearest point's).
 """
 
 from __future__ import annotations
@@ -22,29 +24,48 @@ def _arrays(mesh: o3d.geometry.TriangleMesh) -> tuple:
     return np.asarray(mesh.vertices), np.asarray(mesh.triangles)
 
 
-def _result(vertices: np.ndarray, faces: np.ndarray, report: dict, with_report: bool):
+def _result(vertices: np.ndarray, faces: np.ndarray, report: dict, with_report: bool, source):
     out = o3d.geometry.TriangleMesh(
         o3d.utility.Vector3dVector(vertices),
         o3d.utility.Vector3iVector(faces.astype(np.int32)),
     )
+    _carry_attributes(source, out)
     return (out, report) if with_report else out
+
+
+def _carry_attributes(source, out: o3d.geometry.TriangleMesh) -> None:
+    """The vertex normals and colours of ``source`` (a mesh or a cloud)
+    carried to ``out``'s vertices."""
+    if isinstance(source, o3d.geometry.TriangleMesh):
+        from_v, from_f = _arrays(source)
+        normals, colours = source.vertex_normals, source.vertex_colors
+    else:
+        from_v, from_f = np.asarray(source.points), None
+        normals, colours = source.normals, source.colors
+    to = np.asarray(out.vertices)
+    if len(normals):
+        carried = meshtrim.carry(from_v, from_f, np.asarray(normals), to, normals=True)
+        out.vertex_normals = o3d.utility.Vector3dVector(carried)
+    if len(colours):
+        carried = meshtrim.carry(from_v, from_f, np.asarray(colours), to)
+        out.vertex_colors = o3d.utility.Vector3dVector(carried)
 
 
 def trim(mesh: o3d.geometry.TriangleMesh, cloud: o3d.geometry.PointCloud, *, report: bool = False, **options):
     """``mesh`` (e.g. Open3D's Poisson) cut along the smoothed boundary of
     ``cloud``: a new ``TriangleMesh``."""
     vertices, faces = _arrays(mesh)
-    return _result(*meshtrim.trim(vertices, faces, np.asarray(cloud.points), **options), report)
+    return _result(*meshtrim.trim(vertices, faces, np.asarray(cloud.points), **options), report, mesh)
 
 
 def clean(mesh: o3d.geometry.TriangleMesh, *, report: bool = False, **options):
     """A scanned ``mesh`` with its jagged border smoothed: a new ``TriangleMesh``."""
-    return _result(*meshtrim.clean(*_arrays(mesh), **options), report)
+    return _result(*meshtrim.clean(*_arrays(mesh), **options), report, mesh)
 
 
 def mesh(cloud: o3d.geometry.PointCloud, *, report: bool = False, **options):
     """A Delaunay ``TriangleMesh`` of ``cloud`` within its smoothed boundary."""
-    return _result(*meshtrim.mesh(np.asarray(cloud.points), **options), report)
+    return _result(*meshtrim.mesh(np.asarray(cloud.points), **options), report, cloud)
 
 
 def detect(cloud: o3d.geometry.PointCloud, **options) -> meshtrim.Detection:

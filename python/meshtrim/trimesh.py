@@ -1,6 +1,8 @@
 """meshtrim on trimesh objects: a new ``trimesh.Trimesh`` out, built with
 ``process=False`` so that its arrays are meshtrim's exactly; the report is
-in ``result.metadata["meshtrim"]``.
+in ``result.metadata["meshtrim"]``. Vertex colours, when the input has
+them, are carried to the new mesh (:func:`meshtrim.carry`); trimesh
+computes normals from the faces.
 
 >>> cleaned = meshtrim.trimesh.clean(trimesh.load("scan.stl", process=False))
 """
@@ -15,8 +17,13 @@ import meshtrim
 __all__ = ["trim", "clean"]
 
 
-def _result(vertices: np.ndarray, faces: np.ndarray, report: dict) -> trimesh.Trimesh:
-    out = trimesh.Trimesh(vertices=vertices, faces=faces, process=False)
+def _result(vertices: np.ndarray, faces: np.ndarray, report: dict, source: trimesh.Trimesh) -> trimesh.Trimesh:
+    colours = None
+    if source.visual.kind == "vertex":
+        rgba = np.asarray(source.visual.vertex_colors, dtype=np.float64)
+        carried = meshtrim.carry(source.vertices, source.faces, rgba, vertices)
+        colours = np.clip(np.rint(carried), 0, 255).astype(np.uint8)
+    out = trimesh.Trimesh(vertices=vertices, faces=faces, vertex_colors=colours, process=False)
     out.metadata["meshtrim"] = report
     return out
 
@@ -26,9 +33,9 @@ def trim(mesh: trimesh.Trimesh, points, **options) -> trimesh.Trimesh:
     ``(n, 3)`` array or a ``trimesh.PointCloud``)."""
     if isinstance(points, trimesh.PointCloud):
         points = points.vertices
-    return _result(*meshtrim.trim(mesh.vertices, mesh.faces, points, **options))
+    return _result(*meshtrim.trim(mesh.vertices, mesh.faces, points, **options), mesh)
 
 
 def clean(mesh: trimesh.Trimesh, **options) -> trimesh.Trimesh:
     """A scanned ``mesh`` with its jagged border smoothed."""
-    return _result(*meshtrim.clean(mesh.vertices, mesh.faces, **options))
+    return _result(*meshtrim.clean(mesh.vertices, mesh.faces, **options), mesh)

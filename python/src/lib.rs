@@ -361,30 +361,149 @@ fn read_cloud(py: Python<'_>, path: PathBuf, scan: Option<usize>) -> PyResult<Po
     points_array(py, &cloud.points)
 }
 
-/// A mesh's vertices and faces, read as `trim` and `clean` read a mesh.
+/// A mesh as read: vertices, faces, normals, colours (RGBA in 0..1) and
+/// whether the file had an alpha channel.
+type MeshRead<'py> = (
+    Points<'py>,
+    Faces<'py>,
+    Option<Points<'py>>,
+    Option<Bound<'py, PyArray2<f64>>>,
+    bool,
+);
+
+/// A mesh's vertices, faces and vertex attributes, read as `trim` and
+/// `clean` read a mesh.
 #[pyfunction]
-fn read_mesh(py: Python<'_>, path: PathBuf) -> PyResult<(Points<'_>, Faces<'_>)> {
+fn read_mesh(py: Python<'_>, path: PathBuf) -> PyResult<MeshRead<'_>> {
     let hint = "read it with read_cloud";
-    let mesh = without_gil(py, || meshtrim::io::read_mesh_with_faces(&path, hint))?;
+    let (mesh, attributes) =
+        without_gil(py, || meshtrim::io::read_mesh_with_attributes(&path, hint))?;
+    let normals = match &attributes.normals {
+        Some(normals) => Some(points_array(py, normals)?),
+        None => None,
+    };
+    let (colours, alpha) = match &attributes.colours {
+        Some(c) => {
+            let flat = PyArray1::from_slice(py, c.rgba.as_flattened());
+            (Some(flat.reshape([c.rgba.len(), 4])?), c.alpha)
+        }
+        None => (None, false),
+    };
     Ok((
         points_array(py, &mesh.vertices)?,
         faces_array(py, &mesh.faces)?,
+        normals,
+        colours,
+        alpha,
     ))
 }
 
 /// Writes a mesh as the CLI writes its outputs (format by extension,
-/// atomically).
+/// atomically), with per-vertex normals and colours (RGB or RGBA in
+/// 0..1) when given.
 #[pyfunction]
+#[pyo3(signature = (path, vertices, faces, normals, colours))]
 fn write_mesh(
     py: Python<'_>,
     path: PathBuf,
     vertices: PyReadonlyArray2<'_, f64>,
     faces: PyReadonlyArray2<'_, u32>,
+    normals: Option<PyReadonlyArray2<'_, f64>>,
+    colours: Option<PyReadonlyArray2<'_, f64>>,
 ) -> PyResult<()> {
     let mesh = mesh_of(&vertices, &faces)?;
+    let normals = normals.map(|n| rows(&n, "normals")).transpose()?;
+    let colours = colours.map(|c| colours_of(&c)).transpose()?;
+    let attributes = meshtrim::io::VertexAttributes { normals, colours };
     without_gil(py, || {
-        meshtrim::io::write_mesh(&path, &mesh.vertices, &mesh.faces)
+        meshtrim::io::write_mesh_with(&path, &mesh.vertices, &mesh.faces, &attributes)
     })
+}
+
+/// Colours from an `(n, 3)` or `(n, 4)` array in 0..1 (alpha 1 when
+/// there are three columns).
+fn colours_of(array: &PyReadonlyArray2<'_, f64>) -> PyResult<meshtrim::io::Colours> {
+    let width = array.shape()[1];
+    if width != 3 && width != 4 {
+        return Err(MeshtrimError::new_err(format!(
+            "colours: expected an array of shape (n, 3) or (n, 4), got {:?}",
+            array.shape()
+        )));
+    }
+    let rgba = array
+        .as_array()
+        .rows()
+        .into_iter()
+        .map(|r| std::array::from_fn(|c| if c < width { r[c] } else { 1.0 }))
+        .collect();
+    Ok(meshtrim::io::Colours {
+        rgba,
+        alpha: width == 4,
+    })
+}
+
+/// Per-vertex `values` (`(n, k)`, one row per vertex of the mesh
+/// `vertices`, `faces`) carried to the vertices `to` of a mesh made from
+/// it, as the CLI carries normals and colours: a kept vertex's row
+/// copied, a new one's blended from its closest point on the surface (or
+/// taken from the nearest point when there are no faces). With `normals`
+/// (`k` = 3) the rows are blended as normals (direction and length).
+#[pyfunction]
+#[pyo3(signature = (vertices, faces, values, to, normals))]
+fn carry<'py>(
+    py: Python<'py>,
+    vertices: PyReadonlyArray2<'py, f64>,
+    faces: PyReadonlyArray2<'py, u32>,
+    values: PyReadonlyArray2<'py, f64>,
+    to: PyReadonlyArray2<'py, f64>,
+    normals: bool,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let from = mesh_of(&vertices, &faces)?;
+    let to = rows(&to, "to")?;
+    let width = values.shape()[1];
+    if values.shape()[0] != from.vertices.len() {
+        return Err(MeshtrimError::new_err(format!(
+            "values: {} rows for {} vertices",
+            values.shape()[0],
+            from.vertices.len()
+        )));
+    }
+    if normals && width != 3 {
+        return Err(MeshtrimError::new_err(format!(
+            "values: normals have 3 columns, these have {width}"
+        )));
+    }
+    let columns: Vec<Vec<[f64; 1]>> = (0..width)
+        .map(|c| values.as_array().column(c).iter().map(|&x| [x]).collect())
+        .collect();
+    let rows_in = if normals {
+        rows(&values, "values")?
+    } else {
+        Vec::new()
+    };
+    if let Some(&v) = from.faces.iter().flatten().find(|&&v| v as usize >= from.vertices.len()) {
+        return Err(MeshtrimError::new_err(format!(
+            "faces: vertex {v} does not exist ({} vertices)",
+            from.vertices.len()
+        )));
+    }
+    let carried = without_gil(py, || {
+        let Some(sources) = library::vertex_sources(&from, &to) else {
+            anyhow::bail!("vertices: there are none to carry values from");
+        };
+        if normals {
+            let carried = library::carry_normals(&from, &sources, &rows_in);
+            return Ok(carried.as_flattened().to_vec());
+        }
+        let carried: Vec<Vec<[f64; 1]>> = columns
+            .iter()
+            .map(|column| library::carry(&from, &sources, column))
+            .collect();
+        Ok((0..to.len())
+            .flat_map(|i| carried.iter().map(move |column| column[i][0]))
+            .collect())
+    })?;
+    PyArray1::from_vec(py, carried).reshape([to.len(), width])
 }
 
 /// The batch's list of work, as `meshtrim batch INPUTS --out-dir OUT_DIR
@@ -537,5 +656,6 @@ fn _meshtrim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(write_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(write_edges_py, m)?)?;
     m.add_function(wrap_pyfunction!(batch_plan, m)?)?;
+    m.add_function(wrap_pyfunction!(carry, m)?)?;
     Ok(())
 }

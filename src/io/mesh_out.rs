@@ -209,11 +209,14 @@ fn check_attributes(vertices: usize, attributes: &VertexAttributes) -> Result<()
         if colours.rgba.len() != vertices {
             bail!("{} colours for {vertices} vertices", colours.rgba.len());
         }
+        if let Some(i) = colours.rgba.iter().position(|c| c.iter().any(|x| !x.is_finite())) {
+            bail!("vertex {i} has a non-finite colour {:?}", colours.rgba[i]);
+        }
     }
     Ok(())
 }
 
-/// A colour channel in 0..1 as a byte (NaN as 0).
+/// A colour channel in 0..1 as a byte (clamped).
 pub(crate) fn channel_byte(c: f64) -> u8 {
     (c.clamp(0.0, 1.0) * 255.0).round() as u8
 }

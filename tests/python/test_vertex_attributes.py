@@ -201,3 +201,105 @@ def test_carried_attributes_do_not_depend_on_threads(coloured, tmp_path):
         )
         outputs.append(out.read_bytes())
     assert outputs[0] == outputs[1]
+
+
+# --------------------------------------------------------------------------
+# The Python package: the same carrying, and the adapters.
+
+
+def test_python_carry_and_write_give_the_clis_bytes(coloured, tmp_path):
+    import meshtrim
+
+    for job in ("trim", "clean"):
+        src = coloured / ("poisson.ply" if job == "trim" else "scan.ply")
+        cli = tmp_path / f"{job}_cli.ply"
+        if job == "trim":
+            run_meshtrim(src, coloured / "cloud.ply", cli)
+        else:
+            run_meshtrim("clean", src, cli)
+        v, f, attrs = meshtrim.read_mesh(src, attributes=True)
+        assert attrs.normals is not None and attrs.colours.shape == (len(v), 4)
+        if job == "trim":
+            out_v, out_f, _ = meshtrim.trim(v, f, meshtrim.read_cloud(coloured / "cloud.ply"))
+        else:
+            out_v, out_f, _ = meshtrim.clean(v, f)
+        py = tmp_path / f"{job}_py.ply"
+        meshtrim.write_mesh(
+            py,
+            out_v,
+            out_f,
+            normals=meshtrim.carry(v, f, attrs.normals, out_v, normals=True),
+            colours=meshtrim.carry(v, f, attrs.colours, out_v),
+        )
+        assert py.read_bytes() == cli.read_bytes(), job
+
+
+def test_python_carry_shapes_and_errors(coloured):
+    import meshtrim
+
+    v, f, attrs = meshtrim.read_mesh(coloured / "poisson.ply", attributes=True)
+    quality = v[:, 0] * 2.0
+    out = meshtrim.carry(v, f, quality, v[:10] + 1e-3)
+    assert out.shape == (10,)
+    # The value is linear in position, so blending reproduces it closely.
+    assert np.allclose(out, (v[:10, 0] + 1e-3) * 2.0, atol=0.05)
+    assert np.array_equal(meshtrim.carry(v, None, quality, v[:5]), quality[:5]), "a cloud: the point's own"
+    with pytest.raises(meshtrim.MeshtrimError, match="values"):
+        meshtrim.carry(v, f, quality[:-1], v)
+    with pytest.raises(meshtrim.MeshtrimError, match="normals have 3 columns"):
+        meshtrim.carry(v, f, attrs.colours, v, normals=True)
+    with pytest.raises(meshtrim.MeshtrimError, match="colours"):
+        meshtrim.write_mesh("/tmp/never.ply", v, f, colours=np.zeros((len(v), 2)))
+    _, _, plain = meshtrim.read_mesh(FIXTURES / "blade_jagged.stl", attributes=True)
+    assert plain == meshtrim.VertexAttributes(None, None)
+
+
+def test_pymeshlab_adapter_carries_colours_normals_and_quality(coloured, tmp_path):
+    import meshtrim.pymeshlab
+
+    cli = tmp_path / "cli.ply"
+    run_meshtrim(coloured / "poisson.ply", coloured / "cloud.ply", cli)
+    _, _, n_cli, c_cli = load(cli)
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(str(coloured / "poisson.ply"))
+    ms.load_new_mesh(str(coloured / "cloud.ply"))
+    assert ms.mesh(0).has_vertex_scalar()
+    meshtrim.pymeshlab.trim(ms, 0, 1)
+    out = ms.current_mesh()
+    assert out.has_vertex_color() and out.has_vertex_scalar()
+    assert np.abs(np.rint(out.vertex_color_matrix() * 255) - c_cli).max() <= 1
+    # PyMeshLab's Mesh() replaces the normals of border vertices by its
+    # own (measured: exactly the 880 border vertices here); the others
+    # are meshtrim's.
+    faces = out.face_matrix()
+    edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
+    unique, counts = np.unique(edges, axis=0, return_counts=True)
+    inner = np.ones(out.vertex_number(), dtype=bool)
+    inner[unique[counts == 1].ravel()] = False
+    assert inner.sum() > 0.8 * len(inner)
+    assert np.allclose(out.vertex_normal_matrix()[inner], n_cli[inner], atol=1e-5)
+    # Poisson's density, carried: between the input's extremes.
+    q_in, q_out = ms.mesh(0).vertex_scalar_array(), out.vertex_scalar_array()
+    assert q_in.min() - 1e-9 <= q_out.min() and q_out.max() <= q_in.max() + 1e-9 and np.ptp(q_out) > 0
+
+
+def test_open3d_and_trimesh_adapters_carry_colours(coloured):
+    import open3d as o3d
+    import meshtrim.open3d
+    import meshtrim.trimesh
+
+    scan = o3d.io.read_triangle_mesh(str(coloured / "scan.ply"))
+    assert scan.has_vertex_colors() and scan.has_vertex_normals()
+    cleaned = meshtrim.open3d.clean(scan)
+    assert cleaned.has_vertex_colors() and cleaned.has_vertex_normals()
+    v, f, attrs = meshtrim.read_mesh(coloured / "scan.ply", attributes=True)
+    out_v = np.asarray(cleaned.vertices)
+    want = meshtrim.carry(v, f, attrs.colours[:, :3], out_v)
+    assert np.abs(np.asarray(cleaned.vertex_colors) - want).max() < 1e-6
+
+    tm = trimesh.load(coloured / "scan.ply", process=False)
+    assert tm.visual.kind == "vertex"
+    out = meshtrim.trimesh.clean(tm)
+    assert out.visual.kind == "vertex"
+    got = np.asarray(out.visual.vertex_colors, dtype=float)[:, :3]
+    assert np.abs(got - want * 255).max() <= 1.0
