@@ -19,7 +19,7 @@ import pymeshlab
 import pytest
 import trimesh
 
-from meshtrim_cli import MESHTRIM, ROOT, run_meshtrim
+from meshtrim_cli import MESHTRIM, ROOT, run_meshtrim, shared_data
 
 FIXTURES = ROOT / "fixtures" / "meshes"
 
@@ -136,6 +136,21 @@ def test_clean_carries_a_scans_normals_and_colours(coloured, tmp_path):
     out = tmp_path / "out.ply"
     run_meshtrim("clean", coloured / "scan.ply", out)
     check_carried(coloured / "scan.ply", out)
+
+
+def test_clean_carries_a_real_colour_scans_colours(tmp_path):
+    """Laurana50k, MeshLab's sample bust scanned in colour (RGBA per
+    vertex, no normals): the cleaned base keeps the scan's colours."""
+    src, out, report = shared_data("meshlab_scans/Laurana50k.ply"), tmp_path / "out.ply", tmp_path / "r.json"
+    run_meshtrim("clean", src, out, "--report", report)
+    assert json.loads(report.read_text())["vertex_attributes"] == ["colours"]
+    v_in, f_in, _, c_in = load(src)
+    v_out, _, _, c_out = load(out)
+    out_kept, in_kept, new = kept_and_new(v_in, v_out)
+    assert len(new) > 100, len(new)
+    assert np.array_equal(c_out[out_kept], c_in[in_kept])
+    want = expected_at(v_in, f_in, c_in.astype(float), v_out[new])
+    assert np.abs(c_out[new] - want).max() <= 1.0, np.abs(c_out[new] - want).max()
 
 
 def test_mesh_takes_each_vertexs_from_the_nearest_point(coloured, tmp_path):
