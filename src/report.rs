@@ -61,18 +61,27 @@ pub fn emit<R: Serialize + Table>(report: &R, file: Option<&Path>, json: bool) -
     }
 }
 
-/// The report's row on the input's vertex attributes: those written
-/// (carried as `how` says) and those the output's format cannot hold;
-/// `None` when the input had none.
-pub fn attributes_row(written: &[&str], not_written: &[&str], how: &str) -> Option<String> {
-    match (written, not_written) {
-        ([], []) => None,
-        (written, []) => Some(format!("{} ({how})", written.join(", "))),
-        (_, not_written) => Some(format!(
+/// Adds the report's row on the input's vertex attributes before the
+/// times: those written (carried as `how` says) and those the output's
+/// format cannot hold; no row when the input had none.
+pub fn add_attributes_row(
+    rows: &mut Vec<(&str, String)>,
+    [written, not_written]: [&[&str]; 2],
+    how: &str,
+) {
+    let row = match (written, not_written) {
+        ([], []) => return,
+        (written, []) => format!("{} ({how})", written.join(", ")),
+        (_, not_written) => format!(
             "{} not written: the output's format holds none",
             not_written.join(", ")
-        )),
-    }
+        ),
+    };
+    let at = rows
+        .iter()
+        .position(|(label, _)| *label == "read time")
+        .unwrap_or(rows.len());
+    rows.insert(at, ("vertex attributes", row));
 }
 
 /// Lays out (label, value) rows as the commands print them.

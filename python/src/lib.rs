@@ -481,7 +481,12 @@ fn carry<'py>(
     } else {
         Vec::new()
     };
-    if let Some(&v) = from.faces.iter().flatten().find(|&&v| v as usize >= from.vertices.len()) {
+    if let Some(&v) = from
+        .faces
+        .iter()
+        .flatten()
+        .find(|&&v| v as usize >= from.vertices.len())
+    {
         return Err(MeshtrimError::new_err(format!(
             "faces: vertex {v} does not exist ({} vertices)",
             from.vertices.len()

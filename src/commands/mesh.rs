@@ -255,14 +255,12 @@ impl crate::report::Table for Report {
             ("write time", format!("{:.1} ms", self.write_ms)),
             ("output", shown(&self.output)),
         ];
-        if let Some(row) = crate::report::attributes_row(
-            &self.vertex_attributes,
-            &self.vertex_attributes_not_written,
+        let attributes = [&self.vertex_attributes, &self.vertex_attributes_not_written];
+        crate::report::add_attributes_row(
+            &mut rows,
+            attributes.map(Vec::as_slice),
             "each vertex's from the nearest cloud point",
-        ) {
-            let before_times = rows.len() - 6;
-            rows.insert(before_times, ("vertex attributes", row));
-        }
+        );
         crate::report::rows(&rows)
     }
 }

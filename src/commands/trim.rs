@@ -478,14 +478,12 @@ impl crate::report::Table for Report {
             ("write time", format!("{:.1} ms", self.write_ms)),
             ("output", shown(&self.output)),
         ];
-        if let Some(row) = crate::report::attributes_row(
-            &self.vertex_attributes,
-            &self.vertex_attributes_not_written,
+        let attributes = [&self.vertex_attributes, &self.vertex_attributes_not_written];
+        crate::report::add_attributes_row(
+            &mut rows,
+            attributes.map(Vec::as_slice),
             "kept vertices' as read, new ones' from the mesh's surface",
-        ) {
-            let before_times = rows.len() - 6;
-            rows.insert(before_times, ("vertex attributes", row));
-        }
+        );
         crate::report::rows(&rows)
     }
 }

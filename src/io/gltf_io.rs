@@ -990,7 +990,12 @@ mod tests {
     fn normals_and_colours_round_trip() {
         let (v, f) = square();
         let attributes = VertexAttributes {
-            normals: Some(vec![[0.0, 0.0, 2.0], [0.0, 0.0, 0.0], [0.6, 0.0, 0.8], [0.0, -1.0, 0.0]]),
+            normals: Some(vec![
+                [0.0, 0.0, 2.0],
+                [0.0, 0.0, 0.0],
+                [0.6, 0.0, 0.8],
+                [0.0, -1.0, 0.0],
+            ]),
             colours: Some(Colours {
                 rgba: vec![[1.0, 0.0, 0.2, 1.0]; 4],
                 alpha: true,
@@ -1007,7 +1012,12 @@ mod tests {
             let mesh = read_gltf(&bytes, Path::new(".")).unwrap();
             let normals = mesh.normals.unwrap();
             // Written as unit f32 vectors; a zero normal as +z.
-            let want = [[0.0, 0.0, 1.0], [0.0, 0.0, 1.0], [0.6, 0.0, 0.8], [0.0, -1.0, 0.0]];
+            let want = [
+                [0.0, 0.0, 1.0],
+                [0.0, 0.0, 1.0],
+                [0.6, 0.0, 0.8],
+                [0.0, -1.0, 0.0],
+            ];
             for (got, want) in normals.iter().zip(want) {
                 assert!((0..3).all(|k| (got[k] - want[k]).abs() < 1e-7), "{got:?}");
             }

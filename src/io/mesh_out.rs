@@ -209,7 +209,11 @@ fn check_attributes(vertices: usize, attributes: &VertexAttributes) -> Result<()
         if colours.rgba.len() != vertices {
             bail!("{} colours for {vertices} vertices", colours.rgba.len());
         }
-        if let Some(i) = colours.rgba.iter().position(|c| c.iter().any(|x| !x.is_finite())) {
+        if let Some(i) = colours
+            .rgba
+            .iter()
+            .position(|c| c.iter().any(|x| !x.is_finite()))
+        {
             bail!("vertex {i} has a non-finite colour {:?}", colours.rgba[i]);
         }
     }

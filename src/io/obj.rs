@@ -294,7 +294,11 @@ mod tests {
             })
         );
         for partly in ["v 0 0 0 1 0.5 0\nv 1 0 0\n", "v 0 0 0 1 0.5 0\nv 1 0 0 1\n"] {
-            assert_eq!(read_obj(partly.as_bytes()).unwrap().colours, None, "{partly}");
+            assert_eq!(
+                read_obj(partly.as_bytes()).unwrap().colours,
+                None,
+                "{partly}"
+            );
         }
     }
 

@@ -27,7 +27,7 @@ use parry3d_f64::query::PointQueryWithLocation;
 use parry3d_f64::shape::Triangle;
 use rayon::prelude::*;
 
-use crate::geom::{cross, norm2, unit, Point3};
+use crate::geom::{cross, dot, norm2, sub, unit, Point3};
 use crate::hash::HashMap;
 use crate::mesh::Mesh;
 use crate::spatial::closest_face::{FaceIndex, Scratch};
@@ -99,8 +99,8 @@ pub fn vertex_sources_reference(from: &Mesh, to: &[Point3]) -> Vec<VertexSource>
             if from.faces.is_empty() {
                 let nearest = (0..from.vertices.len())
                     .min_by(|&a, &b| {
-                        let da = norm2(crate::geom::sub(from.vertices[a], *p));
-                        let db = norm2(crate::geom::sub(from.vertices[b], *p));
+                        let da = norm2(sub(from.vertices[a], *p));
+                        let db = norm2(sub(from.vertices[b], *p));
                         da.total_cmp(&db)
                     })
                     .unwrap_or(0);
@@ -239,14 +239,11 @@ fn face_source(from: &Mesh, face: u32, p: Point3) -> VertexSource {
 fn face_normal(from: &Mesh, face: u32, normals: &[Point3]) -> Point3 {
     let [a, b, c] = from.faces[face as usize];
     let [pa, pb, pc] = [a, b, c].map(|v| from.vertices[v as usize]);
-    let n = cross(crate::geom::sub(pb, pa), crate::geom::sub(pc, pa));
+    let n = cross(sub(pb, pa), sub(pc, pa));
     if norm2(n) == 0.0 {
         return normals[a as usize];
     }
-    let side: f64 = [a, b, c]
-        .iter()
-        .map(|&v| crate::geom::dot(n, normals[v as usize]))
-        .sum();
+    let side: f64 = [a, b, c].iter().map(|&v| dot(n, normals[v as usize])).sum();
     let n = unit(n);
     if side < 0.0 {
         n.map(|x| -x)
@@ -319,7 +316,7 @@ mod tests {
             let fast_points = carry(&mesh, &fast, &mesh.vertices);
             let reference_points = carry(&mesh, &reference, &mesh.vertices);
             for (i, (f, r)) in fast_points.iter().zip(&reference_points).enumerate() {
-                let gap = norm2(crate::geom::sub(*f, *r)).sqrt();
+                let gap = norm2(sub(*f, *r)).sqrt();
                 assert!(gap < 1e-9, "seed {seed}, point {i}: {f:?} against {r:?}");
             }
             for (f, r) in fast.iter().zip(&reference) {
@@ -340,16 +337,25 @@ mod tests {
         let tilted = [0.6, 0.0, 0.8];
         let unit_normals = carry_normals(&mesh, &sources, &[[0.0, 0.0, 1.0], tilted, tilted]);
         let length = norm2(unit_normals[0]).sqrt();
-        assert!((length - 1.0).abs() < 1e-15, "unit normals blend to a unit one: {length}");
+        assert!(
+            (length - 1.0).abs() < 1e-15,
+            "unit normals blend to a unit one: {length}"
+        );
         assert_eq!(unit_normals[1], [0.0, 0.0, 1.0]);
         let long = [[0.0, 0.0, 2.0], [0.0, 0.0, 6.0], [0.0, 0.0, 6.0]];
         let carried = carry_normals(&mesh, &sources, &long);
         // Weights 0.5, 0.25, 0.25: the lengths blend to 4.
         assert_eq!(carried[0], [0.0, 0.0, 4.0]);
-        assert_eq!(carried[1], long[0], "a kept vertex keeps its normal as it was");
+        assert_eq!(
+            carried[1], long[0],
+            "a kept vertex keeps its normal as it was"
+        );
         let cancelling = [[0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [0.0, 0.0, 0.0]];
         let midpoint = vertex_sources(&mesh, &[[0.5, 0.0, 0.0]]).unwrap();
-        assert_eq!(carry_normals(&mesh, &midpoint, &cancelling)[0], [0.0, 0.0, 1.0]);
+        assert_eq!(
+            carry_normals(&mesh, &midpoint, &cancelling)[0],
+            [0.0, 0.0, 1.0]
+        );
     }
 
     #[test]

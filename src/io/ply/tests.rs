@@ -404,7 +404,11 @@ fn binary_vertices_decoded_in_parallel_as_one_at_a_time() {
         let colour_ty = types[below(8)];
         if below(2) == 0 {
             let channels = 3 + below(2);
-            names.extend(["red", "green", "blue", "alpha"][..channels].iter().map(|c| c.to_string()));
+            names.extend(
+                ["red", "green", "blue", "alpha"][..channels]
+                    .iter()
+                    .map(|c| c.to_string()),
+            );
         }
         for extra in 0..below(4) {
             let at = below(names.len() as u64 + 1);
@@ -689,7 +693,10 @@ fn ascii_colours_in_pieces_read_as_in_one_pass() {
         }
         text.into_bytes()
     });
-    assert!((300..2700).contains(&errors), "{errors} errors in 3000 cases");
+    assert!(
+        (300..2700).contains(&errors),
+        "{errors} errors in 3000 cases"
+    );
 }
 
 #[test]
@@ -715,7 +722,10 @@ fn colours_are_read_by_their_type() {
     assert_eq!((read.rgba[0], read.alpha), ([1.0, 0.0, 0.0, 0.0], true));
     let float = "property float diffuse_red\nproperty float diffuse_green\n\
                  property float diffuse_blue\n";
-    assert_eq!(colours(float, "0.5 2 -1").unwrap().rgba[0], [0.5, 1.0, 0.0, 1.0]);
+    assert_eq!(
+        colours(float, "0.5 2 -1").unwrap().rgba[0],
+        [0.5, 1.0, 0.0, 1.0]
+    );
     let mixed = "property uchar red\nproperty float green\nproperty uchar blue\n";
     assert_eq!(colours(mixed, "1 0.5 1"), None, "channels of mixed types");
     assert_eq!(colours("property uchar red\n", "255"), None, "red alone");
@@ -729,7 +739,11 @@ fn normals_and_colours_written_read_back() {
         let attributes = crate::io::VertexAttributes {
             normals: Some(vec![[0.0, 0.0, 1.0], [0.0, 0.5, 0.75], [0.25, 0.0, -1.0]]),
             colours: Some(Colours {
-                rgba: vec![[1.0, 0.0, 0.2, 1.0], [0.0, 1.0, 0.4, 0.6], [0.2, 0.4, 0.6, 0.0]],
+                rgba: vec![
+                    [1.0, 0.0, 0.2, 1.0],
+                    [0.0, 1.0, 0.4, 0.6],
+                    [0.2, 0.4, 0.6, 0.0],
+                ],
                 alpha,
             }),
         };
