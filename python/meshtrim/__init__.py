@@ -385,14 +385,28 @@ def write_edges(
     _meshtrim.write_edges(os.fspath(path), pts, boundary, loops, str(units), bool(dxf_splines))
 
 
-def read_cloud(path: PathLike, *, scan: Optional[int] = None) -> np.ndarray:
+def read_cloud(path: PathLike, *, scan: Optional[int] = None, attributes: bool = False):
     """The points of a cloud file, as every command reads a cloud: PLY,
     PCD, OBJ, LAS/LAZ, E57, XYZ/TXT/CSV/ASC/PTS, or a mesh's vertices (STL,
     glTF/GLB). An E57 file's scans are merged in the file's frame, each in
-    its pose; ``scan=N`` reads scan N alone (the CLI's ``--scan``)."""
+    its pose; ``scan=N`` reads scan N alone (the CLI's ``--scan``). With
+    ``attributes=True``, ``(points, VertexAttributes)``: the normals (PLY,
+    PCD, glTF) and colours (PLY, OBJ, glTF, PCD ``rgb``/``rgba``, LAS,
+    E57) that ``mesh`` carries to its vertices."""
     if scan is not None:
         scan = _k(scan)
-    return _meshtrim.read_cloud(os.fspath(path), scan)
+    points, normals, colours, alpha = _meshtrim.read_cloud(os.fspath(path), scan)
+    if not attributes:
+        return points
+    return points, _attributes(normals, colours, alpha)
+
+
+def _attributes(normals, colours, alpha) -> "VertexAttributes":
+    """Normals and colours as :class:`VertexAttributes` (RGB when the file
+    had no alpha)."""
+    if colours is not None and not alpha:
+        colours = np.ascontiguousarray(colours[:, :3])
+    return VertexAttributes(normals, colours)
 
 
 class VertexAttributes(NamedTuple):
@@ -414,9 +428,7 @@ def read_mesh(path: PathLike, *, attributes: bool = False) -> tuple:
     vertices, faces, normals, colours, alpha = _meshtrim.read_mesh(os.fspath(path))
     if not attributes:
         return vertices, faces
-    if colours is not None and not alpha:
-        colours = np.ascontiguousarray(colours[:, :3])
-    return vertices, faces, VertexAttributes(normals, colours)
+    return vertices, faces, _attributes(normals, colours, alpha)
 
 
 def write_mesh(

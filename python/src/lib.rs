@@ -351,14 +351,51 @@ fn clean_py<'py>(
     mesh_result(py, &out, &report)
 }
 
-/// A cloud's points, read as every command reads a cloud (`scan`: one
-/// scan of an E57 file, as `--scan`).
+/// A cloud's points, normals and colours (RGBA in 0..1, and whether the
+/// file had an alpha channel), read as every command reads a cloud
+/// (`scan`: one scan of an E57 file, as `--scan`).
 #[pyfunction]
 #[pyo3(signature = (path, scan=None))]
-fn read_cloud(py: Python<'_>, path: PathBuf, scan: Option<usize>) -> PyResult<Points<'_>> {
+fn read_cloud(
+    py: Python<'_>,
+    path: PathBuf,
+    scan: Option<usize>,
+) -> PyResult<AttributedPoints<'_>> {
     let options = meshtrim::io::CloudOptions { scan };
     let cloud = without_gil(py, || meshtrim::io::read_cloud_with(&path, &options))?;
-    points_array(py, &cloud.points)
+    let (normals, colours, alpha) =
+        attribute_arrays(py, cloud.normals.as_deref(), cloud.colours.as_ref())?;
+    Ok((points_array(py, &cloud.points)?, normals, colours, alpha))
+}
+
+/// A new `(n, 4)` float64 array of colours, RGBA in 0..1.
+type ColourArray<'py> = Bound<'py, PyArray2<f64>>;
+/// Normals, colours and whether the file had an alpha channel.
+type AttributeArrays<'py> = (Option<Points<'py>>, Option<ColourArray<'py>>, bool);
+/// Points or vertices with their normals, colours (RGBA in 0..1) and
+/// whether the file had an alpha channel.
+type AttributedPoints<'py> = (
+    Points<'py>,
+    Option<Points<'py>>,
+    Option<ColourArray<'py>>,
+    bool,
+);
+
+/// Normals and colours as new arrays, and whether the colours had alpha.
+fn attribute_arrays<'py>(
+    py: Python<'py>,
+    normals: Option<&[Point3]>,
+    colours: Option<&meshtrim::io::Colours>,
+) -> PyResult<AttributeArrays<'py>> {
+    let normals = normals.map(|n| points_array(py, n)).transpose()?;
+    let (colours, alpha) = match colours {
+        Some(c) => {
+            let flat = PyArray1::from_slice(py, c.rgba.as_flattened());
+            (Some(flat.reshape([c.rgba.len(), 4])?), c.alpha)
+        }
+        None => (None, false),
+    };
+    Ok((normals, colours, alpha))
 }
 
 /// A mesh as read: vertices, faces, normals, colours (RGBA in 0..1) and
@@ -367,7 +404,7 @@ type MeshRead<'py> = (
     Points<'py>,
     Faces<'py>,
     Option<Points<'py>>,
-    Option<Bound<'py, PyArray2<f64>>>,
+    Option<ColourArray<'py>>,
     bool,
 );
 
@@ -378,17 +415,11 @@ fn read_mesh(py: Python<'_>, path: PathBuf) -> PyResult<MeshRead<'_>> {
     let hint = "read it with read_cloud";
     let (mesh, attributes) =
         without_gil(py, || meshtrim::io::read_mesh_with_attributes(&path, hint))?;
-    let normals = match &attributes.normals {
-        Some(normals) => Some(points_array(py, normals)?),
-        None => None,
-    };
-    let (colours, alpha) = match &attributes.colours {
-        Some(c) => {
-            let flat = PyArray1::from_slice(py, c.rgba.as_flattened());
-            (Some(flat.reshape([c.rgba.len(), 4])?), c.alpha)
-        }
-        None => (None, false),
-    };
+    let (normals, colours, alpha) = attribute_arrays(
+        py,
+        attributes.normals.as_deref(),
+        attributes.colours.as_ref(),
+    )?;
     Ok((
         points_array(py, &mesh.vertices)?,
         faces_array(py, &mesh.faces)?,

@@ -12,7 +12,10 @@
 //! and is dropped and counted, as PCD's NaN points are. Every page's CRC is
 //! checked. Row and column indices (`rowIndex`, `columnIndex`) are kept with
 //! each point's scan, when a scan read has them, for `detect`'s CSV and PLY
-//! outputs; intensity and colour are not kept.
+//! outputs. Colours (`colorRed`, `colorGreen`, `colorBlue`, scaled to
+//! 0..1 by the scan's colour limits) are kept when every scan read has
+//! them, so that `mesh` carries them to its vertices; a point whose
+//! colour is marked invalid is black. Intensity is not kept.
 
 use std::io::Cursor;
 
@@ -20,7 +23,7 @@ use anyhow::{anyhow, bail, Context, Result};
 use e57::{CartesianCoordinate, E57Reader, RecordName};
 use rayon::prelude::*;
 
-use super::{Cloud, Format, GridIndex, Point3};
+use super::{Cloud, Colours, Format, GridIndex, Point3};
 
 /// The file signature at the start of every E57 file.
 const SIGNATURE: &[u8] = b"ASTM-E57";
@@ -56,20 +59,26 @@ pub fn read_e57(bytes: Vec<u8>, scan: Option<usize>) -> Result<Cloud> {
         );
     }
     let with_grid = chosen.iter().any(|&n| has_grid(&scans[n]));
+    let with_colour = chosen.iter().all(|&n| scans[n].has_color());
     let read: Vec<Result<Scan>> = chosen
         .par_iter()
         .map(|&n| {
-            read_scan(&bytes, &scans[n], with_grid.then_some(n))
-                .with_context(|| format!("scan {n}"))
+            let wanted = Wanted {
+                grid_of: with_grid.then_some(n),
+                colour: with_colour,
+            };
+            read_scan(&bytes, &scans[n], wanted).with_context(|| format!("scan {n}"))
         })
         .collect();
     let mut points: Vec<Point3> = Vec::with_capacity(reservation(records, bytes.len()));
     let mut grid: Vec<GridIndex> = Vec::new();
+    let mut rgba: Vec<[f64; 4]> = Vec::new();
     let mut dropped = 0;
     for scan in read {
         let scan = scan?;
         points.extend_from_slice(&scan.points);
         grid.extend_from_slice(&scan.grid);
+        rgba.extend_from_slice(&scan.colours);
         dropped += scan.dropped;
     }
     Ok(Cloud {
@@ -78,7 +87,7 @@ pub fn read_e57(bytes: Vec<u8>, scan: Option<usize>) -> Result<Cloud> {
         dropped_non_finite: dropped,
         format: Format::E57,
         scale_offset: None,
-        colours: None,
+        colours: with_colour.then_some(Colours { rgba, alpha: false }),
         grid: with_grid.then_some(grid),
     })
 }
@@ -102,17 +111,27 @@ fn has_grid(scan: &e57::PointCloud) -> bool {
         .any(|r| matches!(r.name, RecordName::RowIndex | RecordName::ColumnIndex))
 }
 
-/// One scan's valid points, posed, their grid indices (when asked for),
-/// and how many had no position.
+/// One scan's valid points, posed, their grid indices and colours (when
+/// asked for), and how many had no position.
 struct Scan {
     points: Vec<Point3>,
     grid: Vec<GridIndex>,
+    colours: Vec<[f64; 4]>,
     dropped: usize,
 }
 
-/// Reads one scan; with `grid_of` (its `data3D` index), also each valid
-/// point's row and column (−1 where the scan has none).
-fn read_scan(bytes: &[u8], scan: &e57::PointCloud, grid_of: Option<usize>) -> Result<Scan> {
+/// What a scan's reading keeps besides positions.
+#[derive(Clone, Copy)]
+struct Wanted {
+    /// The scan's `data3D` index, to keep each point's row and column
+    /// (−1 where the scan has none).
+    grid_of: Option<usize>,
+    /// Whether to keep each point's colour.
+    colour: bool,
+}
+
+/// Reads one scan, keeping what `wanted` asks for besides positions.
+fn read_scan(bytes: &[u8], scan: &e57::PointCloud, wanted: Wanted) -> Result<Scan> {
     let pose = Pose::of(scan)?;
     let mut reader = open(bytes)?;
     let mut iter = reader.pointcloud_simple(scan).map_err(|e| anyhow!("{e}"))?;
@@ -120,9 +139,11 @@ fn read_scan(bytes: &[u8], scan: &e57::PointCloud, grid_of: Option<usize>) -> Re
     iter.apply_pose(false);
     iter.spherical_to_cartesian(true);
     iter.normalize_intensity(false);
-    iter.normalize_color(false);
+    // Colours in 0..1 by the scan's colour limits.
+    iter.normalize_color(true);
     let mut points = Vec::with_capacity(reservation(scan.records, bytes.len()));
     let mut grid = Vec::new();
+    let mut colours = Vec::new();
     let mut dropped = 0;
     for (index, point) in iter.enumerate() {
         let point = point.map_err(|e| anyhow!("point {index}: {e}"))?;
@@ -132,8 +153,11 @@ fn read_scan(bytes: &[u8], scan: &e57::PointCloud, grid_of: Option<usize>) -> Re
                     bail!("point {index} has a non-finite coordinate ({x}, {y}, {z})");
                 }
                 points.push(pose.apply([x, y, z]));
-                if let Some(n) = grid_of {
+                if let Some(n) = wanted.grid_of {
                     grid.push(grid_index(n, point.row, point.column, index)?);
+                }
+                if wanted.colour {
+                    colours.push(colour_of(point.color.as_ref()));
                 }
             }
             CartesianCoordinate::Direction { .. } | CartesianCoordinate::Invalid => dropped += 1,
@@ -142,8 +166,26 @@ fn read_scan(bytes: &[u8], scan: &e57::PointCloud, grid_of: Option<usize>) -> Re
     Ok(Scan {
         points,
         grid,
+        colours,
         dropped,
     })
+}
+
+/// A point's colour in 0..1 (clamped: limits a file understates leave
+/// values beyond them), black where the point's colour is invalid.
+fn colour_of(colour: Option<&e57::Color>) -> [f64; 4] {
+    let channel = |c: f32| {
+        let c = f64::from(c);
+        if c.is_nan() {
+            0.0
+        } else {
+            c.clamp(0.0, 1.0)
+        }
+    };
+    match colour {
+        Some(c) => [channel(c.red), channel(c.green), channel(c.blue), 1.0],
+        None => [0.0, 0.0, 0.0, 1.0],
+    }
 }
 
 /// A point's [`GridIndex`]; the e57 crate gives −1 for a missing index.

@@ -1,7 +1,12 @@
 //! LAS 1.0–1.4 and LAZ point clouds (the `las` crate; LAZ through its `laz`
 //! feature), in and out.
 //!
-//! **Reading.** Every point format (0–10) is read; only x, y, z are kept.
+//! **Reading.** Every point format (0–10) is read; x, y, z are kept, and
+//! the colour of the formats that have one (2, 3, 5, 7, 8, 10), so that
+//! `mesh` carries it to its vertices. The standard stores colour channels
+//! as 16 bits, but many writers put 8-bit values there: a file whose
+//! channels are all at most 255 is read as 0–255, any other as 0–65535
+//! (the rule CloudCompare's reader offers).
 //! LAZ chunks are decompressed in parallel, which needs the chunk table (a
 //! file whose table is lost is refused, as laspy refuses it). LAZ has no
 //! checksums: damage inside a chunk decodes into wrong points, which no
@@ -28,7 +33,7 @@ use las::{Builder, PointDataBuilder, Transform, Vector, Vlr};
 
 use rayon::prelude::*;
 
-use super::{Cloud, Format, Point3};
+use super::{Cloud, Colours, Format, Point3};
 
 /// Bytes of decompressed records read per chunk: a bounded buffer however
 /// many points the header announces or however long it says a record is.
@@ -65,7 +70,7 @@ pub fn read_las(bytes: Vec<u8>) -> Result<Cloud> {
             u32::MAX
         );
     }
-    let points = if header.point_format().is_compressed {
+    let (points, rgb) = if header.point_format().is_compressed {
         read_compressed(&mut reader, &header, total)?
     } else {
         read_uncompressed(bytes.as_ref(), &header, frame, total)?
@@ -76,10 +81,28 @@ pub fn read_las(bytes: Vec<u8>) -> Result<Cloud> {
         dropped_non_finite: 0,
         format: Format::Las,
         scale_offset: Some(frame),
-        colours: None,
+        colours: rgb.map(colours_of),
         grid: None,
     })
 }
+
+/// The points' colours in 0..1 from their 16-bit channels: 0–255 when no
+/// channel exceeds 255 (8-bit values in 16-bit fields), else 0–65535.
+fn colours_of(rgb: Vec<[u16; 3]>) -> Colours {
+    let eight_bit = rgb.par_iter().all(|c| c.iter().all(|&v| v <= 255));
+    let full = if eight_bit { 255.0 } else { 65535.0 };
+    let rgba = rgb
+        .par_iter()
+        .map(|c| {
+            let [r, g, b] = c.map(|v| f64::from(v) / full);
+            [r, g, b, 1.0]
+        })
+        .collect();
+    Colours { rgba, alpha: false }
+}
+
+/// Points, and their colours when the point format has them.
+type PointsRead = (Vec<Point3>, Option<Vec<[u16; 3]>>);
 
 /// The file's bytes, shared by the `las` reader (which wants to own its
 /// source) and the direct decoding of uncompressed records.
@@ -97,8 +120,9 @@ fn read_compressed(
     reader: &mut las::Reader,
     header: &las::Header,
     total: u64,
-) -> Result<Vec<Point3>> {
+) -> Result<PointsRead> {
     let mut points: Vec<Point3> = Vec::new();
+    let mut rgb = header.point_format().has_color.then(Vec::new);
     let mut data = PointDataBuilder::new().for_header(header).build();
     let chunk = (CHUNK_BYTES / u64::from(header.point_format().len()).max(1)).max(1);
     while (points.len() as u64) < total {
@@ -115,6 +139,9 @@ fn read_compressed(
                 .zip(data.z())
                 .map(|((x, y), z)| [x, y, z]),
         );
+        if let (Some(rgb), Some(read)) = (rgb.as_mut(), data.rgb()) {
+            rgb.extend(read.map(|(r, g, b)| [r, g, b]));
+        }
     }
     if (points.len() as u64) != total {
         bail!(
@@ -122,7 +149,7 @@ fn read_compressed(
             points.len()
         );
     }
-    Ok(points)
+    Ok((points, rgb))
 }
 
 /// Uncompressed records decoded in place, in parallel: X, Y and Z are the
@@ -133,7 +160,7 @@ fn read_uncompressed(
     header: &las::Header,
     frame: ScaleOffset,
     total: u64,
-) -> Result<Vec<Point3>> {
+) -> Result<PointsRead> {
     let raw = las::raw::Header::read_from(bytes).map_err(|e| anyhow!("bad LAS header: {e}"))?;
     let start = raw.offset_to_point_data as usize;
     let record = usize::from(header.point_format().len());
@@ -147,7 +174,7 @@ fn read_uncompressed(
     let data = &bytes[start..start + total as usize * record];
     let [sx, sy, sz] = frame.scale;
     let [ox, oy, oz] = frame.offset;
-    Ok(data
+    let points = data
         .par_chunks_exact(record)
         .with_min_len(1 << 14)
         .map(|r| {
@@ -155,7 +182,35 @@ fn read_uncompressed(
                 |at: usize| f64::from(i32::from_le_bytes([r[at], r[at + 1], r[at + 2], r[at + 3]]));
             [sx * int(0) + ox, sy * int(4) + oy, sz * int(8) + oz]
         })
-        .collect())
+        .collect();
+    let rgb = match colour_offset(header.point_format()) {
+        Some(at) if at + 6 <= record => Some(
+            data.par_chunks_exact(record)
+                .with_min_len(1 << 14)
+                .map(|r| [0, 2, 4].map(|k| u16::from_le_bytes([r[at + k], r[at + k + 1]])))
+                .collect(),
+        ),
+        Some(_) => {
+            bail!("bad LAS header: point records of {record} bytes cannot hold their colour")
+        }
+        None => None,
+    };
+    Ok((points, rgb))
+}
+
+/// Where a point record's red, green and blue (three little-endian u16)
+/// start, for the formats that have a colour: after the 20 bytes of the
+/// legacy formats' fields and their GPS time, or after the 30 of the
+/// extended formats (6–10), which always have one.
+fn colour_offset(format: &las::point::Format) -> Option<usize> {
+    if !format.has_color {
+        return None;
+    }
+    Some(match (format.is_extended, format.has_gps_time) {
+        (true, _) => 30,
+        (false, true) => 28,
+        (false, false) => 20,
+    })
 }
 
 /// A LAZ file's chunk table must fit its point data: the decoder

@@ -2,8 +2,11 @@
 //! `binary_compressed`.
 //!
 //! The header lists the fields of a point (FIELDS, SIZE, TYPE, COUNT); x, y
-//! and z may have any numeric type and every other field (rgba, normals,
-//! curvature, padding `_`, COUNT > 1 descriptors) is skipped by its size.
+//! and z may have any numeric type. Kept besides: `normal_x`, `normal_y`,
+//! `normal_z`, and the colour PCL packs into one field, `rgb` (a 4-byte
+//! float whose bits are 0x00RRGGBB) or `rgba` (a 4-byte unsigned integer,
+//! 0xAARRGGBB; the alpha is not kept). Every other field (curvature,
+//! padding `_`, COUNT > 1 descriptors) is skipped by its size.
 //! `binary` stores points one after the other; `binary_compressed` is a u32
 //! compressed size, a u32 uncompressed size and LZF data that holds the
 //! fields one after the other (all x, then all y, ...).
@@ -18,8 +21,8 @@ use anyhow::{anyhow, bail, Result};
 use rayon::prelude::*;
 
 use super::{
-    capacity, cut_after_newlines, lines, mixed_line_ending, strip_bom, truncated, Cloud, Format,
-    HeaderEol, Point3, PIECE_BYTES,
+    capacity, cut_after_newlines, lines, mixed_line_ending, strip_bom, truncated, Cloud, Colours,
+    Format, HeaderEol, Point3, PIECE_BYTES,
 };
 
 /// One field of a PCD point.
@@ -78,10 +81,15 @@ impl Header {
     }
 }
 
-/// The fields the reader keeps: x, y, z and, if present, a normal.
+/// The fields the reader keeps: x, y, z and, if present, a normal and
+/// the packed colour (its field three times, so that it is read as the
+/// others are; unpacked at the end).
 struct Wanted {
     xyz: [usize; 3],
     normal: Option<[usize; 3]>,
+    colour: Option<[usize; 3]>,
+    /// Whether the colour field is a float (`rgb`) rather than an integer.
+    colour_is_float: bool,
 }
 
 /// Reads a PCD file, dropping (and counting) non-finite points.
@@ -95,7 +103,7 @@ pub fn read_pcd(bytes: &[u8]) -> Result<Cloud> {
         Data::Binary => read_binary(&header, &wanted, body)?,
         Data::Compressed => read_compressed(&header, &wanted, body)?,
     };
-    Ok(keep_finite(raw))
+    Ok(keep_finite(raw, wanted.colour_is_float))
 }
 
 fn wanted_fields(header: &Header) -> Result<Wanted> {
@@ -108,7 +116,28 @@ fn wanted_fields(header: &Header) -> Result<Wanted> {
         (Some(x), Some(y), Some(z)) => Some([x, y, z]),
         _ => None,
     };
-    Ok(Wanted { xyz, normal })
+    // A packed colour is four bytes; any other size is not PCL's.
+    let colour = f("rgb")
+        .or_else(|| f("rgba"))
+        .filter(|&c| header.fields[c].size == 4);
+    Ok(Wanted {
+        xyz,
+        normal,
+        colour: colour.map(|c| [c; 3]),
+        colour_is_float: colour.is_some_and(|c| header.fields[c].ty == 'F'),
+    })
+}
+
+/// A PCL packed colour, read as a number, as RGBA in 0..1: a float's bits
+/// or an integer's value hold 0x??RRGGBB.
+fn unpack_colour(value: f64, is_float: bool) -> [f64; 4] {
+    let bits = if is_float {
+        (value as f32).to_bits()
+    } else {
+        value as u32
+    };
+    let channel = |shift: u32| f64::from((bits >> shift) & 0xff) / 255.0;
+    [channel(16), channel(8), channel(0), 1.0]
 }
 
 fn parse_header(bytes: &[u8]) -> Result<Header> {
@@ -278,6 +307,8 @@ fn fill_fields(
 struct Raw {
     points: Vec<Point3>,
     normals: Option<Vec<Point3>>,
+    /// The packed colour field, three times.
+    colours: Option<Vec<Point3>>,
 }
 
 impl Raw {
@@ -285,6 +316,7 @@ impl Raw {
         Raw {
             points: Vec::with_capacity(capacity(n)),
             normals: wanted.normal.map(|_| Vec::with_capacity(capacity(n))),
+            colours: wanted.colour.map(|_| Vec::with_capacity(capacity(n))),
         }
     }
 
@@ -296,6 +328,9 @@ impl Raw {
         self.points.push([value(x)?, value(y)?, value(z)?]);
         if let (Some([x, y, z]), Some(normals)) = (wanted.normal, self.normals.as_mut()) {
             normals.push([value(x)?, value(y)?, value(z)?]);
+        }
+        if let (Some([c, _, _]), Some(colours)) = (wanted.colour, self.colours.as_mut()) {
+            colours.push([value(c)?; 3]);
         }
         Ok(())
     }
@@ -332,6 +367,9 @@ fn read_ascii_in_pieces(
         raw.points.extend_from_slice(&piece.points[..take]);
         if let (Some(normals), Some(more)) = (raw.normals.as_mut(), piece.normals.as_ref()) {
             normals.extend_from_slice(&more[..take]);
+        }
+        if let (Some(colours), Some(more)) = (raw.colours.as_mut(), piece.colours.as_ref()) {
+            colours.extend_from_slice(&more[..take]);
         }
         if take == room {
             break;
@@ -372,6 +410,7 @@ impl AsciiLayout {
 struct AsciiPiece {
     points: Vec<Point3>,
     normals: Option<Vec<Point3>>,
+    colours: Option<Vec<Point3>>,
     lines: usize,
     /// The piece's first error; parsing stops there.
     error: Option<(usize, String)>,
@@ -380,6 +419,7 @@ struct AsciiPiece {
 fn parse_ascii_piece(text: &str, wanted: &Wanted, layout: &AsciiLayout) -> AsciiPiece {
     let mut piece = AsciiPiece {
         normals: wanted.normal.map(|_| Vec::new()),
+        colours: wanted.colour.map(|_| Vec::new()),
         ..AsciiPiece::default()
     };
     // Not sized by the header's counts, which a damaged file makes absurd.
@@ -425,9 +465,16 @@ fn push_ascii_point(
         Some([x, y, z]) => Some([value(x)?, value(y)?, value(z)?]),
         None => None,
     };
+    let colour = match wanted.colour {
+        Some([c, _, _]) => Some([value(c)?; 3]),
+        None => None,
+    };
     piece.points.push(point);
     if let (Some(normal), Some(normals)) = (normal, piece.normals.as_mut()) {
         normals.push(normal);
+    }
+    if let (Some(colour), Some(colours)) = (colour, piece.colours.as_mut()) {
+        colours.push(colour);
     }
     Ok(())
 }
@@ -512,6 +559,7 @@ fn decode_points(wanted: &Wanted, n: usize, value: impl Fn(usize, usize) -> f64 
     Raw {
         points: triple(wanted.xyz),
         normals: wanted.normal.map(triple),
+        colours: wanted.colour.map(triple),
     }
 }
 
@@ -529,38 +577,37 @@ fn offsets(header: &Header, len: impl Fn(&Field) -> usize) -> Vec<usize> {
         .collect()
 }
 
-fn keep_finite(raw: Raw) -> Cloud {
+fn keep_finite(raw: Raw, colour_is_float: bool) -> Cloud {
     let finite: Vec<bool> = raw
         .points
         .par_iter()
         .map(|p| p.iter().all(|c| c.is_finite()))
         .collect();
-    if !finite.contains(&false) {
-        return Cloud {
-            points: raw.points,
-            normals: raw.normals,
-            dropped_non_finite: 0,
-            format: Format::Pcd,
-            scale_offset: None,
-            colours: None,
-            grid: None,
-        };
-    }
+    let dropped = finite.iter().filter(|&&ok| !ok).count();
     let keep = |v: Vec<Point3>| -> Vec<Point3> {
+        if dropped == 0 {
+            return v;
+        }
         v.into_iter()
             .zip(&finite)
             .filter(|(_, &ok)| ok)
             .map(|(p, _)| p)
             .collect()
     };
-    let dropped = finite.iter().filter(|&&ok| !ok).count();
+    let colours = raw.colours.map(|packed| Colours {
+        rgba: keep(packed)
+            .par_iter()
+            .map(|c| unpack_colour(c[0], colour_is_float))
+            .collect(),
+        alpha: false,
+    });
     Cloud {
         points: keep(raw.points),
         normals: raw.normals.map(keep),
         dropped_non_finite: dropped,
         format: Format::Pcd,
         scale_offset: None,
-        colours: None,
+        colours,
         grid: None,
     }
 }

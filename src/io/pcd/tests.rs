@@ -134,7 +134,28 @@ fn ascii() -> String {
 fn check(cloud: Cloud) {
     assert_eq!(cloud.points, vec![POINTS[0], POINTS[2]]);
     assert_eq!(cloud.normals, Some(vec![[0.0, 0.0, 1.0]; 2]));
+    // rgba 0x00ff00ff: red and blue; kept beside the points kept.
+    let colours = cloud.colours.unwrap();
+    assert_eq!(colours.rgba, vec![[1.0, 0.0, 1.0, 1.0]; 2]);
     assert_eq!(cloud.dropped_non_finite, 1);
+}
+
+/// PCL's float `rgb`: the float's bits hold 0x00RRGGBB (a denormal or a
+/// tiny number), read alike from ASCII and binary data.
+#[test]
+fn packed_float_rgb_is_read_by_its_bits() {
+    let bits: u32 = 0x0012_80ff;
+    let rgb = f32::from_bits(bits);
+    let head = "FIELDS x y z rgb\nSIZE 4 4 4 4\nTYPE F F F F\nWIDTH 1\nHEIGHT 1\nPOINTS 1\n";
+    let ascii = format!("{head}DATA ascii\n0 0 0 {rgb:e}\n");
+    let mut binary = format!("{head}DATA binary\n").into_bytes();
+    for v in [0.0f32, 0.0, 0.0, rgb] {
+        binary.extend(v.to_le_bytes());
+    }
+    let want = [18.0 / 255.0, 128.0 / 255.0, 1.0, 1.0];
+    for bytes in [ascii.as_bytes(), &binary[..]] {
+        assert_eq!(read_pcd(bytes).unwrap().colours.unwrap().rgba, vec![want]);
+    }
 }
 
 /// A random cloud in all three encodings: fields of random types and
