@@ -458,31 +458,43 @@ def _per_vertex(array: Any, name: str, vertices: int, widths: tuple) -> np.ndarr
     return a
 
 
-def carry(vertices: Any, faces: Any, values: Any, to: Any, *, normals: bool = False) -> np.ndarray:
+def carry(
+    vertices: Any, faces: Any, values: Any, out_vertices: Any, out_faces: Any = None, *, normals: bool = False
+) -> np.ndarray:
     """Per-vertex ``values`` of the mesh ``vertices``, ``faces`` (or of a
-    cloud: ``faces`` ``None`` or empty) at the vertices ``to`` of a mesh
-    made from it by :func:`trim`, :func:`clean` or :func:`mesh`, as the
-    CLI carries normals and colours to its outputs: a vertex at an input
-    vertex's exact position takes its row, any other the row blended by
-    the barycentric weights of its closest point on the input surface
-    (from a cloud, the nearest point's row). ``values`` is ``(n,)`` or
-    ``(n, k)``: colours, a quality, texture coordinates. With
-    ``normals=True`` (``k`` = 3) rows blend as normals do: the direction,
-    at the blended length.
+    cloud: ``faces`` ``None`` or empty) at the vertices of a mesh made
+    from it by :func:`trim`, :func:`clean` or :func:`mesh`
+    (``out_vertices``, ``out_faces``), as the CLI carries normals and
+    colours to its outputs: a vertex at an input vertex's exact position
+    takes its row, any other the row blended by the barycentric weights of
+    its closest point on the input surface (from a cloud, the nearest
+    point's row). Where input vertices share a position (a seam), the
+    output faces say which is which: give ``out_faces`` for meshes with
+    seams. ``values`` is ``(n,)`` or ``(n, k)``: colours, a quality,
+    texture coordinates. With ``normals=True`` (``k`` = 3) rows blend as
+    normals do: the direction, at the blended length.
 
     >>> v, f, attrs = meshtrim.read_mesh("poisson.ply", attributes=True)
     >>> out_v, out_f, _ = meshtrim.trim(v, f, points)
-    >>> colours = meshtrim.carry(v, f, attrs.colours, out_v)
+    >>> colours = meshtrim.carry(v, f, attrs.colours, out_v, out_f)
     """
     v = _float_rows(vertices, "vertices")
-    f = np.empty((0, 3), dtype=np.uint32) if faces is None or np.size(faces) == 0 else _face_rows(faces, len(v))
+    f = _faces_or_none(faces, len(v))
     values = np.asarray(values, dtype=np.float64)
     flat = values.ndim == 1
     table = np.ascontiguousarray(values.reshape(-1, 1) if flat else values)
     if table.ndim != 2 or table.shape[0] != len(v):
         raise MeshtrimError(f"values: expected an array of shape ({len(v)},) or ({len(v)}, k), got {values.shape}")
-    out = _meshtrim.carry(v, f, table, _float_rows(to, "to"), bool(normals))
+    to = _float_rows(out_vertices, "out_vertices")
+    out = _meshtrim.carry(v, f, table, to, _faces_or_none(out_faces, len(to)), bool(normals))
     return out[:, 0] if flat else out
+
+
+def _faces_or_none(faces: Any, vertices: int) -> np.ndarray:
+    """Face rows, or none for ``None`` or an empty array."""
+    if faces is None or np.size(faces) == 0:
+        return np.empty((0, 3), dtype=np.uint32)
+    return _face_rows(faces, vertices)
 
 
 class BatchJob(NamedTuple):

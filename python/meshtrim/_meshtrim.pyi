@@ -67,6 +67,7 @@ def carry(
     faces: npt.NDArray[np.uint32],
     values: npt.NDArray[np.float64],
     to: Points,
+    to_faces: npt.NDArray[np.uint32],
     normals: bool,
 ) -> npt.NDArray[np.float64]: ...
 def write_edges(

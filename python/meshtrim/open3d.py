@@ -42,12 +42,12 @@ def _carry_attributes(source, out: o3d.geometry.TriangleMesh) -> None:
     else:
         from_v, from_f = np.asarray(source.points), None
         normals, colours = source.normals, source.colors
-    to = np.asarray(out.vertices)
+    to, to_faces = _arrays(out)
     if len(normals):
-        carried = meshtrim.carry(from_v, from_f, np.asarray(normals), to, normals=True)
+        carried = meshtrim.carry(from_v, from_f, np.asarray(normals), to, to_faces, normals=True)
         out.vertex_normals = o3d.utility.Vector3dVector(carried)
     if len(colours):
-        carried = meshtrim.carry(from_v, from_f, np.asarray(colours), to)
+        carried = meshtrim.carry(from_v, from_f, np.asarray(colours), to, to_faces)
         out.vertex_colors = o3d.utility.Vector3dVector(carried)
 
 

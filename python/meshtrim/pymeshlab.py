@@ -25,13 +25,14 @@ def _add(ms: pymeshlab.MeshSet, vertices: np.ndarray, faces: np.ndarray, name: s
     layer it was made from carried to it."""
     from_v = source.vertex_matrix()
     from_f = source.face_matrix() if source.face_number() else None
-    carried = dict(
-        v_normals_matrix=meshtrim.carry(from_v, from_f, source.vertex_normal_matrix(), vertices, normals=True)
-    )
+    def carried_values(values, **kind):
+        return meshtrim.carry(from_v, from_f, values, vertices, faces, **kind)
+
+    carried = dict(v_normals_matrix=carried_values(source.vertex_normal_matrix(), normals=True))
     if source.has_vertex_color():
-        carried["v_color_matrix"] = meshtrim.carry(from_v, from_f, source.vertex_color_matrix(), vertices)
+        carried["v_color_matrix"] = carried_values(source.vertex_color_matrix())
     if source.has_vertex_scalar():
-        carried["v_scalar_array"] = meshtrim.carry(from_v, from_f, source.vertex_scalar_array(), vertices)
+        carried["v_scalar_array"] = carried_values(source.vertex_scalar_array())
     layer = pymeshlab.Mesh(vertex_matrix=vertices, face_matrix=faces.astype(np.int32), **carried)
     ms.add_mesh(layer, mesh_name=name)
 

@@ -21,7 +21,7 @@ def _result(vertices: np.ndarray, faces: np.ndarray, report: dict, source: trime
     colours = None
     if source.visual.kind == "vertex":
         rgba = np.asarray(source.visual.vertex_colors, dtype=np.float64)
-        carried = meshtrim.carry(source.vertices, source.faces, rgba, vertices)
+        carried = meshtrim.carry(source.vertices, source.faces, rgba, vertices, faces)
         colours = np.clip(np.rint(carried), 0, 255).astype(np.uint8)
     out = trimesh.Trimesh(vertices=vertices, faces=faces, vertex_colors=colours, process=False)
     out.metadata["meshtrim"] = report

@@ -475,27 +475,31 @@ fn colours_of(array: &PyReadonlyArray2<'_, f64>) -> PyResult<meshtrim::io::Colou
 
 /// Per-vertex `values` (`(n, k)`, one row per vertex of the mesh
 /// `vertices`, `faces`) carried to the vertices `to` of a mesh made from
-/// it, as the CLI carries normals and colours: a kept vertex's row
-/// copied, a new one's blended from its closest point on the surface (or
-/// taken from the nearest point when there are no faces). With `normals`
-/// (`k` = 3) the rows are blended as normals (direction and length).
+/// it (`to_faces`, which tell a seam's sides apart), as the CLI carries
+/// normals and colours: a kept vertex's row copied, a new one's blended
+/// from its closest point on the surface (or taken from the nearest point
+/// when there are no faces). With `normals` (`k` = 3) the rows are
+/// blended as normals (direction and length).
 #[pyfunction]
-#[pyo3(signature = (vertices, faces, values, to, normals))]
+#[pyo3(signature = (vertices, faces, values, to, to_faces, normals))]
 fn carry<'py>(
     py: Python<'py>,
     vertices: PyReadonlyArray2<'py, f64>,
     faces: PyReadonlyArray2<'py, u32>,
     values: PyReadonlyArray2<'py, f64>,
     to: PyReadonlyArray2<'py, f64>,
+    to_faces: PyReadonlyArray2<'py, u32>,
     normals: bool,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let from = mesh_of(&vertices, &faces)?;
-    let to = rows(&to, "to")?;
-    let width = values.shape()[1];
-    if values.shape()[0] != from.vertices.len() {
+    let to = Mesh {
+        vertices: rows(&to, "to")?,
+        faces: rows(&to_faces, "to_faces")?,
+    };
+    let [rows_in, width] = [values.shape()[0], values.shape()[1]];
+    if rows_in != from.vertices.len() {
         return Err(MeshtrimError::new_err(format!(
-            "values: {} rows for {} vertices",
-            values.shape()[0],
+            "values: {rows_in} rows for {} vertices",
             from.vertices.len()
         )));
     }
@@ -504,42 +508,40 @@ fn carry<'py>(
             "values: normals have 3 columns, these have {width}"
         )));
     }
-    let columns: Vec<Vec<[f64; 1]>> = (0..width)
-        .map(|c| values.as_array().column(c).iter().map(|&x| [x]).collect())
-        .collect();
-    let rows_in = if normals {
+    for (name, mesh) in [("faces", &from), ("to_faces", &to)] {
+        let count = mesh.vertices.len();
+        if let Some(&v) = mesh.faces.iter().flatten().find(|&&v| v as usize >= count) {
+            return Err(MeshtrimError::new_err(format!(
+                "{name}: vertex {v} does not exist ({count} vertices)"
+            )));
+        }
+    }
+    let normal_rows = if normals {
         rows(&values, "values")?
     } else {
         Vec::new()
     };
-    if let Some(&v) = from
-        .faces
-        .iter()
-        .flatten()
-        .find(|&&v| v as usize >= from.vertices.len())
-    {
-        return Err(MeshtrimError::new_err(format!(
-            "faces: vertex {v} does not exist ({} vertices)",
-            from.vertices.len()
-        )));
-    }
+    let columns: Vec<Vec<[f64; 1]>> = (0..width)
+        .map(|c| values.as_array().column(c).iter().map(|&x| [x]).collect())
+        .collect();
+    let count = to.vertices.len();
     let carried = without_gil(py, || {
         let Some(sources) = library::vertex_sources(&from, &to) else {
             anyhow::bail!("vertices: there are none to carry values from");
         };
         if normals {
-            let carried = library::carry_normals(&from, &sources, &rows_in);
+            let carried = library::carry_normals(&from, &sources, &normal_rows);
             return Ok(carried.as_flattened().to_vec());
         }
         let carried: Vec<Vec<[f64; 1]>> = columns
             .iter()
             .map(|column| library::carry(&from, &sources, column))
             .collect();
-        Ok((0..to.len())
+        Ok((0..count)
             .flat_map(|i| carried.iter().map(move |column| column[i][0]))
             .collect())
     })?;
-    PyArray1::from_vec(py, carried).reshape([to.len(), width])
+    PyArray1::from_vec(py, carried).reshape([count, width])
 }
 
 /// The batch's list of work, as `meshtrim batch INPUTS --out-dir OUT_DIR

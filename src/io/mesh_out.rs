@@ -177,7 +177,7 @@ pub fn write_mesh_carrying(
 ) -> Result<AttributesWritten> {
     let holds = MeshFormat::from_path(path).is_some_and(MeshFormat::holds_attributes);
     let carried = if holds {
-        attributes.carried(from, &out.vertices)
+        attributes.carried(from, out)
     } else {
         VertexAttributes::default()
     };

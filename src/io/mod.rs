@@ -168,11 +168,11 @@ impl VertexAttributes {
         self.normals.is_none() && self.colours.is_none()
     }
 
-    /// These attributes, of `from`'s vertices, at the vertices `to` of a
+    /// These attributes, of `from`'s vertices, at the vertices of `to`, a
     /// mesh made from it: copied where a vertex was kept, blended from the
     /// closest point of `from` elsewhere (see [`trim::vertex_sources`]).
     /// Empty when there is nothing to carry or `from` has no vertex.
-    pub fn carried(&self, from: &trim::Mesh, to: &[Point3]) -> VertexAttributes {
+    pub fn carried(&self, from: &trim::Mesh, to: &trim::Mesh) -> VertexAttributes {
         if self.is_empty() {
             return VertexAttributes::default();
         }

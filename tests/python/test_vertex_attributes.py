@@ -243,8 +243,8 @@ def test_python_carry_and_write_give_the_clis_bytes(coloured, tmp_path):
             py,
             out_v,
             out_f,
-            normals=meshtrim.carry(v, f, attrs.normals, out_v, normals=True),
-            colours=meshtrim.carry(v, f, attrs.colours, out_v),
+            normals=meshtrim.carry(v, f, attrs.normals, out_v, out_f, normals=True),
+            colours=meshtrim.carry(v, f, attrs.colours, out_v, out_f),
         )
         assert py.read_bytes() == cli.read_bytes(), job
 
@@ -308,8 +308,8 @@ def test_open3d_and_trimesh_adapters_carry_colours(coloured):
     cleaned = meshtrim.open3d.clean(scan)
     assert cleaned.has_vertex_colors() and cleaned.has_vertex_normals()
     v, f, attrs = meshtrim.read_mesh(coloured / "scan.ply", attributes=True)
-    out_v = np.asarray(cleaned.vertices)
-    want = meshtrim.carry(v, f, attrs.colours[:, :3], out_v)
+    out_v, out_f = np.asarray(cleaned.vertices), np.asarray(cleaned.triangles)
+    want = meshtrim.carry(v, f, attrs.colours[:, :3], out_v, out_f)
     assert np.abs(np.asarray(cleaned.vertex_colors) - want).max() < 1e-6
 
     tm = trimesh.load(coloured / "scan.ply", process=False)
@@ -318,3 +318,40 @@ def test_open3d_and_trimesh_adapters_carry_colours(coloured):
     assert out.visual.kind == "vertex"
     got = np.asarray(out.visual.vertex_colors, dtype=float)[:, :3]
     assert np.abs(got - want * 255).max() <= 1.0
+
+
+def test_each_side_of_a_seam_keeps_its_colour(coloured, tmp_path):
+    """The Poisson mesh split down the middle into two colour charts, as
+    a textured or hard-edged mesh is: the faces right of the middle get
+    their own copies of the vertices they share with the left ones, and
+    the right side is red. Trimmed, every output face is a piece of one
+    input face, so its three corners are of one side: all red or none,
+    kept and new vertices alike (position alone would give the seam's
+    right copies the left colours, and the right faces along the seam
+    mixed corners)."""
+    v, f, n_in, c_in = load(coloured / "poisson.ply")
+    middle = np.median(v[:, 0])
+    right = v[f].mean(axis=1)[:, 0] > middle
+    seam = np.intersect1d(np.unique(f[right]), np.unique(f[~right]))
+    assert len(seam) > 50
+    copy = np.arange(len(v))
+    copy[seam] = len(v) + np.arange(len(seam))
+    vertices = np.vstack([v, v[seam]])
+    colours = np.vstack([c_in, c_in[seam]]) / 255.0
+    normals = np.vstack([n_in, n_in[seam]])
+    faces = f.copy()
+    faces[right] = copy[f[right]]
+    colours[np.unique(faces[right])] = [1.0, 0.0, 0.0, 1.0]
+    ms = pymeshlab.MeshSet()
+    ms.add_mesh(pymeshlab.Mesh(vertices, faces, v_normals_matrix=normals, v_color_matrix=colours))
+    split = tmp_path / "split.ply"
+    ms.save_current_mesh(str(split), save_vertex_color=True, save_vertex_normal=True)
+    assert len(load(split)[0]) == len(vertices), "PyMeshLab kept the seam's copies"
+    out = tmp_path / "out.ply"
+    run_meshtrim(split, coloured / "cloud.ply", out)
+    _, f_out, _, c_out = load(out)
+    red = c_out[f_out][..., 1] == 0
+    all_red, none_red = red.all(axis=1), ~red.any(axis=1)
+    assert all_red.sum() > 1000 and none_red.sum() > 1000, (all_red.sum(), none_red.sum())
+    mixed = ~(all_red | none_red)
+    assert not mixed.any(), mixed.sum()

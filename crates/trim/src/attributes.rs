@@ -6,29 +6,40 @@
 //! they were and adds a few: where trimming cuts a face, where cleanup's
 //! smoothed loops replace a jagged border, where the Delaunay path meshes
 //! a cloud. The stages know nothing of attributes, so the carrying is done
-//! after them, from positions alone:
+//! after them, from the output mesh's positions and faces:
 //!
 //! - an output vertex at exactly the position of an input vertex is that
-//!   vertex ([`VertexSource::Vertex`]), its attributes copied bit for bit;
-//!   the first such input vertex when several share the position;
+//!   vertex ([`VertexSource::Vertex`]), its attributes copied bit for bit.
+//!   Where several input vertices share the position (a seam: a hard edge's
+//!   split normals, a texture chart's border), the output faces tell them
+//!   apart: an output face whose corners are an input face's, in the same
+//!   turn, takes that face's vertices, so each side of a seam keeps its
+//!   own. A vertex no such face settles (its faces were all cut or are
+//!   new) takes the vertex at its position of the input face nearest the
+//!   centroid of its first output face, among the faces around the
+//!   candidates: a cut face's piece lies on the face it was cut from;
 //! - any other lies on or near the input surface, and takes the
 //!   barycentric weights of its closest point on the closest input face
-//!   ([`VertexSource::Face`]; the lower face index on a tie), so a cut
-//!   vertex on an edge blends that edge's two ends;
+//!   ([`VertexSource::Face`]), so a cut vertex on an edge blends that
+//!   edge's two ends. On a tie (a vertex on a seam's edge is on the faces
+//!   of both sides) the face under the centroid of the vertex's first
+//!   output face wins, the face that piece was cut from; then the lower
+//!   face index;
 //! - from an input without faces (a cloud), the nearest input point.
 //!
 //! Normals are blended in direction and in length (unit ones stay unit);
-//! colours blended.
-//! Positions decide everything, so the result does not depend on how a
-//! stage numbered its vertices, nor on the number of threads.
+//! colours blended. The result is a function of the input and output
+//! meshes alone, whatever the number of threads.
 
 use parry3d_f64::math::Vector;
 use parry3d_f64::query::PointQueryWithLocation;
 use parry3d_f64::shape::Triangle;
+use std::collections::hash_map::Entry;
+
 use rayon::prelude::*;
 
 use crate::geom::{cross, dot, norm2, sub, unit, Point3};
-use crate::hash::HashMap;
+use crate::hash::{HashMap, HashSet};
 use crate::mesh::Mesh;
 use crate::spatial::closest_face::{FaceIndex, Scratch};
 use crate::spatial::PointTree;
@@ -48,15 +59,19 @@ pub enum VertexSource {
     },
 }
 
-/// Where each of `to` takes its attributes from in `from` (see the module
-/// doc); `from`'s face indices must be valid. `None` when `from` has no
-/// vertex to take them from (and `to` is not empty).
-pub fn vertex_sources(from: &Mesh, to: &[Point3]) -> Option<Vec<VertexSource>> {
-    let same_position = vertex_at_position(&from.vertices);
-    let exact: Vec<Option<u32>> = to
+/// Where each vertex of `to` takes its attributes from in `from` (see
+/// the module doc); the face indices of both must be valid. `None` when
+/// `from` has no vertex to take them from (and `to` has vertices).
+pub fn vertex_sources(from: &Mesh, to: &Mesh) -> Option<Vec<VertexSource>> {
+    let (same_position, seams) = vertex_at_position(&from.vertices);
+    let mut exact: Vec<Option<u32>> = to
+        .vertices
         .par_iter()
         .map(|p| same_position.get(&bits(p)).copied())
         .collect();
+    if !seams.is_empty() {
+        settle_seams(from, to, &seams, &mut exact);
+    }
     if exact.iter().all(Option::is_some) {
         return Some(
             exact
@@ -67,53 +82,244 @@ pub fn vertex_sources(from: &Mesh, to: &[Point3]) -> Option<Vec<VertexSource>> {
         );
     }
     if from.faces.is_empty() {
-        return nearest_points(&from.vertices, to, &exact);
+        return nearest_points(&from.vertices, &to.vertices, &exact);
     }
     let index = FaceIndex::new(from);
     let identity: Vec<u32> = (0..from.faces.len() as u32).collect();
     let labels = index.labels(&identity);
+    let first_face = first_faces(to, &exact);
+    let tie = TIE * diagonal(&from.vertices);
     let sources = to
+        .vertices
         .par_iter()
         .zip(&exact)
-        .map_init(Scratch::default, |scratch, (&p, found)| match *found {
-            Some(v) => VertexSource::Vertex(v),
-            None => {
-                // Every face is within an infinite reach of a finite point.
-                let face = index.nearest_label(p, f64::INFINITY, &labels, scratch);
-                face_source(from, face.unwrap_or(0), p)
+        .enumerate()
+        .map_init(Scratch::default, |scratch, (o, (&p, found))| {
+            if let Some(v) = *found {
+                return VertexSource::Vertex(v);
             }
+            // Every face is within an infinite reach of a finite point.
+            let mut nearest = |q: Point3| {
+                index
+                    .nearest_label(q, f64::INFINITY, &labels, scratch)
+                    .unwrap_or(0)
+            };
+            let closest = nearest(p);
+            let face = match first_face.get(&(o as u32)) {
+                Some(out) => {
+                    let own = nearest(centroid(&to.vertices, *out));
+                    own_face_if_as_near(from, p, [closest, own], tie)
+                }
+                None => closest,
+            };
+            face_source(from, face, p)
         })
         .collect();
     Some(sources)
 }
 
-/// [`vertex_sources`] by comparing every face: the reference it is tested
-/// against.
+/// How much farther than the closest face (relative to the input's
+/// bounding diagonal) the face of a new vertex's own output face may be
+/// and still be taken: rounding, as a vertex on a seam's edge lies on the
+/// faces of both sides.
+const TIE: f64 = 1e-9;
+
+/// The face a new vertex takes: `own`, the input face under the centroid
+/// of its first output face (the face that face is a piece of), when `p`
+/// is as near it as to `closest` (within `tie`); else `closest`. On a
+/// seam's edge both sides are nearest, and the piece says which.
+fn own_face_if_as_near(from: &Mesh, p: Point3, [closest, own]: [u32; 2], tie: f64) -> u32 {
+    let distance = |f: u32| closest_on_face(from, f, p).0.sqrt();
+    if own != closest && distance(own) <= distance(closest) + tie {
+        own
+    } else {
+        closest
+    }
+}
+
+/// The first output face at each output vertex without an exact source
+/// (a few, along the new border: a map rather than a slot per vertex).
+fn first_faces(to: &Mesh, exact: &[Option<u32>]) -> HashMap<u32, [u32; 3]> {
+    let mut first = HashMap::default();
+    for &face in &to.faces {
+        for v in face {
+            if exact[v as usize].is_none() {
+                first.entry(v).or_insert(face);
+            }
+        }
+    }
+    first
+}
+
+/// The length of the points' bounding box diagonal.
+fn diagonal(points: &[Point3]) -> f64 {
+    let mut low = [f64::INFINITY; 3];
+    let mut high = [f64::NEG_INFINITY; 3];
+    for p in points {
+        for k in 0..3 {
+            low[k] = low[k].min(p[k]);
+            high[k] = high[k].max(p[k]);
+        }
+    }
+    if points.is_empty() {
+        0.0
+    } else {
+        norm2(sub(high, low)).sqrt()
+    }
+}
+
+/// A face's corner positions, from corner `k` on in the face's turn.
+type Corners = [[u64; 3]; 3];
+
+fn corners_from(vertices: &[Point3], face: [u32; 3], k: usize) -> Corners {
+    std::array::from_fn(|j| bits(&vertices[face[(k + j) % 3] as usize]))
+}
+
+/// Gives the output vertices at a seam's positions (`seams`: positions
+/// several input vertices share) their own input vertex (see the module
+/// doc): by an input face with the same corners in the same turn (the
+/// first output face and the first input face settle it), else by the
+/// input face nearest their first output face's centroid.
+fn settle_seams(from: &Mesh, to: &Mesh, seams: &HashSet<[u64; 3]>, exact: &mut [Option<u32>]) {
+    // Looked up once per vertex, in parallel, rather than per face corner.
+    let seam_flags = |vertices: &[Point3]| -> Vec<bool> {
+        vertices
+            .par_iter()
+            .map(|p| seams.contains(&bits(p)))
+            .collect()
+    };
+    let (input_on_seam, output_on_seam) = (seam_flags(&from.vertices), seam_flags(&to.vertices));
+    let mut input_corner: HashMap<Corners, u32> = HashMap::default();
+    // The input faces around each seam position, in face order.
+    let mut around: HashMap<[u64; 3], Vec<u32>> = HashMap::default();
+    for (f, &face) in from.faces.iter().enumerate() {
+        for k in 0..3 {
+            if input_on_seam[face[k] as usize] {
+                let key = corners_from(&from.vertices, face, k);
+                input_corner.entry(key).or_insert(face[k]);
+                around.entry(key[0]).or_default().push(f as u32);
+            }
+        }
+    }
+    let mut settled = vec![false; to.vertices.len()];
+    let mut first_face: HashMap<u32, [u32; 3]> = HashMap::default();
+    for &face in &to.faces {
+        for k in 0..3 {
+            let v = face[k];
+            if settled[v as usize] || !output_on_seam[v as usize] {
+                continue;
+            }
+            first_face.entry(v).or_insert(face);
+            let key = corners_from(&to.vertices, face, k);
+            if let Some(&input) = input_corner.get(&key) {
+                exact[v as usize] = Some(input);
+                settled[v as usize] = true;
+            }
+        }
+    }
+    for (v, face) in first_face {
+        if !settled[v as usize] {
+            let position = bits(&to.vertices[v as usize]);
+            let faces = around.get(&position).map_or(&[][..], Vec::as_slice);
+            if let Some(input) = nearest_corner(from, faces, position, centroid(&to.vertices, face))
+            {
+                exact[v as usize] = Some(input);
+            }
+        }
+    }
+}
+
+fn centroid(vertices: &[Point3], face: [u32; 3]) -> Point3 {
+    let [a, b, c] = face.map(|v| vertices[v as usize]);
+    [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0)
+}
+
+/// The vertex at `position` of the face among `faces` nearest `p` (the
+/// lower index on a tie).
+fn nearest_corner(from: &Mesh, faces: &[u32], position: [u64; 3], p: Point3) -> Option<u32> {
+    let nearest = faces
+        .iter()
+        .map(|&f| (closest_on_face(from, f, p).0, f))
+        .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))?
+        .1;
+    from.faces[nearest as usize]
+        .into_iter()
+        .find(|&v| bits(&from.vertices[v as usize]) == position)
+}
+
+/// [`vertex_sources`] by comparing every vertex and face: the reference
+/// it is tested against.
 #[doc(hidden)]
-pub fn vertex_sources_reference(from: &Mesh, to: &[Point3]) -> Vec<VertexSource> {
-    to.iter()
-        .map(|p| {
-            if let Some(v) = from.vertices.iter().position(|q| bits(q) == bits(p)) {
-                return VertexSource::Vertex(v as u32);
+pub fn vertex_sources_reference(from: &Mesh, to: &Mesh) -> Vec<VertexSource> {
+    (0..to.vertices.len())
+        .map(|o| {
+            let p = to.vertices[o];
+            let at_p: Vec<u32> = (0..from.vertices.len() as u32)
+                .filter(|&v| bits(&from.vertices[v as usize]) == bits(&p))
+                .collect();
+            if let Some(&first) = at_p.first() {
+                let settled = (at_p.len() > 1)
+                    .then(|| same_face_corner(from, to, o as u32))
+                    .flatten();
+                return VertexSource::Vertex(settled.unwrap_or(first));
             }
             if from.faces.is_empty() {
                 let nearest = (0..from.vertices.len())
                     .min_by(|&a, &b| {
-                        let da = norm2(sub(from.vertices[a], *p));
-                        let db = norm2(sub(from.vertices[b], *p));
+                        let da = norm2(sub(from.vertices[a], p));
+                        let db = norm2(sub(from.vertices[b], p));
                         da.total_cmp(&db)
                     })
                     .unwrap_or(0);
                 return VertexSource::Vertex(nearest as u32);
             }
-            let nearest = (0..from.faces.len())
-                .map(|f| (closest_on_face(from, f as u32, *p).0, f as u32))
-                .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))
-                .map(|(_, f)| f)
-                .unwrap_or(0);
-            face_source(from, nearest, *p)
+            let nearest = |q: Point3| {
+                (0..from.faces.len())
+                    .map(|f| (closest_on_face(from, f as u32, q).0, f as u32))
+                    .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))
+                    .map_or(0, |(_, f)| f)
+            };
+            let closest = nearest(p);
+            let face = match to.faces.iter().find(|out| out.contains(&(o as u32))) {
+                Some(out) => {
+                    let own = nearest(centroid(&to.vertices, *out));
+                    let tie = TIE * diagonal(&from.vertices);
+                    own_face_if_as_near(from, p, [closest, own], tie)
+                }
+                None => closest,
+            };
+            face_source(from, face, p)
         })
         .collect()
+}
+
+/// The input vertex at output vertex `o`'s corner of the first input face
+/// whose corners, in turn, are those of the first output face at `o` that
+/// has such a twin; else the corner at `o`'s position of the input face
+/// nearest the centroid of the first output face at `o`.
+fn same_face_corner(from: &Mesh, to: &Mesh, o: u32) -> Option<u32> {
+    let at_o = |out: &[u32; 3]| out.iter().position(|&v| v == o);
+    let twin = to.faces.iter().find_map(|&out| {
+        let key = corners_from(&to.vertices, out, at_o(&out)?);
+        from.faces.iter().find_map(|&face| {
+            (0..3)
+                .find(|&j| corners_from(&from.vertices, face, j) == key)
+                .map(|j| face[j])
+        })
+    });
+    if twin.is_some() {
+        return twin;
+    }
+    let first = to.faces.iter().find(|out| at_o(out).is_some())?;
+    let position = bits(&to.vertices[o as usize]);
+    let around: Vec<u32> = (0..from.faces.len() as u32)
+        .filter(|&f| {
+            from.faces[f as usize]
+                .iter()
+                .any(|&v| bits(&from.vertices[v as usize]) == position)
+        })
+        .collect();
+    nearest_corner(from, &around, position, centroid(&to.vertices, *first))
 }
 
 /// `values` (one per input vertex) at each source: copied from a vertex,
@@ -173,14 +379,24 @@ fn bits(p: &Point3) -> [u64; 3] {
     p.map(f64::to_bits)
 }
 
-/// The first input vertex at each position.
-fn vertex_at_position(vertices: &[Point3]) -> HashMap<[u64; 3], u32> {
+/// The first input vertex at each position, and the positions several
+/// input vertices share.
+fn vertex_at_position(vertices: &[Point3]) -> (HashMap<[u64; 3], u32>, HashSet<[u64; 3]>) {
     let mut map = HashMap::default();
     map.reserve(vertices.len());
+    let mut shared = HashSet::default();
     for (v, p) in vertices.iter().enumerate() {
-        map.entry(bits(p)).or_insert(v as u32);
+        let key = bits(p);
+        match map.entry(key) {
+            Entry::Occupied(_) => {
+                shared.insert(key);
+            }
+            Entry::Vacant(slot) => {
+                slot.insert(v as u32);
+            }
+        }
     }
-    map
+    (map, shared)
 }
 
 /// Sources from a cloud: the exact match, else the nearest point (ties
@@ -257,6 +473,14 @@ mod tests {
     use super::*;
     use rand::{RngExt, SeedableRng};
 
+    /// Points without faces, as the mesh to carry attributes to.
+    fn points(vertices: &[Point3]) -> Mesh {
+        Mesh {
+            vertices: vertices.to_vec(),
+            faces: Vec::new(),
+        }
+    }
+
     /// A jittered grid sheet, its height a wave.
     fn sheet(n: usize, seed: u64) -> Mesh {
         let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
@@ -285,7 +509,7 @@ mod tests {
         let mesh = sheet(4, 1);
         let [a, b, _] = mesh.faces[0].map(|v| mesh.vertices[v as usize]);
         let midpoint = [0, 1, 2].map(|c| 0.5 * (a[c] + b[c]));
-        let sources = vertex_sources(&mesh, &[mesh.vertices[5], midpoint]).unwrap();
+        let sources = vertex_sources(&mesh, &points(&[mesh.vertices[5], midpoint])).unwrap();
         assert_eq!(sources[0], VertexSource::Vertex(5));
         let colours: Vec<[f64; 1]> = (0..mesh.vertices.len()).map(|v| [v as f64]).collect();
         let carried = carry(&mesh, &sources, &colours);
@@ -309,6 +533,7 @@ mod tests {
                 })
                 .collect();
             to.extend(mesh.vertices.iter().step_by(7));
+            let to = points(&to);
             let fast = vertex_sources(&mesh, &to).unwrap();
             let reference = vertex_sources_reference(&mesh, &to);
             // Carrying the positions themselves gives each source's point:
@@ -333,7 +558,8 @@ mod tests {
             vertices: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
             faces: vec![[0, 1, 2]],
         };
-        let sources = vertex_sources(&mesh, &[[0.25, 0.25, 0.0], [0.0, 0.0, 0.0]]).unwrap();
+        let sources =
+            vertex_sources(&mesh, &points(&[[0.25, 0.25, 0.0], [0.0, 0.0, 0.0]])).unwrap();
         let tilted = [0.6, 0.0, 0.8];
         let unit_normals = carry_normals(&mesh, &sources, &[[0.0, 0.0, 1.0], tilted, tilted]);
         let length = norm2(unit_normals[0]).sqrt();
@@ -351,11 +577,133 @@ mod tests {
             "a kept vertex keeps its normal as it was"
         );
         let cancelling = [[0.0, 0.0, 1.0], [0.0, 0.0, -1.0], [0.0, 0.0, 0.0]];
-        let midpoint = vertex_sources(&mesh, &[[0.5, 0.0, 0.0]]).unwrap();
+        let midpoint = vertex_sources(&mesh, &points(&[[0.5, 0.0, 0.0]])).unwrap();
         assert_eq!(
             carry_normals(&mesh, &midpoint, &cancelling)[0],
             [0.0, 0.0, 1.0]
         );
+    }
+
+    /// A sheet whose faces right of x = 5 have their own copies of their
+    /// vertices (a seam down the middle, and the originals of the right
+    /// half left unused, first at their positions); the output is the
+    /// sheet with its faces and vertices shuffled. Every output vertex
+    /// finds the input vertex its faces used, on either side of the seam,
+    /// as the reference does.
+    #[test]
+    fn each_side_of_a_seam_keeps_its_own_vertices() {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(3);
+        let mut mesh = sheet(10, 5);
+        let n = mesh.vertices.len() as u32;
+        let right: Vec<bool> = mesh
+            .faces
+            .iter()
+            .map(|f| f.iter().map(|&v| mesh.vertices[v as usize][0]).sum::<f64>() > 15.0)
+            .collect();
+        mesh.vertices.extend_from_within(..);
+        for (face, &right) in mesh.faces.iter_mut().zip(&right) {
+            if right {
+                *face = face.map(|v| v + n);
+            }
+        }
+        // The output: vertices in a random order, faces renumbered and
+        // turned to start at another corner.
+        let mut order: Vec<u32> = (0..mesh.vertices.len() as u32).collect();
+        for i in (1..order.len()).rev() {
+            order.swap(i, rng.random_range(0..=i));
+        }
+        let mut new_index = vec![0; order.len()];
+        for (new, &old) in order.iter().enumerate() {
+            new_index[old as usize] = new as u32;
+        }
+        let out = Mesh {
+            vertices: order.iter().map(|&v| mesh.vertices[v as usize]).collect(),
+            faces: mesh
+                .faces
+                .iter()
+                .rev()
+                .map(|f| [f[1], f[2], f[0]].map(|v| new_index[v as usize]))
+                .collect(),
+        };
+        let fast = vertex_sources(&mesh, &out).unwrap();
+        assert_eq!(fast, vertex_sources_reference(&mesh, &out));
+        for face in &out.faces {
+            for &v in face {
+                assert_eq!(fast[v as usize], VertexSource::Vertex(order[v as usize]));
+            }
+        }
+    }
+
+    /// The seamed sheet with every face cut in three at its centroid, so
+    /// that no output face has an input twin: each seam vertex takes the
+    /// vertex of the face its first piece was cut from.
+    #[test]
+    fn a_seam_whose_faces_were_all_cut_keeps_its_sides() {
+        let mut mesh = sheet(8, 6);
+        let n = mesh.vertices.len() as u32;
+        mesh.vertices.extend_from_within(..);
+        for face in mesh.faces.iter_mut() {
+            if face
+                .iter()
+                .map(|&v| mesh.vertices[v as usize][0])
+                .sum::<f64>()
+                > 12.0
+            {
+                *face = face.map(|v| v + n);
+            }
+        }
+        let mut out = mesh.clone();
+        out.faces.clear();
+        for &[a, b, c] in &mesh.faces {
+            let m = out.vertices.len() as u32;
+            out.vertices.push(centroid(&mesh.vertices, [a, b, c]));
+            out.faces.extend([[a, b, m], [b, c, m], [c, a, m]]);
+        }
+        let fast = vertex_sources(&mesh, &out).unwrap();
+        assert_eq!(fast, vertex_sources_reference(&mesh, &out));
+        // A used vertex is itself; an unused copy, in no face, the first
+        // vertex at its position.
+        let used: HashSet<u32> = mesh.faces.iter().flatten().copied().collect();
+        for v in 0..mesh.vertices.len() as u32 {
+            let want = if used.contains(&v) { v } else { v % n };
+            assert_eq!(fast[v as usize], VertexSource::Vertex(want), "vertex {v}");
+        }
+    }
+
+    /// Two triangles on either side of a seam, each with its own copies
+    /// of the seam's ends (face 0 left, face 1 right). A new vertex on the
+    /// seam's edge is on both; the piece of the right face it belongs to
+    /// gives it the right face, though face 0 has the lower index.
+    #[test]
+    fn a_new_vertex_on_a_seam_takes_its_pieces_face() {
+        let seam = [[0.0, 0.0, 0.0], [0.0, 2.0, 0.0]];
+        let mesh = Mesh {
+            vertices: vec![
+                seam[0],
+                seam[1],
+                [-1.0, 1.0, 0.0],
+                seam[0],
+                [1.0, 1.0, 0.0],
+                seam[1],
+            ],
+            faces: vec![[0, 1, 2], [3, 4, 5]],
+        };
+        // The right face cut along y = 1: its lower piece, with the cut's
+        // vertex on the seam at (0, 1, 0) and one on its other edge.
+        let out = Mesh {
+            vertices: vec![seam[0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
+            faces: vec![[0, 1, 2]],
+        };
+        for sources in [
+            vertex_sources(&mesh, &out).unwrap(),
+            vertex_sources_reference(&mesh, &out),
+        ] {
+            assert_eq!(sources[0], VertexSource::Vertex(3));
+            assert!(
+                matches!(sources[2], VertexSource::Face { face: 1, .. }),
+                "{sources:?}"
+            );
+        }
     }
 
     #[test]
@@ -364,7 +712,7 @@ mod tests {
             vertices: vec![[0.0, 0.0, 0.0], [10.0, 0.0, 0.0]],
             faces: Vec::new(),
         };
-        let to = [[1.0, 0.0, 0.0], [9.0, 1.0, 0.0], [10.0, 0.0, 0.0]];
+        let to = points(&[[1.0, 0.0, 0.0], [9.0, 1.0, 0.0], [10.0, 0.0, 0.0]]);
         let expected = [0, 1, 1].map(VertexSource::Vertex).to_vec();
         assert_eq!(vertex_sources(&cloud, &to), Some(expected.clone()));
         assert_eq!(vertex_sources(&Mesh::default(), &to), None);
