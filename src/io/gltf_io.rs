@@ -21,8 +21,9 @@
 //! Vertex attributes: `NORMAL` (float VEC3, turned by the world matrix's
 //! inverse transpose and scaled to unit length) and `COLOR_0` (float, or
 //! normalised unsigned byte or short, RGB or RGBA) are read when every
-//! primitive has them; the other attributes (texture coordinates,
-//! tangents, joints) are not.
+//! primitive has them in those types (otherwise the mesh is read without
+//! them); the other attributes (texture coordinates, tangents, joints)
+//! are not.
 //!
 //! Writing: one mesh with one primitive, `f32` positions with the `min` and
 //! `max` bounds the spec requires, `u32` indices, and with the vertex
@@ -111,13 +112,11 @@ fn add_normals(
         *normals = None;
         return Ok(());
     };
+    // Normals of another type (quantised ones) are not read: the mesh
+    // goes without them rather than not at all.
     if accessor.data_type() != DataType::F32 || accessor.dimensions() != Dimensions::Vec3 {
-        bail!(
-            "accessor {} (NORMAL) is {:?} {:?}, only float VEC3 normals are supported",
-            accessor.index(),
-            accessor.data_type(),
-            accessor.dimensions()
-        );
+        *normals = None;
+        return Ok(());
     }
     check_count(&accessor, primitive, "NORMAL")?;
     let (data, stride) = accessor_data(&accessor, buffers, 12, "NORMAL")?;
@@ -127,10 +126,9 @@ fn add_normals(
         let local = [0, 4, 8].map(|o| f64::from(LittleEndian::read_f32(&record[o..])));
         let n = turn.map(|row| row[0] * local[0] + row[1] * local[1] + row[2] * local[2]);
         let length = n.iter().map(|c| c * c).sum::<f64>().sqrt();
-        if !length.is_finite() {
-            bail!("NORMAL {i} is non-finite: {}", show(&local));
-        }
-        list.push(if length > 0.0 {
+        // A zero or non-finite normal stays as it is: the carrying takes
+        // a non-finite one as no direction.
+        list.push(if length > 0.0 && length.is_finite() {
             n.map(|c| c / length)
         } else {
             n
@@ -168,22 +166,24 @@ fn add_colours(
         *colours = None;
         return Ok(());
     };
+    // Colours of a type the spec does not allow are not read: the mesh
+    // goes without them rather than not at all.
     let channels = match accessor.dimensions() {
         Dimensions::Vec3 => 3,
         Dimensions::Vec4 => 4,
-        other => bail!(
-            "accessor {} (COLOR_0) is {other:?}, not VEC3 or VEC4",
-            accessor.index()
-        ),
+        _ => {
+            *colours = None;
+            return Ok(());
+        }
     };
     let (bytes, scale) = match (accessor.data_type(), accessor.normalized()) {
         (DataType::F32, _) => (4, 1.0),
         (DataType::U8, true) => (1, 1.0 / 255.0),
         (DataType::U16, true) => (2, 1.0 / 65535.0),
-        (other, _) => bail!(
-            "accessor {} (COLOR_0) is {other:?}, not float or normalised unsigned byte or short",
-            accessor.index()
-        ),
+        _ => {
+            *colours = None;
+            return Ok(());
+        }
     };
     check_count(&accessor, primitive, "COLOR_0")?;
     let (data, stride) = accessor_data(&accessor, buffers, channels * bytes, "COLOR_0")?;

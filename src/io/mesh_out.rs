@@ -112,7 +112,8 @@ pub fn write_mesh_with(
         })
         .with_context(|| path.display().to_string())?;
     check_mesh(format, vertices, faces).with_context(|| path.display().to_string())?;
-    check_attributes(vertices.len(), attributes).with_context(|| path.display().to_string())?;
+    check_attributes(format, vertices.len(), attributes)
+        .with_context(|| path.display().to_string())?;
     write_atomic(path, |w| format.write(w, vertices, faces, attributes))
 }
 
@@ -192,17 +193,34 @@ pub fn write_mesh_carrying(
     })
 }
 
-/// Checks that there is one normal and one colour per vertex, all finite.
-fn check_attributes(vertices: usize, attributes: &VertexAttributes) -> Result<()> {
+/// Checks that `format` holds the attributes given, one normal and one
+/// colour per vertex, all finite (normals within `f32`'s range for PLY,
+/// which stores them as `float`).
+fn check_attributes(
+    format: MeshFormat,
+    vertices: usize,
+    attributes: &VertexAttributes,
+) -> Result<()> {
+    if !format.holds_attributes() && !attributes.is_empty() {
+        bail!(
+            "{} holds no vertex normals or colours: write .ply, .obj, .gltf or .glb",
+            format_name(format)
+        );
+    }
     if let Some(normals) = &attributes.normals {
         if normals.len() != vertices {
             bail!("{} normals for {vertices} vertices", normals.len());
         }
-        if let Some(i) = normals
-            .iter()
-            .position(|n| n.iter().any(|c| !c.is_finite()))
-        {
-            bail!("vertex {i} has a non-finite normal {}", show(&normals[i]));
+        let fits = |c: &f64| match format {
+            MeshFormat::Ply => (*c as f32).is_finite(),
+            _ => c.is_finite(),
+        };
+        if let Some(i) = normals.iter().position(|n| !n.iter().all(fits)) {
+            bail!(
+                "vertex {i}'s normal {} is not finite in {}",
+                show(&normals[i]),
+                format_name(format)
+            );
         }
     }
     if let Some(colours) = &attributes.colours {

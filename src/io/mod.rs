@@ -171,7 +171,8 @@ impl VertexAttributes {
     /// These attributes, of `from`'s vertices, at the vertices of `to`, a
     /// mesh made from it: copied where a vertex was kept, blended from the
     /// closest point of `from` elsewhere (see [`trim::vertex_sources`]).
-    /// Empty when there is nothing to carry or `from` has no vertex.
+    /// A non-finite normal is carried as zero (no direction). Empty when
+    /// there is nothing to carry or `from` has no vertex.
     pub fn carried(&self, from: &trim::Mesh, to: &trim::Mesh) -> VertexAttributes {
         if self.is_empty() {
             return VertexAttributes::default();
@@ -180,10 +181,18 @@ impl VertexAttributes {
             return VertexAttributes::default();
         };
         VertexAttributes {
-            normals: self
-                .normals
-                .as_ref()
-                .map(|normals| trim::carry_normals(from, &sources, normals)),
+            normals: self.normals.as_ref().map(|normals| {
+                // A file's NaN normal has no direction: zero, so that it
+                // blends as none and the output stays writable.
+                let finite: Vec<Point3> = normals
+                    .iter()
+                    .map(|n| match n.iter().all(|c| c.is_finite()) {
+                        true => *n,
+                        false => [0.0; 3],
+                    })
+                    .collect();
+                trim::carry_normals(from, &sources, &finite)
+            }),
             colours: self.colours.as_ref().map(|colours| Colours {
                 rgba: trim::carry(from, &sources, &colours.rgba),
                 alpha: colours.alpha,

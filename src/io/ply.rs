@@ -913,9 +913,17 @@ struct ColourColumns {
 impl ColourColumns {
     /// Red, green, blue and alpha in 0..1 (alpha 1 where there is none).
     fn rgba(&self, rgb: Point3, alpha: Option<f64>) -> [f64; 4] {
-        let [r, g, b] = rgb.map(|c| (c * self.scale).clamp(0.0, 1.0));
-        let a = alpha.map_or(1.0, |a| (a * self.scale).clamp(0.0, 1.0));
-        [r, g, b, a]
+        let unit = |c: f64| {
+            let c = c * self.scale;
+            // A NaN channel (of a float colour) reads as 0.
+            if c.is_nan() {
+                0.0
+            } else {
+                c.clamp(0.0, 1.0)
+            }
+        };
+        let [r, g, b] = rgb.map(unit);
+        [r, g, b, alpha.map_or(1.0, unit)]
     }
 }
 

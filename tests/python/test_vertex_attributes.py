@@ -265,6 +265,16 @@ def test_python_carry_shapes_and_errors(coloured):
         meshtrim.carry(v, f, attrs.colours, v, normals=True)
     with pytest.raises(meshtrim.MeshtrimError, match="colours"):
         meshtrim.write_mesh("/tmp/never.ply", v, f, colours=np.zeros((len(v), 2)))
+    with pytest.raises(meshtrim.MeshtrimError, match="STL holds no vertex normals or colours"):
+        meshtrim.write_mesh("/tmp/never.stl", v, f, colours=attrs.colours)
+    huge = attrs.normals.copy()
+    huge[7] = [1e300, 0, 0]
+    with pytest.raises(meshtrim.MeshtrimError, match="vertex 7's normal .* is not finite in PLY"):
+        meshtrim.write_mesh("/tmp/never.ply", v, f, normals=huge)
+    nan = attrs.colours.copy()
+    nan[3, 1] = np.nan
+    with pytest.raises(meshtrim.MeshtrimError, match="vertex 3 has a non-finite colour"):
+        meshtrim.write_mesh("/tmp/never.ply", v, f, colours=nan)
     _, _, plain = meshtrim.read_mesh(FIXTURES / "blade_jagged.stl", attributes=True)
     assert plain == meshtrim.VertexAttributes(None, None)
 
@@ -355,3 +365,32 @@ def test_each_side_of_a_seam_keeps_its_colour(coloured, tmp_path):
     assert all_red.sum() > 1000 and none_red.sum() > 1000, (all_red.sum(), none_red.sum())
     mixed = ~(all_red | none_red)
     assert not mixed.any(), mixed.sum()
+
+
+def test_a_nan_normal_in_the_input_does_not_stop_the_job(coloured, tmp_path):
+    """A PLY whose normals include NaN (written here by hand: PyMeshLab
+    replaces a NaN normal by one of its own): cleaned all the same, the
+    NaN carried as a zero normal."""
+    v, f, n, _ = load(coloured / "scan.ply")
+    plain = tmp_path / "plain.ply"
+    run_meshtrim("clean", coloured / "scan.ply", plain)
+    kept = {tuple(p) for p in load(plain)[0].tolist()}
+    inner = next(i for i, p in enumerate(v.tolist()) if tuple(p) in kept)
+    n = n.copy()
+    n[inner] = np.nan
+    src = tmp_path / "nan.ply"
+    header = (
+        f"ply\nformat ascii 1.0\nelement vertex {len(v)}\n"
+        "property double x\nproperty double y\nproperty double z\n"
+        "property float nx\nproperty float ny\nproperty float nz\n"
+        f"element face {len(f)}\nproperty list uchar int vertex_indices\nend_header\n"
+    )
+    rows = [" ".join(map(repr, [*p, *q])) for p, q in zip(v.tolist(), n.tolist())]
+    faces = [f"3 {a} {b} {c}" for a, b, c in f.tolist()]
+    src.write_text(header + "\n".join(rows + faces) + "\n")
+    out = tmp_path / "out.ply"
+    run_meshtrim("clean", src, out)
+    v_out, _, n_out, _ = load(out)
+    assert np.isfinite(n_out).all()
+    at = np.flatnonzero((v_out == v[inner]).all(axis=1))
+    assert len(at) == 1 and (n_out[at[0]] == 0).all(), n_out[at]
