@@ -50,14 +50,21 @@ def check_nearest(points, colours, vertices, got, report):
     assert np.array_equal(got, colours[nearest].astype(int))
 
 
-def test_e57_colours_reach_the_mesh(tmp_path):
+def write_coloured_e57(path):
+    """The coloured blade as one E57 scan, written by pye57; its points
+    and colours."""
     points, rgb = blade()
-    path = tmp_path / "blade.e57"
     e = pye57.E57(str(path), mode="w")
     data = {"cartesianX": points[:, 0], "cartesianY": points[:, 1], "cartesianZ": points[:, 2]}
     data.update(colorRed=rgb[:, 0], colorGreen=rgb[:, 1], colorBlue=rgb[:, 2])
     e.write_scan_raw(data)
     e.close()
+    return points, rgb
+
+
+def test_e57_colours_reach_the_mesh(tmp_path):
+    path = tmp_path / "blade.e57"
+    points, rgb = write_coloured_e57(path)
     scan = pye57.E57(str(path)).read_scan(0, colors=True, ignore_missing_fields=True)
     read = np.column_stack([scan["colorRed"], scan["colorGreen"], scan["colorBlue"]])
     assert np.array_equal(read, rgb)
@@ -146,13 +153,8 @@ def test_pcd_rgba_of_a_real_stereo_scan():
 def test_read_cloud_gives_the_reference_readers_colours(tmp_path):
     import meshtrim
 
-    points, rgb = blade()
     path = tmp_path / "blade.e57"
-    e = pye57.E57(str(path), mode="w")
-    data = {"cartesianX": points[:, 0], "cartesianY": points[:, 1], "cartesianZ": points[:, 2]}
-    data.update(colorRed=rgb[:, 0], colorGreen=rgb[:, 1], colorBlue=rgb[:, 2])
-    e.write_scan_raw(data)
-    e.close()
+    points, rgb = write_coloured_e57(path)
     _, attrs = meshtrim.read_cloud(path, attributes=True)
     assert attrs.normals is None and attrs.colours.shape == (len(points), 3)
     assert np.array_equal(np.rint(attrs.colours * 255).astype(np.uint8), rgb)
