@@ -101,7 +101,7 @@ pub struct Cloud {
     /// normal_x/normal_y/normal_z).
     pub normals: Option<Vec<Point3>>,
     /// Per-point colours, when the file has them (PLY, OBJ and glTF
-    /// vertex colours).
+    /// vertex colours, E57 and LAS colour, PCD's packed `rgb`/`rgba`).
     pub colours: Option<Colours>,
     /// Points dropped by the reader: a NaN or infinite coordinate (PCD), or
     /// no position (E57's invalid states).
