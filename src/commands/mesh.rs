@@ -127,22 +127,24 @@ pub fn run(args: &Args) -> Result<()> {
     // The cloud's normals and colours, carried to the vertices from the
     // nearest point (the cloud's own points are the mesh's vertices).
     let attributes = VertexAttributes {
-        normals: cloud.normals.clone(),
-        colours: cloud.colours.clone(),
+        normals: cloud.normals,
+        colours: cloud.colours,
     };
     let points = trim::Mesh {
-        // Copied only when there is something to carry.
-        vertices: match attributes.is_empty() {
-            true => Vec::new(),
-            false => cloud.points.clone(),
-        },
+        vertices: cloud.points,
         faces: Vec::new(),
     };
     let carried = write_mesh_carrying(&args.output, &mesh, &points, &attributes)?;
     report.vertex_attributes = carried.written;
     report.vertex_attributes_not_written = carried.not_written;
     if let Some(path) = &args.edges {
-        write_edges(path, &cloud.points, &detection, &edges, args.file.options())?;
+        write_edges(
+            path,
+            &points.vertices,
+            &detection,
+            &edges,
+            args.file.options(),
+        )?;
     }
     report.read_ms = millis(read_time);
     report.write_ms = millis(started.elapsed());

@@ -23,7 +23,7 @@ use anyhow::{anyhow, bail, Context, Result};
 use e57::{CartesianCoordinate, E57Reader, RecordName};
 use rayon::prelude::*;
 
-use super::{Cloud, Colours, Format, GridIndex, Point3};
+use super::{unit_channel, Cloud, Colours, Format, GridIndex, Point3};
 
 /// The file signature at the start of every E57 file.
 const SIGNATURE: &[u8] = b"ASTM-E57";
@@ -174,14 +174,7 @@ fn read_scan(bytes: &[u8], scan: &e57::PointCloud, wanted: Wanted) -> Result<Sca
 /// A point's colour in 0..1 (clamped: limits a file understates leave
 /// values beyond them), black where the point's colour is invalid.
 fn colour_of(colour: Option<&e57::Color>) -> [f64; 4] {
-    let channel = |c: f32| {
-        let c = f64::from(c);
-        if c.is_nan() {
-            0.0
-        } else {
-            c.clamp(0.0, 1.0)
-        }
-    };
+    let channel = |c: f32| unit_channel(f64::from(c));
     match colour {
         Some(c) => [channel(c.red), channel(c.green), channel(c.blue), 1.0],
         None => [0.0, 0.0, 0.0, 1.0],

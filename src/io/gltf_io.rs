@@ -41,7 +41,7 @@ use byteorder::{ByteOrder, LittleEndian};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 
-use super::{show, Colours, Mesh, Point3, VertexAttributes};
+use super::{show, unit_channel, Colours, Mesh, Point3, VertexAttributes};
 
 /// Whether the bytes are a GLB container (the `glTF` magic).
 pub fn is_glb(bytes: &[u8]) -> bool {
@@ -197,9 +197,7 @@ fn add_colours(
         let record = &data[i * stride..];
         let mut rgba = [1.0; 4];
         for (c, slot) in rgba.iter_mut().enumerate().take(channels) {
-            let v = value(&record[c * bytes..]) * scale;
-            // NaN too becomes 0, so a colour is always in 0..1.
-            *slot = if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
+            *slot = unit_channel(value(&record[c * bytes..]) * scale);
         }
         list.rgba.push(rgba);
     }

@@ -151,6 +151,16 @@ pub struct Colours {
     pub alpha: bool,
 }
 
+/// A colour channel already scaled to 0..1 by its type, clamped there; a
+/// NaN (of a float channel) reads as 0, so colours are always in 0..1.
+pub(crate) fn unit_channel(c: f64) -> f64 {
+    if c.is_nan() {
+        0.0
+    } else {
+        c.clamp(0.0, 1.0)
+    }
+}
+
 /// The per-vertex attributes a mesh file holds besides positions, which
 /// the commands that write a mesh carry to it
 /// ([`trim::vertex_sources`]).

@@ -13,7 +13,9 @@ use anyhow::{anyhow, bail, Result};
 
 use rayon::prelude::*;
 
-use super::{cut_after_newlines, lines, show, text_of, Colours, Mesh, Point3, PIECE_BYTES};
+use super::{
+    cut_after_newlines, lines, show, text_of, unit_channel, Colours, Mesh, Point3, PIECE_BYTES,
+};
 
 /// Reads the vertices and faces of an OBJ file.
 ///
@@ -180,7 +182,8 @@ fn parse_vertex<'a>(words: impl Iterator<Item = &'a str>) -> Result<(Point3, Opt
     let rest: Vec<f64> = words.take(4).map_while(|w| w.parse().ok()).collect();
     let colour = match rest[..] {
         [r, g, b] if [r, g, b].iter().all(|c| c.is_finite()) => {
-            Some([r.clamp(0.0, 1.0), g.clamp(0.0, 1.0), b.clamp(0.0, 1.0), 1.0])
+            let [r, g, b] = [r, g, b].map(unit_channel);
+            Some([r, g, b, 1.0])
         }
         _ => None,
     };

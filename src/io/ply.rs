@@ -54,7 +54,7 @@ use rayon::prelude::*;
 
 use super::{
     capacity, cut_after_newlines, mixed_line_ending, next_line, show, strip_bom, truncated,
-    Colours, HeaderEol, Mesh, Point3, PIECE_BYTES,
+    unit_channel, Colours, HeaderEol, Mesh, Point3, PIECE_BYTES,
 };
 
 /// A PLY scalar type.
@@ -913,15 +913,7 @@ struct ColourColumns {
 impl ColourColumns {
     /// Red, green, blue and alpha in 0..1 (alpha 1 where there is none).
     fn rgba(&self, rgb: Point3, alpha: Option<f64>) -> [f64; 4] {
-        let unit = |c: f64| {
-            let c = c * self.scale;
-            // A NaN channel (of a float colour) reads as 0.
-            if c.is_nan() {
-                0.0
-            } else {
-                c.clamp(0.0, 1.0)
-            }
-        };
+        let unit = |c: f64| unit_channel(c * self.scale);
         let [r, g, b] = rgb.map(unit);
         [r, g, b, alpha.map_or(1.0, unit)]
     }

@@ -41,7 +41,7 @@ use rayon::prelude::*;
 use crate::geom::{cross, dot, norm2, sub, unit, Point3};
 use crate::hash::{HashMap, HashSet};
 use crate::mesh::Mesh;
-use crate::spatial::closest_face::{FaceIndex, Scratch};
+use crate::spatial::closest_face::{bounds, FaceIndex, Scratch};
 use crate::spatial::PointTree;
 
 /// Where an output vertex takes its attributes from in the input mesh.
@@ -88,7 +88,7 @@ pub fn vertex_sources(from: &Mesh, to: &Mesh) -> Option<Vec<VertexSource>> {
     let identity: Vec<u32> = (0..from.faces.len() as u32).collect();
     let labels = index.labels(&identity);
     let first_face = first_faces(to, &exact);
-    let tie = TIE * diagonal(&from.vertices);
+    let tie = TIE * diagonal(from);
     let sources = to
         .vertices
         .par_iter()
@@ -137,6 +137,13 @@ fn own_face_if_as_near(from: &Mesh, p: Point3, [closest, own]: [u32; 2], tie: f6
     }
 }
 
+/// The length of the diagonal of the mesh's bounding box (a mesh with
+/// faces has vertices, so the box is not empty).
+fn diagonal(mesh: &Mesh) -> f64 {
+    let (low, high) = bounds(mesh.vertices.iter().copied());
+    norm2(sub(high, low)).sqrt()
+}
+
 /// The first output face at each output vertex without an exact source
 /// (a few, along the new border: a map rather than a slot per vertex).
 fn first_faces(to: &Mesh, exact: &[Option<u32>]) -> HashMap<u32, [u32; 3]> {
@@ -149,23 +156,6 @@ fn first_faces(to: &Mesh, exact: &[Option<u32>]) -> HashMap<u32, [u32; 3]> {
         }
     }
     first
-}
-
-/// The length of the points' bounding box diagonal.
-fn diagonal(points: &[Point3]) -> f64 {
-    let mut low = [f64::INFINITY; 3];
-    let mut high = [f64::NEG_INFINITY; 3];
-    for p in points {
-        for k in 0..3 {
-            low[k] = low[k].min(p[k]);
-            high[k] = high[k].max(p[k]);
-        }
-    }
-    if points.is_empty() {
-        0.0
-    } else {
-        norm2(sub(high, low)).sqrt()
-    }
 }
 
 /// A face's corner positions, from corner `k` on in the face's turn.
@@ -283,7 +273,7 @@ pub fn vertex_sources_reference(from: &Mesh, to: &Mesh) -> Vec<VertexSource> {
             let face = match to.faces.iter().find(|out| out.contains(&(o as u32))) {
                 Some(out) => {
                     let own = nearest(centroid(&to.vertices, *out));
-                    let tie = TIE * diagonal(&from.vertices);
+                    let tie = TIE * diagonal(from);
                     own_face_if_as_near(from, p, [closest, own], tie)
                 }
                 None => closest,
