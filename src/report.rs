@@ -66,16 +66,20 @@ pub fn emit<R: Serialize + Table>(report: &R, file: Option<&Path>, json: bool) -
 /// format cannot hold; no row when the input had none.
 pub fn add_attributes_row(
     rows: &mut Vec<(&str, String)>,
-    [written, not_written]: [&[&str]; 2],
+    [written, not_written]: [&[String]; 2],
     how: &str,
 ) {
-    let row = match (written, not_written) {
-        ([], []) => return,
-        (written, []) => format!("{} ({how})", written.join(", ")),
-        (_, not_written) => format!(
-            "{} not written: the output's format holds none",
+    let written = (!written.is_empty()).then(|| format!("{} ({how})", written.join(", ")));
+    let not_written = (!not_written.is_empty()).then(|| {
+        format!(
+            "{} not written: the output's format does not hold them",
             not_written.join(", ")
-        ),
+        )
+    });
+    let row = match (written, not_written) {
+        (None, None) => return,
+        (Some(row), None) | (None, Some(row)) => row,
+        (Some(written), Some(not_written)) => format!("{written}; {not_written}"),
     };
     let at = rows
         .iter()

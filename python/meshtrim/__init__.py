@@ -395,28 +395,49 @@ def read_cloud(path: PathLike, *, scan: Optional[int] = None, attributes: bool =
     E57) that ``mesh`` carries to its vertices."""
     if scan is not None:
         scan = _k(scan)
-    points, normals, colours, alpha = _meshtrim.read_cloud(os.fspath(path), scan)
+    points, normals, colours, alpha, fields = _meshtrim.read_cloud(os.fspath(path), scan)
     if not attributes:
         return points
-    return points, _attributes(normals, colours, alpha)
+    return points, _attributes(normals, colours, alpha, fields)
 
 
-def _attributes(normals, colours, alpha) -> "VertexAttributes":
-    """Normals and colours as :class:`VertexAttributes` (RGB when the file
-    had no alpha)."""
+_PLY_TYPES = {
+    "char": np.int8,
+    "uchar": np.uint8,
+    "short": np.int16,
+    "ushort": np.uint16,
+    "int": np.int32,
+    "uint": np.uint32,
+    "float": np.float32,
+    "double": np.float64,
+}
+"""The PLY types of a file's own values and the NumPy types that hold
+them."""
+
+
+def _attributes(normals, colours, alpha, fields) -> "VertexAttributes":
+    """Normals, colours and the file's own values as
+    :class:`VertexAttributes` (RGB when the file had no alpha; each value
+    in the NumPy type of its PLY type)."""
     if colours is not None and not alpha:
         colours = np.ascontiguousarray(colours[:, :3])
-    return VertexAttributes(normals, colours)
+    scalars = {name: values.astype(_PLY_TYPES[kind]) for name, kind, values in fields}
+    return VertexAttributes(normals, colours, scalars)
 
 
 class VertexAttributes(NamedTuple):
     """A mesh file's per-vertex attributes: ``normals`` ``(n, 3)``
     float64 and ``colours`` ``(n, 4)`` float64 RGBA in 0..1 (alpha 1 where
     the file has none, and then ``colours[:, :3]`` is what it held), each
-    ``None`` when the file has none."""
+    ``None`` when the file has none; ``scalars``, the file's own values
+    by name (PLY's other vertex properties, such as MeshLab's ``quality``
+    or a scanner's ``confidence``; glTF's ``_NAME`` attributes), each an
+    ``(n,)`` array of the NumPy type of its stored type (``uchar``:
+    uint8, ``int``: int32, ``float``: float32 …)."""
 
     normals: Optional[np.ndarray]
     colours: Optional[np.ndarray]
+    scalars: dict = {}
 
 
 def read_mesh(path: PathLike, *, attributes: bool = False) -> tuple:
@@ -425,14 +446,20 @@ def read_mesh(path: PathLike, *, attributes: bool = False) -> tuple:
     ``attributes=True``, ``(vertices, faces, VertexAttributes)``: the
     vertex normals (PLY, glTF) and colours (PLY, OBJ, glTF) the CLI
     carries to its outputs."""
-    vertices, faces, normals, colours, alpha = _meshtrim.read_mesh(os.fspath(path))
+    vertices, faces, normals, colours, alpha, fields = _meshtrim.read_mesh(os.fspath(path))
     if not attributes:
         return vertices, faces
-    return vertices, faces, _attributes(normals, colours, alpha)
+    return vertices, faces, _attributes(normals, colours, alpha, fields)
 
 
 def write_mesh(
-    path: PathLike, vertices: Any, faces: Any, *, normals: Any = None, colours: Any = None
+    path: PathLike,
+    vertices: Any,
+    faces: Any,
+    *,
+    normals: Any = None,
+    colours: Any = None,
+    scalars: Optional[dict] = None,
 ) -> None:
     """Writes a mesh as the CLI writes its outputs: the format from the
     extension (.obj, .ply and .stl binary, .gltf, .glb), missing parent
@@ -441,12 +468,29 @@ def write_mesh(
     0..1) are written with the vertices by every format but STL, as the
     CLI writes them: PLY ``float nx ny nz`` and ``uchar red green blue
     [alpha]``, OBJ ``v x y z r g b`` and ``vn``, glTF ``NORMAL`` (unit) and
-    ``COLOR_0``."""
+    ``COLOR_0``. ``scalars`` (name: ``(n,)`` array) are values of the
+    file's own, written as PLY properties of the array's type (int8 …
+    uint32, float32, float64) or glTF ``_NAME`` attributes; OBJ and STL
+    hold none."""
     v = _float_rows(vertices, "vertices")
     f = _face_rows(faces, len(v))
     n = None if normals is None else _per_vertex(normals, "normals", len(v), (3,))
     c = None if colours is None else _per_vertex(colours, "colours", len(v), (3, 4))
-    _meshtrim.write_mesh(os.fspath(path), v, f, n, c)
+    fields = [_field(name, values, len(v)) for name, values in (scalars or {}).items()]
+    _meshtrim.write_mesh(os.fspath(path), v, f, n, c, fields)
+
+
+def _field(name: Any, values: Any, vertices: int) -> tuple:
+    """``(name, PLY type, float64 values)`` of one of the file's own
+    values."""
+    a = np.asarray(values)
+    kinds = {np.dtype(t): kind for kind, t in _PLY_TYPES.items()}
+    if a.dtype not in kinds:
+        known = ", ".join(np.dtype(t).name for t in _PLY_TYPES.values())
+        raise MeshtrimError(f"scalars[{name!r}]: {a.dtype} values have no PLY type; give one of {known}")
+    if a.shape != (vertices,):
+        raise MeshtrimError(f"scalars[{name!r}]: expected an array of shape ({vertices},), got {a.shape}")
+    return str(name), kinds[a.dtype], np.ascontiguousarray(a, dtype=np.float64)
 
 
 def _per_vertex(array: Any, name: str, vertices: int, widths: tuple) -> np.ndarray:
@@ -459,7 +503,14 @@ def _per_vertex(array: Any, name: str, vertices: int, widths: tuple) -> np.ndarr
 
 
 def carry(
-    vertices: Any, faces: Any, values: Any, out_vertices: Any, out_faces: Any = None, *, normals: bool = False
+    vertices: Any,
+    faces: Any,
+    values: Any,
+    out_vertices: Any,
+    out_faces: Any = None,
+    *,
+    normals: bool = False,
+    nearest: Optional[bool] = None,
 ) -> np.ndarray:
     """Per-vertex ``values`` of the mesh ``vertices``, ``faces`` (or of a
     cloud: ``faces`` ``None`` or empty) at the vertices of a mesh made
@@ -472,7 +523,11 @@ def carry(
     output faces say which is which: give ``out_faces`` for meshes with
     seams. ``values`` is ``(n,)`` or ``(n, k)``: colours, a quality,
     texture coordinates. With ``normals=True`` (``k`` = 3) rows blend as
-    normals do: the direction, at the blended length.
+    normals do: the direction, at the blended length. Integer (and bool)
+    values, labels or flags, are not blended: a new vertex takes the row
+    of its face's corner of the largest weight, in the values' own type
+    (``nearest``, by default whether the values are integers, says which).
+    A corner of weight 0 adds nothing to a blend, not even a NaN.
 
     >>> v, f, attrs = meshtrim.read_mesh("poisson.ply", attributes=True)
     >>> out_v, out_f, _ = meshtrim.trim(v, f, points)
@@ -480,14 +535,18 @@ def carry(
     """
     v = _float_rows(vertices, "vertices")
     f = _faces_or_none(faces, len(v))
-    values = np.asarray(values, dtype=np.float64)
+    given = np.asarray(values)
+    labels = given.dtype.kind in "biu"
+    nearest = labels if nearest is None else bool(nearest)
+    values = given.astype(np.float64)
     flat = values.ndim == 1
     table = np.ascontiguousarray(values.reshape(-1, 1) if flat else values)
     if table.ndim != 2 or table.shape[0] != len(v):
         raise MeshtrimError(f"values: expected an array of shape ({len(v)},) or ({len(v)}, k), got {values.shape}")
     to = _float_rows(out_vertices, "out_vertices")
-    out = _meshtrim.carry(v, f, table, to, _faces_or_none(out_faces, len(to)), bool(normals))
-    return out[:, 0] if flat else out
+    out = _meshtrim.carry(v, f, table, to, _faces_or_none(out_faces, len(to)), bool(normals), nearest)
+    out = out[:, 0] if flat else out
+    return out.astype(given.dtype) if labels and nearest else out
 
 
 def _faces_or_none(faces: Any, vertices: int) -> np.ndarray:

@@ -49,18 +49,21 @@ def clean(
     view_from: Vector,
     repair: bool,
 ) -> Tuple[Points, Faces, str]: ...
+Fields = list[Tuple[str, str, npt.NDArray[np.float64]]]
+
 def read_cloud(
     path: str | PathLike[str], scan: Optional[int] = None
-) -> Tuple[Points, Optional[Points], Optional[npt.NDArray[np.float64]], bool]: ...
+) -> Tuple[Points, Optional[Points], Optional[npt.NDArray[np.float64]], bool, Fields]: ...
 def read_mesh(
     path: str | PathLike[str],
-) -> Tuple[Points, Faces, Optional[Points], Optional[npt.NDArray[np.float64]], bool]: ...
+) -> Tuple[Points, Faces, Optional[Points], Optional[npt.NDArray[np.float64]], bool, Fields]: ...
 def write_mesh(
     path: str | PathLike[str],
     vertices: Points,
     faces: npt.NDArray[np.uint32],
     normals: Optional[Points],
     colours: Optional[npt.NDArray[np.float64]],
+    scalars: Fields,
 ) -> None: ...
 def carry(
     vertices: Points,
@@ -69,6 +72,7 @@ def carry(
     to: Points,
     to_faces: npt.NDArray[np.uint32],
     normals: bool,
+    nearest: bool,
 ) -> npt.NDArray[np.float64]: ...
 def write_edges(
     path: str | PathLike[str],

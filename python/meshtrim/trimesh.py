@@ -1,8 +1,10 @@
 """meshtrim on trimesh objects: a new ``trimesh.Trimesh`` out, built with
 ``process=False`` so that its arrays are meshtrim's exactly; the report is
 in ``result.metadata["meshtrim"]``. Vertex colours, when the input has
-them, are carried to the new mesh (:func:`meshtrim.carry`); trimesh
-computes normals from the faces.
+them, and its ``vertex_attributes`` (glTF's ``_NAME`` attributes, say) are
+carried to the new mesh (:func:`meshtrim.carry`: integer ones from the
+nearest corner, in their own type); trimesh computes normals from the
+faces.
 
 >>> cleaned = meshtrim.trimesh.clean(trimesh.load("scan.stl", process=False))
 """
@@ -23,7 +25,18 @@ def _result(vertices: np.ndarray, faces: np.ndarray, report: dict, source: trime
         rgba = np.asarray(source.visual.vertex_colors, dtype=np.float64)
         carried = meshtrim.carry(source.vertices, source.faces, rgba, vertices, faces)
         colours = np.clip(np.rint(carried), 0, 255).astype(np.uint8)
-    out = trimesh.Trimesh(vertices=vertices, faces=faces, vertex_colors=colours, process=False)
+    attributes = {
+        name: meshtrim.carry(source.vertices, source.faces, values, vertices, faces).astype(values.dtype)
+        for name, values in source.vertex_attributes.items()
+        if np.ndim(values) in (1, 2) and len(values) == len(source.vertices)
+    }
+    out = trimesh.Trimesh(
+        vertices=vertices,
+        faces=faces,
+        vertex_colors=colours,
+        vertex_attributes=attributes,
+        process=False,
+    )
     out.metadata["meshtrim"] = report
     return out
 

@@ -352,7 +352,7 @@ fn clean_py<'py>(
 }
 
 /// A cloud's points, normals and colours (RGBA in 0..1, and whether the
-/// file had an alpha channel), read as every command reads a cloud
+/// file had an alpha channel) and the file's own values, read as every command reads a cloud
 /// (`scan`: one scan of an E57 file, as `--scan`).
 #[pyfunction]
 #[pyo3(signature = (path, scan=None))]
@@ -365,7 +365,56 @@ fn read_cloud(
     let cloud = without_gil(py, || meshtrim::io::read_cloud_with(&path, &options))?;
     let (normals, colours, alpha) =
         attribute_arrays(py, cloud.normals.as_deref(), cloud.colours.as_ref())?;
-    Ok((points_array(py, &cloud.points)?, normals, colours, alpha))
+    let fields = field_arrays(py, &cloud.scalars);
+    Ok((
+        points_array(py, &cloud.points)?,
+        normals,
+        colours,
+        alpha,
+        fields,
+    ))
+}
+
+/// A file's own per-vertex values: name, PLY type name and the values.
+type FieldArrays<'py> = Vec<(String, &'static str, Bound<'py, PyArray1<f64>>)>;
+
+/// The file's own values as new float64 arrays, with their names and
+/// types.
+fn field_arrays<'py>(py: Python<'py>, fields: &[meshtrim::io::ScalarField]) -> FieldArrays<'py> {
+    fields
+        .iter()
+        .map(|f| {
+            (
+                f.name.clone(),
+                f.kind.name(),
+                PyArray1::from_slice(py, &f.values),
+            )
+        })
+        .collect()
+}
+
+/// The file's own values from (name, PLY type name, values) triples.
+fn fields_of(
+    fields: Vec<(String, String, PyReadonlyArray1<'_, f64>)>,
+) -> PyResult<Vec<meshtrim::io::ScalarField>> {
+    fields
+        .into_iter()
+        .map(|(name, kind, values)| {
+            let kind = meshtrim::io::ply::Scalar::parse(&kind).ok_or_else(|| {
+                MeshtrimError::new_err(format!("scalars['{name}']: no PLY type '{kind}'"))
+            })?;
+            if name.is_empty() || name.contains(|c: char| c.is_whitespace()) {
+                return Err(MeshtrimError::new_err(format!(
+                    "scalars: the name '{name}' must be a word, without spaces"
+                )));
+            }
+            Ok(meshtrim::io::ScalarField {
+                name,
+                kind,
+                values: values.as_array().to_vec(),
+            })
+        })
+        .collect()
 }
 
 /// A new `(n, 4)` float64 array of colours, RGBA in 0..1.
@@ -379,6 +428,7 @@ type AttributedPoints<'py> = (
     Option<Points<'py>>,
     Option<ColourArray<'py>>,
     bool,
+    FieldArrays<'py>,
 );
 
 /// Normals and colours as new arrays, and whether the colours had alpha.
@@ -398,14 +448,15 @@ fn attribute_arrays<'py>(
     Ok((normals, colours, alpha))
 }
 
-/// A mesh as read: vertices, faces, normals, colours (RGBA in 0..1) and
-/// whether the file had an alpha channel.
+/// A mesh as read: vertices, faces, normals, colours (RGBA in 0..1),
+/// whether the file had an alpha channel, and the file's own values.
 type MeshRead<'py> = (
     Points<'py>,
     Faces<'py>,
     Option<Points<'py>>,
     Option<ColourArray<'py>>,
     bool,
+    FieldArrays<'py>,
 );
 
 /// A mesh's vertices, faces and vertex attributes, read as `trim` and
@@ -426,14 +477,15 @@ fn read_mesh(py: Python<'_>, path: PathBuf) -> PyResult<MeshRead<'_>> {
         normals,
         colours,
         alpha,
+        field_arrays(py, &attributes.scalars),
     ))
 }
 
 /// Writes a mesh as the CLI writes its outputs (format by extension,
-/// atomically), with per-vertex normals and colours (RGB or RGBA in
-/// 0..1) when given.
+/// atomically), with per-vertex normals, colours (RGB or RGBA in 0..1)
+/// and values of the file's own (name, PLY type name, values) when given.
 #[pyfunction]
-#[pyo3(signature = (path, vertices, faces, normals, colours))]
+#[pyo3(signature = (path, vertices, faces, normals, colours, scalars))]
 fn write_mesh(
     py: Python<'_>,
     path: PathBuf,
@@ -441,11 +493,16 @@ fn write_mesh(
     faces: PyReadonlyArray2<'_, u32>,
     normals: Option<PyReadonlyArray2<'_, f64>>,
     colours: Option<PyReadonlyArray2<'_, f64>>,
+    scalars: Vec<(String, String, PyReadonlyArray1<'_, f64>)>,
 ) -> PyResult<()> {
     let mesh = mesh_of(&vertices, &faces)?;
     let normals = normals.map(|n| rows(&n, "normals")).transpose()?;
     let colours = colours.map(|c| colours_of(&c)).transpose()?;
-    let attributes = meshtrim::io::VertexAttributes { normals, colours };
+    let attributes = meshtrim::io::VertexAttributes {
+        normals,
+        colours,
+        scalars: fields_of(scalars)?,
+    };
     without_gil(py, || {
         meshtrim::io::write_mesh_with(&path, &mesh.vertices, &mesh.faces, &attributes)
     })
@@ -479,9 +536,11 @@ fn colours_of(array: &PyReadonlyArray2<'_, f64>) -> PyResult<meshtrim::io::Colou
 /// normals and colours: a kept vertex's row copied, a new one's blended
 /// from its closest point on the surface (or taken from the nearest point
 /// when there are no faces). With `normals` (`k` = 3) the rows are
-/// blended as normals (direction and length).
+/// blended as normals (direction and length); with `nearest` (labels,
+/// flags) not blended but taken from the corner of the largest weight.
 #[pyfunction]
-#[pyo3(signature = (vertices, faces, values, to, to_faces, normals))]
+#[pyo3(signature = (vertices, faces, values, to, to_faces, normals, nearest))]
+#[allow(clippy::too_many_arguments)]
 fn carry<'py>(
     py: Python<'py>,
     vertices: PyReadonlyArray2<'py, f64>,
@@ -490,6 +549,7 @@ fn carry<'py>(
     to: PyReadonlyArray2<'py, f64>,
     to_faces: PyReadonlyArray2<'py, u32>,
     normals: bool,
+    nearest: bool,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let from = mesh_of(&vertices, &faces)?;
     let to = Mesh {
@@ -521,8 +581,8 @@ fn carry<'py>(
     } else {
         Vec::new()
     };
-    let columns: Vec<Vec<[f64; 1]>> = (0..width)
-        .map(|c| values.as_array().column(c).iter().map(|&x| [x]).collect())
+    let columns: Vec<Vec<f64>> = (0..width)
+        .map(|c| values.as_array().column(c).to_vec())
         .collect();
     let count = to.vertices.len();
     let carried = without_gil(py, || {
@@ -533,12 +593,15 @@ fn carry<'py>(
             let carried = library::carry_normals(&from, &sources, &normal_rows);
             return Ok(carried.as_flattened().to_vec());
         }
-        let carried: Vec<Vec<[f64; 1]>> = columns
+        let carried: Vec<Vec<f64>> = columns
             .iter()
-            .map(|column| library::carry(&from, &sources, column))
+            .map(|column| match nearest {
+                true => library::carry_nearest_corner(&from, &sources, column),
+                false => library::carry_values(&from, &sources, column),
+            })
             .collect();
         Ok((0..count)
-            .flat_map(|i| carried.iter().map(move |column| column[i][0]))
+            .flat_map(|i| carried.iter().map(move |column| column[i]))
             .collect())
     })?;
     PyArray1::from_vec(py, carried).reshape([count, width])

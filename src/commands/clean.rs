@@ -138,10 +138,10 @@ pub struct Report {
     /// The input's vertex attributes written to the output ("normals",
     /// "colours"), carried to the new vertices from the input's surface.
     #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub vertex_attributes: Vec<&'static str>,
+    pub vertex_attributes: Vec<String>,
     /// The input's vertex attributes the output's format cannot hold (STL).
     #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub vertex_attributes_not_written: Vec<&'static str>,
+    pub vertex_attributes_not_written: Vec<String>,
     /// Reading time, ms.
     pub read_ms: f64,
     /// Local resolution (β of every vertex) time, ms.
@@ -214,7 +214,7 @@ fn clean(
     let name = input.display().to_string();
     let (out, mut report) = clean_in_memory(&mesh, stages, repair, &name)?;
     let started = Instant::now();
-    let carried = write_mesh_carrying(output, &out, &mesh, &attributes)?;
+    let carried = write_mesh_carrying(output, &out, &mesh, attributes)?;
     report.vertex_attributes = carried.written;
     report.vertex_attributes_not_written = carried.not_written;
     report.read_ms = millis(read_time);

@@ -88,10 +88,10 @@ pub struct Report {
     /// The cloud's point attributes written to the output ("normals",
     /// "colours"), each vertex's from the nearest point.
     #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub vertex_attributes: Vec<&'static str>,
+    pub vertex_attributes: Vec<String>,
     /// The cloud's point attributes the output's format cannot hold (STL).
     #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub vertex_attributes_not_written: Vec<&'static str>,
+    pub vertex_attributes_not_written: Vec<String>,
     /// Time of each stage, in milliseconds.
     pub read_ms: f64,
     /// Boundary detection time.
@@ -129,12 +129,13 @@ pub fn run(args: &Args) -> Result<()> {
     let attributes = VertexAttributes {
         normals: cloud.normals,
         colours: cloud.colours,
+        scalars: cloud.scalars,
     };
     let points = trim::Mesh {
         vertices: cloud.points,
         faces: Vec::new(),
     };
-    let carried = write_mesh_carrying(&args.output, &mesh, &points, &attributes)?;
+    let carried = write_mesh_carrying(&args.output, &mesh, &points, attributes)?;
     report.vertex_attributes = carried.written;
     report.vertex_attributes_not_written = carried.not_written;
     if let Some(path) = &args.edges {

@@ -166,10 +166,10 @@ pub struct Report {
     /// The mesh's vertex attributes written to the output ("normals",
     /// "colours"), carried to the new vertices from the mesh's surface.
     #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub vertex_attributes: Vec<&'static str>,
+    pub vertex_attributes: Vec<String>,
     /// The mesh's vertex attributes the output's format cannot hold (STL).
     #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub vertex_attributes_not_written: Vec<&'static str>,
+    pub vertex_attributes_not_written: Vec<String>,
     /// Time of each stage, in milliseconds.
     pub read_ms: f64,
     /// Boundary detection time.
@@ -265,7 +265,7 @@ pub fn trim_file(
         edges,
     } = trim_in_memory(&mesh, &cloud.points, settings, &names)?;
     let started = Instant::now();
-    let carried = write_mesh_carrying(output, &out, &mesh, &attributes)?;
+    let carried = write_mesh_carrying(output, &out, &mesh, attributes)?;
     if let Some((path, options)) = edges_output {
         write_edges(path, &cloud.points, &detection, &edges, options)?;
     }

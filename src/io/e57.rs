@@ -84,6 +84,7 @@ pub fn read_e57(bytes: Vec<u8>, scan: Option<usize>) -> Result<Cloud> {
     Ok(Cloud {
         points,
         normals: None,
+        scalars: Vec::new(),
         dropped_non_finite: dropped,
         format: Format::E57,
         scale_offset: None,

@@ -41,7 +41,10 @@ use byteorder::{ByteOrder, LittleEndian};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 
-use super::{show, unit_channel, Colours, Mesh, Point3, VertexAttributes};
+use super::ply::Scalar;
+use super::{
+    is_written_name, show, unit_channel, Colours, Mesh, Point3, ScalarField, VertexAttributes,
+};
 
 /// Whether the bytes are a GLB container (the `glTF` magic).
 pub fn is_glb(bytes: &[u8]) -> bool {
@@ -72,6 +75,7 @@ pub fn read_gltf(bytes: &[u8], dir: &Path) -> Result<Mesh> {
     // Each attribute is kept only if every primitive has it.
     let mut normals = Some(Vec::new());
     let mut colours = Some(Colours::default());
+    let mut fields = None;
     for Instance {
         node,
         mesh: m,
@@ -91,11 +95,118 @@ pub fn read_gltf(bytes: &[u8], dir: &Path) -> Result<Mesh> {
             add_primitive(&primitive, &buffers, world, &mut mesh).with_context(at)?;
             add_normals(&primitive, &buffers, world, &mut normals).with_context(at)?;
             add_colours(&primitive, &buffers, &mut colours).with_context(at)?;
+            add_fields(&primitive, &buffers, &mut fields).with_context(at)?;
         }
     }
     mesh.normals = normals;
     mesh.colours = colours;
+    mesh.scalars = fields.unwrap_or_default();
     Ok(mesh)
+}
+
+/// Appends the primitive's application-specific scalar attributes
+/// (`_NAME`, float or 8- or 16-bit integers) to `fields`: the first
+/// primitive names them, and a field goes where a later primitive lacks
+/// it or stores it in another type. Normalised integers are read as the
+/// fractions they stand for. Other custom attributes (vectors, or a name
+/// the writer uses itself) are not read.
+fn add_fields(
+    primitive: &gltf::Primitive,
+    buffers: &[Cow<[u8]>],
+    fields: &mut Option<Vec<ScalarField>>,
+) -> Result<()> {
+    let found: Vec<(String, gltf::Accessor)> = primitive
+        .attributes()
+        .filter_map(|(semantic, accessor)| match semantic {
+            gltf::Semantic::Extras(name) if !is_written_name(&name) => Some((name, accessor)),
+            _ => None,
+        })
+        .filter(|(_, accessor)| accessor.dimensions() == Dimensions::Scalar)
+        .filter(|(_, accessor)| field_kind(accessor).is_some())
+        .collect();
+    let fields = fields.get_or_insert_with(|| {
+        let field = |(name, accessor): &(String, gltf::Accessor)| ScalarField {
+            name: name.clone(),
+            kind: field_kind(accessor).unwrap_or(Scalar::F32),
+            values: Vec::new(),
+        };
+        found.iter().map(field).collect()
+    });
+    fields.retain(|field| {
+        found
+            .iter()
+            .any(|(name, a)| *name == field.name && field_kind(a) == Some(field.kind))
+    });
+    for field in fields.iter_mut() {
+        let Some((_, accessor)) = found.iter().find(|(name, _)| *name == field.name) else {
+            continue;
+        };
+        let what = format!("_{}", field.name);
+        check_count(accessor, primitive, &what)?;
+        let size = accessor.data_type().size();
+        let (data, stride) = accessor_data(accessor, buffers, size, &what)?;
+        let normalized = accessor.normalized();
+        let value = |b: &[u8]| match accessor.data_type() {
+            DataType::I8 if normalized => (f64::from(b[0] as i8) / 127.0).max(-1.0),
+            DataType::U8 if normalized => f64::from(b[0]) / 255.0,
+            DataType::I16 if normalized => {
+                (f64::from(LittleEndian::read_i16(b)) / 32767.0).max(-1.0)
+            }
+            DataType::U16 if normalized => f64::from(LittleEndian::read_u16(b)) / 65535.0,
+            DataType::I8 => f64::from(b[0] as i8),
+            DataType::U8 => f64::from(b[0]),
+            DataType::I16 => f64::from(LittleEndian::read_i16(b)),
+            DataType::U16 => f64::from(LittleEndian::read_u16(b)),
+            DataType::U32 => f64::from(LittleEndian::read_u32(b)),
+            DataType::F32 => f64::from(LittleEndian::read_f32(b)),
+        };
+        field
+            .values
+            .extend((0..accessor.count()).map(|i| value(&data[i * stride..])));
+    }
+    Ok(())
+}
+
+/// The type a scalar custom attribute's values are kept as.
+fn field_kind(accessor: &gltf::Accessor) -> Option<Scalar> {
+    if accessor.normalized() {
+        return (accessor.data_type() != DataType::F32).then_some(Scalar::F32);
+    }
+    Some(match accessor.data_type() {
+        DataType::I8 => Scalar::I8,
+        DataType::U8 => Scalar::U8,
+        DataType::I16 => Scalar::I16,
+        DataType::U16 => Scalar::U16,
+        DataType::U32 => Scalar::U32,
+        DataType::F32 => Scalar::F32,
+    })
+}
+
+/// Whether glTF holds `field` as an application-specific attribute:
+/// 8- and 16-bit integers in their own types; the others as `f32`, so
+/// their values must be finite, and 32-bit integers within ±2^24, where
+/// `f32` holds every integer (a bit mask beyond would change).
+pub fn holds_field(field: &ScalarField) -> bool {
+    match field.kind {
+        Scalar::I8 | Scalar::U8 | Scalar::I16 | Scalar::U16 => true,
+        Scalar::I32 | Scalar::U32 => field.values.iter().all(|v| v.abs() <= 16_777_216.0),
+        Scalar::F32 | Scalar::F64 => field
+            .values
+            .iter()
+            .all(|&v| v.is_finite() && (v as f32).is_finite()),
+    }
+}
+
+/// The component type a held field is written as: its own for 8- and
+/// 16-bit integers, `FLOAT` for the others.
+fn written_component(kind: Scalar) -> (u32, usize) {
+    match kind {
+        Scalar::I8 => (5120, 1),
+        Scalar::U8 => (5121, 1),
+        Scalar::I16 => (5122, 2),
+        Scalar::U16 => (5123, 2),
+        _ => (5126, 4),
+    }
 }
 
 /// Appends the primitive's `NORMAL`s, turned into world coordinates by
@@ -828,10 +939,14 @@ fn document(
         "buffer": 0, "byteOffset": 0, "byteLength": bin.len(), "target": 34962
     })];
     let mut primitive_attributes = serde_json::json!({ "POSITION": 0 });
-    let mut add_view = |bin: &Vec<u8>, start: usize, target: u32| {
-        views.push(serde_json::json!({
+    let mut add_view = |bin: &Vec<u8>, start: usize, target: u32, stride: Option<usize>| {
+        let mut view = serde_json::json!({
             "buffer": 0, "byteOffset": start, "byteLength": bin.len() - start, "target": target
-        }));
+        });
+        if let Some(stride) = stride {
+            view["byteStride"] = stride.into();
+        }
+        views.push(view);
         views.len() - 1
     };
     if let Some(normals) = &attributes.normals {
@@ -841,7 +956,7 @@ fn document(
                 bin.extend_from_slice(&c.to_le_bytes());
             }
         }
-        let view = add_view(&bin, start, 34962);
+        let view = add_view(&bin, start, 34962, None);
         primitive_attributes["NORMAL"] = accessors.len().into();
         accessors.push(serde_json::json!({
             "bufferView": view, "componentType": 5126, "count": vertices.len(), "type": "VEC3"
@@ -852,18 +967,38 @@ fn document(
         for rgba in &colours.rgba {
             bin.extend(rgba.iter().map(|&c| super::mesh_out::channel_byte(c)));
         }
-        let view = add_view(&bin, start, 34962);
+        let view = add_view(&bin, start, 34962, None);
         primitive_attributes["COLOR_0"] = accessors.len().into();
         accessors.push(serde_json::json!({
             "bufferView": view, "componentType": 5121, "normalized": true,
             "count": vertices.len(), "type": "VEC4"
         }));
     }
+    for field in &attributes.scalars {
+        // Each element starts on 4 bytes, as the spec requires of vertex
+        // attributes: 8- and 16-bit values are padded to a stride of 4.
+        let (component, size) = written_component(field.kind);
+        let start = bin.len();
+        for &v in &field.values {
+            if component == 5126 {
+                bin.extend((v as f32).to_le_bytes());
+            } else {
+                field.kind.push_le(&mut bin, v);
+                bin.resize(bin.len() + 4 - size, 0);
+            }
+        }
+        let view = add_view(&bin, start, 34962, (size < 4).then_some(4));
+        primitive_attributes[format!("_{}", field.name)] = accessors.len().into();
+        accessors.push(serde_json::json!({
+            "bufferView": view, "componentType": component, "count": vertices.len(),
+            "type": "SCALAR"
+        }));
+    }
     let start = bin.len();
     for v in faces.iter().flatten() {
         bin.extend_from_slice(&v.to_le_bytes());
     }
-    let indices_view = add_view(&bin, start, 34963);
+    let indices_view = add_view(&bin, start, 34963, None);
     let indices = accessors.len();
     accessors.push(serde_json::json!({
         "bufferView": indices_view, "componentType": 5125, "count": 3 * faces.len(), "type": "SCALAR"
@@ -998,6 +1133,7 @@ mod tests {
                 rgba: vec![[1.0, 0.0, 0.2, 1.0]; 4],
                 alpha: true,
             }),
+            scalars: Vec::new(),
         };
         for glb in [true, false] {
             let mut bytes = Vec::new();
@@ -1021,6 +1157,63 @@ mod tests {
             }
             assert_eq!(mesh.colours, attributes.colours);
         }
+    }
+
+    /// The file's own values as `_NAME` attributes: 8- and 16-bit
+    /// integers in their types (padded to 4 bytes), the others as `f32`,
+    /// which a 32-bit integer beyond 2^24 or a NaN does not go into.
+    #[test]
+    fn own_values_round_trip() {
+        let (v, f) = square();
+        let field = |name: &str, kind, values: [f64; 4]| ScalarField {
+            name: name.into(),
+            kind,
+            values: values.into(),
+        };
+        let scalars = vec![
+            field("label", Scalar::U8, [0.0, 1.0, 255.0, 3.0]),
+            field("offset", Scalar::I16, [-32768.0, 0.0, 5.0, 32767.0]),
+            field("flags", Scalar::I32, [0.0, -16777216.0, 16777216.0, 3.0]),
+            field("quality", Scalar::F64, [0.1, -2.5, 1e10, 0.0]),
+        ];
+        for held in &scalars {
+            assert!(holds_field(held), "{}", held.name);
+        }
+        let attributes = VertexAttributes {
+            scalars: scalars.clone(),
+            ..VertexAttributes::default()
+        };
+        for glb in [true, false] {
+            let mut bytes = Vec::new();
+            match glb {
+                true => write_glb(&mut bytes, &v, &f, &attributes).unwrap(),
+                false => write_gltf(&mut bytes, &v, &f, &attributes).unwrap(),
+            }
+            let mut read = read_gltf(&bytes, Path::new(".")).unwrap().scalars;
+            read.sort_by(|a, b| a.name.cmp(&b.name));
+            let kinds: Vec<_> = read.iter().map(|f| (f.name.as_str(), f.kind)).collect();
+            assert_eq!(
+                kinds,
+                [
+                    ("flags", Scalar::F32),
+                    ("label", Scalar::U8),
+                    ("offset", Scalar::I16),
+                    ("quality", Scalar::F32)
+                ]
+            );
+            for got in &read {
+                let want = scalars.iter().find(|w| w.name == got.name).unwrap();
+                let rounded: Vec<f64> = want.values.iter().map(|&v| f64::from(v as f32)).collect();
+                assert_eq!(got.values, rounded, "{}", got.name);
+            }
+        }
+        let beyond = field("flags", Scalar::U32, [0.0, 16777217.0, 0.0, 0.0]);
+        assert!(!holds_field(&beyond));
+        assert!(!holds_field(&field(
+            "q",
+            Scalar::F32,
+            [0.0, f64::NAN, 0.0, 0.0]
+        )));
     }
 
     /// A node's matrix turns normals by its inverse transpose: under a

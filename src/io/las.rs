@@ -78,6 +78,7 @@ pub fn read_las(bytes: Vec<u8>) -> Result<Cloud> {
     Ok(Cloud {
         points,
         normals: None,
+        scalars: Vec::new(),
         dropped_non_finite: 0,
         format: Format::Las,
         scale_offset: Some(frame),

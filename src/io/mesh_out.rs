@@ -20,7 +20,7 @@ use anyhow::{anyhow, bail, Context, Result};
 
 use super::atomic::write_atomic;
 use super::float_text::push_f64_debug;
-use super::{gltf_io, show, stl, write_formatted, Point3, VertexAttributes};
+use super::{gltf_io, show, stl, write_formatted, Point3, ScalarField, VertexAttributes};
 
 /// The mesh formats meshtrim writes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -76,8 +76,40 @@ impl MeshFormat {
     }
 
     /// Whether the format stores vertex normals and colours.
-    pub fn holds_attributes(self) -> bool {
+    pub fn holds_normals_and_colours(self) -> bool {
         self != MeshFormat::Stl
+    }
+
+    /// Whether the format stores `field` as it is: PLY any, glTF one
+    /// whose values `f32` holds (see [`gltf_io`]), OBJ and STL none.
+    pub fn holds_field(self, field: &ScalarField) -> bool {
+        match self {
+            MeshFormat::Ply => true,
+            MeshFormat::Glb | MeshFormat::Gltf => gltf_io::holds_field(field),
+            MeshFormat::Obj | MeshFormat::Stl => false,
+        }
+    }
+
+    /// `attributes` split into those this format holds and the names of
+    /// the others.
+    pub fn split_attributes(self, attributes: VertexAttributes) -> (VertexAttributes, Vec<String>) {
+        let VertexAttributes {
+            normals,
+            colours,
+            scalars,
+        } = attributes;
+        let mut held = VertexAttributes::default();
+        let mut not_held = VertexAttributes::default();
+        let side = match self.holds_normals_and_colours() {
+            true => &mut held,
+            false => &mut not_held,
+        };
+        side.normals = normals;
+        side.colours = colours;
+        let (fields, others) = scalars.into_iter().partition(|f| self.holds_field(f));
+        held.scalars = fields;
+        not_held.scalars = others;
+        (held, not_held.names())
     }
 }
 
@@ -160,36 +192,33 @@ pub fn check_mesh(format: MeshFormat, vertices: &[Point3], faces: &[[u32; 3]]) -
 /// What [`write_mesh_carrying`] did with the input's vertex attributes.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct AttributesWritten {
-    /// Written to the output ("normals", "colours").
-    pub written: Vec<&'static str>,
-    /// Read but not written, the output's format holding none (STL).
-    pub not_written: Vec<&'static str>,
+    /// Written to the output ("normals", "colours", the file's own
+    /// values by name).
+    pub written: Vec<String>,
+    /// Read but not written, the output's format holding none of them
+    /// (STL none at all, OBJ no values of the file's own).
+    pub not_written: Vec<String>,
 }
 
 /// Writes `out`, made from `from` (whose vertices carry `attributes`), to
-/// `path` as [`write_mesh_with`] does, its vertices' normals and colours
-/// carried from `from` ([`VertexAttributes::carried`]) when the format
-/// holds them.
+/// `path` as [`write_mesh_with`] does, with the attributes the format
+/// holds carried from `from` ([`VertexAttributes::carried`]).
 pub fn write_mesh_carrying(
     path: &Path,
     out: &trim::Mesh,
     from: &trim::Mesh,
-    attributes: &VertexAttributes,
+    attributes: VertexAttributes,
 ) -> Result<AttributesWritten> {
-    let holds = MeshFormat::from_path(path).is_some_and(MeshFormat::holds_attributes);
-    let carried = if holds {
-        attributes.carried(from, out)
-    } else {
-        VertexAttributes::default()
+    let (held, not_written) = match MeshFormat::from_path(path) {
+        Some(format) => format.split_attributes(attributes),
+        // write_mesh_with names the unknown extension.
+        None => (VertexAttributes::default(), Vec::new()),
     };
+    let carried = held.carried(from, out);
     write_mesh_with(path, &out.vertices, &out.faces, &carried)?;
     Ok(AttributesWritten {
         written: carried.names(),
-        not_written: if holds {
-            Vec::new()
-        } else {
-            attributes.names()
-        },
+        not_written,
     })
 }
 
@@ -201,11 +230,15 @@ fn check_attributes(
     vertices: usize,
     attributes: &VertexAttributes,
 ) -> Result<()> {
-    if !format.holds_attributes() && !attributes.is_empty() {
+    let normals_or_colours = attributes.normals.is_some() || attributes.colours.is_some();
+    if !format.holds_normals_and_colours() && normals_or_colours {
         bail!(
             "{} holds no vertex normals or colours: write .ply, .obj, .gltf or .glb",
             format_name(format)
         );
+    }
+    for field in &attributes.scalars {
+        check_field(format, vertices, field)?;
     }
     if let Some(normals) = &attributes.normals {
         if normals.len() != vertices {
@@ -234,6 +267,38 @@ fn check_attributes(
         {
             bail!("vertex {i} has a non-finite colour {:?}", colours.rgba[i]);
         }
+    }
+    Ok(())
+}
+
+/// Checks one of the file's own values: one per vertex, each one its
+/// type holds, and a format that holds it.
+fn check_field(format: MeshFormat, vertices: usize, field: &ScalarField) -> Result<()> {
+    let name = &field.name;
+    if field.values.len() != vertices {
+        bail!(
+            "{} values of '{name}' for {vertices} vertices",
+            field.values.len()
+        );
+    }
+    if let Some(i) = field.values.iter().position(|&v| !field.kind.holds(v)) {
+        bail!(
+            "vertex {i}'s '{name}' value {} is not a {} value",
+            field.values[i],
+            field.kind.name()
+        );
+    }
+    if !format.holds_field(field) {
+        let why = match format {
+            MeshFormat::Glb | MeshFormat::Gltf => {
+                "whose values must be finite and, for 32-bit integers, within ±2^24 (f32)"
+            }
+            _ => "which holds no per-vertex values of a file's own",
+        };
+        bail!(
+            "'{name}' cannot be written to {}, {why}: write .ply",
+            format_name(format)
+        );
     }
     Ok(())
 }
@@ -334,8 +399,10 @@ pub fn write_obj(
     })
 }
 
-/// PLY, binary little-endian: `double x y z`, then the faces as
-/// `list uchar int vertex_indices` (the list type most readers expect).
+/// PLY, binary little-endian: `double x y z`, `float nx ny nz`, `uchar`
+/// colours and the file's own values in their own types, as given; then
+/// the faces as `list uchar int vertex_indices` (the list type most
+/// readers expect).
 pub fn write_ply(
     w: &mut dyn Write,
     vertices: &[Point3],
@@ -351,6 +418,9 @@ pub fn write_ply(
         if colours.alpha {
             properties.push_str("property uchar alpha\n");
         }
+    }
+    for field in &attributes.scalars {
+        properties.push_str(&format!("property {} {}\n", field.kind.name(), field.name));
     }
     write!(
         w,
@@ -376,6 +446,9 @@ pub fn write_ply(
         if let Some(colours) = &attributes.colours {
             let channels = if colours.alpha { 4 } else { 3 };
             out.extend(colours.rgba[i][..channels].iter().map(|&c| channel_byte(c)));
+        }
+        for field in &attributes.scalars {
+            field.kind.push_le(out, field.values[i]);
         }
     })?;
     write_formatted(w, faces.len(), |out, i| {

@@ -103,6 +103,8 @@ pub struct Cloud {
     /// Per-point colours, when the file has them (PLY, OBJ and glTF
     /// vertex colours, E57 and LAS colour, PCD's packed `rgb`/`rgba`).
     pub colours: Option<Colours>,
+    /// The file's own per-point values (PLY's other vertex properties).
+    pub scalars: Vec<ScalarField>,
     /// Points dropped by the reader: a NaN or infinite coordinate (PCD), or
     /// no position (E57's invalid states).
     pub dropped_non_finite: usize,
@@ -137,6 +139,8 @@ pub struct Mesh {
     pub normals: Option<Vec<Point3>>,
     /// Per-vertex colours, when the file has them.
     pub colours: Option<Colours>,
+    /// The file's own per-vertex values ([`ScalarField`]).
+    pub scalars: Vec<ScalarField>,
     /// Triangles as vertex indices, polygons split into fans; `None` when
     /// the file has no face element or `f` lines at all.
     pub faces: Option<Vec<[u32; 3]>>,
@@ -149,6 +153,49 @@ pub struct Colours {
     pub rgba: Vec<[f64; 4]>,
     /// Whether the file had an alpha channel (written back only then).
     pub alpha: bool,
+}
+
+/// A per-vertex value of the file's own, which meshtrim has no other use
+/// for: MeshLab's `quality` (screened Poisson's density) and `flags`, a
+/// scanner's `confidence` or `intensity`, a CloudCompare scalar field.
+/// Carried to the output as the file stores it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ScalarField {
+    /// The property's name in the file.
+    pub name: String,
+    /// The type the file stores it as, which the output keeps.
+    pub kind: ply::Scalar,
+    /// One per vertex, each exactly representable in `kind`.
+    pub values: Vec<f64>,
+}
+
+impl ScalarField {
+    /// The field at the sources: blended where `kind` is a float (a
+    /// measurement), from the nearest corner where it is an integer (a
+    /// label, flags or a count, which a blend would turn into values no
+    /// vertex had).
+    fn carried(&self, from: &trim::Mesh, sources: &[trim::VertexSource]) -> ScalarField {
+        let values = if self.kind.is_integer() {
+            trim::carry_nearest_corner(from, sources, &self.values)
+        } else {
+            trim::carry_values(from, sources, &self.values)
+        };
+        ScalarField {
+            name: self.name.clone(),
+            kind: self.kind,
+            values,
+        }
+    }
+}
+
+/// Whether the mesh writer gives a property of its own this name: such a
+/// property is never read as a file's own value (a PLY `red` that is not
+/// part of a colour is dropped, rather than written twice).
+pub(crate) fn is_written_name(name: &str) -> bool {
+    [
+        "x", "y", "z", "nx", "ny", "nz", "red", "green", "blue", "alpha",
+    ]
+    .contains(&name)
 }
 
 /// A colour channel already scaled to 0..1 by its type, clamped there; a
@@ -170,12 +217,14 @@ pub struct VertexAttributes {
     pub normals: Option<Vec<Point3>>,
     /// Colours, one per vertex.
     pub colours: Option<Colours>,
+    /// The file's own values, one per vertex each.
+    pub scalars: Vec<ScalarField>,
 }
 
 impl VertexAttributes {
     /// Whether there is nothing to carry.
     pub fn is_empty(&self) -> bool {
-        self.normals.is_none() && self.colours.is_none()
+        self.normals.is_none() && self.colours.is_none() && self.scalars.is_empty()
     }
 
     /// These attributes, of `from`'s vertices, at the vertices of `to`, a
@@ -207,18 +256,25 @@ impl VertexAttributes {
                 rgba: trim::carry(from, &sources, &colours.rgba),
                 alpha: colours.alpha,
             }),
+            scalars: self
+                .scalars
+                .iter()
+                .map(|field| field.carried(from, &sources))
+                .collect(),
         }
     }
 
-    /// The names of what there is, for reports: "normals", "colours".
-    pub fn names(&self) -> Vec<&'static str> {
+    /// The names of what there is, for reports: "normals", "colours",
+    /// then the file's own values by their names.
+    pub fn names(&self) -> Vec<String> {
         let mut names = Vec::new();
         if self.normals.is_some() {
-            names.push("normals");
+            names.push("normals".to_string());
         }
         if self.colours.is_some() {
-            names.push("colours");
+            names.push("colours".to_string());
         }
+        names.extend(self.scalars.iter().map(|field| field.name.clone()));
         names
     }
 }
@@ -260,7 +316,8 @@ pub fn read_mesh_with_faces(path: &Path, hint: &str) -> Result<trim::Mesh> {
     Ok(read_mesh_with_attributes(path, hint)?.0)
 }
 
-/// [`read_mesh_with_faces`], with the vertices' normals and colours.
+/// [`read_mesh_with_faces`], with the vertices' normals, colours and the
+/// file's own values.
 pub fn read_mesh_with_attributes(
     path: &Path,
     hint: &str,
@@ -272,6 +329,7 @@ pub fn read_mesh_with_attributes(
     let attributes = VertexAttributes {
         normals: read.normals,
         colours: read.colours,
+        scalars: read.scalars,
     };
     let mesh = trim::Mesh {
         vertices: read.vertices,
@@ -412,6 +470,7 @@ fn from_mesh(mesh: Mesh, format: Format) -> Cloud {
         points: mesh.vertices,
         normals: mesh.normals,
         colours: mesh.colours,
+        scalars: mesh.scalars,
         dropped_non_finite: 0,
         format,
         scale_offset: None,

@@ -604,6 +604,7 @@ fn keep_finite(raw: Raw, colour_is_float: bool) -> Cloud {
     Cloud {
         points: keep(raw.points),
         normals: raw.normals.map(keep),
+        scalars: Vec::new(),
         dropped_non_finite: dropped,
         format: Format::Pcd,
         scale_offset: None,

@@ -53,8 +53,8 @@ use byteorder::{BigEndian, ByteOrder, LittleEndian, WriteBytesExt};
 use rayon::prelude::*;
 
 use super::{
-    capacity, cut_after_newlines, mixed_line_ending, next_line, show, strip_bom, truncated,
-    unit_channel, Colours, HeaderEol, Mesh, Point3, PIECE_BYTES,
+    capacity, cut_after_newlines, is_written_name, mixed_line_ending, next_line, show, strip_bom,
+    truncated, unit_channel, Colours, HeaderEol, Mesh, Point3, ScalarField, PIECE_BYTES,
 };
 
 /// A PLY scalar type.
@@ -92,6 +92,55 @@ impl Scalar {
             "double" | "float64" => Scalar::F64,
             _ => return None,
         })
+    }
+
+    /// The header's name of the type.
+    pub fn name(self) -> &'static str {
+        match self {
+            Scalar::I8 => "char",
+            Scalar::U8 => "uchar",
+            Scalar::I16 => "short",
+            Scalar::U16 => "ushort",
+            Scalar::I32 => "int",
+            Scalar::U32 => "uint",
+            Scalar::F32 => "float",
+            Scalar::F64 => "double",
+        }
+    }
+
+    /// Whether the type is an integer one.
+    pub fn is_integer(self) -> bool {
+        !matches!(self, Scalar::F32 | Scalar::F64)
+    }
+
+    /// Whether this type stores `v`: an integer type exactly, `float`
+    /// rounded but within its range, `double` anything.
+    pub fn holds(self, v: f64) -> bool {
+        let range = match self {
+            Scalar::I8 => (i8::MIN.into(), i8::MAX.into()),
+            Scalar::U8 => (0.0, u8::MAX.into()),
+            Scalar::I16 => (i16::MIN.into(), i16::MAX.into()),
+            Scalar::U16 => (0.0, u16::MAX.into()),
+            Scalar::I32 => (i32::MIN.into(), i32::MAX.into()),
+            Scalar::U32 => (0.0, u32::MAX.into()),
+            Scalar::F32 => return !v.is_finite() || (v as f32).is_finite(),
+            Scalar::F64 => return true,
+        };
+        v.fract() == 0.0 && (range.0..=range.1).contains(&v)
+    }
+
+    /// Appends `v`, a value this type holds, in little-endian binary.
+    pub fn push_le(self, out: &mut Vec<u8>, v: f64) {
+        match self {
+            Scalar::I8 => out.push(v as i8 as u8),
+            Scalar::U8 => out.push(v as u8),
+            Scalar::I16 => out.extend((v as i16).to_le_bytes()),
+            Scalar::U16 => out.extend((v as u16).to_le_bytes()),
+            Scalar::I32 => out.extend((v as i32).to_le_bytes()),
+            Scalar::U32 => out.extend((v as u32).to_le_bytes()),
+            Scalar::F32 => out.extend((v as f32).to_le_bytes()),
+            Scalar::F64 => out.extend(v.to_le_bytes()),
+        }
     }
 
     /// Size in bytes in the binary encodings.
@@ -778,12 +827,8 @@ struct Record {
 
 /// What the body reader keeps from an element.
 enum Role {
-    /// x, y, z and optional nx, ny, nz property indices.
-    Vertex {
-        xyz: [usize; 3],
-        normal: Option<[usize; 3]>,
-        colour: Option<ColourColumns>,
-    },
+    /// The vertex element's columns the reader keeps.
+    Vertex(VertexColumns),
     /// Index of the vertex index list property.
     Face {
         list: usize,
@@ -801,20 +846,11 @@ fn read_body(header: &Header, values: &mut dyn Values, grid: bool) -> Result<Mes
     let mut range_grid = None;
     for element in &header.elements {
         match role_of(element, grid)? {
-            Role::Vertex {
-                xyz,
-                normal,
-                colour,
-            } => {
+            Role::Vertex(columns) => {
                 if vertex_count.is_some() {
                     bail!("the file has two vertex elements");
                 }
                 vertex_count = Some(element.count);
-                let columns = VertexColumns {
-                    xyz,
-                    normal,
-                    colour,
-                };
                 read_vertices(element, values, &columns, &mut mesh)?;
             }
             Role::Face { list } => {
@@ -870,11 +906,13 @@ fn role_of(element: &Element, grid: bool) -> Result<Role> {
                 _ => None,
             };
             let colour = colour_columns(element, &find);
-            Ok(Role::Vertex {
+            let scalars = scalar_columns(element, xyz, normal, colour);
+            Ok(Role::Vertex(VertexColumns {
                 xyz,
                 normal,
                 colour,
-            })
+                scalars,
+            }))
         }
         "face" => {
             let list = element.properties.iter().position(|p| {
@@ -899,6 +937,62 @@ struct VertexColumns {
     xyz: [usize; 3],
     normal: Option<[usize; 3]>,
     colour: Option<ColourColumns>,
+    /// The other scalar properties, the file's own values.
+    scalars: Vec<usize>,
+}
+
+/// The vertex element's scalar properties that are not its position,
+/// normal or colour: the file's own values, the first of each name.
+fn scalar_columns(
+    element: &Element,
+    xyz: [usize; 3],
+    normal: Option<[usize; 3]>,
+    colour: Option<ColourColumns>,
+) -> Vec<usize> {
+    let mut taken: Vec<usize> = xyz
+        .into_iter()
+        .chain(normal.into_iter().flatten())
+        .collect();
+    if let Some(colour) = colour {
+        taken.extend(colour.rgb.into_iter().chain(colour.alpha));
+    }
+    let mut names = Vec::new();
+    let mut columns = Vec::new();
+    for (k, property) in element.properties.iter().enumerate() {
+        let Property::Scalar { name, .. } = property else {
+            continue;
+        };
+        if taken.contains(&k) || is_written_name(name) || names.contains(&name) {
+            continue;
+        }
+        names.push(name);
+        columns.push(k);
+    }
+    columns
+}
+
+/// The file's own values as read: a column of an integer type holding a
+/// value that type does not (an ASCII file's `2.5` in a `uchar`), or of
+/// `float` beyond its range, is kept as `double`, exactly as read.
+fn scalar_fields(element: &Element, columns: &[usize], values: Vec<Vec<f64>>) -> Vec<ScalarField> {
+    columns
+        .iter()
+        .zip(values)
+        .map(|(&k, values)| {
+            let Property::Scalar { ref name, ty } = element.properties[k] else {
+                unreachable!("scalar_columns keeps scalar properties only")
+            };
+            let kind = match values.iter().all(|&v| ty.holds(v)) {
+                true => ty,
+                false => Scalar::F64,
+            };
+            ScalarField {
+                name: name.clone(),
+                kind,
+                values,
+            }
+        })
+        .collect()
 }
 
 /// A vertex colour's columns: red, green, blue, and alpha if there is
@@ -961,6 +1055,7 @@ fn read_vertices(
         xyz,
         normal,
         colour,
+        ref scalars,
     } = *columns;
     if element
         .properties
@@ -972,14 +1067,16 @@ fn read_vertices(
             .chain(normal)
             .chain(colour.map(|c| c.rgb))
             .chain(alpha)
+            .chain(scalar_triples(scalars))
             .collect();
         if let Some(rows) = values.read_rows(element, &triples) {
-            return vertices_from_rows(rows, columns, mesh);
+            return vertices_from_rows(element, rows, columns, mesh);
         }
     }
     mesh.vertices.reserve(capacity(element.count));
     let mut normals = normal.map(|_| Vec::with_capacity(capacity(element.count)));
     let mut colours = colour.map(|_| Vec::with_capacity(capacity(element.count)));
+    let mut own = vec![Vec::with_capacity(capacity(element.count)); scalars.len()];
     read_element(element, values, None, |i, record| {
         let p = xyz.map(|k| record.scalars[k]);
         if p.iter().any(|c| !c.is_finite()) {
@@ -993,8 +1090,12 @@ fn read_vertices(
             let rgb = c.rgb.map(|k| record.scalars[k]);
             out.push(c.rgba(rgb, c.alpha.map(|k| record.scalars[k])));
         }
+        for (out, &k) in own.iter_mut().zip(scalars) {
+            out.push(record.scalars[k]);
+        }
         Ok(())
     })?;
+    mesh.scalars = scalar_fields(element, scalars, own);
     mesh.normals = normals;
     mesh.colours = colours.map(|rgba| Colours {
         rgba,
@@ -1003,9 +1104,23 @@ fn read_vertices(
     Ok(())
 }
 
-/// The vertices (and normals and colours) of records read at once; the
-/// same checks and messages as [`read_vertices`]'s.
-fn vertices_from_rows(rows: Rows, columns: &VertexColumns, mesh: &mut Mesh) -> Result<()> {
+/// The file's own columns in triples, as [`Values::read_rows`] reads
+/// them, the last padded with its last column.
+fn scalar_triples(columns: &[usize]) -> impl Iterator<Item = [usize; 3]> + '_ {
+    columns
+        .chunks(3)
+        .map(|c| [c[0], c[1.min(c.len() - 1)], c[c.len() - 1]])
+}
+
+/// The vertices (and normals, colours and the file's own values) of
+/// records read at once; the same checks and messages as
+/// [`read_vertices`]'s.
+fn vertices_from_rows(
+    element: &Element,
+    rows: Rows,
+    columns: &VertexColumns,
+    mesh: &mut Mesh,
+) -> Result<()> {
     let mut triples = rows.triples.into_iter();
     mesh.vertices = triples.next().unwrap_or_default();
     if columns.normal.is_some() {
@@ -1027,6 +1142,13 @@ fn vertices_from_rows(rows: Rows, columns: &VertexColumns, mesh: &mut Mesh) -> R
             alpha: colour.alpha.is_some(),
         });
     }
+    let mut own = vec![Vec::new(); columns.scalars.len()];
+    for (at, triple) in (0..own.len()).step_by(3).zip(triples) {
+        for (k, out) in own[at..].iter_mut().take(3).enumerate() {
+            *out = triple.iter().map(|t| t[k]).collect();
+        }
+    }
+    mesh.scalars = scalar_fields(element, &columns.scalars, own);
     let non_finite = |p: &Point3| p.iter().any(|c| !c.is_finite());
     if let Some(i) = mesh.vertices.iter().position(non_finite) {
         let line = rows

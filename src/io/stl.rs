@@ -100,6 +100,7 @@ impl Merger {
                 vertices: Vec::with_capacity(capacity(triangles / 2)),
                 normals: None,
                 colours: None,
+                scalars: Vec::new(),
                 faces: Some(Vec::with_capacity(capacity(triangles))),
             },
             index: HashMap::with_capacity_and_hasher(capacity(triangles / 2), Default::default()),

@@ -19,6 +19,7 @@ import pymeshlab
 import pytest
 import trimesh
 
+from carrying import expected_at, kept_and_new
 from meshtrim_cli import MESHTRIM, ROOT, run_meshtrim, shared_data
 
 FIXTURES = ROOT / "fixtures" / "meshes"
@@ -69,33 +70,6 @@ def load(path):
     m = ms.current_mesh()
     colours = np.rint(m.vertex_color_matrix() * 255).astype(int) if m.has_vertex_color() else None
     return m.vertex_matrix(), m.face_matrix(), m.vertex_normal_matrix(), colours
-
-
-def expected_at(vertices, faces, values, points):
-    """`values` (per input vertex) at `points`, by Open3D: blended with
-    the barycentric coordinates of each point's closest point on the
-    input surface (its ray-casting scene, in float32)."""
-    import open3d as o3d
-
-    scene = o3d.t.geometry.RaycastingScene()
-    scene.add_triangles(
-        o3d.core.Tensor(vertices.astype(np.float32)), o3d.core.Tensor(faces.astype(np.uint32))
-    )
-    found = scene.compute_closest_points(o3d.core.Tensor(points.astype(np.float32)))
-    corners = faces[found["primitive_ids"].numpy()]
-    u, v = found["primitive_uvs"].numpy().T
-    weights = np.stack([1 - u - v, u, v], axis=1)
-    return np.einsum("ij,ijk->ik", weights, values[corners])
-
-
-def kept_and_new(v_in, v_out):
-    """Output vertex indices at an input vertex's exact position (and
-    those input vertices), and the others."""
-    at = {tuple(p): i for i, p in reversed(list(enumerate(v_in)))}
-    kept = [(o, at[tuple(p)]) for o, p in enumerate(v_out) if tuple(p) in at]
-    new = [o for o, p in enumerate(v_out) if tuple(p) not in at]
-    out_kept, in_kept = (np.array(x, dtype=int) for x in zip(*kept))
-    return out_kept, in_kept, np.array(new, dtype=int)
 
 
 def check_carried(src, out):

@@ -1,6 +1,6 @@
-//! Carrying per-vertex attributes (normals, colours) from a mesh to the
-//! mesh made from it: meshtrim's own layer, which the paper does not cover
-//! (it works on positions only).
+//! Carrying per-vertex attributes (normals, colours, a file's own values)
+//! from a mesh to the mesh made from it: meshtrim's own layer, which the
+//! paper does not cover (it works on positions only).
 //!
 //! Every command that writes a mesh keeps most of its input's vertices as
 //! they were and adds a few: where trimming cuts a face, where cleanup's
@@ -28,7 +28,9 @@
 //! - from an input without faces (a cloud), the nearest input point.
 //!
 //! Normals are blended in direction and in length (unit ones stay unit);
-//! colours blended. The result is a function of the input and output
+//! colours and other measured values blended; labels and flags, which a
+//! blend would turn into values no vertex had, taken from the nearest
+//! corner. The result is a function of the input and output
 //! meshes alone, whatever the number of threads.
 
 use parry3d_f64::math::Vector;
@@ -335,6 +337,56 @@ pub fn carry<const N: usize>(
         .collect()
 }
 
+/// One value per input vertex at each source: copied from a vertex;
+/// from a face, blended by the weights of the corners that weigh
+/// anything, so a corner the point is not on (weight 0) adds nothing, not
+/// even a NaN (a file's "no value"), which a blend it is part of keeps.
+pub fn carry_values(from: &Mesh, sources: &[VertexSource], values: &[f64]) -> Vec<f64> {
+    sources
+        .par_iter()
+        .map(|source| match *source {
+            VertexSource::Vertex(v) => values[v as usize],
+            VertexSource::Face { face, weights } => {
+                let corners = from.faces[face as usize];
+                (0..3)
+                    .filter(|&k| weights[k] != 0.0)
+                    .map(|k| weights[k] * values[corners[k] as usize])
+                    .sum()
+            }
+        })
+        .collect()
+}
+
+/// One value per input vertex at each source, never blended: copied from
+/// a vertex; from a face, its corner of the largest weight (the first of
+/// equals). For values a blend would turn into ones no vertex had:
+/// labels, flags, counts.
+pub fn carry_nearest_corner<T: Copy + Send + Sync>(
+    from: &Mesh,
+    sources: &[VertexSource],
+    values: &[T],
+) -> Vec<T> {
+    sources
+        .par_iter()
+        .map(|source| match *source {
+            VertexSource::Vertex(v) => values[v as usize],
+            VertexSource::Face { face, weights } => {
+                let heaviest = (1..3).fold(
+                    0,
+                    |best, k| {
+                        if weights[k] > weights[best] {
+                            k
+                        } else {
+                            best
+                        }
+                    },
+                );
+                values[from.faces[face as usize][heaviest] as usize]
+            }
+        })
+        .collect()
+}
+
 /// Normals (one per input vertex) at each source: copied from a vertex;
 /// from a face, the direction of the corners' normals blended by the
 /// weights, at the length their lengths blend to (so unit normals give
@@ -506,6 +558,23 @@ mod tests {
         assert_eq!(carried[0], [5.0]);
         // The midpoint of face 0's first edge, vertices 0 and 1.
         assert!((carried[1][0] - 0.5).abs() < 1e-12, "{:?}", carried[1]);
+    }
+
+    #[test]
+    fn values_blend_without_weightless_corners_and_labels_take_the_nearest() {
+        let mesh = Mesh {
+            vertices: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+            faces: vec![[0, 1, 2]],
+        };
+        let to = [[0.6, 0.0, 0.0], [0.1, 0.2, 0.0], [0.0, 1.0, 0.0]];
+        let sources = vertex_sources(&mesh, &points(&to)).unwrap();
+        let values = carry_values(&mesh, &sources, &[1.0, 3.0, f64::NAN]);
+        // On the edge 0-1, away from the NaN corner: 0.4 · 1 + 0.6 · 3.
+        assert!((values[0] - 2.2).abs() < 1e-12, "{values:?}");
+        assert!(values[1].is_nan(), "a blend with a NaN corner is NaN");
+        assert!(values[2].is_nan(), "a kept vertex keeps its value");
+        let labels = carry_nearest_corner(&mesh, &sources, &[10u8, 20, 30]);
+        assert_eq!(labels, [20, 10, 30]);
     }
 
     #[test]

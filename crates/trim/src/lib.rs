@@ -73,7 +73,9 @@ mod trimming;
 
 #[doc(hidden)]
 pub use attributes::vertex_sources_reference;
-pub use attributes::{carry, carry_normals, vertex_sources, VertexSource};
+pub use attributes::{
+    carry, carry_nearest_corner, carry_normals, carry_values, vertex_sources, VertexSource,
+};
 /// The plain detector the fast one is tested against (same labels).
 #[doc(hidden)]
 pub use bpd::detect_boundary_reference;
