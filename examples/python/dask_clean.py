@@ -34,13 +34,15 @@ def process(job: meshtrim.BatchJob) -> dict:
         if len(job.clouds) > 1:
             names = ", ".join(str(c) for c in job.clouds)
             raise meshtrim.MeshtrimError(f"several clouds match this mesh ({names}): keep one")
-        vertices, faces = meshtrim.read_mesh(job.input)
+        vertices, faces, attributes = meshtrim.read_mesh(job.input, attributes=True)
         if job.clouds:
             points = meshtrim.read_cloud(job.clouds[0])
-            vertices, faces, report = meshtrim.trim(vertices, faces, points)
+            out_v, out_f, report = meshtrim.trim(vertices, faces, points)
         else:
-            vertices, faces, report = meshtrim.clean(vertices, faces)
-        meshtrim.write_mesh(job.output, vertices, faces)
+            out_v, out_f, report = meshtrim.clean(vertices, faces)
+        # Normals, colours and the file's own values go with it, as batch
+        # carries them.
+        meshtrim.write_mesh_carrying(job.output, out_v, out_f, vertices, faces, attributes)
         row.update(status="ok", faces_in=report["faces_in"], faces_out=report["faces_out"])
     except meshtrim.MeshtrimError as e:
         row.update(status="failed", error=str(e))

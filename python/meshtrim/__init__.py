@@ -60,6 +60,7 @@ __all__ = [
     "write_mesh",
     "write_edges",
     "VertexAttributes",
+    "write_mesh_carrying",
     "carry",
     "BatchJob",
     "batch_plan",
@@ -478,6 +479,32 @@ def write_mesh(
     c = None if colours is None else _per_vertex(colours, "colours", len(v), (3, 4))
     fields = [_field(name, values, len(v)) for name, values in (scalars or {}).items()]
     _meshtrim.write_mesh(os.fspath(path), v, f, n, c, fields)
+
+
+def write_mesh_carrying(
+    path: PathLike, vertices: Any, faces: Any, source_vertices: Any, source_faces: Any, attributes: "VertexAttributes"
+) -> tuple:
+    """Writes a mesh made from the mesh ``source_vertices``,
+    ``source_faces`` (by :func:`trim`, :func:`clean` or :func:`mesh`) as the
+    CLI writes its outputs, with the source's ``attributes`` (as
+    :func:`read_mesh` gives them) that the format holds carried to it
+    (:func:`carry`, per kind). Returns ``(written, not_written)``, the
+    attributes' names, as the CLI's report lists them: STL holds none, OBJ
+    no values of the file's own.
+
+    >>> v, f, attrs = meshtrim.read_mesh("poisson.ply", attributes=True)
+    >>> out_v, out_f, _ = meshtrim.trim(v, f, points)
+    >>> meshtrim.write_mesh_carrying("trimmed.ply", out_v, out_f, v, f, attrs)
+    """
+    v = _float_rows(vertices, "vertices")
+    f = _face_rows(faces, len(v))
+    sv = _float_rows(source_vertices, "source_vertices")
+    sf = _faces_or_none(source_faces, len(sv))
+    n = None if attributes.normals is None else _per_vertex(attributes.normals, "normals", len(sv), (3,))
+    c = None if attributes.colours is None else _per_vertex(attributes.colours, "colours", len(sv), (3, 4))
+    fields = [_field(name, values, len(sv)) for name, values in attributes.scalars.items()]
+    written, not_written = _meshtrim.write_mesh_carrying(os.fspath(path), v, f, sv, sf, n, c, fields)
+    return written, not_written
 
 
 def _field(name: Any, values: Any, vertices: int) -> tuple:

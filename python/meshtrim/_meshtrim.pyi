@@ -65,6 +65,16 @@ def write_mesh(
     colours: Optional[npt.NDArray[np.float64]],
     scalars: Fields,
 ) -> None: ...
+def write_mesh_carrying(
+    path: str | PathLike[str],
+    vertices: Points,
+    faces: npt.NDArray[np.uint32],
+    from_vertices: Points,
+    from_faces: npt.NDArray[np.uint32],
+    normals: Optional[Points],
+    colours: Optional[npt.NDArray[np.float64]],
+    scalars: Fields,
+) -> Tuple[list[str], list[str]]: ...
 def carry(
     vertices: Points,
     faces: npt.NDArray[np.uint32],

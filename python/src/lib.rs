@@ -508,6 +508,37 @@ fn write_mesh(
     })
 }
 
+/// Writes the mesh `vertices`, `faces`, made from `from_vertices`,
+/// `from_faces` (whose vertices carry `normals`, `colours` and `scalars`),
+/// as the CLI writes its outputs: the attributes the format holds carried
+/// to it. The names of those written and of those not written.
+#[pyfunction]
+#[pyo3(signature = (path, vertices, faces, from_vertices, from_faces, normals, colours, scalars))]
+#[allow(clippy::too_many_arguments)]
+fn write_mesh_carrying(
+    py: Python<'_>,
+    path: PathBuf,
+    vertices: PyReadonlyArray2<'_, f64>,
+    faces: PyReadonlyArray2<'_, u32>,
+    from_vertices: PyReadonlyArray2<'_, f64>,
+    from_faces: PyReadonlyArray2<'_, u32>,
+    normals: Option<PyReadonlyArray2<'_, f64>>,
+    colours: Option<PyReadonlyArray2<'_, f64>>,
+    scalars: Vec<(String, String, PyReadonlyArray1<'_, f64>)>,
+) -> PyResult<(Vec<String>, Vec<String>)> {
+    let out = mesh_of(&vertices, &faces)?;
+    let from = mesh_of(&from_vertices, &from_faces)?;
+    let attributes = meshtrim::io::VertexAttributes {
+        normals: normals.map(|n| rows(&n, "normals")).transpose()?,
+        colours: colours.map(|c| colours_of(&c)).transpose()?,
+        scalars: fields_of(scalars)?,
+    };
+    let written = without_gil(py, || {
+        meshtrim::io::mesh_out::write_mesh_carrying(&path, &out, &from, attributes)
+    })?;
+    Ok((written.written, written.not_written))
+}
+
 /// Colours from an `(n, 3)` or `(n, 4)` array in 0..1 (alpha 1 when
 /// there are three columns).
 fn colours_of(array: &PyReadonlyArray2<'_, f64>) -> PyResult<meshtrim::io::Colours> {
@@ -755,6 +786,7 @@ fn _meshtrim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read_cloud, m)?)?;
     m.add_function(wrap_pyfunction!(read_mesh, m)?)?;
     m.add_function(wrap_pyfunction!(write_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(write_mesh_carrying, m)?)?;
     m.add_function(wrap_pyfunction!(write_edges_py, m)?)?;
     m.add_function(wrap_pyfunction!(batch_plan, m)?)?;
     m.add_function(wrap_pyfunction!(carry, m)?)?;

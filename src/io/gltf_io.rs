@@ -22,13 +22,14 @@
 //! inverse transpose and scaled to unit length) and `COLOR_0` (float, or
 //! normalised unsigned byte or short, RGB or RGBA) are read when every
 //! primitive has them in those types (otherwise the mesh is read without
-//! them); the other attributes (texture coordinates, tangents, joints)
-//! are not.
+//! them); application-specific scalar attributes (`_NAME`) as the file's
+//! own values ([`ScalarField`]); the other attributes (texture
+//! coordinates, tangents, joints) are not.
 //!
 //! Writing: one mesh with one primitive, `f32` positions with the `min` and
 //! `max` bounds the spec requires, `u32` indices, and with the vertex
-//! attributes given, unit `f32` `NORMAL`s and `COLOR_0` as normalised
-//! unsigned bytes RGBA.
+//! attributes given, unit `f32` `NORMAL`s, `COLOR_0` as normalised
+//! unsigned bytes RGBA and the file's own values as `_NAME` ([`holds_field`]).
 
 use std::borrow::Cow;
 use std::collections::HashSet;

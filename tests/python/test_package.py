@@ -30,6 +30,9 @@ JAGGED = FIXTURES / "blade_jagged.stl"
 # What differs between a CLI report and the package's: file names and the
 # times (none of which is a result).
 NOT_RESULTS = {"mesh", "cloud", "output", "input", "file"}
+# What the CLI did with the input's vertex attributes while writing; from
+# Python, write_mesh_carrying says it.
+NOT_RESULTS |= {"vertex_attributes", "vertex_attributes_not_written"}
 
 
 def results(report: dict) -> dict:
@@ -95,12 +98,16 @@ def test_trim_writes_the_cli_bytes(tmp_path, ext):
     cli_out, report_file = tmp_path / f"cli.{ext}", tmp_path / "r.json"
     run_meshtrim(POISSON, CLOUD, cli_out, "--report", report_file)
     cli_report = json.loads(report_file.read_text())
-    vertices, faces = meshtrim.read_mesh(POISSON)
+    vertices, faces, attributes = meshtrim.read_mesh(POISSON, attributes=True)
     out_v, out_f, report = meshtrim.trim(vertices, faces, meshtrim.read_cloud(CLOUD))
     ours = tmp_path / f"py.{ext}"
-    meshtrim.write_mesh(ours, out_v, out_f)
+    # The fixture's screened Poisson has its density as `float quality`.
+    written, not_written = meshtrim.write_mesh_carrying(ours, out_v, out_f, vertices, faces, attributes)
     assert ours.read_bytes() == cli_out.read_bytes()
-    assert set(report) == set(cli_report)
+    assert written == cli_report.get("vertex_attributes", []), written
+    assert not_written == cli_report.get("vertex_attributes_not_written", []), not_written
+    assert written + not_written == ["quality"]
+    assert set(report) == set(cli_report) - NOT_RESULTS | set(report) & NOT_RESULTS
     assert results(report) == results(cli_report)
     assert report["mesh"] is None and report["read_ms"] == 0.0
     assert report["faces_out"] == len(out_f) < report["faces_in"]

@@ -98,7 +98,8 @@ def check_carried(src, out):
 def test_trim_carries_poisson_normals_and_colours(coloured, tmp_path):
     out, report = tmp_path / "out.ply", tmp_path / "r.json"
     run_meshtrim(coloured / "poisson.ply", coloured / "cloud.ply", out, "--report", report)
-    assert json.loads(report.read_text())["vertex_attributes"] == ["normals", "colours"]
+    # PyMeshLab saves screened Poisson's density as the vertex quality.
+    assert json.loads(report.read_text())["vertex_attributes"] == ["normals", "colours", "quality"]
     _, n_in, _, n_out, new = check_carried(coloured / "poisson.ply", out)
     # Screened Poisson's normals are not unit; the new ones are of the
     # same kind (their lengths blended), not unit vectors among them.
@@ -175,9 +176,9 @@ def test_other_formats_hold_the_same_attributes(coloured, tmp_path, ext):
 def test_stl_output_says_what_it_could_not_hold(coloured, tmp_path):
     out, report = tmp_path / "out.stl", tmp_path / "r.json"
     result = run_meshtrim(coloured / "poisson.ply", coloured / "cloud.ply", out, "--report", report)
-    assert "normals, colours not written" in result.stdout, result.stdout
+    assert "normals, colours, quality not written" in result.stdout, result.stdout
     r = json.loads(report.read_text())
-    assert r["vertex_attributes_not_written"] == ["normals", "colours"] and "vertex_attributes" not in r
+    assert r["vertex_attributes_not_written"] == ["normals", "colours", "quality"] and "vertex_attributes" not in r
 
 
 def test_carried_attributes_do_not_depend_on_threads(coloured, tmp_path):
@@ -219,8 +220,13 @@ def test_python_carry_and_write_give_the_clis_bytes(coloured, tmp_path):
             out_f,
             normals=meshtrim.carry(v, f, attrs.normals, out_v, out_f, normals=True),
             colours=meshtrim.carry(v, f, attrs.colours, out_v, out_f),
+            scalars={k: meshtrim.carry(v, f, a, out_v, out_f).astype(a.dtype) for k, a in attrs.scalars.items()},
         )
         assert py.read_bytes() == cli.read_bytes(), job
+        # The same in one call.
+        one = tmp_path / f"{job}_one.ply"
+        meshtrim.write_mesh_carrying(one, out_v, out_f, v, f, attrs)
+        assert one.read_bytes() == cli.read_bytes(), job
 
 
 def test_python_carry_shapes_and_errors(coloured):
