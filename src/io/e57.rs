@@ -15,7 +15,9 @@
 //! outputs. Colours (`colorRed`, `colorGreen`, `colorBlue`, scaled to
 //! 0..1 by the scan's colour limits) are kept when every scan read has
 //! them, so that `mesh` carries them to its vertices; a point whose
-//! colour is marked invalid is black. Intensity is not kept.
+//! colour is marked invalid is black. Intensity is kept likewise, as the
+//! file's own value `intensity` (`f32`, as stored: not scaled by the
+//! scans' limits, which may differ), NaN where it is marked invalid.
 
 use std::io::Cursor;
 
@@ -23,7 +25,8 @@ use anyhow::{anyhow, bail, Context, Result};
 use e57::{CartesianCoordinate, E57Reader, RecordName};
 use rayon::prelude::*;
 
-use super::{unit_channel, Cloud, Colours, Format, GridIndex, Point3};
+use super::ply::Scalar;
+use super::{unit_channel, Cloud, Colours, Format, GridIndex, Point3, ScalarField};
 
 /// The file signature at the start of every E57 file.
 const SIGNATURE: &[u8] = b"ASTM-E57";
@@ -60,12 +63,14 @@ pub fn read_e57(bytes: Vec<u8>, scan: Option<usize>) -> Result<Cloud> {
     }
     let with_grid = chosen.iter().any(|&n| has_grid(&scans[n]));
     let with_colour = chosen.iter().all(|&n| scans[n].has_color());
+    let with_intensity = chosen.iter().all(|&n| scans[n].has_intensity());
     let read: Vec<Result<Scan>> = chosen
         .par_iter()
         .map(|&n| {
             let wanted = Wanted {
                 grid_of: with_grid.then_some(n),
                 colour: with_colour,
+                intensity: with_intensity,
             };
             read_scan(&bytes, &scans[n], wanted).with_context(|| format!("scan {n}"))
         })
@@ -73,18 +78,25 @@ pub fn read_e57(bytes: Vec<u8>, scan: Option<usize>) -> Result<Cloud> {
     let mut points: Vec<Point3> = Vec::with_capacity(reservation(records, bytes.len()));
     let mut grid: Vec<GridIndex> = Vec::new();
     let mut rgba: Vec<[f64; 4]> = Vec::new();
+    let mut intensity: Vec<f64> = Vec::new();
     let mut dropped = 0;
     for scan in read {
         let scan = scan?;
         points.extend_from_slice(&scan.points);
         grid.extend_from_slice(&scan.grid);
         rgba.extend_from_slice(&scan.colours);
+        intensity.extend_from_slice(&scan.intensity);
         dropped += scan.dropped;
     }
+    let intensity = with_intensity.then(|| ScalarField {
+        name: "intensity".to_string(),
+        kind: Scalar::F32,
+        values: intensity,
+    });
     Ok(Cloud {
         points,
         normals: None,
-        scalars: Vec::new(),
+        scalars: intensity.into_iter().collect(),
         dropped_non_finite: dropped,
         format: Format::E57,
         scale_offset: None,
@@ -118,6 +130,7 @@ struct Scan {
     points: Vec<Point3>,
     grid: Vec<GridIndex>,
     colours: Vec<[f64; 4]>,
+    intensity: Vec<f64>,
     dropped: usize,
 }
 
@@ -129,6 +142,8 @@ struct Wanted {
     grid_of: Option<usize>,
     /// Whether to keep each point's colour.
     colour: bool,
+    /// Whether to keep each point's intensity.
+    intensity: bool,
 }
 
 /// Reads one scan, keeping what `wanted` asks for besides positions.
@@ -145,6 +160,7 @@ fn read_scan(bytes: &[u8], scan: &e57::PointCloud, wanted: Wanted) -> Result<Sca
     let mut points = Vec::with_capacity(reservation(scan.records, bytes.len()));
     let mut grid = Vec::new();
     let mut colours = Vec::new();
+    let mut intensity = Vec::new();
     let mut dropped = 0;
     for (index, point) in iter.enumerate() {
         let point = point.map_err(|e| anyhow!("point {index}: {e}"))?;
@@ -160,6 +176,9 @@ fn read_scan(bytes: &[u8], scan: &e57::PointCloud, wanted: Wanted) -> Result<Sca
                 if wanted.colour {
                     colours.push(colour_of(point.color.as_ref()));
                 }
+                if wanted.intensity {
+                    intensity.push(point.intensity.map_or(f64::NAN, f64::from));
+                }
             }
             CartesianCoordinate::Direction { .. } | CartesianCoordinate::Invalid => dropped += 1,
         }
@@ -168,6 +187,7 @@ fn read_scan(bytes: &[u8], scan: &e57::PointCloud, wanted: Wanted) -> Result<Sca
         points,
         grid,
         colours,
+        intensity,
         dropped,
     })
 }

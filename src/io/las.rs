@@ -3,10 +3,14 @@
 //!
 //! **Reading.** Every point format (0–10) is read; x, y, z are kept, and
 //! the colour of the formats that have one (2, 3, 5, 7, 8, 10), so that
-//! `mesh` carries it to its vertices. The standard stores colour channels
+//! `mesh` carries it to its vertices (unless every point is black: a
+//! writer that fills in no colour leaves zeros). The standard stores colour channels
 //! as 16 bits, but many writers put 8-bit values there: a file whose
 //! channels are all at most 255 is read as 0–255, any other as 0–65535
-//! (the rule CloudCompare's reader offers).
+//! (the rule CloudCompare's reader offers). Intensity and classification,
+//! fields of every point format, are kept as the file's own values
+//! (`intensity` u16, `classification` u8, the low five bits in the legacy
+//! formats 0–5) when some point has a value other than 0.
 //! LAZ chunks are decompressed in parallel, which needs the chunk table (a
 //! file whose table is lost is refused, as laspy refuses it). LAZ has no
 //! checksums: damage inside a chunk decodes into wrong points, which no
@@ -33,7 +37,8 @@ use las::{Builder, PointDataBuilder, Transform, Vector, Vlr};
 
 use rayon::prelude::*;
 
-use super::{Cloud, Colours, Format, Point3};
+use super::ply::Scalar;
+use super::{Cloud, Colours, Format, Point3, ScalarField};
 
 /// Bytes of decompressed records read per chunk: a bounded buffer however
 /// many points the header announces or however long it says a record is.
@@ -70,19 +75,30 @@ pub fn read_las(bytes: Vec<u8>) -> Result<Cloud> {
             u32::MAX
         );
     }
-    let (points, rgb) = if header.point_format().is_compressed {
+    let PointsRead {
+        points,
+        rgb,
+        intensity,
+        classification,
+    } = if header.point_format().is_compressed {
         read_compressed(&mut reader, &header, total)?
     } else {
         read_uncompressed(bytes.as_ref(), &header, frame, total)?
     };
+    let scalars = [
+        ("intensity", Scalar::U16, intensity),
+        ("classification", Scalar::U8, classification),
+    ];
     Ok(Cloud {
         points,
         normals: None,
-        scalars: Vec::new(),
+        scalars: scalars.into_iter().filter_map(field_if_set).collect(),
         dropped_non_finite: 0,
         format: Format::Las,
         scale_offset: Some(frame),
-        colours: rgb.map(colours_of),
+        colours: rgb
+            .filter(|rgb| rgb.par_iter().any(|c| *c != [0; 3]))
+            .map(colours_of),
         grid: None,
     })
 }
@@ -102,8 +118,24 @@ fn colours_of(rgb: Vec<[u16; 3]>) -> Colours {
     Colours { rgba, alpha: false }
 }
 
-/// Points, and their colours when the point format has them.
-type PointsRead = (Vec<Point3>, Option<Vec<[u16; 3]>>);
+/// A field of every point format as the file's own value, unless every
+/// point has it 0 (the writer did not fill it in).
+fn field_if_set((name, kind, values): (&str, Scalar, Vec<f64>)) -> Option<ScalarField> {
+    values.par_iter().any(|&v| v != 0.0).then(|| ScalarField {
+        name: name.to_string(),
+        kind,
+        values,
+    })
+}
+
+/// Points, their colours when the point format has them, and the fields
+/// every format has.
+struct PointsRead {
+    points: Vec<Point3>,
+    rgb: Option<Vec<[u16; 3]>>,
+    intensity: Vec<f64>,
+    classification: Vec<f64>,
+}
 
 /// The file's bytes, shared by the `las` reader (which wants to own its
 /// source) and the direct decoding of uncompressed records.
@@ -124,6 +156,8 @@ fn read_compressed(
 ) -> Result<PointsRead> {
     let mut points: Vec<Point3> = Vec::new();
     let mut rgb = header.point_format().has_color.then(Vec::new);
+    let mut intensity = Vec::new();
+    let mut classification = Vec::new();
     let mut data = PointDataBuilder::new().for_header(header).build();
     let chunk = (CHUNK_BYTES / u64::from(header.point_format().len()).max(1)).max(1);
     while (points.len() as u64) < total {
@@ -143,6 +177,8 @@ fn read_compressed(
         if let (Some(rgb), Some(read)) = (rgb.as_mut(), data.rgb()) {
             rgb.extend(read.map(|(r, g, b)| [r, g, b]));
         }
+        intensity.extend(data.intensity().map(f64::from));
+        classification.extend(data.classification().map(f64::from));
     }
     if (points.len() as u64) != total {
         bail!(
@@ -150,7 +186,12 @@ fn read_compressed(
             points.len()
         );
     }
-    Ok((points, rgb))
+    Ok(PointsRead {
+        points,
+        rgb,
+        intensity,
+        classification,
+    })
 }
 
 /// Uncompressed records decoded in place, in parallel: X, Y and Z are the
@@ -165,8 +206,8 @@ fn read_uncompressed(
     let raw = las::raw::Header::read_from(bytes).map_err(|e| anyhow!("bad LAS header: {e}"))?;
     let start = raw.offset_to_point_data as usize;
     let record = usize::from(header.point_format().len());
-    if record < 12 {
-        bail!("bad LAS header: point records of {record} bytes cannot hold x, y, z");
+    if record < 17 {
+        bail!("bad LAS header: point records of {record} bytes cannot hold x, y, z, intensity and classification");
     }
     let held = bytes.len().saturating_sub(start) / record;
     if (held as u64) < total {
@@ -196,7 +237,24 @@ fn read_uncompressed(
         }
         None => None,
     };
-    Ok((points, rgb))
+    // Classification: the low five bits of byte 15 in the legacy formats,
+    // all of byte 16 in the extended ones (as the las crate reads it).
+    let extended = header.point_format().is_extended;
+    let column = |value: fn(&[u8], bool) -> f64| {
+        data.par_chunks_exact(record)
+            .with_min_len(1 << 14)
+            .map(|r| value(r, extended))
+            .collect()
+    };
+    Ok(PointsRead {
+        points,
+        rgb,
+        intensity: column(|r, _| f64::from(u16::from_le_bytes([r[12], r[13]]))),
+        classification: column(|r, extended| match extended {
+            true => f64::from(r[16]),
+            false => f64::from(r[15] & 0x1F),
+        }),
+    })
 }
 
 /// Where a point record's red, green and blue (three little-endian u16)

@@ -5,8 +5,11 @@
 //! and z may have any numeric type. Kept besides: `normal_x`, `normal_y`,
 //! `normal_z`, and the colour PCL packs into one field, `rgb` (a 4-byte
 //! float whose bits are 0x00RRGGBB) or `rgba` (a 4-byte unsigned integer,
-//! 0xAARRGGBB; the alpha is not kept). Every other field (curvature,
-//! padding `_`, COUNT > 1 descriptors) is skipped by its size.
+//! 0xAARRGGBB; the alpha is not kept). Every other field of COUNT 1
+//! (`intensity`, `curvature`, `label`, …) is kept as the file's own value
+//! ([`ScalarField`], in the PLY type of its TYPE and SIZE; 64-bit integers
+//! as doubles); padding `_` and COUNT > 1 descriptors are skipped by
+//! their size.
 //! `binary` stores points one after the other; `binary_compressed` is a u32
 //! compressed size, a u32 uncompressed size and LZF data that holds the
 //! fields one after the other (all x, then all y, ...).
@@ -20,9 +23,10 @@ use anyhow::{anyhow, bail, Result};
 
 use rayon::prelude::*;
 
+use super::ply::Scalar;
 use super::{
-    capacity, cut_after_newlines, lines, mixed_line_ending, strip_bom, truncated, Cloud, Colours,
-    Format, HeaderEol, Point3, PIECE_BYTES,
+    capacity, cut_after_newlines, is_written_name, lines, mixed_line_ending, strip_bom, truncated,
+    Cloud, Colours, Format, HeaderEol, Point3, ScalarField, PIECE_BYTES,
 };
 
 /// One field of a PCD point.
@@ -90,6 +94,11 @@ struct Wanted {
     colour: Option<[usize; 3]>,
     /// Whether the colour field is a float (`rgb`) rather than an integer.
     colour_is_float: bool,
+    /// The other fields of COUNT 1, the file's own values.
+    own: Vec<usize>,
+    /// `own` in triples, as the points are read (the last padded with its
+    /// last field).
+    own_triples: Vec<[usize; 3]>,
 }
 
 /// Reads a PCD file, dropping (and counting) non-finite points.
@@ -103,7 +112,7 @@ pub fn read_pcd(bytes: &[u8]) -> Result<Cloud> {
         Data::Binary => read_binary(&header, &wanted, body)?,
         Data::Compressed => read_compressed(&header, &wanted, body)?,
     };
-    Ok(keep_finite(raw, wanted.colour_is_float))
+    Ok(keep_finite(raw, &header, &wanted))
 }
 
 fn wanted_fields(header: &Header) -> Result<Wanted> {
@@ -120,12 +129,48 @@ fn wanted_fields(header: &Header) -> Result<Wanted> {
     let colour = f("rgb")
         .or_else(|| f("rgba"))
         .filter(|&c| header.fields[c].size == 4);
+    let mut taken: Vec<usize> = xyz
+        .into_iter()
+        .chain(normal.into_iter().flatten())
+        .collect();
+    taken.extend(colour);
+    let mut own: Vec<usize> = Vec::new();
+    for (k, field) in header.fields.iter().enumerate() {
+        let name = field.name.as_str();
+        let repeated = own.iter().any(|&o| header.fields[o].name == name);
+        let packed = matches!(name, "rgb" | "rgba" | "_");
+        if field.count == 1 && !taken.contains(&k) && !packed && !is_written_name(name) && !repeated
+        {
+            own.push(k);
+        }
+    }
+    let own_triples = own
+        .chunks(3)
+        .map(|c| [c[0], c[1.min(c.len() - 1)], c[c.len() - 1]])
+        .collect();
     Ok(Wanted {
         xyz,
         normal,
         colour: colour.map(|c| [c; 3]),
         colour_is_float: colour.is_some_and(|c| header.fields[c].ty == 'F'),
+        own,
+        own_triples,
     })
+}
+
+/// The PLY type that holds a PCD field's values: its own for integers of
+/// up to 4 bytes and floats, `double` for 8-byte integers.
+fn kind_of(field: &Field) -> Scalar {
+    match (field.ty, field.size) {
+        ('F', 4) => Scalar::F32,
+        ('U', 1) => Scalar::U8,
+        ('U', 2) => Scalar::U16,
+        ('U', 4) => Scalar::U32,
+        ('I', 1) => Scalar::I8,
+        ('I', 2) => Scalar::I16,
+        ('I', 4) => Scalar::I32,
+        _ => Scalar::F64,
+    }
 }
 
 /// A PCL packed colour, read as a number, as RGBA in 0..1: a float's bits
@@ -309,6 +354,8 @@ struct Raw {
     normals: Option<Vec<Point3>>,
     /// The packed colour field, three times.
     colours: Option<Vec<Point3>>,
+    /// The file's own values, in [`Wanted::own_triples`].
+    own: Vec<Vec<Point3>>,
 }
 
 impl Raw {
@@ -317,6 +364,7 @@ impl Raw {
             points: Vec::with_capacity(capacity(n)),
             normals: wanted.normal.map(|_| Vec::with_capacity(capacity(n))),
             colours: wanted.colour.map(|_| Vec::with_capacity(capacity(n))),
+            own: vec![Vec::with_capacity(capacity(n)); wanted.own_triples.len()],
         }
     }
 
@@ -331,6 +379,9 @@ impl Raw {
         }
         if let (Some([c, _, _]), Some(colours)) = (wanted.colour, self.colours.as_mut()) {
             colours.push([value(c)?; 3]);
+        }
+        for (own, &[a, b, c]) in self.own.iter_mut().zip(&wanted.own_triples) {
+            own.push([value(a)?, value(b)?, value(c)?]);
         }
         Ok(())
     }
@@ -370,6 +421,9 @@ fn read_ascii_in_pieces(
         }
         if let (Some(colours), Some(more)) = (raw.colours.as_mut(), piece.colours.as_ref()) {
             colours.extend_from_slice(&more[..take]);
+        }
+        for (own, more) in raw.own.iter_mut().zip(&piece.own) {
+            own.extend_from_slice(&more[..take]);
         }
         if take == room {
             break;
@@ -411,6 +465,7 @@ struct AsciiPiece {
     points: Vec<Point3>,
     normals: Option<Vec<Point3>>,
     colours: Option<Vec<Point3>>,
+    own: Vec<Vec<Point3>>,
     lines: usize,
     /// The piece's first error; parsing stops there.
     error: Option<(usize, String)>,
@@ -420,6 +475,7 @@ fn parse_ascii_piece(text: &str, wanted: &Wanted, layout: &AsciiLayout) -> Ascii
     let mut piece = AsciiPiece {
         normals: wanted.normal.map(|_| Vec::new()),
         colours: wanted.colour.map(|_| Vec::new()),
+        own: vec![Vec::new(); wanted.own_triples.len()],
         ..AsciiPiece::default()
     };
     // Not sized by the header's counts, which a damaged file makes absurd.
@@ -469,6 +525,14 @@ fn push_ascii_point(
         Some([c, _, _]) => Some([value(c)?; 3]),
         None => None,
     };
+    let own = wanted
+        .own_triples
+        .iter()
+        .map(|&[a, b, c]| Ok([value(a)?, value(b)?, value(c)?]))
+        .collect::<Result<Vec<Point3>, String>>()?;
+    for (values, triple) in piece.own.iter_mut().zip(own) {
+        values.push(triple);
+    }
     piece.points.push(point);
     if let (Some(normal), Some(normals)) = (normal, piece.normals.as_mut()) {
         normals.push(normal);
@@ -560,6 +624,7 @@ fn decode_points(wanted: &Wanted, n: usize, value: impl Fn(usize, usize) -> f64 
         points: triple(wanted.xyz),
         normals: wanted.normal.map(triple),
         colours: wanted.colour.map(triple),
+        own: wanted.own_triples.iter().map(|&t| triple(t)).collect(),
     }
 }
 
@@ -577,7 +642,9 @@ fn offsets(header: &Header, len: impl Fn(&Field) -> usize) -> Vec<usize> {
         .collect()
 }
 
-fn keep_finite(raw: Raw, colour_is_float: bool) -> Cloud {
+/// The points with finite coordinates, with their normals, colours and
+/// the file's own values.
+fn keep_finite(raw: Raw, header: &Header, wanted: &Wanted) -> Cloud {
     let finite: Vec<bool> = raw
         .points
         .par_iter()
@@ -597,20 +664,44 @@ fn keep_finite(raw: Raw, colour_is_float: bool) -> Cloud {
     let colours = raw.colours.map(|packed| Colours {
         rgba: keep(packed)
             .par_iter()
-            .map(|c| unpack_colour(c[0], colour_is_float))
+            .map(|c| unpack_colour(c[0], wanted.colour_is_float))
             .collect(),
         alpha: false,
     });
     Cloud {
         points: keep(raw.points),
         normals: raw.normals.map(keep),
-        scalars: Vec::new(),
+        scalars: own_fields(header, wanted, raw.own.into_iter().map(&keep).collect()),
         dropped_non_finite: dropped,
         format: Format::Pcd,
         scale_offset: None,
         colours,
         grid: None,
     }
+}
+
+/// The file's own values from their triples: each field under its name,
+/// in the PLY type of its PCD type, or as doubles where a value does not
+/// fit it (an ASCII file's `2.5` in an integer field).
+fn own_fields(header: &Header, wanted: &Wanted, triples: Vec<Vec<Point3>>) -> Vec<ScalarField> {
+    wanted
+        .own
+        .iter()
+        .enumerate()
+        .map(|(k, &f)| {
+            let values: Vec<f64> = triples[k / 3].iter().map(|t| t[k % 3]).collect();
+            let field = &header.fields[f];
+            let kind = match values.iter().all(|&v| kind_of(field).holds(v)) {
+                true => kind_of(field),
+                false => Scalar::F64,
+            };
+            ScalarField {
+                name: field.name.clone(),
+                kind,
+                values,
+            }
+        })
+        .collect()
 }
 
 #[cfg(test)]

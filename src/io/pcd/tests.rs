@@ -49,7 +49,7 @@ fn ascii_pieces_read_as_one_pass_does() {
             None => read_ascii_serial(&header, &wanted, data),
             Some(bytes) => read_ascii_in_pieces(&header, &wanted, data, bytes),
         }
-        .map(|r| (r.points, r.normals))
+        .map(|r| (r.points, r.normals, r.own))
         .map_err(|e| e.to_string())
     };
     let errors = crate::io::piece_tests::compare_with_one_pass(
@@ -59,8 +59,8 @@ fn ascii_pieces_read_as_one_pass_does() {
         |below, _| {
             let declared = below(12);
             format!(
-                "FIELDS x y z normal_x normal_y normal_z\nSIZE 4 4 4 4 4 4\n\
-                 TYPE F F F F F F\nCOUNT 1 1 1 1 1 1\nWIDTH {declared}\nHEIGHT 1\n\
+                "FIELDS x y z normal_x normal_y normal_z intensity\nSIZE 4 4 4 4 4 4 4\n\
+                 TYPE F F F F F F F\nCOUNT 1 1 1 1 1 1 1\nWIDTH {declared}\nHEIGHT 1\n\
                  POINTS {declared}\nDATA ascii\n"
             )
         },
@@ -385,5 +385,33 @@ fn header_and_value_errors() {
     assert_eq!(
         err(b"FIELDS x y z\nPOINTS 1\nDATA ascii\n1 2\n"),
         "line 4: expected 3 values, found 2"
+    );
+}
+
+/// Fields of COUNT 1 other than the position, normal and packed colour
+/// are the file's own values, in the PLY type of their TYPE and SIZE;
+/// padding, descriptors and a repeated name are not.
+#[test]
+fn other_fields_are_the_files_own_values() {
+    let text = "VERSION 0.7\nFIELDS x y z intensity label _ curvature fpfh intensity big\n\
+                SIZE 4 4 4 4 4 1 4 4 2 8\nTYPE F F F F U U F F U I\n\
+                COUNT 1 1 1 1 1 3 1 2 1 1\nWIDTH 3\nHEIGHT 1\nPOINTS 3\nDATA ascii\n\
+                0 0 0 0.5 7 0 0 0 0.25 1 2 3 -9\nnan 0 0 1 8 0 0 0 0 1 2 3 5\n\
+                1 1 1 2 9 0 0 0 0.125 1 2 3 6\n";
+    let cloud = read_pcd(text.as_bytes()).unwrap();
+    let fields: Vec<(&str, Scalar, &[f64])> = cloud
+        .scalars
+        .iter()
+        .map(|f| (f.name.as_str(), f.kind, f.values.as_slice()))
+        .collect();
+    assert_eq!(
+        fields,
+        [
+            ("intensity", Scalar::F32, &[0.5, 2.0][..]),
+            ("label", Scalar::U32, &[7.0, 9.0]),
+            ("curvature", Scalar::F32, &[0.25, 0.125]),
+            ("big", Scalar::F64, &[-9.0, 6.0]),
+        ],
+        "kept beside the points kept"
     );
 }
