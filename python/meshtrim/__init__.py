@@ -392,8 +392,10 @@ def read_cloud(path: PathLike, *, scan: Optional[int] = None, attributes: bool =
     glTF/GLB). An E57 file's scans are merged in the file's frame, each in
     its pose; ``scan=N`` reads scan N alone (the CLI's ``--scan``). With
     ``attributes=True``, ``(points, VertexAttributes)``: the normals (PLY,
-    PCD, glTF) and colours (PLY, OBJ, glTF, PCD ``rgb``/``rgba``, LAS,
-    E57) that ``mesh`` carries to its vertices."""
+    PCD, glTF), colours (PLY, OBJ, glTF, PCD ``rgb``/``rgba``, LAS,
+    E57) and the file's own values (PLY properties, glTF ``_NAME``, LAS
+    ``intensity`` and ``classification``, E57 ``intensity``, PCD's other
+    fields) that ``mesh`` carries to its vertices."""
     if scan is not None:
         scan = _k(scan)
     points, normals, colours, alpha, fields = _meshtrim.read_cloud(os.fspath(path), scan)
@@ -445,7 +447,8 @@ def read_mesh(path: PathLike, *, attributes: bool = False) -> tuple:
     """``(vertices, faces)`` of a mesh file (OBJ, PLY, STL, glTF/GLB),
     polygons split into fans, as ``trim`` and ``clean`` read it; with
     ``attributes=True``, ``(vertices, faces, VertexAttributes)``: the
-    vertex normals (PLY, glTF) and colours (PLY, OBJ, glTF) the CLI
+    vertex normals (PLY, glTF), colours (PLY, OBJ, glTF) and the file's
+    own values (PLY's other vertex properties, glTF ``_NAME``) the CLI
     carries to its outputs."""
     vertices, faces, normals, colours, alpha, fields = _meshtrim.read_mesh(os.fspath(path))
     if not attributes:
