@@ -37,7 +37,8 @@ import json
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, NamedTuple, Optional, Sequence, Union
+from types import MappingProxyType
+from typing import Any, Mapping, NamedTuple, Optional, Sequence, Union
 
 import numpy as np
 
@@ -440,7 +441,8 @@ class VertexAttributes(NamedTuple):
 
     normals: Optional[np.ndarray]
     colours: Optional[np.ndarray]
-    scalars: dict = {}
+    # Read-only, so that the one default is not shared and changed.
+    scalars: Mapping[str, np.ndarray] = MappingProxyType({})
 
 
 def read_mesh(path: PathLike, *, attributes: bool = False) -> tuple:
