@@ -36,11 +36,12 @@
 use parry3d_f64::math::Vector;
 use parry3d_f64::query::PointQueryWithLocation;
 use parry3d_f64::shape::Triangle;
+use std::cmp::Reverse;
 use std::collections::hash_map::Entry;
 
 use rayon::prelude::*;
 
-use crate::geom::{cross, dot, norm2, sub, unit, Point3};
+use crate::geom::{cross, dot, norm2, sub, unit, Length, Point3};
 use crate::hash::{HashMap, HashSet};
 use crate::mesh::Mesh;
 use crate::spatial::closest_face::{bounds, FaceIndex, Scratch};
@@ -86,11 +87,16 @@ pub fn vertex_sources(from: &Mesh, to: &Mesh) -> Option<Vec<VertexSource>> {
     if from.faces.is_empty() {
         return nearest_points(&from.vertices, &to.vertices, &exact);
     }
-    let index = FaceIndex::new(from);
+    let first_face = first_faces(to, &exact);
+    let diagonal = diagonal(from);
+    let tie = TIE * diagonal;
+    let index =
+        match faces_within_reach(from, &query_balls(from, to, &exact, &first_face), diagonal) {
+            Some(near) => FaceIndex::of_faces(from, &near),
+            None => FaceIndex::new(from),
+        };
     let identity: Vec<u32> = (0..from.faces.len() as u32).collect();
     let labels = index.labels(&identity);
-    let first_face = first_faces(to, &exact);
-    let tie = TIE * diagonal(from);
     let sources = to
         .vertices
         .par_iter()
@@ -118,6 +124,142 @@ pub fn vertex_sources(from: &Mesh, to: &Mesh) -> Option<Vec<VertexSource>> {
         })
         .collect();
     Some(sources)
+}
+
+/// A ball around a point the closest input face is asked for, holding
+/// that face: its centre and radius.
+type Ball = (Point3, f64);
+
+/// The points whose closest input face is asked for (each new output
+/// vertex, and the centroid of its first output face), each with a
+/// radius its closest face lies within: a new vertex's bound from
+/// [`surface_distance_bounds`], a centroid's that plus its distance from
+/// the vertex.
+fn query_balls(
+    from: &Mesh,
+    to: &Mesh,
+    exact: &[Option<u32>],
+    first_face: &HashMap<u32, [u32; 3]>,
+) -> Vec<Ball> {
+    let bounds = surface_distance_bounds(from, to, exact);
+    let mut balls = Vec::new();
+    for (o, p) in to.vertices.iter().enumerate() {
+        if exact[o].is_some() {
+            continue;
+        }
+        // A vertex in no output face has no path to the surface.
+        let bound = bounds.get(&(o as u32)).copied().unwrap_or(f64::INFINITY);
+        balls.push((*p, bound));
+        if let Some(&face) = first_face.get(&(o as u32)) {
+            let c = centroid(&to.vertices, face);
+            balls.push((c, bound + norm2(sub(c, *p)).sqrt()));
+        }
+    }
+    balls
+}
+
+/// For each new output vertex (no exact source), a distance its closest
+/// input face lies within: the length of the shortest path along the
+/// output's edges to a kept vertex that is a corner of an input face
+/// (which lies on the input surface, so a point is no farther from the
+/// surface than from it). Infinite where no path leads to one.
+fn surface_distance_bounds(from: &Mesh, to: &Mesh, exact: &[Option<u32>]) -> HashMap<u32, f64> {
+    let mut on_surface = vec![false; from.vertices.len()];
+    for &v in from.faces.iter().flatten() {
+        on_surface[v as usize] = true;
+    }
+    let mut bound: HashMap<u32, f64> = HashMap::default();
+    let mut next: Vec<(u32, u32)> = Vec::new();
+    for face in &to.faces {
+        for k in 0..3 {
+            let (a, b) = (face[k], face[(k + 1) % 3]);
+            for (v, w) in [(a, b), (b, a)] {
+                if exact[v as usize].is_none() {
+                    bound.entry(v).or_insert(f64::INFINITY);
+                    next.push((v, w));
+                }
+            }
+        }
+    }
+    next.sort_unstable();
+    next.dedup();
+    // Dijkstra from every kept vertex on the surface at once.
+    let mut heap = std::collections::BinaryHeap::new();
+    let length =
+        |v: u32, w: u32| norm2(sub(to.vertices[v as usize], to.vertices[w as usize])).sqrt();
+    for &(v, w) in &next {
+        if exact[w as usize].is_some_and(|i| on_surface[i as usize]) {
+            heap.push(Reverse((Length(length(v, w)), v)));
+        }
+    }
+    let mut done: HashSet<u32> = HashSet::default();
+    while let Some(Reverse((Length(d), v))) = heap.pop() {
+        if !done.insert(v) {
+            continue;
+        }
+        bound.insert(v, d);
+        let from_v = next.partition_point(|&(a, _)| a < v);
+        for &(_, w) in next[from_v..].iter().take_while(|&&(a, _)| a == v) {
+            if exact[w as usize].is_none() && !done.contains(&w) {
+                heap.push(Reverse((Length(d + length(v, w)), w)));
+            }
+        }
+    }
+    bound
+}
+
+/// The input faces that may be the closest to a ball's centre: those
+/// whose bounding box meets some ball (each face ever closest to a centre
+/// is among them, as it lies within the ball), and faces larger than the
+/// widest ball, kept unasked. `None` when the balls are too large for a
+/// list to pay (one unbounded, or wider than a quarter of the input's
+/// diagonal): then every face.
+fn faces_within_reach(from: &Mesh, balls: &[Ball], diagonal: f64) -> Option<Vec<u32>> {
+    // Rounding in the bounds and in the distances: a hair more reach.
+    let reach = |r: f64| r * (1.0 + 1e-6) + 1e-9 * diagonal;
+    let widest = balls.iter().map(|b| reach(b.1)).fold(0.0, f64::max);
+    if !(widest.is_finite() && widest > 0.0 && widest <= 0.25 * diagonal) {
+        return None;
+    }
+    // A face no more than `widest` from its box's centre to any side that
+    // meets a ball has that centre within the ball's box grown by
+    // `widest`: each ball is listed in the cells that grown box overlaps
+    // (at most three a side), and a face looks in its centre's cell only.
+    let size = 2.0 * widest;
+    let cell_of = |p: Point3| p.map(|c| (c / size).floor() as i64);
+    let mut grid: HashMap<[i64; 3], Vec<usize>> = HashMap::default();
+    for (b, &(centre, r)) in balls.iter().enumerate() {
+        let grown = reach(r) + widest;
+        let lo = cell_of(centre.map(|c| c - grown));
+        let hi = cell_of(centre.map(|c| c + grown));
+        for x in lo[0]..=hi[0] {
+            for y in lo[1]..=hi[1] {
+                for z in lo[2]..=hi[2] {
+                    grid.entry([x, y, z]).or_default().push(b);
+                }
+            }
+        }
+    }
+    let near = |face: &[u32; 3]| {
+        let (low, high) = bounds(face.iter().map(|&v| from.vertices[v as usize]));
+        if (0..3).any(|k| high[k] - low[k] > 2.0 * widest) {
+            return true;
+        }
+        let middle = [0, 1, 2].map(|k| 0.5 * (low[k] + high[k]));
+        let meets = |&b: &usize| {
+            let (centre, r) = balls[b];
+            let gap = [0, 1, 2].map(|k| (low[k] - centre[k]).max(centre[k] - high[k]).max(0.0));
+            norm2(gap) <= reach(r) * reach(r)
+        };
+        grid.get(&cell_of(middle))
+            .is_some_and(|bs| bs.iter().any(meets))
+    };
+    Some(
+        (0..from.faces.len() as u32)
+            .into_par_iter()
+            .filter(|&f| near(&from.faces[f as usize]))
+            .collect(),
+    )
 }
 
 /// How much farther than the closest face (relative to the input's
@@ -762,6 +904,57 @@ mod tests {
                 matches!(sources[2], VertexSource::Face { face: 1, .. }),
                 "{sources:?}"
             );
+        }
+    }
+
+    /// The sheet with the vertices within a disc moved off the surface by
+    /// up to 0.3 in each direction (as a smoothed border's vertices lie
+    /// near it): new vertices whose closest faces are searched among the
+    /// faces within reach of their kept neighbours only. The faces are
+    /// fewer than all, hold each query's closest face, and the sources
+    /// are the reference's.
+    #[test]
+    fn faces_within_reach_hold_every_closest_face() {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(11);
+        for seed in 0..4 {
+            let mesh = sheet(30, seed);
+            let mut out = mesh.clone();
+            let centre = [rng.random_range(5.0..24.0), rng.random_range(5.0..24.0)];
+            for p in out.vertices.iter_mut() {
+                if (p[0] - centre[0]).hypot(p[1] - centre[1]) < 2.5 {
+                    *p = p.map(|c| c + rng.random_range(-0.3..0.3));
+                }
+            }
+            let fast = vertex_sources(&mesh, &out).unwrap();
+            let reference = vertex_sources_reference(&mesh, &out);
+            let gap = |f: &[Point3], r: &[Point3]| {
+                f.iter()
+                    .zip(r)
+                    .map(|(a, b)| norm2(sub(*a, *b)))
+                    .fold(0.0, f64::max)
+            };
+            let points = [&fast, &reference].map(|s| carry(&mesh, s, &mesh.vertices));
+            assert!(gap(&points[0], &points[1]) < 1e-18, "seed {seed}");
+
+            let exact: Vec<Option<u32>> = fast
+                .iter()
+                .map(|s| match s {
+                    VertexSource::Vertex(v) => Some(*v),
+                    VertexSource::Face { .. } => None,
+                })
+                .collect();
+            let balls = query_balls(&mesh, &out, &exact, &first_faces(&out, &exact));
+            let near = faces_within_reach(&mesh, &balls, diagonal(&mesh)).unwrap();
+            assert!(near.len() < mesh.faces.len() / 4, "{} faces", near.len());
+            for (centre, _) in balls {
+                let closest = (0..mesh.faces.len() as u32)
+                    .min_by(|&a, &b| {
+                        let d = |f| closest_on_face(&mesh, f, centre).0;
+                        d(a).total_cmp(&d(b)).then(a.cmp(&b))
+                    })
+                    .unwrap();
+                assert!(near.binary_search(&closest).is_ok(), "seed {seed}");
+            }
         }
     }
 

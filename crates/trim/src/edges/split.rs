@@ -26,7 +26,7 @@ use std::collections::BinaryHeap;
 use crate::hash::{HashMap, HashSet};
 
 use crate::geom::UnionFind;
-use crate::geom::{dist2, Point3};
+use crate::geom::{dist2, Length, Point3};
 
 use super::cluster::MIN_LOOP_POINTS;
 use super::order::canonical;
@@ -381,29 +381,6 @@ fn link_paths(
     }
     reached.sort_unstable();
     reached
-}
-
-/// A path length ordered for the heap (lengths are finite).
-struct Length(f64);
-
-impl PartialEq for Length {
-    fn eq(&self, other: &Self) -> bool {
-        self.cmp(other).is_eq()
-    }
-}
-
-impl Eq for Length {}
-
-impl PartialOrd for Length {
-    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
-        Some(self.cmp(other))
-    }
-}
-
-impl Ord for Length {
-    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
-        self.0.total_cmp(&other.0)
-    }
 }
 
 #[cfg(test)]

@@ -23,3 +23,26 @@ pub(crate) fn median(values: &[f64]) -> f64 {
     let mid = v.len() / 2;
     *v.select_nth_unstable_by(mid, f64::total_cmp).1
 }
+
+/// A length ordered by `total_cmp`, for the heaps of shortest paths.
+pub(crate) struct Length(pub(crate) f64);
+
+impl PartialEq for Length {
+    fn eq(&self, other: &Self) -> bool {
+        self.cmp(other).is_eq()
+    }
+}
+
+impl Eq for Length {}
+
+impl PartialOrd for Length {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Length {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&other.0)
+    }
+}

@@ -53,18 +53,24 @@ pub struct FaceIndex {
 impl FaceIndex {
     /// Indexes the faces of `mesh` (whose indices must be valid).
     pub fn new(mesh: &Mesh) -> Self {
+        let all: Vec<u32> = (0..mesh.faces.len() as u32).collect();
+        Self::of_faces(mesh, &all)
+    }
+
+    /// Indexes the faces of `mesh` listed in `faces` (valid face indices,
+    /// each once): queries answer among them, by the mesh's face indices
+    /// (so ties go to the lower one, as over the whole mesh).
+    pub fn of_faces(mesh: &Mesh, faces: &[u32]) -> Self {
         let corners = |f: &[u32; 3]| f.map(|v| mesh.vertices[v as usize]);
         // Centroids in f32: they only order the faces (the tree's shape),
         // never decide a distance, and half the bytes move faster.
-        let mut items: Vec<([f32; 3], u32)> = mesh
-            .faces
+        let mut items: Vec<([f32; 3], u32)> = faces
             .par_iter()
-            .enumerate()
-            .map(|(f, face)| {
-                let c = corners(face);
+            .map(|&f| {
+                let c = corners(&mesh.faces[f as usize]);
                 (
                     [0, 1, 2].map(|a| ((c[0][a] + c[1][a] + c[2][a]) / 3.0) as f32),
-                    f as u32,
+                    f,
                 )
             })
             .collect();
