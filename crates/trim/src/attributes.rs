@@ -21,10 +21,13 @@
 //! - any other lies on or near the input surface, and takes the
 //!   barycentric weights of its closest point on the closest input face
 //!   ([`VertexSource::Face`]), so a cut vertex on an edge blends that
-//!   edge's two ends. On a tie (a vertex on a seam's edge is on the faces
-//!   of both sides) the face under the centroid of the vertex's first
-//!   output face wins, the face that piece was cut from; then the lower
-//!   face index;
+//!   edge's two ends. The closest face is searched among the faces within
+//!   reach: a new vertex is no farther from the surface than along the
+//!   output's edges to a kept vertex, so only the faces that meet such
+//!   balls are indexed (every face where a vertex has no such path). On
+//!   a tie (a vertex on a seam's edge is on the faces of both sides) the
+//!   face under the centroid of the vertex's first output face wins, the
+//!   face that piece was cut from; then the lower face index;
 //! - from an input without faces (a cloud), the nearest input point.
 //!
 //! Normals are blended in direction and in length (unit ones stay unit);
