@@ -80,11 +80,12 @@ impl MeshFormat {
         self != MeshFormat::Stl
     }
 
-    /// Whether the format stores `field` as it is: PLY any, glTF one
-    /// whose values `f32` holds (see [`gltf_io`]), OBJ and STL none.
+    /// Whether the format stores `field` as it is: PLY one whose name is
+    /// a word (a header token), glTF one whose values `f32` holds (see
+    /// [`gltf_io`]), OBJ and STL none.
     pub fn holds_field(self, field: &ScalarField) -> bool {
         match self {
-            MeshFormat::Ply => true,
+            MeshFormat::Ply => is_word(&field.name),
             MeshFormat::Glb | MeshFormat::Gltf => gltf_io::holds_field(field),
             MeshFormat::Obj | MeshFormat::Stl => false,
         }
@@ -290,17 +291,25 @@ fn check_field(format: MeshFormat, vertices: usize, field: &ScalarField) -> Resu
     }
     if !format.holds_field(field) {
         let why = match format {
+            MeshFormat::Ply => "whose property names are words (no spaces, not empty)",
             MeshFormat::Glb | MeshFormat::Gltf => {
-                "whose values must be finite and, for 32-bit integers, within ±2^24 (f32)"
+                "whose values must be finite and, for 32-bit integers, within ±2^24 (f32): write .ply"
             }
-            _ => "which holds no per-vertex values of a file's own",
+            MeshFormat::Obj | MeshFormat::Stl => {
+                "which holds no per-vertex values of a file's own: write .ply"
+            }
         };
         bail!(
-            "'{name}' cannot be written to {}, {why}: write .ply",
+            "'{name}' cannot be written to {}, {why}",
             format_name(format)
         );
     }
     Ok(())
+}
+
+/// Whether `name` is one PLY header token: printable ASCII, no spaces.
+fn is_word(name: &str) -> bool {
+    !name.is_empty() && name.bytes().all(|b| b.is_ascii_graphic())
 }
 
 /// A colour channel in 0..1 as a byte (clamped).

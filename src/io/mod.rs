@@ -103,7 +103,9 @@ pub struct Cloud {
     /// Per-point colours, when the file has them (PLY, OBJ and glTF
     /// vertex colours, E57 and LAS colour, PCD's packed `rgb`/`rgba`).
     pub colours: Option<Colours>,
-    /// The file's own per-point values (PLY's other vertex properties).
+    /// The file's own per-point values: PLY's other vertex properties,
+    /// LAS intensity and classification, E57 intensity, PCD's other
+    /// fields.
     pub scalars: Vec<ScalarField>,
     /// Points dropped by the reader: a NaN or infinite coordinate (PCD), or
     /// no position (E57's invalid states).
@@ -165,7 +167,7 @@ pub struct ScalarField {
     pub name: String,
     /// The type the file stores it as, which the output keeps.
     pub kind: ply::Scalar,
-    /// One per vertex, each exactly representable in `kind`.
+    /// One per vertex, each a value `kind` holds ([`ply::Scalar::holds`]).
     pub values: Vec<f64>,
 }
 
@@ -196,6 +198,15 @@ pub(crate) fn is_written_name(name: &str) -> bool {
         "x", "y", "z", "nx", "ny", "nz", "red", "green", "blue", "alpha",
     ]
     .contains(&name)
+}
+
+/// Fields as (name, type, values), for tests to compare at a glance.
+#[cfg(test)]
+pub(crate) fn field_rows(fields: &[ScalarField]) -> Vec<(&str, ply::Scalar, &[f64])> {
+    fields
+        .iter()
+        .map(|f| (f.name.as_str(), f.kind, f.values.as_slice()))
+        .collect()
 }
 
 /// A colour channel already scaled to 0..1 by its type, clamped there; a

@@ -978,19 +978,20 @@ fn scalar_fields(element: &Element, columns: &[usize], values: Vec<Vec<f64>>) ->
     columns
         .iter()
         .zip(values)
-        .map(|(&k, values)| {
+        .filter_map(|(&k, values)| {
+            // scalar_columns keeps scalar properties only.
             let Property::Scalar { ref name, ty } = element.properties[k] else {
-                unreachable!("scalar_columns keeps scalar properties only")
+                return None;
             };
             let kind = match values.iter().all(|&v| ty.holds(v)) {
                 true => ty,
                 false => Scalar::F64,
             };
-            ScalarField {
+            Some(ScalarField {
                 name: name.clone(),
                 kind,
                 values,
-            }
+            })
         })
         .collect()
 }

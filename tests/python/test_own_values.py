@@ -214,3 +214,21 @@ def test_write_mesh_refuses_values_a_format_cannot_hold(tmp_path):
     raw = ply_vertices(tmp_path / "a.ply")[2]
     assert raw.dtype["flags"] == np.uint32 and np.array_equal(raw["flags"], big)
     assert np.array_equal(raw["q"], nan, equal_nan=True)
+
+
+def test_a_name_ply_cannot_hold_is_reported_not_written(tmp_path):
+    """glTF names its attributes freely; a PLY header token cannot hold a
+    space. Such a value is left out of a PLY (the report names it), the
+    others written, and the file reads."""
+    scan = trimesh.load(str(FIXTURES / "blade_jagged.stl"))
+    v, f = scan.vertices, scan.faces
+    values = (v[:, 0] - v[:, 0].min()).astype(np.float32)
+    glb = tmp_path / "scan.glb"
+    attributes = {"_good": values, "_two words": values}
+    trimesh.Trimesh(vertices=v, faces=f, vertex_attributes=attributes, process=False).export(str(glb))
+    out, report = tmp_path / "out.ply", tmp_path / "r.json"
+    result = run_meshtrim("clean", glb, out, "--report", report)
+    r = json.loads(report.read_text())
+    assert r["vertex_attributes"] == ["good"] and r["vertex_attributes_not_written"] == ["two words"], r
+    assert "good (kept vertices'" in result.stdout and "two words not written" in result.stdout, result.stdout
+    assert ply_vertices(out)[2].dtype.names == ("x", "y", "z", "good")

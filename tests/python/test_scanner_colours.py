@@ -16,6 +16,7 @@ from scipy.spatial import cKDTree
 
 import synthetic
 from meshtrim_cli import run_meshtrim
+from scanner_files import las_data
 
 
 def blade():
@@ -80,11 +81,7 @@ def test_las_colours_reach_the_mesh(tmp_path, point_format, version, ext, sixtee
     """8-bit values in the 16-bit fields (what many writers store) read
     as 0-255; full 16-bit values as 0-65535."""
     points, rgb = blade()
-    header = laspy.LasHeader(point_format=point_format, version=version)
-    header.scales = np.array([1e-4, 1e-4, 1e-4])
-    header.offsets = points.min(axis=0)
-    las = laspy.LasData(header)
-    las.x, las.y, las.z = points[:, 0], points[:, 1], points[:, 2]
+    las = las_data(points, point_format, version)
     stored = rgb.astype(np.uint16) * 257 if sixteen_bit else rgb.astype(np.uint16)
     las.red, las.green, las.blue = stored[:, 0], stored[:, 1], stored[:, 2]
     path = tmp_path / f"blade.{ext}"
@@ -99,11 +96,7 @@ def test_las_colours_reach_the_mesh(tmp_path, point_format, version, ext, sixtee
 
 def test_las_without_colour_gives_none(tmp_path):
     points, _ = blade()
-    header = laspy.LasHeader(point_format=1, version="1.2")
-    header.scales = np.array([1e-4, 1e-4, 1e-4])
-    header.offsets = points.min(axis=0)
-    las = laspy.LasData(header)
-    las.x, las.y, las.z = points[:, 0], points[:, 1], points[:, 2]
+    las = las_data(points, 1, "1.2")
     path = tmp_path / "plain.las"
     las.write(str(path))
     out, report = tmp_path / "out.ply", tmp_path / "r.json"

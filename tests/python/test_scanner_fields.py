@@ -18,6 +18,7 @@ from scipy.spatial import cKDTree
 
 import synthetic
 from meshtrim_cli import run_meshtrim
+from scanner_files import las_data
 
 
 def blade():
@@ -49,11 +50,7 @@ def test_las_intensity_and_classification_reach_the_mesh(tmp_path, point_format,
     """Legacy formats store the classification in five bits, the extended
     ones (6-10) in a byte of its own; meshtrim reads both as laspy does."""
     points, intensity, classification = blade()
-    header = laspy.LasHeader(point_format=point_format, version=version)
-    header.scales = np.array([1e-4, 1e-4, 1e-4])
-    header.offsets = points.min(axis=0)
-    las = laspy.LasData(header)
-    las.x, las.y, las.z = points[:, 0], points[:, 1], points[:, 2]
+    las = las_data(points, point_format, version)
     las.intensity = intensity
     las.classification = classification
     path = tmp_path / f"blade.{ext}"
@@ -74,11 +71,7 @@ def test_las_fields_left_at_zero_are_not_carried(tmp_path):
     """A writer that fills in no intensity or classification leaves them 0:
     the output gets no columns of zeros."""
     points, _, _ = blade()
-    header = laspy.LasHeader(point_format=1, version="1.2")
-    header.scales = np.array([1e-4, 1e-4, 1e-4])
-    header.offsets = points.min(axis=0)
-    las = laspy.LasData(header)
-    las.x, las.y, las.z = points[:, 0], points[:, 1], points[:, 2]
+    las = las_data(points, 1, "1.2")
     path = tmp_path / "plain.las"
     las.write(str(path))
     out, report = tmp_path / "out.ply", tmp_path / "r.json"

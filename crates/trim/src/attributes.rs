@@ -459,6 +459,23 @@ fn same_face_corner(from: &Mesh, to: &Mesh, o: u32) -> Option<u32> {
     nearest_corner(from, &around, position, centroid(&to.vertices, *first))
 }
 
+/// Each source's value: `vertex(v)` from a kept vertex, `face(corners,
+/// weights)` from a point of a face.
+fn at_sources<T: Send>(
+    from: &Mesh,
+    sources: &[VertexSource],
+    vertex: impl Fn(u32) -> T + Sync,
+    face: impl Fn([u32; 3], [f64; 3]) -> T + Sync,
+) -> Vec<T> {
+    sources
+        .par_iter()
+        .map(|source| match *source {
+            VertexSource::Vertex(v) => vertex(v),
+            VertexSource::Face { face: f, weights } => face(from.faces[f as usize], weights),
+        })
+        .collect()
+}
+
 /// `values` (one per input vertex) at each source: copied from a vertex,
 /// blended by a face's weights.
 pub fn carry<const N: usize>(
@@ -466,20 +483,18 @@ pub fn carry<const N: usize>(
     sources: &[VertexSource],
     values: &[[f64; N]],
 ) -> Vec<[f64; N]> {
-    sources
-        .par_iter()
-        .map(|source| match *source {
-            VertexSource::Vertex(v) => values[v as usize],
-            VertexSource::Face { face, weights } => {
-                let corners = from.faces[face as usize];
-                std::array::from_fn(|c| {
-                    (0..3)
-                        .map(|k| weights[k] * values[corners[k] as usize][c])
-                        .sum()
-                })
-            }
-        })
-        .collect()
+    at_sources(
+        from,
+        sources,
+        |v| values[v as usize],
+        |corners, weights| {
+            std::array::from_fn(|c| {
+                (0..3)
+                    .map(|k| weights[k] * values[corners[k] as usize][c])
+                    .sum()
+            })
+        },
+    )
 }
 
 /// One value per input vertex at each source: copied from a vertex;
@@ -487,19 +502,17 @@ pub fn carry<const N: usize>(
 /// anything, so a corner the point is not on (weight 0) adds nothing, not
 /// even a NaN (a file's "no value"), which a blend it is part of keeps.
 pub fn carry_values(from: &Mesh, sources: &[VertexSource], values: &[f64]) -> Vec<f64> {
-    sources
-        .par_iter()
-        .map(|source| match *source {
-            VertexSource::Vertex(v) => values[v as usize],
-            VertexSource::Face { face, weights } => {
-                let corners = from.faces[face as usize];
-                (0..3)
-                    .filter(|&k| weights[k] != 0.0)
-                    .map(|k| weights[k] * values[corners[k] as usize])
-                    .sum()
-            }
-        })
-        .collect()
+    at_sources(
+        from,
+        sources,
+        |v| values[v as usize],
+        |corners, weights| {
+            (0..3)
+                .filter(|&k| weights[k] != 0.0)
+                .map(|k| weights[k] * values[corners[k] as usize])
+                .sum()
+        },
+    )
 }
 
 /// One value per input vertex at each source, never blended: copied from
@@ -511,25 +524,24 @@ pub fn carry_nearest_corner<T: Copy + Send + Sync>(
     sources: &[VertexSource],
     values: &[T],
 ) -> Vec<T> {
-    sources
-        .par_iter()
-        .map(|source| match *source {
-            VertexSource::Vertex(v) => values[v as usize],
-            VertexSource::Face { face, weights } => {
-                let heaviest = (1..3).fold(
-                    0,
-                    |best, k| {
-                        if weights[k] > weights[best] {
-                            k
-                        } else {
-                            best
-                        }
-                    },
-                );
-                values[from.faces[face as usize][heaviest] as usize]
-            }
-        })
-        .collect()
+    at_sources(
+        from,
+        sources,
+        |v| values[v as usize],
+        |corners, weights| {
+            let heaviest = (1..3).fold(
+                0,
+                |best, k| {
+                    if weights[k] > weights[best] {
+                        k
+                    } else {
+                        best
+                    }
+                },
+            );
+            values[corners[heaviest] as usize]
+        },
+    )
 }
 
 /// Normals (one per input vertex) at each source: copied from a vertex;

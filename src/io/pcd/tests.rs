@@ -399,11 +399,7 @@ fn other_fields_are_the_files_own_values() {
                 0 0 0 0.5 7 0 0 0 0.25 1 2 3 -9\nnan 0 0 1 8 0 0 0 0 1 2 3 5\n\
                 1 1 1 2 9 0 0 0 0.125 1 2 3 6\n";
     let cloud = read_pcd(text.as_bytes()).unwrap();
-    let fields: Vec<(&str, Scalar, &[f64])> = cloud
-        .scalars
-        .iter()
-        .map(|f| (f.name.as_str(), f.kind, f.values.as_slice()))
-        .collect();
+    let fields = crate::io::field_rows(&cloud.scalars);
     assert_eq!(
         fields,
         [

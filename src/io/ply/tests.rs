@@ -855,11 +855,7 @@ fn own_values_are_read_with_their_types() {
                 property float quality\nproperty uchar level\nend_header\n\
                 0 0 0 7 0.5 2 1 2 3 255 9 2.5\n1 0 0 -1 0.25 0 1 0 2 3\n";
     let mesh = read_ply(text.as_bytes()).unwrap();
-    let fields: Vec<(&str, Scalar, &[f64])> = mesh
-        .scalars
-        .iter()
-        .map(|f| (f.name.as_str(), f.kind, f.values.as_slice()))
-        .collect();
+    let fields = crate::io::field_rows(&mesh.scalars);
     assert_eq!(
         fields,
         [
