@@ -94,9 +94,13 @@ def test_las_colours_reach_the_mesh(tmp_path, point_format, version, ext, sixtee
     check_nearest(xyz, read // 257 if sixteen_bit else read, vertices, got, report)
 
 
-def test_las_without_colour_gives_none(tmp_path):
+@pytest.mark.parametrize("point_format, version", [(1, "1.2"), (3, "1.3")])
+def test_las_without_colour_gives_none(tmp_path, point_format, version):
+    """No colour field (format 1), or colour, intensity and classification
+    fields a writer left at 0 (format 3): no attributes, rather than a
+    black mesh with columns of zeros."""
     points, _ = blade()
-    las = las_data(points, 1, "1.2")
+    las = las_data(points, point_format, version)
     path = tmp_path / "plain.las"
     las.write(str(path))
     out, report = tmp_path / "out.ply", tmp_path / "r.json"

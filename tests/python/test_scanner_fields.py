@@ -67,18 +67,6 @@ def test_las_intensity_and_classification_reach_the_mesh(tmp_path, point_format,
     assert np.array_equal(raw["classification"], classification[at])
 
 
-def test_las_fields_left_at_zero_are_not_carried(tmp_path):
-    """A writer that fills in no intensity or classification leaves them 0:
-    the output gets no columns of zeros."""
-    points, _, _ = blade()
-    las = las_data(points, 1, "1.2")
-    path = tmp_path / "plain.las"
-    las.write(str(path))
-    out, report = tmp_path / "out.ply", tmp_path / "r.json"
-    run_meshtrim("mesh", path, out, "--report", report)
-    assert "vertex_attributes" not in json.loads(report.read_text())
-
-
 def test_e57_intensity_reaches_the_mesh(tmp_path):
     """Intensity as stored (pye57 writes it as floats), not rescaled."""
     points, intensity, _ = blade()
