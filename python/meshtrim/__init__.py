@@ -480,10 +480,7 @@ def write_mesh(
     hold none."""
     v = _float_rows(vertices, "vertices")
     f = _face_rows(faces, len(v))
-    n = None if normals is None else _per_vertex(normals, "normals", len(v), (3,))
-    c = None if colours is None else _per_vertex(colours, "colours", len(v), (3, 4))
-    fields = [_field(name, values, len(v)) for name, values in (scalars or {}).items()]
-    _meshtrim.write_mesh(os.fspath(path), v, f, n, c, fields)
+    _meshtrim.write_mesh(os.fspath(path), v, f, *_attribute_arrays(normals, colours, scalars or {}, len(v)))
 
 
 def write_mesh_carrying(
@@ -505,11 +502,18 @@ def write_mesh_carrying(
     f = _face_rows(faces, len(v))
     sv = _float_rows(source_vertices, "source_vertices")
     sf = _faces_or_none(source_faces, len(sv))
-    n = None if attributes.normals is None else _per_vertex(attributes.normals, "normals", len(sv), (3,))
-    c = None if attributes.colours is None else _per_vertex(attributes.colours, "colours", len(sv), (3, 4))
-    fields = [_field(name, values, len(sv)) for name, values in attributes.scalars.items()]
-    written, not_written = _meshtrim.write_mesh_carrying(os.fspath(path), v, f, sv, sf, n, c, fields)
+    arrays = _attribute_arrays(attributes.normals, attributes.colours, attributes.scalars, len(sv))
+    written, not_written = _meshtrim.write_mesh_carrying(os.fspath(path), v, f, sv, sf, *arrays)
     return written, not_written
+
+
+def _attribute_arrays(normals: Any, colours: Any, scalars: Mapping, vertices: int) -> tuple:
+    """Normals, colours and the file's own values of `vertices` vertices
+    as the native layer takes them, each checked."""
+    n = None if normals is None else _per_vertex(normals, "normals", vertices, (3,))
+    c = None if colours is None else _per_vertex(colours, "colours", vertices, (3, 4))
+    fields = [_field(name, values, vertices) for name, values in scalars.items()]
+    return n, c, fields
 
 
 def _field(name: Any, values: Any, vertices: int) -> tuple:

@@ -496,13 +496,7 @@ fn write_mesh(
     scalars: Vec<(String, String, PyReadonlyArray1<'_, f64>)>,
 ) -> PyResult<()> {
     let mesh = mesh_of(&vertices, &faces)?;
-    let normals = normals.map(|n| rows(&n, "normals")).transpose()?;
-    let colours = colours.map(|c| colours_of(&c)).transpose()?;
-    let attributes = meshtrim::io::VertexAttributes {
-        normals,
-        colours,
-        scalars: fields_of(scalars)?,
-    };
+    let attributes = attributes_of(normals, colours, scalars)?;
     without_gil(py, || {
         meshtrim::io::write_mesh_with(&path, &mesh.vertices, &mesh.faces, &attributes)
     })
@@ -528,15 +522,24 @@ fn write_mesh_carrying(
 ) -> PyResult<(Vec<String>, Vec<String>)> {
     let out = mesh_of(&vertices, &faces)?;
     let from = mesh_of(&from_vertices, &from_faces)?;
-    let attributes = meshtrim::io::VertexAttributes {
-        normals: normals.map(|n| rows(&n, "normals")).transpose()?,
-        colours: colours.map(|c| colours_of(&c)).transpose()?,
-        scalars: fields_of(scalars)?,
-    };
+    let attributes = attributes_of(normals, colours, scalars)?;
     let written = without_gil(py, || {
         meshtrim::io::mesh_out::write_mesh_carrying(&path, &out, &from, attributes)
     })?;
     Ok((written.written, written.not_written))
+}
+
+/// The attributes `write_mesh` and `write_mesh_carrying` take, checked.
+fn attributes_of(
+    normals: Option<PyReadonlyArray2<'_, f64>>,
+    colours: Option<PyReadonlyArray2<'_, f64>>,
+    scalars: Vec<(String, String, PyReadonlyArray1<'_, f64>)>,
+) -> PyResult<meshtrim::io::VertexAttributes> {
+    Ok(meshtrim::io::VertexAttributes {
+        normals: normals.map(|n| rows(&n, "normals")).transpose()?,
+        colours: colours.map(|c| colours_of(&c)).transpose()?,
+        scalars: fields_of(scalars)?,
+    })
 }
 
 /// Colours from an `(n, 3)` or `(n, 4)` array in 0..1 (alpha 1 when

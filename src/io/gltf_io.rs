@@ -116,32 +116,38 @@ fn add_fields(
     buffers: &[Cow<[u8]>],
     fields: &mut Option<Vec<ScalarField>>,
 ) -> Result<()> {
-    let found: Vec<(String, gltf::Accessor)> = primitive
+    let found: Vec<(String, Scalar, gltf::Accessor)> = primitive
         .attributes()
         .filter_map(|(semantic, accessor)| match semantic {
-            gltf::Semantic::Extras(name) if !is_written_name(&name) => Some((name, accessor)),
+            gltf::Semantic::Extras(name)
+                if !is_written_name(&name) && accessor.dimensions() == Dimensions::Scalar =>
+            {
+                field_kind(&accessor).map(|kind| (name, kind, accessor))
+            }
             _ => None,
         })
-        .filter(|(_, accessor)| accessor.dimensions() == Dimensions::Scalar)
-        .filter(|(_, accessor)| field_kind(accessor).is_some())
         .collect();
     let fields = fields.get_or_insert_with(|| {
-        let field = |(name, accessor): &(String, gltf::Accessor)| ScalarField {
+        let field = |(name, kind, _): &(String, Scalar, _)| ScalarField {
             name: name.clone(),
-            kind: field_kind(accessor).unwrap_or(Scalar::F32),
+            kind: *kind,
             values: Vec::new(),
         };
         found.iter().map(field).collect()
     });
-    fields.retain(|field| {
+    let in_this = |field: &ScalarField| {
         found
             .iter()
-            .any(|(name, a)| *name == field.name && field_kind(a) == Some(field.kind))
-    });
+            .find(|(name, kind, _)| *name == field.name && *kind == field.kind)
+            .map(|(_, _, accessor)| accessor.clone())
+    };
+    // A field goes where this primitive lacks it or stores it otherwise.
+    fields.retain(|field| in_this(field).is_some());
     for field in fields.iter_mut() {
-        let Some((_, accessor)) = found.iter().find(|(name, _)| *name == field.name) else {
+        let Some(accessor) = in_this(field) else {
             continue;
         };
+        let accessor = &accessor;
         let what = format!("_{}", field.name);
         check_count(accessor, primitive, &what)?;
         let size = accessor.data_type().size();

@@ -172,6 +172,17 @@ pub struct ScalarField {
 }
 
 impl ScalarField {
+    /// A field read as `kind`, kept as `double` (exactly as read) when a
+    /// value does not fit `kind` (an ASCII file's `2.5` in an integer
+    /// property).
+    pub(crate) fn read_as(name: String, kind: ply::Scalar, values: Vec<f64>) -> ScalarField {
+        let kind = match values.iter().all(|&v| kind.holds(v)) {
+            true => kind,
+            false => ply::Scalar::F64,
+        };
+        ScalarField { name, kind, values }
+    }
+
     /// The field at the sources: blended where `kind` is a float (a
     /// measurement), from the nearest corner where it is an integer (a
     /// label, flags or a count, which a blend would turn into values no
@@ -188,6 +199,22 @@ impl ScalarField {
             values,
         }
     }
+}
+
+/// Columns in triples, as the readers read values three at a time (the
+/// last padded with its last column).
+pub(crate) fn column_triples(columns: &[usize]) -> Vec<[usize; 3]> {
+    columns
+        .chunks(3)
+        .map(|c| [c[0], c[1.min(c.len() - 1)], c[c.len() - 1]])
+        .collect()
+}
+
+/// The `count` columns read by [`column_triples`], one `Vec` each.
+pub(crate) fn columns_of_triples(triples: &[Vec<Point3>], count: usize) -> Vec<Vec<f64>> {
+    (0..count)
+        .map(|k| triples[k / 3].iter().map(|t| t[k % 3]).collect())
+        .collect()
 }
 
 /// Whether the mesh writer gives a property of its own this name: such a

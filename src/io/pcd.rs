@@ -25,8 +25,9 @@ use rayon::prelude::*;
 
 use super::ply::Scalar;
 use super::{
-    capacity, cut_after_newlines, is_written_name, lines, mixed_line_ending, strip_bom, truncated,
-    Cloud, Colours, Format, HeaderEol, Point3, ScalarField, PIECE_BYTES,
+    capacity, column_triples, columns_of_triples, cut_after_newlines, is_written_name, lines,
+    mixed_line_ending, strip_bom, truncated, Cloud, Colours, Format, HeaderEol, Point3,
+    ScalarField, PIECE_BYTES,
 };
 
 /// One field of a PCD point.
@@ -144,10 +145,7 @@ fn wanted_fields(header: &Header) -> Result<Wanted> {
             own.push(k);
         }
     }
-    let own_triples = own
-        .chunks(3)
-        .map(|c| [c[0], c[1.min(c.len() - 1)], c[c.len() - 1]])
-        .collect();
+    let own_triples = column_triples(&own);
     Ok(Wanted {
         xyz,
         normal,
@@ -681,25 +679,16 @@ fn keep_finite(raw: Raw, header: &Header, wanted: &Wanted) -> Cloud {
 }
 
 /// The file's own values from their triples: each field under its name,
-/// in the PLY type of its PCD type, or as doubles where a value does not
-/// fit it (an ASCII file's `2.5` in an integer field).
+/// in the PLY type of its PCD type ([`ScalarField::read_as`]).
 fn own_fields(header: &Header, wanted: &Wanted, triples: Vec<Vec<Point3>>) -> Vec<ScalarField> {
+    let values = columns_of_triples(&triples, wanted.own.len());
     wanted
         .own
         .iter()
-        .enumerate()
-        .map(|(k, &f)| {
-            let values: Vec<f64> = triples[k / 3].iter().map(|t| t[k % 3]).collect();
+        .zip(values)
+        .map(|(&f, values)| {
             let field = &header.fields[f];
-            let kind = match values.iter().all(|&v| kind_of(field).holds(v)) {
-                true => kind_of(field),
-                false => Scalar::F64,
-            };
-            ScalarField {
-                name: field.name.clone(),
-                kind,
-                values,
-            }
+            ScalarField::read_as(field.name.clone(), kind_of(field), values)
         })
         .collect()
 }

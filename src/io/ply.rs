@@ -53,8 +53,9 @@ use byteorder::{BigEndian, ByteOrder, LittleEndian, WriteBytesExt};
 use rayon::prelude::*;
 
 use super::{
-    capacity, cut_after_newlines, is_written_name, mixed_line_ending, next_line, show, strip_bom,
-    truncated, unit_channel, Colours, HeaderEol, Mesh, Point3, ScalarField, PIECE_BYTES,
+    capacity, column_triples, columns_of_triples, cut_after_newlines, is_written_name,
+    mixed_line_ending, next_line, show, strip_bom, truncated, unit_channel, Colours, HeaderEol,
+    Mesh, Point3, ScalarField, PIECE_BYTES,
 };
 
 /// A PLY scalar type.
@@ -971,27 +972,17 @@ fn scalar_columns(
     columns
 }
 
-/// The file's own values as read: a column of an integer type holding a
-/// value that type does not (an ASCII file's `2.5` in a `uchar`), or of
-/// `float` beyond its range, is kept as `double`, exactly as read.
+/// The file's own values as read ([`ScalarField::read_as`]).
 fn scalar_fields(element: &Element, columns: &[usize], values: Vec<Vec<f64>>) -> Vec<ScalarField> {
     columns
         .iter()
         .zip(values)
-        .filter_map(|(&k, values)| {
+        .filter_map(|(&k, values)| match element.properties[k] {
+            Property::Scalar { ref name, ty } => {
+                Some(ScalarField::read_as(name.clone(), ty, values))
+            }
             // scalar_columns keeps scalar properties only.
-            let Property::Scalar { ref name, ty } = element.properties[k] else {
-                return None;
-            };
-            let kind = match values.iter().all(|&v| ty.holds(v)) {
-                true => ty,
-                false => Scalar::F64,
-            };
-            Some(ScalarField {
-                name: name.clone(),
-                kind,
-                values,
-            })
+            Property::List { .. } => None,
         })
         .collect()
 }
@@ -1068,7 +1059,7 @@ fn read_vertices(
             .chain(normal)
             .chain(colour.map(|c| c.rgb))
             .chain(alpha)
-            .chain(scalar_triples(scalars))
+            .chain(column_triples(scalars))
             .collect();
         if let Some(rows) = values.read_rows(element, &triples) {
             return vertices_from_rows(element, rows, columns, mesh);
@@ -1105,14 +1096,6 @@ fn read_vertices(
     Ok(())
 }
 
-/// The file's own columns in triples, as [`Values::read_rows`] reads
-/// them, the last padded with its last column.
-fn scalar_triples(columns: &[usize]) -> impl Iterator<Item = [usize; 3]> + '_ {
-    columns
-        .chunks(3)
-        .map(|c| [c[0], c[1.min(c.len() - 1)], c[c.len() - 1]])
-}
-
 /// The vertices (and normals, colours and the file's own values) of
 /// records read at once; the same checks and messages as
 /// [`read_vertices`]'s.
@@ -1143,12 +1126,8 @@ fn vertices_from_rows(
             alpha: colour.alpha.is_some(),
         });
     }
-    let mut own = vec![Vec::new(); columns.scalars.len()];
-    for (at, triple) in (0..own.len()).step_by(3).zip(triples) {
-        for (k, out) in own[at..].iter_mut().take(3).enumerate() {
-            *out = triple.iter().map(|t| t[k]).collect();
-        }
-    }
+    let own: Vec<Vec<Point3>> = triples.collect();
+    let own = columns_of_triples(&own, columns.scalars.len());
     mesh.scalars = scalar_fields(element, &columns.scalars, own);
     let non_finite = |p: &Point3| p.iter().any(|c| !c.is_finite());
     if let Some(i) = mesh.vertices.iter().position(non_finite) {

@@ -165,7 +165,7 @@ fn query_balls(
 /// input face lies within: the length of the shortest path along the
 /// output's edges to a kept vertex that is a corner of an input face
 /// (which lies on the input surface, so a point is no farther from the
-/// surface than from it). Infinite where no path leads to one.
+/// surface than from it). None (no entry) where no path leads to one.
 fn surface_distance_bounds(from: &Mesh, to: &Mesh, exact: &[Option<u32>]) -> HashMap<u32, f64> {
     let mut on_surface = vec![false; from.vertices.len()];
     for &v in from.faces.iter().flatten() {
@@ -178,7 +178,6 @@ fn surface_distance_bounds(from: &Mesh, to: &Mesh, exact: &[Option<u32>]) -> Has
             let (a, b) = (face[k], face[(k + 1) % 3]);
             for (v, w) in [(a, b), (b, a)] {
                 if exact[v as usize].is_none() {
-                    bound.entry(v).or_insert(f64::INFINITY);
                     next.push((v, w));
                 }
             }
@@ -195,15 +194,15 @@ fn surface_distance_bounds(from: &Mesh, to: &Mesh, exact: &[Option<u32>]) -> Has
             heap.push(Reverse((Length(length(v, w)), v)));
         }
     }
-    let mut done: HashSet<u32> = HashSet::default();
+    // A vertex's bound is set when it leaves the heap, at its shortest.
     while let Some(Reverse((Length(d), v))) = heap.pop() {
-        if !done.insert(v) {
+        if bound.contains_key(&v) {
             continue;
         }
         bound.insert(v, d);
         let from_v = next.partition_point(|&(a, _)| a < v);
         for &(_, w) in next[from_v..].iter().take_while(|&&(a, _)| a == v) {
-            if exact[w as usize].is_none() && !done.contains(&w) {
+            if exact[w as usize].is_none() && !bound.contains_key(&w) {
                 heap.push(Reverse((Length(d + length(v, w)), w)));
             }
         }
