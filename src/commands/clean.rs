@@ -94,6 +94,10 @@ pub struct Report {
     pub loops_left: Vec<LeftLoops>,
     /// Input faces.
     pub faces_in: usize,
+    /// Edges where the input's vertices were split but its surface goes
+    /// on (a texture chart's border, a hard edge), stitched so that they
+    /// are not cleaned as borders.
+    pub seam_edges_stitched: usize,
     /// Input faces that named a vertex twice (no area), dropped.
     pub slivers_dropped: usize,
     /// Input faces that repeated an earlier one (same corners, same turn),
@@ -295,6 +299,7 @@ impl Report {
                 })
                 .collect(),
             faces_in: r.faces_in,
+            seam_edges_stitched: r.seam_edges_stitched,
             slivers_dropped: r.slivers_dropped,
             repeated_faces_dropped: r.repeated_faces_dropped,
             double_sided_faces_removed: r.manifold.double_sided_faces_removed,
@@ -450,6 +455,18 @@ impl crate::report::Table for Report {
                     format!(
                         "{} (faces written twice, same turn)",
                         self.repeated_faces_dropped
+                    ),
+                ),
+            );
+        }
+        if self.seam_edges_stitched > 0 {
+            rows.insert(
+                3,
+                (
+                    "seams stitched",
+                    format!(
+                        "{} edges (vertices split along them, the surface whole)",
+                        self.seam_edges_stitched
                     ),
                 ),
             );

@@ -93,6 +93,7 @@ pub use frame::{fit_plane, Frame};
 pub use geom::rotation_from_quaternion;
 pub use mesh::manifold::ManifoldRepair;
 pub use mesh::repair::FaceRepair;
+pub use mesh::seams::{stitch_seams, Stitched};
 pub use mesh::{check_vertex_range, Mesh};
 pub use resolution::PointResolution;
 pub use spatial::neighbours::NeighbourIndex;

@@ -109,7 +109,27 @@ pub struct Columns {
     column_best: Vec<f64>,
 }
 
-#[cfg(test)]
+/// The β of some of a cloud's points, renumbered: point `i` is point
+/// `of[i]` of `all` (a mesh's used vertices among all it stores).
+pub(crate) struct Picked<'a> {
+    pub(crate) all: &'a dyn PointResolution,
+    pub(crate) of: &'a [u32],
+}
+
+impl PointResolution for Picked<'_> {
+    fn len(&self) -> usize {
+        self.of.len()
+    }
+    fn beta(&self, i: usize) -> f64 {
+        self.all.beta(self.of[i] as usize)
+    }
+    /// The whole cloud's: the scale of its spacing.
+    fn median(&self) -> f64 {
+        self.all.median()
+    }
+}
+
+#[cfg(test)]#[cfg(test)]
 /// [`nearest_distances`] measuring each pair once, the plain way; the
 /// reference for tests.
 pub fn nearest_distances_reference(pts: &[Point2], out: &mut Vec<f64>) {

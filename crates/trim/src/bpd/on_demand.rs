@@ -113,14 +113,15 @@ impl LocalResolution {
         self.at_position(self.position_of_input[i] as usize)
     }
 
-    /// The median β over the input points; for a cloud of more than
+    /// The median β over the distinct positions; for a cloud of more than
     /// [`Self::ALL_AT_ONCE`] points, over 16 runs of 1,024 consecutive
     /// points in spatial order, spread evenly over the cloud.
     pub fn median(&self) -> f64 {
         self.median
     }
 
-    /// Every β by BPD's fast pass; the median over the input points.
+    /// Every β by BPD's fast pass; the median over the distinct positions
+    /// (a point stored twice, as a seam's copies are, counts once).
     fn find_all(&self, options: &BpdOptions) -> f64 {
         let how = TestImpl::Fast;
         let hoods = neighbourhoods(self.spatial.clone(), options, how, &|_| {});
@@ -130,12 +131,7 @@ impl LocalResolution {
         for (slot, b) in self.beta.iter().zip(&betas) {
             slot.store(b.to_bits(), Ordering::Relaxed);
         }
-        let of_inputs: Vec<f64> = self
-            .position_of_input
-            .iter()
-            .map(|&p| betas[p as usize])
-            .collect();
-        median(&of_inputs)
+        median(&betas)
     }
 
     /// The median β over [`MEDIAN_RUNS`] runs of consecutive positions.

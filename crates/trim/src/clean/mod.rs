@@ -96,6 +96,7 @@ use crate::mesh::boundary_loops_of;
 use crate::mesh::manifold::{make_manifold, ManifoldRepair};
 use crate::mesh::pinches::open_new_pinches;
 use crate::mesh::repair::{repair_degenerate_faces, FaceRepair};
+use crate::mesh::seams::stitch_seams;
 use crate::mesh::topology::{
     check_manifold, check_manifold_with, distinct, manifold_at_a_glance, EdgeRows, Topology,
 };
@@ -103,7 +104,7 @@ use crate::mesh::{lowest_first, Mesh};
 use crate::planar::{
     inside_faces, kept_apart, obstacle, untwist, Cdt, Node, Ring, SegmentGrid, Tangle, STEINER,
 };
-use crate::resolution::{ByRef, PointResolution};
+use crate::resolution::{ByRef, Picked, PointResolution};
 use crate::spatial::neighbours::{KNearest, MortonIndex};
 
 /// The segment grid's cells are no smaller than this many β.
@@ -276,6 +277,11 @@ pub struct CleanReport {
     pub loops_left: Vec<LeftLoops>,
     /// Input faces.
     pub faces_in: usize,
+    /// Edges where the input's vertices were split but its surface goes
+    /// on (a texture chart's border, a hard edge), stitched before
+    /// anything else, so that they are not taken for borders
+    /// ([`stitch_seams`]).
+    pub seam_edges_stitched: usize,
     /// Input faces that named a vertex twice, dropped before anything else
     /// (see `without_empty_faces`).
     pub slivers_dropped: usize,
@@ -332,8 +338,23 @@ fn clean_with(
     options: &CleanOptions,
 ) -> Result<(Mesh, CleanReport), CleanError> {
     mesh.validate()?;
+    check_resolution_length(mesh, beta)?;
     let faces_in = mesh.faces.len();
-    let (kept, dropped, edges) = without_empty_faces(mesh);
+    // Seams stitched, so that they do not look like borders; a seam's
+    // other copies are left out, so that the loops' neighbourhoods do not
+    // hold a point twice.
+    let stitched = stitch_seams(mesh);
+    let seam_edges_stitched = stitched.edges;
+    let picked;
+    let beta: &dyn PointResolution = match &stitched.kept {
+        Some(of) => {
+            picked = Picked { all: beta, of };
+            &picked
+        }
+        None => beta,
+    };
+    let stitched: &Mesh = &stitched.mesh;
+    let (kept, dropped, edges) = without_empty_faces(stitched);
     let (kept, edges, manifold) = if options.repair {
         let (repaired, manifold) = make_manifold(&kept);
         let edges = EdgeRows::new(&repaired.faces);
@@ -342,13 +363,14 @@ fn clean_with(
         (kept, edges, ManifoldRepair::default())
     };
     let mesh: &Mesh = &kept;
-    check_cleanable(mesh, beta, &edges)?;
+    check_cleanable(mesh, &edges)?;
     let borders = boundary_loops_of(&edges);
     drop(edges);
     let rings = smoothed_loops(mesh, beta, &borders, options);
     let mut report = CleanReport {
         loops_in: borders.len(),
         faces_in,
+        seam_edges_stitched,
         slivers_dropped: dropped.slivers,
         repeated_faces_dropped: dropped.repeats,
         manifold,
@@ -374,23 +396,26 @@ fn clean_with(
 }
 
 /// What the cleanup needs of the mesh left once its empty faces are dropped:
-/// faces, one β per vertex, every edge used at most twice and never twice
-/// the same way.
+/// faces, every edge used at most twice and never twice the same way.
 fn check_cleanable(
     mesh: &Mesh,
-    beta: &dyn PointResolution,
     edges: &EdgeRows,
 ) -> Result<(), CleanError> {
     if mesh.faces.is_empty() {
         return Err(MeshError::NoFaces.into());
     }
+    Ok(check_manifold_with(mesh, edges)?)
+}
+
+/// One β per vertex of the mesh given.
+fn check_resolution_length(mesh: &Mesh, beta: &dyn PointResolution) -> Result<(), CleanError> {
     if beta.len() != mesh.vertices.len() {
         return Err(CleanError::ResolutionLength {
             values: beta.len(),
             vertices: mesh.vertices.len(),
         });
     }
-    Ok(check_manifold_with(mesh, edges)?)
+    Ok(())
 }
 
 /// Step 2: each border loop smoothed (corners, FFT edges and, with

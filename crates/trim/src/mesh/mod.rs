@@ -12,6 +12,7 @@ pub(crate) mod manifold;
 pub(crate) mod pinches;
 pub(crate) mod repair;
 pub(crate) mod rows;
+pub(crate) mod seams;
 pub(crate) mod topology;
 use crate::geom::{add, cross, dot, norm2, sub, Point3};
 use topology::EdgeRows;

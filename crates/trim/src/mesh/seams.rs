@@ -1,0 +1,253 @@
+//! Seams: a surface stored in pieces that share positions but not
+//! vertices. meshtrim's own layer; the paper meshes clouds and has none.
+//!
+//! A vertex holds one normal, one colour, one texture coordinate, so a
+//! file splits its vertices where those change across an edge: a texture
+//! chart's border, a hard edge. glTF must (its attributes are per vertex),
+//! PLY and OBJ exports often do. Each side of such a seam then runs along
+//! the same positions with vertices of its own, and to the edges the seam
+//! is a border, which the cleanup would smooth as if the surface ended
+//! there. Stitching joins the sides again: where two border edges join
+//! the same two positions, running opposite ways, and no other border
+//! edge joins them, their ends are one vertex each (the lowest index; the
+//! other copies are left out). The attributes stay
+//! with the input's vertices; carrying them to the output splits its
+//! vertices again where the input's were (`attributes.rs`).
+//!
+//! *Choices.* Border edges only, in opposite turns, paired one to one:
+//! a stitch then never puts a third face on an edge nor turns two faces
+//! against each other, so a mesh that was edge-manifold and oriented stays
+//! so. Positions must be equal bit for bit (the seam's copies are copies;
+//! a gap of any width is a border). A vertex that only touches another at
+//! a point (no border edge along it) stays apart, a pinch either way.
+
+use std::borrow::Cow;
+
+use rayon::prelude::*;
+
+use super::topology::EdgeRows;
+use super::Mesh;
+use crate::hash::HashMap;
+
+/// A mesh with its seams stitched ([`stitch_seams`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Stitched<'a> {
+    /// The mesh: the copies along each seam one vertex, the lowest index
+    /// of them, the others left out; the vertices otherwise in order.
+    pub mesh: Cow<'a, Mesh>,
+    /// The index in the mesh given of each vertex of `mesh`; `None` when
+    /// nothing was stitched (`mesh` is the mesh given).
+    pub kept: Option<Vec<u32>>,
+    /// The number of edges stitched.
+    pub edges: usize,
+}
+
+/// `mesh` with its seams stitched (see the module doc); borrowed as it is
+/// when it has none.
+pub fn stitch_seams(mesh: &Mesh) -> Stitched<'_> {
+    let unchanged = Stitched {
+        mesh: Cow::Borrowed(mesh),
+        kept: None,
+        edges: 0,
+    };
+    let shared = shared_positions(&mesh.vertices);
+    if shared.iter().all(|&s| !s) {
+        return unchanged;
+    }
+    let pairs = seam_edge_pairs(mesh, &shared);
+    if pairs.is_empty() {
+        return unchanged;
+    }
+    let mut copies = Copies::new(mesh.vertices.len());
+    for &((a, b), (c, d)) in &pairs {
+        // a → b on one side runs along d → c on the other.
+        copies.join(a, d);
+        copies.join(b, c);
+    }
+    let kept: Vec<u32> = (0..mesh.vertices.len() as u32)
+        .filter(|&v| copies.first(v) == v)
+        .collect();
+    let mut new_index = vec![0; mesh.vertices.len()];
+    for (new, &v) in kept.iter().enumerate() {
+        new_index[v as usize] = new as u32;
+    }
+    let stitched = Mesh {
+        vertices: kept.iter().map(|&v| mesh.vertices[v as usize]).collect(),
+        faces: mesh
+            .faces
+            .iter()
+            .map(|face| face.map(|v| new_index[copies.first(v) as usize]))
+            .collect(),
+    };
+    Stitched {
+        mesh: Cow::Owned(stitched),
+        kept: Some(kept),
+        edges: pairs.len(),
+    }
+}
+
+/// Whether each vertex shares its position (bit for bit) with another.
+fn shared_positions(vertices: &[[f64; 3]]) -> Vec<bool> {
+    let key = |v: u32| vertices[v as usize].map(f64::to_bits);
+    let mut order: Vec<u32> = (0..vertices.len() as u32).collect();
+    order.par_sort_unstable_by_key(|&v| (key(v), v));
+    let mut shared = vec![false; vertices.len()];
+    for run in order.chunk_by(|&a, &b| key(a) == key(b)) {
+        if run.len() > 1 {
+            for &v in run {
+                shared[v as usize] = true;
+            }
+        }
+    }
+    shared
+}
+
+/// A directed edge between two vertices.
+type Edge = (u32, u32);
+
+/// The border edges to stitch, each pair once, in the order of the
+/// first's vertices: both ends of each at shared positions, the two
+/// running between the same positions opposite ways, and no other border
+/// edge between those positions.
+fn seam_edge_pairs(mesh: &Mesh, shared: &[bool]) -> Vec<(Edge, Edge)> {
+    let key = |v: u32| mesh.vertices[v as usize].map(f64::to_bits);
+    let mut between: HashMap<([u64; 3], [u64; 3]), Vec<Edge>> = HashMap::default();
+    let border = EdgeRows::new(&mesh.faces).border();
+    let mut starts: Vec<u32> = border.keys().copied().collect();
+    starts.sort_unstable();
+    for a in starts {
+        for &b in &border[&a] {
+            if shared[a as usize] && shared[b as usize] {
+                between.entry((key(a), key(b))).or_default().push((a, b));
+            }
+        }
+    }
+    let mut pairs = Vec::new();
+    let mut sorted: Vec<_> = between.iter().collect();
+    sorted.sort_unstable_by_key(|(_, edges)| edges[0]);
+    for (&(pa, pb), edges) in sorted {
+        let Some(back) = between.get(&(pb, pa)) else {
+            continue;
+        };
+        // Each pair once: from the side whose first edge is the lower.
+        if let ([one], [other]) = (edges.as_slice(), back.as_slice()) {
+            if one < other {
+                pairs.push((*one, *other));
+            }
+        }
+    }
+    pairs
+}
+
+/// Copies of a vertex joined by stitches (a union-find whose root is the
+/// lowest index of each set).
+struct Copies {
+    parent: Vec<u32>,
+}
+
+impl Copies {
+    fn new(vertices: usize) -> Self {
+        Copies {
+            parent: (0..vertices as u32).collect(),
+        }
+    }
+
+    /// The lowest vertex joined to `v`.
+    fn first(&self, mut v: u32) -> u32 {
+        while self.parent[v as usize] != v {
+            v = self.parent[v as usize];
+        }
+        v
+    }
+
+    fn join(&mut self, a: u32, b: u32) {
+        let (ra, rb) = (self.first(a), self.first(b));
+        let (low, high) = (ra.min(rb), ra.max(rb));
+        self.parent[high as usize] = low;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A grid of `n` × `n` squares, two triangles each, counter-clockwise
+    /// seen from +z; with `split`, the squares right of column `n / 2` get
+    /// their own copies of the vertices on that column.
+    pub(crate) fn grid(n: u32, split: bool) -> Mesh {
+        let at = |i: u32, j: u32| i * (n + 1) + j;
+        let mut vertices: Vec<[f64; 3]> = (0..=n)
+            .flat_map(|i| (0..=n).map(move |j| [j as f64, i as f64, 0.0]))
+            .collect();
+        let middle = n / 2;
+        let mut copy_of = HashMap::default();
+        if split {
+            for i in 0..=n {
+                copy_of.insert(at(i, middle), vertices.len() as u32);
+                vertices.push(vertices[at(i, middle) as usize]);
+            }
+        }
+        let mut faces = Vec::new();
+        for i in 0..n {
+            for j in 0..n {
+                let right = j >= middle;
+                let v = |i, j| {
+                    let v = at(i, j);
+                    match (right, copy_of.get(&v)) {
+                        (true, Some(&c)) => c,
+                        _ => v,
+                    }
+                };
+                faces.push([v(i, j), v(i, j + 1), v(i + 1, j + 1)]);
+                faces.push([v(i, j), v(i + 1, j + 1), v(i + 1, j)]);
+            }
+        }
+        Mesh { vertices, faces }
+    }
+
+    #[test]
+    fn a_seam_is_stitched_to_the_faces_of_the_whole_surface() {
+        let stitched = stitch_seams(&grid(6, true));
+        assert_eq!(stitched.edges, 6);
+        assert_eq!(*stitched.mesh, grid(6, false));
+        let whole = grid(6, false).vertices.len() as u32;
+        assert_eq!(stitched.kept, Some((0..whole).collect()));
+        assert_eq!(stitched.mesh.boundary_loops().len(), 1);
+    }
+
+    #[test]
+    fn a_surface_without_seams_is_borrowed() {
+        let mesh = grid(5, false);
+        let same = stitch_seams(&mesh);
+        assert_eq!((same.edges, same.kept), (0, None));
+        assert!(matches!(same.mesh, Cow::Borrowed(_)));
+    }
+
+    #[test]
+    fn sides_running_the_same_way_are_not_stitched() {
+        // The right side turned over: its seam edges run as the left's.
+        let mut mesh = grid(4, true);
+        let left = mesh.vertices.len() as u32 - 5;
+        for face in mesh.faces.iter_mut() {
+            if face.iter().any(|&v| v >= left || mesh.vertices[v as usize][0] > 2.0) {
+                face.swap(1, 2);
+            }
+        }
+        let same = stitch_seams(&mesh);
+        assert_eq!(same.edges, 0);
+        assert_eq!(*same.mesh, mesh);
+    }
+
+    #[test]
+    fn a_third_border_edge_between_the_same_positions_leaves_the_seam_open() {
+        let mut mesh = grid(4, true);
+        // A lone triangle on the seam's first edge, turned as the right side.
+        let n = mesh.vertices.len() as u32;
+        mesh.vertices.extend([[2.0, 0.0, 0.0], [2.0, 1.0, 0.0], [3.0, -1.0, 0.0]]);
+        mesh.faces.push([n, n + 2, n + 1]);
+        let stitched = stitch_seams(&mesh);
+        assert_eq!(stitched.edges, 3);
+        assert!(stitched.mesh.is_edge_manifold());
+        assert_eq!(stitched.mesh.boundary_loops().len(), 2);
+    }
+}
