@@ -207,7 +207,8 @@ mod tests {
 
     #[test]
     fn a_seam_is_stitched_to_the_faces_of_the_whole_surface() {
-        let stitched = stitch_seams(&grid(6, true));
+        let split = grid(6, true);
+        let stitched = stitch_seams(&split);
         assert_eq!(stitched.edges, 6);
         assert_eq!(*stitched.mesh, grid(6, false));
         let whole = grid(6, false).vertices.len() as u32;
