@@ -456,3 +456,55 @@ fn beta_found_on_demand_cleans_the_same() {
         assert_eq!(format!("{got_report:?}"), format!("{want_report:?}"));
     }
 }
+
+/// `mesh` with the faces right of x = 0 given their own copies of the
+/// vertices they share with the faces left of it (a texture chart's
+/// border), the copies at the end.
+fn split_down_the_middle(mesh: &Mesh) -> Mesh {
+    let right = |f: &[u32; 3]| f.iter().map(|&v| mesh.vertices[v as usize][0]).sum::<f64>() > 0.0;
+    let mut on_side = [vec![false; mesh.vertices.len()], vec![false; mesh.vertices.len()]];
+    for f in &mesh.faces {
+        for &v in f {
+            on_side[usize::from(right(f))][v as usize] = true;
+        }
+    }
+    let mut split = mesh.clone();
+    let mut copy = HashMap::default();
+    for v in 0..mesh.vertices.len() {
+        if on_side[0][v] && on_side[1][v] {
+            copy.insert(v as u32, split.vertices.len() as u32);
+            split.vertices.push(mesh.vertices[v]);
+        }
+    }
+    for (f, face) in split.faces.iter_mut().enumerate() {
+        if right(&mesh.faces[f]) {
+            *face = face.map(|v| copy.get(&v).copied().unwrap_or(v));
+        }
+    }
+    split
+}
+
+/// Split along a seam, the annulus is cleaned to the mesh the whole one
+/// is (without the stitching the seam was border, and smoothed).
+#[test]
+fn a_mesh_split_along_a_seam_is_cleaned_as_one_surface() {
+    let whole = jagged_annulus(20.0, 6.0, 7);
+    let split = split_down_the_middle(&whole);
+    assert!(split.vertices.len() > whole.vertices.len() + 10);
+    // Two half annuli, their borders running along the seam too.
+    let border = |m: &Mesh| m.boundary_loops().iter().map(Vec::len).sum::<usize>();
+    assert!(border(&split) > border(&whole) + 20);
+    let detection = detect_boundary(&split.vertices, &BpdOptions::default()).unwrap();
+    let (out, report) = clean_mesh(&split, &detection.beta, &CleanOptions::default()).unwrap();
+    let (expected, expected_report) = clean(&whole);
+    assert_eq!(out, expected);
+    assert_eq!(report.loops_in, 2);
+    assert!(report.seam_edges_stitched > 10, "{report:?}");
+    assert_eq!(
+        CleanReport {
+            seam_edges_stitched: 0,
+            ..report
+        },
+        expected_report
+    );
+}
