@@ -203,7 +203,9 @@ pub struct AttributesWritten {
 
 /// Writes `out`, made from `from` (whose vertices carry `attributes`), to
 /// `path` as [`write_mesh_with`] does, with the attributes the format
-/// holds carried from `from` ([`VertexAttributes::carried`]).
+/// holds carried from `from` ([`VertexAttributes::carried`]); where
+/// `from`'s vertices are split along a seam and the format holds one of
+/// its attributes, `out`'s are split there too.
 pub fn write_mesh_carrying(
     path: &Path,
     out: &trim::Mesh,
@@ -216,9 +218,10 @@ pub fn write_mesh_carrying(
         None => (VertexAttributes::default(), Vec::new()),
     };
     let carried = held.carried(from, out);
-    write_mesh_with(path, &out.vertices, &out.faces, &carried)?;
+    let out = carried.mesh.as_ref().unwrap_or(out);
+    write_mesh_with(path, &out.vertices, &out.faces, &carried.attributes)?;
     Ok(AttributesWritten {
-        written: carried.names(),
+        written: carried.attributes.names(),
         not_written,
     })
 }

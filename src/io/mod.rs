@@ -259,6 +259,16 @@ pub struct VertexAttributes {
     pub scalars: Vec<ScalarField>,
 }
 
+/// Attributes carried to a mesh ([`VertexAttributes::carried`]).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Carried {
+    /// The mesh with its vertices split along the input's seams; `None`
+    /// when none is (the mesh the attributes were carried to).
+    pub mesh: Option<trim::Mesh>,
+    /// The attributes, one per vertex of that mesh.
+    pub attributes: VertexAttributes,
+}
+
 impl VertexAttributes {
     /// Whether there is nothing to carry.
     pub fn is_empty(&self) -> bool {
@@ -267,16 +277,26 @@ impl VertexAttributes {
 
     /// These attributes, of `from`'s vertices, at the vertices of `to`, a
     /// mesh made from it: copied where a vertex was kept, blended from the
-    /// closest point of `from` elsewhere (see [`trim::vertex_sources`]).
-    /// A non-finite normal is carried as zero (no direction). Empty when
-    /// there is nothing to carry or `from` has no vertex.
-    pub fn carried(&self, from: &trim::Mesh, to: &trim::Mesh) -> VertexAttributes {
+    /// closest point of `from` elsewhere, with `to`'s vertices split where
+    /// `from`'s are along a seam, so that each side keeps its own (see
+    /// [`trim::split_sources`]). A non-finite normal is carried as zero (no
+    /// direction). Empty when there is nothing to carry or `from` has no
+    /// vertex.
+    pub fn carried(&self, from: &trim::Mesh, to: &trim::Mesh) -> Carried {
         if self.is_empty() {
-            return VertexAttributes::default();
+            return Carried::default();
         }
-        let Some(sources) = trim::vertex_sources(from, to) else {
-            return VertexAttributes::default();
+        let Some(split) = trim::split_sources(from, to) else {
+            return Carried::default();
         };
+        Carried {
+            mesh: split.split_mesh(to),
+            attributes: self.at_sources(from, &split.sources),
+        }
+    }
+
+    /// These attributes at `sources` in `from`.
+    fn at_sources(&self, from: &trim::Mesh, sources: &[trim::VertexSource]) -> VertexAttributes {
         VertexAttributes {
             normals: self.normals.as_ref().map(|normals| {
                 // A file's NaN normal has no direction: zero, so that it
@@ -288,16 +308,16 @@ impl VertexAttributes {
                         false => [0.0; 3],
                     })
                     .collect();
-                trim::carry_normals(from, &sources, &finite)
+                trim::carry_normals(from, sources, &finite)
             }),
             colours: self.colours.as_ref().map(|colours| Colours {
-                rgba: trim::carry(from, &sources, &colours.rgba),
+                rgba: trim::carry(from, sources, &colours.rgba),
                 alpha: colours.alpha,
             }),
             scalars: self
                 .scalars
                 .iter()
-                .map(|field| field.carried(from, &sources))
+                .map(|field| field.carried(from, sources))
                 .collect(),
         }
     }

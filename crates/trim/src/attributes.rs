@@ -50,6 +50,9 @@ use crate::mesh::Mesh;
 use crate::spatial::closest_face::{bounds, FaceIndex, Scratch};
 use crate::spatial::PointTree;
 
+mod split;
+pub use split::{split_sources, SplitSources};
+
 /// Where an output vertex takes its attributes from in the input mesh.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum VertexSource {
@@ -69,6 +72,11 @@ pub enum VertexSource {
 /// the module doc); the face indices of both must be valid. `None` when
 /// `from` has no vertex to take them from (and `to` has vertices).
 pub fn vertex_sources(from: &Mesh, to: &Mesh) -> Option<Vec<VertexSource>> {
+    sources_and_seams(from, to).map(|(sources, _)| sources)
+}
+
+/// [`vertex_sources`], and the positions several input vertices share.
+fn sources_and_seams(from: &Mesh, to: &Mesh) -> Option<(Vec<VertexSource>, HashSet<[u64; 3]>)> {
     let (same_position, seams) = vertex_at_position(&from.vertices);
     let mut exact: Vec<Option<u32>> = to
         .vertices
@@ -79,16 +87,15 @@ pub fn vertex_sources(from: &Mesh, to: &Mesh) -> Option<Vec<VertexSource>> {
         settle_seams(from, to, &seams, &mut exact);
     }
     if exact.iter().all(Option::is_some) {
-        return Some(
-            exact
-                .into_iter()
-                .flatten()
-                .map(VertexSource::Vertex)
-                .collect(),
-        );
+        let sources = exact
+            .into_iter()
+            .flatten()
+            .map(VertexSource::Vertex)
+            .collect();
+        return Some((sources, seams));
     }
     if from.faces.is_empty() {
-        return nearest_points(&from.vertices, &to.vertices, &exact);
+        return nearest_points(&from.vertices, &to.vertices, &exact).map(|s| (s, seams));
     }
     let first_face = first_faces(to, &exact);
     let diagonal = diagonal(from);
@@ -126,7 +133,7 @@ pub fn vertex_sources(from: &Mesh, to: &Mesh) -> Option<Vec<VertexSource>> {
             face_source(from, face, p)
         })
         .collect();
-    Some(sources)
+    Some((sources, seams))
 }
 
 /// A ball around a point the closest input face is asked for, holding

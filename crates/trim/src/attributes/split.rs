@@ -1,0 +1,345 @@
+//! The output's vertices split again where the input's were split along a
+//! seam, so that each side keeps its own attributes.
+//!
+//! The cleanup stitches a seam's copies into one vertex (`mesh/seams.rs`),
+//! and a vertex holds one value of each attribute: a texture coordinate
+//! at a chart's border has one value per side. So each output face corner
+//! at or along a seam asks which side it is on: its face's own input face
+//! (the input face with the same corners in the same turn, else, among
+//! the input faces round the seam vertices the corner's source reads, the
+//! one nearest the face's centroid) says.
+//! A corner whose side reads other input vertices than its vertex's source
+//! moves to a copy of the vertex, one copy per side, as the input stored
+//! it. Everywhere else (no seam near) nothing changes.
+
+use rayon::prelude::*;
+
+use super::{
+    bits, centroid, closest_on_face, corners_from, face_source, nearest_corner, Corners,
+    VertexSource,
+};
+use crate::hash::{HashMap, HashSet};
+use crate::mesh::Mesh;
+
+/// Where the vertices of a mesh take their attributes from, its vertices
+/// split where the input's are along a seam ([`split_sources`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct SplitSources {
+    /// One source per vertex: the output's, then its copies'.
+    pub sources: Vec<VertexSource>,
+    /// The output vertex each copy repeats; copy `i` is vertex
+    /// `to.vertices.len() + i`.
+    pub copies: Vec<u32>,
+    /// The output's faces, with the corners on another side of a seam
+    /// than their vertex's source renamed to copies; `None` when no vertex
+    /// is split (`copies` is empty).
+    pub faces: Option<Vec<[u32; 3]>>,
+}
+
+impl SplitSources {
+    /// `to` with its vertices split (the copies at the end), or `None`
+    /// when none is.
+    pub fn split_mesh(&self, to: &Mesh) -> Option<Mesh> {
+        let faces = self.faces.clone()?;
+        let mut vertices = to.vertices.clone();
+        vertices.extend(self.copies.iter().map(|&o| to.vertices[o as usize]));
+        Some(Mesh { vertices, faces })
+    }
+}
+
+/// [`super::vertex_sources`] of `to` from `from`, with `to`'s vertices
+/// split where `from`'s are along a seam (see the module doc). `None`
+/// when `from` has no vertex to take attributes from.
+pub fn split_sources(from: &Mesh, to: &Mesh) -> Option<SplitSources> {
+    let (mut sources, seams) = super::sources_and_seams(from, to)?;
+    let (faces, copies) = match split_at_seams(from, to, &mut sources, &seams) {
+        Some((faces, copies)) => (Some(faces), copies),
+        None => (None, Vec::new()),
+    };
+    Some(SplitSources {
+        sources,
+        copies,
+        faces,
+    })
+}
+
+/// A weight below this (of a corner's 1) reads nothing from the corner:
+/// a point cut on an edge is off it by rounding.
+const SIGNIFICANT: f64 = 1e-9;
+
+/// The seam vertices a source reads, ascending, padded with `u32::MAX`:
+/// two corners of one output vertex are on one side when they read the
+/// same ones.
+type Side = [u32; 3];
+
+const NO_SEAM: Side = [u32::MAX; 3];
+
+/// The input's faces round its seam positions, which the sides are told
+/// by.
+struct SeamFaces<'a> {
+    from: &'a Mesh,
+    on_seam: Vec<bool>,
+    /// The input vertex at each corner (on a seam) of each input face,
+    /// keyed by the face's corner positions from that corner on.
+    corner: HashMap<Corners, u32>,
+    /// The input faces round each seam position, in face order.
+    around: HashMap<[u64; 3], Vec<u32>>,
+}
+
+impl<'a> SeamFaces<'a> {
+    fn new(from: &'a Mesh, seams: &HashSet<[u64; 3]>) -> Self {
+        let on_seam: Vec<bool> = from
+            .vertices
+            .par_iter()
+            .map(|p| seams.contains(&bits(p)))
+            .collect();
+        let mut corner = HashMap::default();
+        let mut around: HashMap<[u64; 3], Vec<u32>> = HashMap::default();
+        for (f, &face) in from.faces.iter().enumerate() {
+            for k in 0..3 {
+                if on_seam[face[k] as usize] {
+                    let key = corners_from(&from.vertices, face, k);
+                    corner.entry(key).or_insert(face[k]);
+                    around.entry(key[0]).or_default().push(f as u32);
+                }
+            }
+        }
+        SeamFaces {
+            from,
+            on_seam,
+            corner,
+            around,
+        }
+    }
+
+    fn side(&self, source: &VertexSource) -> Side {
+        let mut side = NO_SEAM;
+        let mut read = |v: u32, slot: &mut usize| {
+            if self.on_seam[v as usize] {
+                side[*slot] = v;
+                *slot += 1;
+            }
+        };
+        let mut slot = 0;
+        match *source {
+            VertexSource::Vertex(v) => read(v, &mut slot),
+            VertexSource::Face { face, weights } => {
+                for (k, &v) in self.from.faces[face as usize].iter().enumerate() {
+                    if weights[k] > SIGNIFICANT {
+                        read(v, &mut slot);
+                    }
+                }
+            }
+        }
+        side.sort_unstable();
+        side
+    }
+
+    /// The source of corner `k` of output face `face`, whose vertex's own
+    /// source `own` reads a seam vertex: from the input face on that
+    /// corner's side.
+    fn corner_source(&self, to: &Mesh, face: [u32; 3], k: usize, own: VertexSource) -> VertexSource {
+        let centre = centroid(&to.vertices, face);
+        let p = to.vertices[face[k] as usize];
+        match own {
+            VertexSource::Vertex(_) => {
+                let corners = corners_from(&to.vertices, face, k);
+                if let Some(&twin) = self.corner.get(&corners) {
+                    return VertexSource::Vertex(twin);
+                }
+                let faces = self.around.get(&corners[0]).map_or(&[][..], Vec::as_slice);
+                nearest_corner(self.from, faces, corners[0], centre).map_or(own, VertexSource::Vertex)
+            }
+            VertexSource::Face { face: f, .. } => {
+                let mut candidates: Vec<u32> = self.from.faces[f as usize]
+                    .iter()
+                    .filter(|&&v| self.on_seam[v as usize])
+                    .flat_map(|&v| self.around_vertex(v))
+                    .chain([f])
+                    .collect();
+                candidates.sort_unstable();
+                candidates.dedup();
+                // The face's side, even where the corner is nearer the
+                // other (a new face laid across the seam): the corners of
+                // one face then read one texture chart.
+                let on_side = candidates
+                    .into_iter()
+                    .map(|c| (closest_on_face(self.from, c, centre).0, c))
+                    .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+                on_side.map_or(own, |(_, c)| face_source(self.from, c, p))
+            }
+        }
+    }
+
+    fn around_vertex(&self, v: u32) -> impl Iterator<Item = u32> + '_ {
+        let position = bits(&self.from.vertices[v as usize]);
+        self.around.get(&position).into_iter().flatten().copied()
+    }
+}
+
+/// Splits `to`'s vertices along `from`'s seams: the faces with corners
+/// renamed and the output vertex each copy repeats, the copies' sources
+/// pushed onto `sources`; `None` when no vertex is split.
+fn split_at_seams(
+    from: &Mesh,
+    to: &Mesh,
+    sources: &mut Vec<VertexSource>,
+    seams: &HashSet<[u64; 3]>,
+) -> Option<(Vec<[u32; 3]>, Vec<u32>)> {
+    if seams.is_empty() || from.faces.is_empty() {
+        return None;
+    }
+    let seam_faces = SeamFaces::new(from, seams);
+    let own_side: Vec<Side> = sources.par_iter().map(|s| seam_faces.side(s)).collect();
+    if own_side.iter().all(|&s| s == NO_SEAM) {
+        return None;
+    }
+    let mut faces = to.faces.clone();
+    let mut copies = Vec::new();
+    // Each split vertex's other sides, and the copy that holds each.
+    let mut sides: HashMap<u32, Vec<(Side, u32)>> = HashMap::default();
+    for (out, face) in faces.iter_mut().enumerate() {
+        for k in 0..3 {
+            let o = face[k];
+            if own_side[o as usize] == NO_SEAM {
+                continue;
+            }
+            let source = seam_faces.corner_source(to, to.faces[out], k, sources[o as usize]);
+            let side = seam_faces.side(&source);
+            if side == own_side[o as usize] {
+                continue;
+            }
+            let known = sides.entry(o).or_default();
+            face[k] = match known.iter().find(|(s, _)| *s == side) {
+                Some(&(_, copy)) => copy,
+                None => {
+                    let copy = (to.vertices.len() + copies.len()) as u32;
+                    copies.push(o);
+                    sources.push(source);
+                    known.push((side, copy));
+                    copy
+                }
+            };
+        }
+    }
+    (!copies.is_empty()).then_some((faces, copies))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::Point3;
+
+    fn key(p: Point3) -> [u64; 3] {
+        bits(&p)
+    }
+
+    /// A strip of squares along x at y in 0..2, its faces right of x = 2
+    /// given their own copies of the vertices on x = 2.
+    fn split_strip() -> Mesh {
+        let at = |x: u32, y: u32| [x as f64, y as f64, 0.0];
+        let mut vertices = Vec::new();
+        let mut index = HashMap::default();
+        let mut vertex = |x: u32, y: u32, right: bool| -> u32 {
+            let side = right && x == 2;
+            *index.entry((x, y, side)).or_insert_with(|| {
+                vertices.push(at(x, y));
+                (vertices.len() - 1) as u32
+            })
+        };
+        let mut faces = Vec::new();
+        for x in 0..4 {
+            for y in 0..2 {
+                let right = x >= 2;
+                let [a, b, c, d] = [
+                    vertex(x, y, right),
+                    vertex(x + 1, y, right),
+                    vertex(x + 1, y + 1, right),
+                    vertex(x, y + 1, right),
+                ];
+                faces.push([a, b, c]);
+                faces.push([a, c, d]);
+            }
+        }
+        Mesh { vertices, faces }
+    }
+
+    #[test]
+    fn a_stitched_seam_is_split_again_as_the_input_was() {
+        let from = split_strip();
+        let stitched = crate::stitch_seams(&from);
+        assert_eq!(stitched.edges, 2);
+        let split = split_sources(&from, &stitched.mesh).unwrap();
+        let out = split.split_mesh(&stitched.mesh).unwrap();
+        assert_eq!(split.copies.len(), 3);
+        // Every corner reads the vertex the input face in its place has.
+        for (o, face) in out.faces.iter().enumerate() {
+            for k in 0..3 {
+                let VertexSource::Vertex(v) = split.sources[face[k] as usize] else {
+                    panic!("a kept corner without its vertex");
+                };
+                assert_eq!(v, from.faces[o][k], "face {o} corner {k}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_new_vertex_on_a_seam_edge_gets_a_copy_for_each_side() {
+        let from = split_strip();
+        let mut to = crate::stitch_seams(&from).mesh.into_owned();
+        // The seam's edge (2, 0)–(2, 1) cut at its middle, and each face
+        // on it split in two there.
+        let (low, high) = (key([2.0, 0.0, 0.0]), key([2.0, 1.0, 0.0]));
+        let at = |p: [u64; 3]| to.vertices.iter().position(|q| key(*q) == p).unwrap() as u32;
+        let (a, b) = (at(low), at(high));
+        let m = to.vertices.len() as u32;
+        to.vertices.push([2.0, 0.5, 0.0]);
+        let mut faces = Vec::new();
+        for face in &to.faces {
+            match (0..3).find(|&k| {
+                let (u, v) = (face[k], face[(k + 1) % 3]);
+                (u, v) == (a, b) || (u, v) == (b, a)
+            }) {
+                Some(k) => {
+                    let (u, v, w) = (face[k], face[(k + 1) % 3], face[(k + 2) % 3]);
+                    faces.push([u, m, w]);
+                    faces.push([m, v, w]);
+                }
+                None => faces.push(*face),
+            }
+        }
+        to.faces = faces;
+        let split = split_sources(&from, &to).unwrap();
+        let out = split.split_mesh(&to).unwrap();
+        let at_middle: HashSet<u32> = out
+            .faces
+            .iter()
+            .flatten()
+            .copied()
+            .filter(|&v| out.vertices[v as usize] == [2.0, 0.5, 0.0])
+            .collect();
+        assert_eq!(at_middle.len(), 2, "one vertex per side");
+        for v in at_middle {
+            let VertexSource::Face { face, weights } = split.sources[v as usize] else {
+                panic!("the middle is no input vertex");
+            };
+            let corners = from.faces[face as usize];
+            // Its face's corners are those of the faces using this copy.
+            let users: Vec<&[u32; 3]> = out.faces.iter().filter(|f| f.contains(&v)).collect();
+            let right = |c: &[u32; 3]| c.iter().any(|&x| from.vertices[x as usize][0] > 2.0);
+            assert!(users.iter().all(|f| {
+                let user_right = f.iter().any(|&x| out.vertices[x as usize][0] > 2.0);
+                user_right == right(&corners)
+            }));
+            assert!(weights.iter().filter(|&&w| w > 0.4).count() == 2, "{weights:?}");
+        }
+    }
+
+    #[test]
+    fn a_mesh_without_seams_is_not_split() {
+        let mut from = split_strip();
+        from = crate::stitch_seams(&from).mesh.into_owned();
+        let split = split_sources(&from, &from).unwrap();
+        assert_eq!((split.copies.len(), split.faces), (0, None));
+    }
+}
