@@ -5,9 +5,10 @@
 //! and a vertex holds one value of each attribute: a texture coordinate
 //! at a chart's border has one value per side. So each output face corner
 //! at or along a seam asks which side it is on: its face's own input face
-//! (the input face with the same corners in the same turn, else, among
-//! the input faces round the seam vertices the corner's source reads, the
-//! one nearest the face's centroid) says.
+//! says, the input face with the same corners in the same turn, else,
+//! among the input faces round the seam vertices its corners' sources
+//! read, the one nearest the face's centroid (one face for all three
+//! corners, so that they read one side).
 //! A corner whose side reads other input vertices than its vertex's source
 //! moves to a copy of the vertex, one copy per side, as the input stored
 //! it. Everywhere else (no seam near) nothing changes.
@@ -18,6 +19,7 @@ use super::{
     bits, centroid, closest_on_face, corners_from, face_source, nearest_corner, Corners,
     VertexSource,
 };
+use crate::geom::Point3;
 use crate::hash::{HashMap, HashSet};
 use crate::mesh::Mesh;
 
@@ -68,8 +70,8 @@ pub fn split_sources(from: &Mesh, to: &Mesh) -> Option<SplitSources> {
 const SIGNIFICANT: f64 = 1e-9;
 
 /// The seam vertices a source reads, ascending, padded with `u32::MAX`:
-/// two corners of one output vertex are on one side when they read the
-/// same ones.
+/// two corners of one output vertex are on two sides when they read one
+/// position through two of its copies.
 type Side = [u32; 3];
 
 const NO_SEAM: Side = [u32::MAX; 3];
@@ -135,46 +137,94 @@ impl<'a> SeamFaces<'a> {
         side
     }
 
-    /// The source of corner `k` of output face `face`, whose vertex's own
-    /// source `own` reads a seam vertex: from the input face on that
-    /// corner's side.
-    fn corner_source(&self, to: &Mesh, face: [u32; 3], k: usize, own: VertexSource) -> VertexSource {
-        let centre = centroid(&to.vertices, face);
-        let p = to.vertices[face[k] as usize];
-        match own {
-            VertexSource::Vertex(_) => {
-                let corners = corners_from(&to.vertices, face, k);
-                if let Some(&twin) = self.corner.get(&corners) {
-                    return VertexSource::Vertex(twin);
+    /// The input faces that may hold a corner whose own source is
+    /// `source`: those round the seam vertices it reads (and, for a point
+    /// of a face, that face).
+    fn candidates(&self, source: VertexSource, out: &mut Vec<u32>) {
+        match source {
+            VertexSource::Vertex(v) => out.extend(self.around_vertex(v)),
+            VertexSource::Face { face, .. } => {
+                for &v in &self.from.faces[face as usize] {
+                    if self.on_seam[v as usize] {
+                        out.extend(self.around_vertex(v));
+                    }
                 }
-                let faces = self.around.get(&corners[0]).map_or(&[][..], Vec::as_slice);
-                nearest_corner(self.from, faces, corners[0], centre).map_or(own, VertexSource::Vertex)
-            }
-            VertexSource::Face { face: f, .. } => {
-                let mut candidates: Vec<u32> = self.from.faces[f as usize]
-                    .iter()
-                    .filter(|&&v| self.on_seam[v as usize])
-                    .flat_map(|&v| self.around_vertex(v))
-                    .chain([f])
-                    .collect();
-                candidates.sort_unstable();
-                candidates.dedup();
-                // The face's side, even where the corner is nearer the
-                // other (a new face laid across the seam): the corners of
-                // one face then read one texture chart.
-                let on_side = candidates
-                    .into_iter()
-                    .map(|c| (closest_on_face(self.from, c, centre).0, c))
-                    .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-                on_side.map_or(own, |(_, c)| face_source(self.from, c, p))
+                out.push(face);
             }
         }
+    }
+
+    /// A point inside the input face on output face `face`'s side of the
+    /// seam: the centroid of the candidate face nearest its centroid (the
+    /// lower index on a tie). One point for the whole face, so that its
+    /// corners read one side even where a new face lies along the seam.
+    fn side_point(&self, to: &Mesh, face: [u32; 3], sources: &[VertexSource]) -> Point3 {
+        let centre = centroid(&to.vertices, face);
+        let mut candidates = Vec::new();
+        for v in face {
+            self.candidates(sources[v as usize], &mut candidates);
+        }
+        candidates.sort_unstable();
+        candidates.dedup();
+        candidates
+            .into_iter()
+            .map(|c| (closest_on_face(self.from, c, centre).0, c))
+            .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))
+            .map_or(centre, |(_, c)| centroid(&self.from.vertices, self.from.faces[c as usize]))
+    }
+
+    /// The source of corner `k` of output face `face`, whose vertex's own
+    /// source `own` reads a seam vertex: the input face with the face's
+    /// corners, else the candidate nearest the face's `side_point`.
+    fn corner_source(
+        &self,
+        to: &Mesh,
+        face: [u32; 3],
+        k: usize,
+        own: VertexSource,
+        side_point: Point3,
+    ) -> VertexSource {
+        let p = to.vertices[face[k] as usize];
+        if let VertexSource::Vertex(_) = own {
+            let corners = corners_from(&to.vertices, face, k);
+            if let Some(&twin) = self.corner.get(&corners) {
+                return VertexSource::Vertex(twin);
+            }
+            let faces = self.around.get(&corners[0]).map_or(&[][..], Vec::as_slice);
+            return nearest_corner(self.from, faces, corners[0], side_point)
+                .map_or(own, VertexSource::Vertex);
+        }
+        let mut candidates = Vec::new();
+        self.candidates(own, &mut candidates);
+        // The face's side, even where the corner is nearer the other (a
+        // new face laid across the seam): one face reads one texture chart.
+        candidates
+            .into_iter()
+            .map(|c| (closest_on_face(self.from, c, side_point).0, c))
+            .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))
+            .map_or(own, |(_, c)| face_source(self.from, c, p))
+    }
+
+    /// Whether a corner reading the seam vertices `side` is across a seam
+    /// from the corners that read `read`: some position is read there
+    /// through one copy and here through another. (Corners that read no
+    /// position in common are not told apart: nothing says they differ.)
+    fn across(&self, read: &[u32], side: &Side) -> bool {
+        let position = |v: u32| bits(&self.from.vertices[v as usize]);
+        side.iter()
+            .filter(|&&v| v != u32::MAX)
+            .any(|&v| read.iter().any(|&r| r != v && position(r) == position(v)))
     }
 
     fn around_vertex(&self, v: u32) -> impl Iterator<Item = u32> + '_ {
         let position = bits(&self.from.vertices[v as usize]);
         self.around.get(&position).into_iter().flatten().copied()
     }
+}
+
+/// The seam vertices a side reads.
+fn read(side: &Side) -> Vec<u32> {
+    side.iter().copied().filter(|&v| v != u32::MAX).collect()
 }
 
 /// Splits `to`'s vertices along `from`'s seams: the faces with corners
@@ -196,30 +246,38 @@ fn split_at_seams(
     }
     let mut faces = to.faces.clone();
     let mut copies = Vec::new();
-    // Each split vertex's other sides, and the copy that holds each.
-    let mut sides: HashMap<u32, Vec<(Side, u32)>> = HashMap::default();
+    // The sides found at each vertex near a seam: the seam vertices read
+    // there, and the vertex (the output's own, or a copy) that holds them.
+    let mut sides: HashMap<u32, Vec<(Vec<u32>, u32)>> = HashMap::default();
     for (out, face) in faces.iter_mut().enumerate() {
+        if face.iter().all(|&o| own_side[o as usize] == NO_SEAM) {
+            continue;
+        }
+        let side_point = seam_faces.side_point(to, to.faces[out], sources);
         for k in 0..3 {
             let o = face[k];
             if own_side[o as usize] == NO_SEAM {
                 continue;
             }
-            let source = seam_faces.corner_source(to, to.faces[out], k, sources[o as usize]);
+            let own = sources[o as usize];
+            let source = seam_faces.corner_source(to, to.faces[out], k, own, side_point);
             let side = seam_faces.side(&source);
-            if side == own_side[o as usize] {
-                continue;
-            }
-            let known = sides.entry(o).or_default();
-            face[k] = match known.iter().find(|(s, _)| *s == side) {
-                Some(&(_, copy)) => copy,
+            let known = sides
+                .entry(o)
+                .or_insert_with(|| vec![(read(&own_side[o as usize]), o)]);
+            match known.iter_mut().find(|(read, _)| !seam_faces.across(read, &side)) {
+                Some((read, holder)) => {
+                    read.extend(side.iter().filter(|&&v| v != u32::MAX));
+                    face[k] = *holder;
+                }
                 None => {
                     let copy = (to.vertices.len() + copies.len()) as u32;
                     copies.push(o);
                     sources.push(source);
-                    known.push((side, copy));
-                    copy
+                    known.push((read(&side), copy));
+                    face[k] = copy;
                 }
-            };
+            }
         }
     }
     (!copies.is_empty()).then_some((faces, copies))
@@ -228,7 +286,6 @@ fn split_at_seams(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geom::Point3;
 
     fn key(p: Point3) -> [u64; 3] {
         bits(&p)
