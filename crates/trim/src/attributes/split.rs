@@ -392,6 +392,144 @@ mod tests {
         }
     }
 
+    /// A jittered sheet cut into charts by two random wavy lines, each
+    /// chart with its own copies of the vertices it shares with another
+    /// (three or four copies where the lines cross); and each face's
+    /// chart.
+    fn charted_sheet(n: u32, seed: u64) -> (Mesh, Vec<usize>) {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+        let vertices: Vec<Point3> = (0..n * n)
+            .map(|i| {
+                let (x, y) = ((i % n) as f64, (i / n) as f64);
+                let jitter = |rng: &mut rand::rngs::StdRng| rng.random_range(-0.3..0.3);
+                [x + jitter(&mut rng), y + jitter(&mut rng), (0.3 * x).sin()]
+            })
+            .collect();
+        let (a, b) = (rng.random_range(0.3..0.7), rng.random_range(0.3..0.7));
+        let (wave, phase) = (rng.random_range(0.5..2.0), rng.random_range(0.0..6.0));
+        let size = n as f64;
+        let chart = |p: Point3| {
+            let right = p[0] > a * size + wave * (p[1] + phase).sin();
+            let top = p[1] > b * size + wave * (p[0] * 0.7).cos();
+            usize::from(right) + 2 * usize::from(top)
+        };
+        let mut faces = Vec::new();
+        for j in 0..n - 1 {
+            for i in 0..n - 1 {
+                let v = j * n + i;
+                faces.push([v, v + 1, v + n + 1]);
+                faces.push([v, v + n + 1, v + n]);
+            }
+        }
+        let mut mesh = Mesh { vertices, faces };
+        let charts: Vec<usize> = mesh
+            .faces
+            .iter()
+            .map(|&face| chart(centroid(&mesh.vertices, face)))
+            .collect();
+        let mut copy: HashMap<(u32, usize), u32> = HashMap::default();
+        for (f, &c) in charts.iter().enumerate() {
+            for k in 0..3 {
+                let v = mesh.faces[f][k];
+                let first = *copy.entry((v, usize::MAX)).or_insert(c as u32);
+                if first as usize != c {
+                    let next = mesh.vertices.len() as u32;
+                    let id = *copy.entry((v, c)).or_insert(next);
+                    if id == next {
+                        mesh.vertices.push(mesh.vertices[v as usize]);
+                    }
+                    mesh.faces[f][k] = id;
+                }
+            }
+        }
+        (mesh, charts)
+    }
+
+    /// Stitched and split again, random charted sheets come back as they
+    /// were stored: every corner reads its input face's vertex, and there
+    /// is one vertex per copy.
+    #[test]
+    fn random_charts_stitched_are_split_back_as_stored() {
+        for seed in 0..8 {
+            let (from, _) = charted_sheet(24, seed);
+            let stitched = crate::stitch_seams(&from);
+            assert!(stitched.edges > 20, "seed {seed}: {}", stitched.edges);
+            let split = split_sources(&from, &stitched.mesh).unwrap();
+            let out = split.split_mesh(&stitched.mesh).unwrap();
+            assert_eq!(out.vertices.len(), from.vertices.len(), "seed {seed}");
+            for (o, face) in out.faces.iter().enumerate() {
+                let read = face.map(|v| match split.sources[v as usize] {
+                    VertexSource::Vertex(v) => v,
+                    other => panic!("seed {seed}: a kept corner reads {other:?}"),
+                });
+                assert_eq!(read, from.faces[o], "seed {seed}, face {o}");
+            }
+        }
+    }
+
+    /// The faces of `mesh` at a seam position each cut in four at their
+    /// edges' middles (one middle per edge of the stitched surface, so
+    /// the middles of the seam's edges are on faces of both sides), with
+    /// the face of `mesh` each face of the result was cut from.
+    fn cut_at_seams(mesh: &Mesh, seam: &HashSet<[u64; 3]>) -> (Mesh, Vec<usize>) {
+        let mut out = Mesh {
+            vertices: mesh.vertices.clone(),
+            faces: Vec::new(),
+        };
+        let mut parent = Vec::new();
+        let mut middles: HashMap<(u32, u32), u32> = HashMap::default();
+        for (f, &face) in mesh.faces.iter().enumerate() {
+            if !face.iter().any(|&v| seam.contains(&bits(&mesh.vertices[v as usize]))) {
+                out.faces.push(face);
+                parent.push(f);
+                continue;
+            }
+            let m: [u32; 3] = std::array::from_fn(|k| {
+                let (a, b) = (face[k], face[(k + 1) % 3]);
+                *middles.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                    let [p, q] = [a, b].map(|v| mesh.vertices[v as usize]);
+                    out.vertices.push(std::array::from_fn(|c| 0.5 * (p[c] + q[c])));
+                    (out.vertices.len() - 1) as u32
+                })
+            });
+            let [a, b, c] = face;
+            for piece in [[a, m[0], m[2]], [m[0], b, m[1]], [m[2], m[1], c], m] {
+                out.faces.push(piece);
+                parent.push(f);
+            }
+        }
+        (out, parent)
+    }
+
+    /// Random charted sheets stitched and their faces at the seams cut:
+    /// every corner of every piece reads the chart of the input face it
+    /// was cut from (a chart number per input vertex, carried as any
+    /// label is).
+    #[test]
+    fn pieces_cut_at_random_seams_read_their_own_chart() {
+        for seed in 0..8 {
+            let (from, charts) = charted_sheet(20, seed);
+            let mut chart_of_vertex = vec![0; from.vertices.len()];
+            for (face, &chart) in from.faces.iter().zip(&charts) {
+                for &v in face {
+                    chart_of_vertex[v as usize] = chart;
+                }
+            }
+            let stitched = crate::stitch_seams(&from);
+            let seam = super::super::vertex_at_position(&from.vertices).1;
+            let (to, parent) = cut_at_seams(&stitched.mesh, &seam);
+            let split = split_sources(&from, &to).unwrap();
+            let out = split.split_mesh(&to).unwrap();
+            assert!(split.copies.len() > 20, "seed {seed}");
+            let read = crate::carry_nearest_corner(&from, &split.sources, &chart_of_vertex);
+            for (o, face) in out.faces.iter().enumerate() {
+                let own = charts[parent[o]];
+                assert_eq!(face.map(|v| read[v as usize]), [own; 3], "seed {seed}, face {o}");
+            }
+        }
+    }
+
     #[test]
     fn a_mesh_without_seams_is_not_split() {
         let mut from = split_strip();
