@@ -15,7 +15,7 @@ import pymeshlab
 import pytest
 import trimesh
 
-from meshtrim_cli import run_meshtrim, shared_data
+from meshtrim_cli import ROOT, run_meshtrim, shared_data
 
 BLUE, RED = [0.0, 0.0, 1.0, 1.0], [1.0, 0.0, 0.0, 1.0]
 
@@ -145,3 +145,24 @@ def test_each_side_of_the_seam_keeps_its_colour_in_gltf(scan, tmp_path):
     whole_v, whole_f, _ = read(tmp_path / "whole_out.glb")
     # glTF stores f32: the input's positions as trimesh wrote them.
     check_sides(out_v, out_f, out_c.astype(int), vs.astype(np.float32).astype(float), fs, (whole_v, whole_f))
+
+
+def test_a_triangle_soup_is_cleaned_as_the_welded_mesh():
+    """trimesh's STL loading with `process=False` gives each triangle its
+    own corners, every edge a seam: the package's `clean` stitches them
+    and gives the faces it gives the mesh trimesh welds."""
+    import meshtrim
+
+    stl = ROOT / "fixtures" / "meshes" / "blade_jagged.stl"
+    soup = trimesh.load(str(stl), process=False)
+    welded = trimesh.load(str(stl))
+    assert len(soup.vertices) == 3 * len(soup.faces) > 5 * len(welded.vertices)
+    out_soup = meshtrim.clean(np.asarray(soup.vertices), np.asarray(soup.faces))
+    out_welded = meshtrim.clean(np.asarray(welded.vertices), np.asarray(welded.faces))
+
+    def triangles(v, f):
+        return {tuple(sorted(map(tuple, v[face].tolist()))) for face in f}
+
+    assert triangles(*out_soup[:2]) == triangles(*out_welded[:2])
+    edges = len(trimesh.grouping.group_rows(welded.edges_sorted, require_count=2))
+    assert out_soup[2]["seam_edges_stitched"] == edges
