@@ -129,7 +129,8 @@ impl PointResolution for Picked<'_> {
     }
 }
 
-#[cfg(test)]#[cfg(test)]
+#[cfg(test)]
+#[cfg(test)]
 /// [`nearest_distances`] measuring each pair once, the plain way; the
 /// reference for tests.
 pub fn nearest_distances_reference(pts: &[Point2], out: &mut Vec<f64>) {

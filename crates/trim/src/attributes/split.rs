@@ -170,7 +170,9 @@ impl<'a> SeamFaces<'a> {
             .into_iter()
             .map(|c| (closest_on_face(self.from, c, centre).0, c))
             .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)))
-            .map_or(centre, |(_, c)| centroid(&self.from.vertices, self.from.faces[c as usize]))
+            .map_or(centre, |(_, c)| {
+                centroid(&self.from.vertices, self.from.faces[c as usize])
+            })
     }
 
     /// The source of corner `k` of output face `face`, whose vertex's own
@@ -245,42 +247,79 @@ fn split_at_seams(
         return None;
     }
     let mut faces = to.faces.clone();
-    let mut copies = Vec::new();
-    // The sides found at each vertex near a seam: the seam vertices read
-    // there, and the vertex (the output's own, or a copy) that holds them.
-    let mut sides: HashMap<u32, Vec<(Vec<u32>, u32)>> = HashMap::default();
+    let mut copies = Copies::new(to.vertices.len());
     for (out, face) in faces.iter_mut().enumerate() {
-        if face.iter().all(|&o| own_side[o as usize] == NO_SEAM) {
+        let original = to.faces[out];
+        if original.iter().all(|&o| own_side[o as usize] == NO_SEAM) {
             continue;
         }
-        let side_point = seam_faces.side_point(to, to.faces[out], sources);
-        for k in 0..3 {
-            let o = face[k];
+        let side_point = seam_faces.side_point(to, original, sources);
+        for (k, corner) in face.iter_mut().enumerate() {
+            let o = original[k];
             if own_side[o as usize] == NO_SEAM {
                 continue;
             }
             let own = sources[o as usize];
-            let source = seam_faces.corner_source(to, to.faces[out], k, own, side_point);
-            let side = seam_faces.side(&source);
-            let known = sides
-                .entry(o)
-                .or_insert_with(|| vec![(read(&own_side[o as usize]), o)]);
-            match known.iter_mut().find(|(read, _)| !seam_faces.across(read, &side)) {
-                Some((read, holder)) => {
-                    read.extend(side.iter().filter(|&&v| v != u32::MAX));
-                    face[k] = *holder;
-                }
-                None => {
-                    let copy = (to.vertices.len() + copies.len()) as u32;
-                    copies.push(o);
-                    sources.push(source);
-                    known.push((read(&side), copy));
-                    face[k] = copy;
-                }
-            }
+            let source = seam_faces.corner_source(to, original, k, own, side_point);
+            *corner = copies.holder(&seam_faces, o, &own_side[o as usize], source);
         }
     }
-    (!copies.is_empty()).then_some((faces, copies))
+    sources.extend(copies.sources);
+    (!copies.of.is_empty()).then_some((faces, copies.of))
+}
+
+/// The copies made of the output's vertices, one per further side.
+struct Copies {
+    /// The number of output vertices (the first copy's index).
+    first: usize,
+    /// The output vertex each copy repeats.
+    of: Vec<u32>,
+    /// Each copy's source.
+    sources: Vec<VertexSource>,
+    /// The sides found at each vertex near a seam: the seam vertices read
+    /// there, and the vertex (the output's own, or a copy) that holds them.
+    sides: HashMap<u32, Vec<(Vec<u32>, u32)>>,
+}
+
+impl Copies {
+    fn new(first: usize) -> Self {
+        Copies {
+            first,
+            of: Vec::new(),
+            sources: Vec::new(),
+            sides: HashMap::default(),
+        }
+    }
+
+    /// The vertex that holds output vertex `o` (whose own source reads
+    /// `own_side`) for a corner whose source is `source`: the first side
+    /// found there that the corner is not across a seam from, else a new
+    /// copy.
+    fn holder(
+        &mut self,
+        seam_faces: &SeamFaces,
+        o: u32,
+        own_side: &Side,
+        source: VertexSource,
+    ) -> u32 {
+        let side = seam_faces.side(&source);
+        let known = self
+            .sides
+            .entry(o)
+            .or_insert_with(|| vec![(read(own_side), o)]);
+        if let Some((read, holder)) = known
+            .iter_mut()
+            .find(|(read, _)| !seam_faces.across(read, &side))
+        {
+            read.extend(side.iter().filter(|&&v| v != u32::MAX));
+            return *holder;
+        }
+        let copy = (self.first + self.of.len()) as u32;
+        self.of.push(o);
+        self.sources.push(source);
+        known.push((read(&side), copy));
+        copy
+    }
 }
 
 #[cfg(test)]
@@ -331,12 +370,11 @@ mod tests {
         assert_eq!(split.copies.len(), 3);
         // Every corner reads the vertex the input face in its place has.
         for (o, face) in out.faces.iter().enumerate() {
-            for k in 0..3 {
-                let VertexSource::Vertex(v) = split.sources[face[k] as usize] else {
-                    panic!("a kept corner without its vertex");
-                };
-                assert_eq!(v, from.faces[o][k], "face {o} corner {k}");
-            }
+            let read = face.map(|v| match split.sources[v as usize] {
+                VertexSource::Vertex(v) => v,
+                other => panic!("a kept corner reads {other:?}"),
+            });
+            assert_eq!(read, from.faces[o], "face {o}");
         }
     }
 
@@ -388,7 +426,10 @@ mod tests {
                 let user_right = f.iter().any(|&x| out.vertices[x as usize][0] > 2.0);
                 user_right == right(&corners)
             }));
-            assert!(weights.iter().filter(|&&w| w > 0.4).count() == 2, "{weights:?}");
+            assert!(
+                weights.iter().filter(|&&w| w > 0.4).count() == 2,
+                "{weights:?}"
+            );
         }
     }
 
@@ -480,7 +521,10 @@ mod tests {
         let mut parent = Vec::new();
         let mut middles: HashMap<(u32, u32), u32> = HashMap::default();
         for (f, &face) in mesh.faces.iter().enumerate() {
-            if !face.iter().any(|&v| seam.contains(&bits(&mesh.vertices[v as usize]))) {
+            if !face
+                .iter()
+                .any(|&v| seam.contains(&bits(&mesh.vertices[v as usize])))
+            {
                 out.faces.push(face);
                 parent.push(f);
                 continue;
@@ -489,7 +533,8 @@ mod tests {
                 let (a, b) = (face[k], face[(k + 1) % 3]);
                 *middles.entry((a.min(b), a.max(b))).or_insert_with(|| {
                     let [p, q] = [a, b].map(|v| mesh.vertices[v as usize]);
-                    out.vertices.push(std::array::from_fn(|c| 0.5 * (p[c] + q[c])));
+                    out.vertices
+                        .push(std::array::from_fn(|c| 0.5 * (p[c] + q[c])));
                     (out.vertices.len() - 1) as u32
                 })
             });
@@ -525,7 +570,11 @@ mod tests {
             let read = crate::carry_nearest_corner(&from, &split.sources, &chart_of_vertex);
             for (o, face) in out.faces.iter().enumerate() {
                 let own = charts[parent[o]];
-                assert_eq!(face.map(|v| read[v as usize]), [own; 3], "seed {seed}, face {o}");
+                assert_eq!(
+                    face.map(|v| read[v as usize]),
+                    [own; 3],
+                    "seed {seed}, face {o}"
+                );
             }
         }
     }

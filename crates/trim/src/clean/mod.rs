@@ -397,10 +397,7 @@ fn clean_with(
 
 /// What the cleanup needs of the mesh left once its empty faces are dropped:
 /// faces, every edge used at most twice and never twice the same way.
-fn check_cleanable(
-    mesh: &Mesh,
-    edges: &EdgeRows,
-) -> Result<(), CleanError> {
+fn check_cleanable(mesh: &Mesh, edges: &EdgeRows) -> Result<(), CleanError> {
     if mesh.faces.is_empty() {
         return Err(MeshError::NoFaces.into());
     }

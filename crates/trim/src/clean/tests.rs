@@ -462,7 +462,10 @@ fn beta_found_on_demand_cleans_the_same() {
 /// border), the copies at the end.
 fn split_down_the_middle(mesh: &Mesh) -> Mesh {
     let right = |f: &[u32; 3]| f.iter().map(|&v| mesh.vertices[v as usize][0]).sum::<f64>() > 0.0;
-    let mut on_side = [vec![false; mesh.vertices.len()], vec![false; mesh.vertices.len()]];
+    let mut on_side = [
+        vec![false; mesh.vertices.len()],
+        vec![false; mesh.vertices.len()],
+    ];
     for f in &mesh.faces {
         for &v in f {
             on_side[usize::from(right(f))][v as usize] = true;
@@ -470,10 +473,10 @@ fn split_down_the_middle(mesh: &Mesh) -> Mesh {
     }
     let mut split = mesh.clone();
     let mut copy = HashMap::default();
-    for v in 0..mesh.vertices.len() {
+    for (v, &p) in mesh.vertices.iter().enumerate() {
         if on_side[0][v] && on_side[1][v] {
             copy.insert(v as u32, split.vertices.len() as u32);
-            split.vertices.push(mesh.vertices[v]);
+            split.vertices.push(p);
         }
     }
     for (f, face) in split.faces.iter_mut().enumerate() {

@@ -230,7 +230,10 @@ mod tests {
         let mut mesh = grid(4, true);
         let left = mesh.vertices.len() as u32 - 5;
         for face in mesh.faces.iter_mut() {
-            if face.iter().any(|&v| v >= left || mesh.vertices[v as usize][0] > 2.0) {
+            if face
+                .iter()
+                .any(|&v| v >= left || mesh.vertices[v as usize][0] > 2.0)
+            {
                 face.swap(1, 2);
             }
         }
@@ -244,7 +247,8 @@ mod tests {
         let mut mesh = grid(4, true);
         // A lone triangle on the seam's first edge, turned as the right side.
         let n = mesh.vertices.len() as u32;
-        mesh.vertices.extend([[2.0, 0.0, 0.0], [2.0, 1.0, 0.0], [3.0, -1.0, 0.0]]);
+        mesh.vertices
+            .extend([[2.0, 0.0, 0.0], [2.0, 1.0, 0.0], [3.0, -1.0, 0.0]]);
         mesh.faces.push([n, n + 2, n + 1]);
         let stitched = stitch_seams(&mesh);
         assert_eq!(stitched.edges, 3);
