@@ -96,7 +96,7 @@ use crate::mesh::boundary_loops_of;
 use crate::mesh::manifold::{make_manifold, ManifoldRepair};
 use crate::mesh::pinches::open_new_pinches;
 use crate::mesh::repair::{repair_degenerate_faces, FaceRepair};
-use crate::mesh::seams::stitch_seams;
+use crate::mesh::seams::{stitch_seams_with, Stitched};
 use crate::mesh::topology::{
     check_manifold, check_manifold_with, distinct, manifold_at_a_glance, EdgeRows, Topology,
 };
@@ -340,21 +340,32 @@ fn clean_with(
     mesh.validate()?;
     check_resolution_length(mesh, beta)?;
     let faces_in = mesh.faces.len();
+    let (kept, dropped, edges) = without_empty_faces(mesh);
     // Seams stitched, so that they do not look like borders; a seam's
     // other copies are left out, so that the loops' neighbourhoods do not
     // hold a point twice.
-    let stitched = stitch_seams(mesh);
-    let seam_edges_stitched = stitched.edges;
+    let Stitched {
+        mesh: stitched,
+        kept: stitched_from,
+        edges: seam_edges_stitched,
+    } = stitch_seams_with(&kept, &edges);
     let picked;
-    let beta: &dyn PointResolution = match &stitched.kept {
+    let beta: &dyn PointResolution = match &stitched_from {
         Some(of) => {
             picked = Picked { all: beta, of };
             &picked
         }
         None => beta,
     };
-    let stitched: &Mesh = &stitched.mesh;
-    let (kept, dropped, edges) = without_empty_faces(stitched);
+    let (kept, dropped, edges) = match stitched {
+        Cow::Borrowed(_) => (kept, dropped, edges),
+        // Two corners of one face may have been stitched together.
+        Cow::Owned(stitched) => {
+            let (again, more, edges) = without_empty_faces(&stitched);
+            let again = Cow::Owned(again.into_owned());
+            (again, dropped + more, edges)
+        }
+    };
     let (kept, edges, manifold) = if options.repair {
         let (repaired, manifold) = make_manifold(&kept);
         let edges = EdgeRows::new(&repaired.faces);
@@ -929,6 +940,16 @@ struct DroppedFaces {
     slivers: usize,
     /// Faces that repeated an earlier one, corners and turn alike.
     repeats: usize,
+}
+
+impl std::ops::Add for DroppedFaces {
+    type Output = DroppedFaces;
+    fn add(self, more: DroppedFaces) -> DroppedFaces {
+        DroppedFaces {
+            slivers: self.slivers + more.slivers,
+            repeats: self.repeats + more.repeats,
+        }
+    }
 }
 
 /// `mesh` without the faces that add no surface, and how many there were.

@@ -23,11 +23,9 @@
 
 use std::borrow::Cow;
 
-use rayon::prelude::*;
-
 use super::topology::EdgeRows;
 use super::Mesh;
-use crate::hash::HashMap;
+use crate::hash::{HashMap, HashSet};
 
 /// A mesh with its seams stitched ([`stitch_seams`]).
 #[derive(Debug, Clone, PartialEq)]
@@ -45,16 +43,24 @@ pub struct Stitched<'a> {
 /// `mesh` with its seams stitched (see the module doc); borrowed as it is
 /// when it has none.
 pub fn stitch_seams(mesh: &Mesh) -> Stitched<'_> {
+    stitch_seams_with(mesh, &EdgeRows::new(&mesh.faces))
+}
+
+/// [`stitch_seams`] with the mesh's edge rows built. Only border vertices
+/// are looked at, so a mesh without seams costs little more than its
+/// border.
+pub(crate) fn stitch_seams_with<'a>(mesh: &'a Mesh, edges: &EdgeRows) -> Stitched<'a> {
     let unchanged = Stitched {
         mesh: Cow::Borrowed(mesh),
         kept: None,
         edges: 0,
     };
-    let shared = shared_positions(&mesh.vertices);
-    if shared.iter().all(|&s| !s) {
+    let border = edges.border();
+    let shared = shared_positions(mesh, &border);
+    if shared.is_empty() {
         return unchanged;
     }
-    let pairs = seam_edge_pairs(mesh, &shared);
+    let pairs = seam_edge_pairs(mesh, &border, &shared);
     if pairs.is_empty() {
         return unchanged;
     }
@@ -86,20 +92,27 @@ pub fn stitch_seams(mesh: &Mesh) -> Stitched<'_> {
     }
 }
 
-/// Whether each vertex shares its position (bit for bit) with another.
-fn shared_positions(vertices: &[[f64; 3]]) -> Vec<bool> {
-    let key = |v: u32| vertices[v as usize].map(f64::to_bits);
-    let mut order: Vec<u32> = (0..vertices.len() as u32).collect();
-    order.par_sort_unstable_by_key(|&v| (key(v), v));
-    let mut shared = vec![false; vertices.len()];
-    for run in order.chunk_by(|&a, &b| key(a) == key(b)) {
-        if run.len() > 1 {
-            for &v in run {
-                shared[v as usize] = true;
+/// The border vertices that share their position (bit for bit) with
+/// another border vertex.
+fn shared_positions(mesh: &Mesh, border: &HashMap<u32, Vec<u32>>) -> HashSet<u32> {
+    let mut at: HashMap<[u64; 3], Vec<u32>> = HashMap::default();
+    let ends = border.iter().flat_map(|(&a, bs)| bs.iter().map(move |&b| (a, b)));
+    for (a, b) in ends {
+        for v in [a, b] {
+            let copies = at.entry(key(mesh, v)).or_default();
+            if !copies.contains(&v) {
+                copies.push(v);
             }
         }
     }
-    shared
+    at.into_values()
+        .filter(|copies| copies.len() > 1)
+        .flatten()
+        .collect()
+}
+
+fn key(mesh: &Mesh, v: u32) -> [u64; 3] {
+    mesh.vertices[v as usize].map(f64::to_bits)
 }
 
 /// A directed edge between two vertices.
@@ -109,16 +122,21 @@ type Edge = (u32, u32);
 /// first's vertices: both ends of each at shared positions, the two
 /// running between the same positions opposite ways, and no other border
 /// edge between those positions.
-fn seam_edge_pairs(mesh: &Mesh, shared: &[bool]) -> Vec<(Edge, Edge)> {
-    let key = |v: u32| mesh.vertices[v as usize].map(f64::to_bits);
+fn seam_edge_pairs(
+    mesh: &Mesh,
+    border: &HashMap<u32, Vec<u32>>,
+    shared: &HashSet<u32>,
+) -> Vec<(Edge, Edge)> {
     let mut between: HashMap<([u64; 3], [u64; 3]), Vec<Edge>> = HashMap::default();
-    let border = EdgeRows::new(&mesh.faces).border();
     let mut starts: Vec<u32> = border.keys().copied().collect();
     starts.sort_unstable();
     for a in starts {
         for &b in &border[&a] {
-            if shared[a as usize] && shared[b as usize] {
-                between.entry((key(a), key(b))).or_default().push((a, b));
+            if shared.contains(&a) && shared.contains(&b) {
+                between
+                    .entry((key(mesh, a), key(mesh, b)))
+                    .or_default()
+                    .push((a, b));
             }
         }
     }
