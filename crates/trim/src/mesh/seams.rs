@@ -96,7 +96,9 @@ pub(crate) fn stitch_seams_with<'a>(mesh: &'a Mesh, edges: &EdgeRows) -> Stitche
 /// another border vertex.
 fn shared_positions(mesh: &Mesh, border: &HashMap<u32, Vec<u32>>) -> HashSet<u32> {
     let mut at: HashMap<[u64; 3], Vec<u32>> = HashMap::default();
-    let ends = border.iter().flat_map(|(&a, bs)| bs.iter().map(move |&b| (a, b)));
+    let ends = border
+        .iter()
+        .flat_map(|(&a, bs)| bs.iter().map(move |&b| (a, b)));
     for (a, b) in ends {
         for v in [a, b] {
             let copies = at.entry(key(mesh, v)).or_default();
