@@ -508,3 +508,92 @@ fn a_wall_blocked_by_the_smoothed_loop_leaves_the_loop() {
     assert_eq!(stdout.matches("left unchanged").count(), 2, "{stdout}");
     assert!(output.exists());
 }
+
+/// The fixture written as a triangle soup (each face with its own three
+/// `v` lines, as a flat-shaded export stores it): every inner edge is a
+/// seam. It is cleaned to the fixture's own output, the report counting
+/// every inner edge stitched.
+#[test]
+fn a_triangle_soup_is_cleaned_as_the_welded_scan() {
+    let dir = tempfile::tempdir().unwrap();
+    let (soup, mesh) = soup_of_the_fixture(dir.path(), |_| None);
+    let json = cleaned_like_the_fixture(dir.path(), &soup);
+    let border: usize = mesh.boundary_loops().iter().map(Vec::len).sum();
+    let inner_edges = (3 * mesh.faces.len() - border) / 2;
+    assert_eq!(json["seam_edges_stitched"], inner_edges as u64);
+    let run = meshtrim(&["clean", s(&soup), s(&dir.path().join("again.stl"))], None);
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        stdout.contains(&format!("seams stitched       {inner_edges} edges")),
+        "{stdout}"
+    );
+}
+
+/// The soup with a colour per face (flat shading): cleaned to PLY, the
+/// output is split again where the soup was, so every face kept keeps its
+/// own colour at its three corners.
+#[test]
+fn each_face_of_a_flat_shaded_soup_keeps_its_colour() {
+    let dir = tempfile::tempdir().unwrap();
+    let colour = |f: usize| [f % 251, (f / 251) % 251, 7].map(|c| c as f64 / 255.0);
+    let (soup, mesh) = soup_of_the_fixture(dir.path(), |f| Some(colour(f)));
+    let out = dir.path().join("out.ply");
+    let run = meshtrim(&["clean", s(&soup), s(&out)], None);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let written = meshtrim::io::read_mesh(&out).unwrap();
+    let rgba = written.colours.unwrap().rgba;
+    let key = |p: [f64; 3]| p.map(f64::to_bits);
+    let mut face_of: std::collections::HashMap<[[u64; 3]; 3], usize> = Default::default();
+    for (f, face) in mesh.faces.iter().enumerate() {
+        let mut corners = face.map(|v| key(mesh.vertices[v as usize]));
+        corners.sort_unstable();
+        face_of.insert(corners, f);
+    }
+    let mut kept = 0;
+    for face in written.faces.unwrap() {
+        let mut corners = face.map(|v| key(written.vertices[v as usize]));
+        corners.sort_unstable();
+        if let Some(&f) = face_of.get(&corners) {
+            kept += 1;
+            for v in face {
+                let [r, g, b, _] = rgba[v as usize];
+                let bytes = |c: [f64; 3]| c.map(|x| (x * 255.0).round() as u8);
+                assert_eq!(bytes([r, g, b]), bytes(colour(f)), "face {f}");
+            }
+        }
+    }
+    assert!(kept > 4000, "{kept} faces kept");
+}
+
+/// Writes the fixture as an OBJ triangle soup, each face's corners given
+/// `colour(face)` if any; returns its path and the welded fixture.
+fn soup_of_the_fixture(
+    dir: &Path,
+    colour: impl Fn(usize) -> Option<[f64; 3]>,
+) -> (std::path::PathBuf, trim::Mesh) {
+    let read = meshtrim::io::read_mesh(Path::new(JAGGED)).unwrap();
+    let mesh = trim::Mesh {
+        vertices: read.vertices,
+        faces: read.faces.unwrap(),
+    };
+    let mut text = String::new();
+    for (f, face) in mesh.faces.iter().enumerate() {
+        for &v in face {
+            let [x, y, z] = mesh.vertices[v as usize];
+            text += &match colour(f) {
+                Some([r, g, b]) => format!("v {x:?} {y:?} {z:?} {r:?} {g:?} {b:?}\n"),
+                None => format!("v {x:?} {y:?} {z:?}\n"),
+            };
+        }
+    }
+    for f in 0..mesh.faces.len() {
+        text += &format!("f {} {} {}\n", 3 * f + 1, 3 * f + 2, 3 * f + 3);
+    }
+    let path = dir.join("soup.obj");
+    std::fs::write(&path, text).unwrap();
+    (path, mesh)
+}

@@ -280,7 +280,7 @@ pub struct CleanReport {
     /// Edges where the input's vertices were split but its surface goes
     /// on (a texture chart's border, a hard edge), stitched before
     /// anything else, so that they are not taken for borders
-    /// ([`stitch_seams`]).
+    /// ([`crate::stitch_seams`]).
     pub seam_edges_stitched: usize,
     /// Input faces that named a vertex twice, dropped before anything else
     /// (see `without_empty_faces`).
