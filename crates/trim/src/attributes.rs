@@ -51,6 +51,7 @@ use crate::spatial::closest_face::{bounds, FaceIndex, Scratch};
 use crate::spatial::PointTree;
 
 mod split;
+use split::SeamFaces;
 pub use split::{split_sources, SplitSources};
 
 /// Where an output vertex takes its attributes from in the input mesh.
@@ -75,16 +76,21 @@ pub fn vertex_sources(from: &Mesh, to: &Mesh) -> Option<Vec<VertexSource>> {
     sources_and_seams(from, to).map(|(sources, _)| sources)
 }
 
-/// [`vertex_sources`], and the positions several input vertices share.
-fn sources_and_seams(from: &Mesh, to: &Mesh) -> Option<(Vec<VertexSource>, HashSet<[u64; 3]>)> {
+/// [`vertex_sources`], and the input's faces round the positions several
+/// input vertices share, if any do.
+fn sources_and_seams<'a>(
+    from: &'a Mesh,
+    to: &Mesh,
+) -> Option<(Vec<VertexSource>, Option<SeamFaces<'a>>)> {
     let (same_position, seams) = vertex_at_position(&from.vertices);
+    let seams = (!seams.is_empty()).then(|| SeamFaces::new(from, seams));
     let mut exact: Vec<Option<u32>> = to
         .vertices
         .par_iter()
         .map(|p| same_position.get(&bits(p)).copied())
         .collect();
-    if !seams.is_empty() {
-        settle_seams(from, to, &seams, &mut exact);
+    if let Some(seam_faces) = &seams {
+        settle_seams(to, seam_faces, &mut exact);
     }
     if exact.iter().all(Option::is_some) {
         let sources = exact
@@ -323,27 +329,13 @@ fn corners_from(vertices: &[Point3], face: [u32; 3], k: usize) -> Corners {
 /// doc): by an input face with the same corners in the same turn (the
 /// first output face and the first input face settle it), else by the
 /// input face nearest their first output face's centroid.
-fn settle_seams(from: &Mesh, to: &Mesh, seams: &HashSet<[u64; 3]>, exact: &mut [Option<u32>]) {
+fn settle_seams(to: &Mesh, seam_faces: &SeamFaces, exact: &mut [Option<u32>]) {
     // Looked up once per vertex, in parallel, rather than per face corner.
-    let seam_flags = |vertices: &[Point3]| -> Vec<bool> {
-        vertices
-            .par_iter()
-            .map(|p| seams.contains(&bits(p)))
-            .collect()
-    };
-    let (input_on_seam, output_on_seam) = (seam_flags(&from.vertices), seam_flags(&to.vertices));
-    let mut input_corner: HashMap<Corners, u32> = HashMap::default();
-    // The input faces around each seam position, in face order.
-    let mut around: HashMap<[u64; 3], Vec<u32>> = HashMap::default();
-    for (f, &face) in from.faces.iter().enumerate() {
-        for k in 0..3 {
-            if input_on_seam[face[k] as usize] {
-                let key = corners_from(&from.vertices, face, k);
-                input_corner.entry(key).or_insert(face[k]);
-                around.entry(key[0]).or_default().push(f as u32);
-            }
-        }
-    }
+    let output_on_seam: Vec<bool> = to
+        .vertices
+        .par_iter()
+        .map(|p| seam_faces.is_seam(p))
+        .collect();
     let mut settled = vec![false; to.vertices.len()];
     let mut first_face: HashMap<u32, [u32; 3]> = HashMap::default();
     for &face in &to.faces {
@@ -353,8 +345,7 @@ fn settle_seams(from: &Mesh, to: &Mesh, seams: &HashSet<[u64; 3]>, exact: &mut [
                 continue;
             }
             first_face.entry(v).or_insert(face);
-            let key = corners_from(&to.vertices, face, k);
-            if let Some(&input) = input_corner.get(&key) {
+            if let Some(input) = seam_faces.twin(&corners_from(&to.vertices, face, k)) {
                 exact[v as usize] = Some(input);
                 settled[v as usize] = true;
             }
@@ -363,9 +354,13 @@ fn settle_seams(from: &Mesh, to: &Mesh, seams: &HashSet<[u64; 3]>, exact: &mut [
     for (v, face) in first_face {
         if !settled[v as usize] {
             let position = bits(&to.vertices[v as usize]);
-            let faces = around.get(&position).map_or(&[][..], Vec::as_slice);
-            if let Some(input) = nearest_corner(from, faces, position, centroid(&to.vertices, face))
-            {
+            let faces = seam_faces.around(&position);
+            if let Some(input) = nearest_corner(
+                seam_faces.from,
+                faces,
+                position,
+                centroid(&to.vertices, face),
+            ) {
                 exact[v as usize] = Some(input);
             }
         }

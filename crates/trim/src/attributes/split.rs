@@ -54,7 +54,8 @@ impl SplitSources {
 /// when `from` has no vertex to take attributes from.
 pub fn split_sources(from: &Mesh, to: &Mesh) -> Option<SplitSources> {
     let (mut sources, seams) = super::sources_and_seams(from, to)?;
-    let (faces, copies) = match split_at_seams(from, to, &mut sources, &seams) {
+    let split = seams.and_then(|seam_faces| split_at_seams(&seam_faces, to, &mut sources));
+    let (faces, copies) = match split {
         Some((faces, copies)) => (Some(faces), copies),
         None => (None, Vec::new()),
     };
@@ -76,10 +77,11 @@ type Side = [u32; 3];
 
 const NO_SEAM: Side = [u32::MAX; 3];
 
-/// The input's faces round its seam positions, which the sides are told
-/// by.
-struct SeamFaces<'a> {
-    from: &'a Mesh,
+/// The input's faces round its seam positions (positions several input
+/// vertices share), which tell a seam's sides apart.
+pub(super) struct SeamFaces<'a> {
+    pub(super) from: &'a Mesh,
+    seams: HashSet<[u64; 3]>,
     on_seam: Vec<bool>,
     /// The input vertex at each corner (on a seam) of each input face,
     /// keyed by the face's corner positions from that corner on.
@@ -89,7 +91,7 @@ struct SeamFaces<'a> {
 }
 
 impl<'a> SeamFaces<'a> {
-    fn new(from: &'a Mesh, seams: &HashSet<[u64; 3]>) -> Self {
+    pub(super) fn new(from: &'a Mesh, seams: HashSet<[u64; 3]>) -> Self {
         let on_seam: Vec<bool> = from
             .vertices
             .par_iter()
@@ -108,10 +110,27 @@ impl<'a> SeamFaces<'a> {
         }
         SeamFaces {
             from,
+            seams,
             on_seam,
             corner,
             around,
         }
+    }
+
+    /// Whether `p` is at a seam position.
+    pub(super) fn is_seam(&self, p: &Point3) -> bool {
+        self.seams.contains(&bits(p))
+    }
+
+    /// The input vertex at the first corner of the input face whose corner
+    /// positions, in turn from that corner, are `corners`.
+    pub(super) fn twin(&self, corners: &Corners) -> Option<u32> {
+        self.corner.get(corners).copied()
+    }
+
+    /// The input faces round a seam position.
+    pub(super) fn around(&self, position: &[u64; 3]) -> &[u32] {
+        self.around.get(position).map_or(&[][..], Vec::as_slice)
     }
 
     fn side(&self, source: &VertexSource) -> Side {
@@ -189,11 +208,10 @@ impl<'a> SeamFaces<'a> {
         let p = to.vertices[face[k] as usize];
         if let VertexSource::Vertex(_) = own {
             let corners = corners_from(&to.vertices, face, k);
-            if let Some(&twin) = self.corner.get(&corners) {
+            if let Some(twin) = self.twin(&corners) {
                 return VertexSource::Vertex(twin);
             }
-            let faces = self.around.get(&corners[0]).map_or(&[][..], Vec::as_slice);
-            return nearest_corner(self.from, faces, corners[0], side_point)
+            return nearest_corner(self.from, self.around(&corners[0]), corners[0], side_point)
                 .map_or(own, VertexSource::Vertex);
         }
         let mut candidates = Vec::new();
@@ -219,8 +237,9 @@ impl<'a> SeamFaces<'a> {
     }
 
     fn around_vertex(&self, v: u32) -> impl Iterator<Item = u32> + '_ {
-        let position = bits(&self.from.vertices[v as usize]);
-        self.around.get(&position).into_iter().flatten().copied()
+        self.around(&bits(&self.from.vertices[v as usize]))
+            .iter()
+            .copied()
     }
 }
 
@@ -233,15 +252,13 @@ fn read(side: &Side) -> Vec<u32> {
 /// renamed and the output vertex each copy repeats, the copies' sources
 /// pushed onto `sources`; `None` when no vertex is split.
 fn split_at_seams(
-    from: &Mesh,
+    seam_faces: &SeamFaces,
     to: &Mesh,
     sources: &mut Vec<VertexSource>,
-    seams: &HashSet<[u64; 3]>,
 ) -> Option<(Vec<[u32; 3]>, Vec<u32>)> {
-    if seams.is_empty() || from.faces.is_empty() {
+    if seam_faces.from.faces.is_empty() {
         return None;
     }
-    let seam_faces = SeamFaces::new(from, seams);
     let own_side: Vec<Side> = sources.par_iter().map(|s| seam_faces.side(s)).collect();
     if own_side.iter().all(|&s| s == NO_SEAM) {
         return None;
@@ -261,7 +278,7 @@ fn split_at_seams(
             }
             let own = sources[o as usize];
             let source = seam_faces.corner_source(to, original, k, own, side_point);
-            *corner = copies.holder(&seam_faces, o, &own_side[o as usize], source);
+            *corner = copies.holder(seam_faces, o, &own_side[o as usize], source);
         }
     }
     sources.extend(copies.sources);
