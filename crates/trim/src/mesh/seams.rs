@@ -25,6 +25,7 @@ use std::borrow::Cow;
 
 use super::topology::EdgeRows;
 use super::Mesh;
+use crate::geom::UnionFind;
 use crate::hash::{HashMap, HashSet};
 
 /// A mesh with its seams stitched ([`stitch_seams`]).
@@ -64,14 +65,15 @@ pub(crate) fn stitch_seams_with<'a>(mesh: &'a Mesh, edges: &EdgeRows) -> Stitche
     if pairs.is_empty() {
         return unchanged;
     }
-    let mut copies = Copies::new(mesh.vertices.len());
+    // The smaller root wins each union: each set's root is its lowest copy.
+    let mut copies = UnionFind::new(mesh.vertices.len());
     for &((a, b), (c, d)) in &pairs {
         // a → b on one side runs along d → c on the other.
-        copies.join(a, d);
-        copies.join(b, c);
+        copies.union(a, d);
+        copies.union(b, c);
     }
     let kept: Vec<u32> = (0..mesh.vertices.len() as u32)
-        .filter(|&v| copies.first(v) == v)
+        .filter(|&v| copies.find(v) == v)
         .collect();
     let mut new_index = vec![0; mesh.vertices.len()];
     for (new, &v) in kept.iter().enumerate() {
@@ -82,7 +84,7 @@ pub(crate) fn stitch_seams_with<'a>(mesh: &'a Mesh, edges: &EdgeRows) -> Stitche
         faces: mesh
             .faces
             .iter()
-            .map(|face| face.map(|v| new_index[copies.first(v) as usize]))
+            .map(|face| face.map(|v| new_index[copies.find(v) as usize]))
             .collect(),
     };
     Stitched {
@@ -157,34 +159,6 @@ fn seam_edge_pairs(
         }
     }
     pairs
-}
-
-/// Copies of a vertex joined by stitches (a union-find whose root is the
-/// lowest index of each set).
-struct Copies {
-    parent: Vec<u32>,
-}
-
-impl Copies {
-    fn new(vertices: usize) -> Self {
-        Copies {
-            parent: (0..vertices as u32).collect(),
-        }
-    }
-
-    /// The lowest vertex joined to `v`.
-    fn first(&self, mut v: u32) -> u32 {
-        while self.parent[v as usize] != v {
-            v = self.parent[v as usize];
-        }
-        v
-    }
-
-    fn join(&mut self, a: u32, b: u32) {
-        let (ra, rb) = (self.first(a), self.first(b));
-        let (low, high) = (ra.min(rb), ra.max(rb));
-        self.parent[high as usize] = low;
-    }
 }
 
 #[cfg(test)]
