@@ -110,7 +110,8 @@ pub struct Columns {
 }
 
 /// The β of some of a cloud's points, renumbered: point `i` is point
-/// `of[i]` of `all` (a mesh's used vertices among all it stores).
+/// `of[i]` of `all` (the vertices a mesh keeps once its seams are
+/// stitched, among all it stored).
 pub(crate) struct Picked<'a> {
     pub(crate) all: &'a dyn PointResolution,
     pub(crate) of: &'a [u32],
@@ -129,7 +130,6 @@ impl PointResolution for Picked<'_> {
     }
 }
 
-#[cfg(test)]
 #[cfg(test)]
 /// [`nearest_distances`] measuring each pair once, the plain way; the
 /// reference for tests.
