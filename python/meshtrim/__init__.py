@@ -326,7 +326,12 @@ def clean(
     ``--repair``) makes a mesh that is not edge-manifold or consistently
     oriented so first (faces on edges of more than two faces removed,
     smallest first; faces wound against their neighbours turned) rather
-    than refusing it.
+    than refusing it. Vertices split along a seam (two border edges
+    between the same positions, running opposite ways: a texture chart's
+    border, a triangle soup) are stitched first (``seam_edges_stitched``
+    in the report), and the mesh returned is the stitched one;
+    :func:`write_mesh_carrying` splits it again where the input was split,
+    as the CLI writes it.
     """
     k, anisotropy, along, from_ = _options(k, anisotropy, view_along, view_from)
     v = _float_rows(vertices, "vertices")
