@@ -47,6 +47,7 @@ import lazrs  # noqa: F401
 import pye57  # noqa: F401
 import ezdxf  # noqa: F401
 import gmsh  # noqa: F401
+import PIL  # noqa: F401
 
 # A small cap of a sphere: screened Poisson must produce faces.
 rng = np.random.default_rng(1)

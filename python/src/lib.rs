@@ -539,6 +539,7 @@ fn attributes_of(
         normals: normals.map(|n| rows(&n, "normals")).transpose()?,
         colours: colours.map(|c| colours_of(&c)).transpose()?,
         scalars: fields_of(scalars)?,
+        ..Default::default()
     })
 }
 

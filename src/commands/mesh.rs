@@ -130,6 +130,7 @@ pub fn run(args: &Args) -> Result<()> {
         normals: cloud.normals,
         colours: cloud.colours,
         scalars: cloud.scalars,
+        ..VertexAttributes::default()
     };
     let points = trim::Mesh {
         vertices: cloud.points,

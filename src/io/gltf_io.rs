@@ -19,17 +19,20 @@
 //! [`MAX_INSTANCED_TRIANGLES`] (beyond what it stores) is refused.
 //!
 //! Vertex attributes: `NORMAL` (float VEC3, turned by the world matrix's
-//! inverse transpose and scaled to unit length) and `COLOR_0` (float, or
-//! normalised unsigned byte or short, RGB or RGBA) are read when every
-//! primitive has them in those types (otherwise the mesh is read without
-//! them); application-specific scalar attributes (`_NAME`) as the file's
-//! own values ([`ScalarField`]); the other attributes (texture
-//! coordinates, tangents, joints) are not.
+//! inverse transpose and scaled to unit length), `COLOR_0` (float, or
+//! normalised unsigned byte or short, RGB or RGBA) and `TEXCOORD_0`
+//! (float, or normalised unsigned byte or short; v turned upwards, as
+//! OBJ and PLY store it) are read when every primitive has them in those
+//! types (otherwise the mesh is read without them); application-specific
+//! scalar attributes (`_NAME`) as the file's own values ([`ScalarField`]);
+//! the other attributes (more texture coordinate sets, tangents, joints)
+//! and the materials are not.
 //!
 //! Writing: one mesh with one primitive, `f32` positions with the `min` and
 //! `max` bounds the spec requires, `u32` indices, and with the vertex
 //! attributes given, unit `f32` `NORMAL`s, `COLOR_0` as normalised
-//! unsigned bytes RGBA and the file's own values as `_NAME` ([`holds_field`]).
+//! unsigned bytes RGBA, `f32` `TEXCOORD_0` and the file's own values as
+//! `_NAME` ([`holds_field`]).
 
 use std::borrow::Cow;
 use std::collections::HashSet;
@@ -76,6 +79,7 @@ pub fn read_gltf(bytes: &[u8], dir: &Path) -> Result<Mesh> {
     // Each attribute is kept only if every primitive has it.
     let mut normals = Some(Vec::new());
     let mut colours = Some(Colours::default());
+    let mut texcoords = Some(Vec::new());
     let mut fields = None;
     for Instance {
         node,
@@ -96,11 +100,13 @@ pub fn read_gltf(bytes: &[u8], dir: &Path) -> Result<Mesh> {
             add_primitive(&primitive, &buffers, world, &mut mesh).with_context(at)?;
             add_normals(&primitive, &buffers, world, &mut normals).with_context(at)?;
             add_colours(&primitive, &buffers, &mut colours).with_context(at)?;
+            add_texcoords(&primitive, &buffers, &mut texcoords).with_context(at)?;
             add_fields(&primitive, &buffers, &mut fields).with_context(at)?;
         }
     }
     mesh.normals = normals;
     mesh.colours = colours;
+    mesh.texcoords = texcoords;
     mesh.scalars = fields.unwrap_or_default();
     Ok(mesh)
 }
@@ -318,6 +324,51 @@ fn add_colours(
             *slot = unit_channel(value(&record[c * bytes..]) * scale);
         }
         list.rgba.push(rgba);
+    }
+    Ok(())
+}
+
+/// Appends the primitive's `TEXCOORD_0` (float, or normalised unsigned
+/// byte or short) to `texcoords`, v turned upwards (1 − v) as OBJ and
+/// PLY store it; without it, `texcoords` becomes `None`.
+fn add_texcoords(
+    primitive: &gltf::Primitive,
+    buffers: &[Cow<[u8]>],
+    texcoords: &mut Option<Vec<[f64; 2]>>,
+) -> Result<()> {
+    let (Some(list), Some(accessor)) = (
+        texcoords.as_mut(),
+        primitive.get(&gltf::Semantic::TexCoords(0)),
+    ) else {
+        *texcoords = None;
+        return Ok(());
+    };
+    let (bytes, scale) = match (accessor.data_type(), accessor.normalized()) {
+        (DataType::F32, _) => (4, 1.0),
+        (DataType::U8, true) => (1, 1.0 / 255.0),
+        (DataType::U16, true) => (2, 1.0 / 65535.0),
+        _ => {
+            *texcoords = None;
+            return Ok(());
+        }
+    };
+    if accessor.dimensions() != Dimensions::Vec2 {
+        *texcoords = None;
+        return Ok(());
+    }
+    check_count(&accessor, primitive, "TEXCOORD_0")?;
+    let (data, stride) = accessor_data(&accessor, buffers, 2 * bytes, "TEXCOORD_0")?;
+    let value = |b: &[u8]| match bytes {
+        4 => f64::from(LittleEndian::read_f32(b)),
+        2 => f64::from(LittleEndian::read_u16(b)) * scale,
+        _ => f64::from(b[0]) * scale,
+    };
+    for i in 0..accessor.count() {
+        let record = &data[i * stride..];
+        let [u, v] = [0, bytes].map(|o| value(&record[o..]));
+        // A NaN coordinate has no place on the image: the image's corner.
+        let finite = |c: f64| if c.is_finite() { c } else { 0.0 };
+        list.push([finite(u), 1.0 - finite(v)]);
     }
     Ok(())
 }
@@ -920,7 +971,8 @@ fn accessor_data<'b>(
 /// The glTF JSON document and binary buffer of one mesh; `uri` is the
 /// buffer's URI (`None` for the GLB binary chunk). Normals, when given,
 /// are written as unit `f32` vectors (as the spec requires: a zero one as
-/// +z); colours as `COLOR_0`, normalised unsigned bytes RGBA.
+/// +z); colours as `COLOR_0`, normalised unsigned bytes RGBA; texture
+/// coordinates as `f32` `TEXCOORD_0`, v turned down the image.
 fn document(
     vertices: &[Point3],
     faces: &[[u32; 3]],
@@ -979,6 +1031,20 @@ fn document(
         accessors.push(serde_json::json!({
             "bufferView": view, "componentType": 5121, "normalized": true,
             "count": vertices.len(), "type": "VEC4"
+        }));
+    }
+    if let Some(texcoords) = &attributes.texcoords {
+        let start = bin.len();
+        for &[u, v] in texcoords {
+            // glTF's v runs down the image.
+            for c in [u, 1.0 - v] {
+                bin.extend_from_slice(&(c as f32).to_le_bytes());
+            }
+        }
+        let view = add_view(&bin, start, 34962, None);
+        primitive_attributes["TEXCOORD_0"] = accessors.len().into();
+        accessors.push(serde_json::json!({
+            "bufferView": view, "componentType": 5126, "count": vertices.len(), "type": "VEC2"
         }));
     }
     for field in &attributes.scalars {
@@ -1127,7 +1193,7 @@ mod tests {
     }
 
     #[test]
-    fn normals_and_colours_round_trip() {
+    fn normals_colours_and_texcoords_round_trip() {
         let (v, f) = square();
         let attributes = VertexAttributes {
             normals: Some(vec![
@@ -1140,7 +1206,9 @@ mod tests {
                 rgba: vec![[1.0, 0.0, 0.2, 1.0]; 4],
                 alpha: true,
             }),
-            scalars: Vec::new(),
+            // Exact in f32, and once turned (1 - v) and back.
+            texcoords: Some(vec![[0.0, 0.0], [0.5, 0.25], [1.0, 0.75], [-2.0, 3.0]]),
+            ..VertexAttributes::default()
         };
         for glb in [true, false] {
             let mut bytes = Vec::new();
@@ -1163,6 +1231,7 @@ mod tests {
                 assert!((0..3).all(|k| (got[k] - want[k]).abs() < 1e-7), "{got:?}");
             }
             assert_eq!(mesh.colours, attributes.colours);
+            assert_eq!(mesh.texcoords, attributes.texcoords);
         }
     }
 

@@ -67,7 +67,7 @@ impl MeshFormat {
         attributes: &VertexAttributes,
     ) -> std::io::Result<()> {
         match self {
-            MeshFormat::Obj => write_obj(w, vertices, faces, attributes),
+            MeshFormat::Obj => write_obj(w, vertices, faces, attributes, None),
             MeshFormat::Ply => write_ply(w, vertices, faces, attributes),
             MeshFormat::Stl => stl::write_stl(w, vertices, faces),
             MeshFormat::Glb => gltf_io::write_glb(w, vertices, faces, attributes),
@@ -98,6 +98,8 @@ impl MeshFormat {
             normals,
             colours,
             scalars,
+            texcoords,
+            material,
         } = attributes;
         let mut held = VertexAttributes::default();
         let mut not_held = VertexAttributes::default();
@@ -107,6 +109,12 @@ impl MeshFormat {
         };
         side.normals = normals;
         side.colours = colours;
+        side.texcoords = texcoords;
+        // Only OBJ names an OBJ material; the others keep the coordinates.
+        match self {
+            MeshFormat::Obj => held.material = material,
+            _ => not_held.material = material,
+        }
         let (fields, others) = scalars.into_iter().partition(|f| self.holds_field(f));
         held.scalars = fields;
         not_held.scalars = others;
@@ -147,7 +155,24 @@ pub fn write_mesh_with(
     check_mesh(format, vertices, faces).with_context(|| path.display().to_string())?;
     check_attributes(format, vertices.len(), attributes)
         .with_context(|| path.display().to_string())?;
+    if let (MeshFormat::Obj, Some(material)) = (format, &attributes.material) {
+        let used = ObjMaterialLines {
+            libraries: super::obj_material::libraries_for_output(path, material)?,
+            name: &material.name,
+        };
+        return write_atomic(path, |w| {
+            write_obj(w, vertices, faces, attributes, Some(&used))
+        });
+    }
     write_atomic(path, |w| format.write(w, vertices, faces, attributes))
+}
+
+/// The material lines of an OBJ: `mtllib` names and the `usemtl` name.
+pub struct ObjMaterialLines<'a> {
+    /// The libraries, as the OBJ names them.
+    pub libraries: Vec<String>,
+    /// The material every face uses.
+    pub name: &'a str,
 }
 
 /// Checks that `format` can hold the mesh, with a message naming the
@@ -234,12 +259,31 @@ fn check_attributes(
     vertices: usize,
     attributes: &VertexAttributes,
 ) -> Result<()> {
-    let normals_or_colours = attributes.normals.is_some() || attributes.colours.is_some();
-    if !format.holds_normals_and_colours() && normals_or_colours {
+    let per_vertex = attributes.normals.is_some()
+        || attributes.colours.is_some()
+        || attributes.texcoords.is_some();
+    if !format.holds_normals_and_colours() && per_vertex {
         bail!(
-            "{} holds no vertex normals or colours: write .ply, .obj, .gltf or .glb",
+            "{} holds no vertex normals, colours or texture coordinates: write .ply, .obj, .gltf or .glb",
             format_name(format)
         );
+    }
+    if let Some(texcoords) = &attributes.texcoords {
+        if texcoords.len() != vertices {
+            bail!(
+                "{} texture coordinates for {vertices} vertices",
+                texcoords.len()
+            );
+        }
+        if let Some(i) = texcoords
+            .iter()
+            .position(|t| !t.iter().all(|c| c.is_finite()))
+        {
+            bail!(
+                "vertex {i} has a non-finite texture coordinate {:?}",
+                texcoords[i]
+            );
+        }
     }
     for field in &attributes.scalars {
         check_field(format, vertices, field)?;
@@ -357,16 +401,19 @@ fn format_name(format: MeshFormat) -> &'static str {
     }
 }
 
-/// OBJ: a comment, `v` lines (Rust's shortest round-trip decimals, with an
-/// exponent for very large or small values; with colours, `v x y z r g b`
-/// as MeshLab and trimesh write them, each channel a multiple of 1/255),
-/// with normals `vn` lines, one per vertex, and `f a//a b//b c//c`;
-/// otherwise `f` lines 1-based.
+/// OBJ: a comment, the material's `mtllib` lines, `v` lines (Rust's
+/// shortest round-trip decimals, with an exponent for very large or small
+/// values; with colours, `v x y z r g b` as MeshLab and trimesh write
+/// them, each channel a multiple of 1/255), `vt` and `vn` lines, one per
+/// vertex, then `usemtl` and the `f` lines, 1-based, each corner's
+/// texture coordinate and normal those of its vertex (`f a/a/a …`,
+/// `f a/a …`, `f a//a …` or `f a b c`).
 pub fn write_obj(
     w: &mut dyn Write,
     vertices: &[Point3],
     faces: &[[u32; 3]],
     attributes: &VertexAttributes,
+    material: Option<&ObjMaterialLines>,
 ) -> std::io::Result<()> {
     writeln!(
         w,
@@ -374,6 +421,9 @@ pub fn write_obj(
         vertices.len(),
         faces.len()
     )?;
+    for library in material.iter().flat_map(|m| &m.libraries) {
+        writeln!(w, "mtllib {library}")?;
+    }
     let colours = attributes.colours.as_ref();
     super::write_formatted(w, vertices.len(), |out, i| {
         out.push(b'v');
@@ -389,30 +439,50 @@ pub fn write_obj(
         }
         out.push(b'\n');
     })?;
-    if let Some(normals) = &attributes.normals {
-        super::write_formatted(w, normals.len(), |out, i| {
-            out.extend_from_slice(b"vn");
-            for c in normals[i] {
-                out.push(b' ');
-                push_f64_debug(out, c);
-            }
-            out.push(b'\n');
-        })?;
+    if let Some(texcoords) = &attributes.texcoords {
+        write_vectors(w, "vt", texcoords)?;
     }
-    let with_normals = attributes.normals.is_some();
+    if let Some(normals) = &attributes.normals {
+        write_vectors(w, "vn", normals)?;
+    }
+    if let Some(material) = material {
+        writeln!(w, "usemtl {}", material.name)?;
+    }
+    let corner = match (attributes.texcoords.is_some(), attributes.normals.is_some()) {
+        (true, true) => |out: &mut Vec<u8>, v: u64| write!(out, " {v}/{v}/{v}"),
+        (true, false) => |out: &mut Vec<u8>, v: u64| write!(out, " {v}/{v}"),
+        (false, true) => |out: &mut Vec<u8>, v: u64| write!(out, " {v}//{v}"),
+        (false, false) => |out: &mut Vec<u8>, v: u64| write!(out, " {v}"),
+    };
     super::write_formatted(w, faces.len(), |out, i| {
-        let [a, b, c] = faces[i].map(|v| u64::from(v) + 1);
-        // Writing into a Vec cannot fail.
-        let _ = if with_normals {
-            writeln!(out, "f {a}//{a} {b}//{b} {c}//{c}")
-        } else {
-            writeln!(out, "f {a} {b} {c}")
-        };
+        out.push(b'f');
+        for v in faces[i] {
+            // Writing into a Vec cannot fail.
+            let _ = corner(out, u64::from(v) + 1);
+        }
+        out.push(b'\n');
+    })
+}
+
+/// One line per vector: `keyword x y …` in shortest round-trip decimals.
+fn write_vectors<const N: usize>(
+    w: &mut dyn Write,
+    keyword: &str,
+    vectors: &[[f64; N]],
+) -> std::io::Result<()> {
+    super::write_formatted(w, vectors.len(), |out, i| {
+        out.extend_from_slice(keyword.as_bytes());
+        for c in vectors[i] {
+            out.push(b' ');
+            push_f64_debug(out, c);
+        }
+        out.push(b'\n');
     })
 }
 
 /// PLY, binary little-endian: `double x y z`, `float nx ny nz`, `uchar`
-/// colours and the file's own values in their own types, as given; then
+/// colours, `float texture_u texture_v` (MeshLab's names) and the file's
+/// own values in their own types, as given; then
 /// the faces as `list uchar int vertex_indices` (the list type most
 /// readers expect).
 pub fn write_ply(
@@ -430,6 +500,10 @@ pub fn write_ply(
         if colours.alpha {
             properties.push_str("property uchar alpha\n");
         }
+    }
+    if attributes.texcoords.is_some() {
+        // MeshLab's names.
+        properties.push_str("property float texture_u\nproperty float texture_v\n");
     }
     for field in &attributes.scalars {
         properties.push_str(&format!("property {} {}\n", field.kind.name(), field.name));
@@ -458,6 +532,11 @@ pub fn write_ply(
         if let Some(colours) = &attributes.colours {
             let channels = if colours.alpha { 4 } else { 3 };
             out.extend(colours.rgba[i][..channels].iter().map(|&c| channel_byte(c)));
+        }
+        if let Some(texcoords) = &attributes.texcoords {
+            for c in texcoords[i] {
+                out.extend((c as f32).to_le_bytes());
+            }
         }
         for field in &attributes.scalars {
             field.kind.push_le(out, field.values[i]);
@@ -491,7 +570,14 @@ mod tests {
     fn obj_text_is_shortest_round_trip() {
         let mut out = Vec::new();
         let v = [[0.1, -2.0, 1e300], [1.0 / 3.0, -0.0, 5e-324]];
-        write_obj(&mut out, &v, &[[0, 1, 0]], &VertexAttributes::default()).unwrap();
+        write_obj(
+            &mut out,
+            &v,
+            &[[0, 1, 0]],
+            &VertexAttributes::default(),
+            None,
+        )
+        .unwrap();
         assert_eq!(
             String::from_utf8(out).unwrap(),
             "# meshtrim mesh: 2 vertices, 1 triangles\nv 0.1 -2.0 1e300\n\

@@ -24,6 +24,7 @@ pub mod labels;
 pub mod las;
 pub mod mesh_out;
 pub mod obj;
+mod obj_material;
 pub mod pcd;
 pub mod ply;
 pub mod stl;
@@ -143,9 +144,24 @@ pub struct Mesh {
     pub colours: Option<Colours>,
     /// The file's own per-vertex values ([`ScalarField`]).
     pub scalars: Vec<ScalarField>,
+    /// Per-vertex texture coordinates (u, v), v upwards as OBJ stores it.
+    pub texcoords: Option<Vec<[f64; 2]>>,
+    /// The OBJ material the faces use, when they all use one.
+    pub material: Option<ObjMaterial>,
     /// Triangles as vertex indices, polygons split into fans; `None` when
     /// the file has no face element or `f` lines at all.
     pub faces: Option<Vec<[u32; 3]>>,
+}
+
+/// An OBJ material: where it is defined and its name, which the texture
+/// coordinates index into (its images).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ObjMaterial {
+    /// The material libraries (`mtllib`), as paths from the current
+    /// directory.
+    pub libraries: Vec<std::path::PathBuf>,
+    /// The material's name (`usemtl`).
+    pub name: String,
 }
 
 /// Vertex colours as read: red, green, blue and alpha in 0..1.
@@ -257,6 +273,11 @@ pub struct VertexAttributes {
     pub colours: Option<Colours>,
     /// The file's own values, one per vertex each.
     pub scalars: Vec<ScalarField>,
+    /// Texture coordinates (u, v), one per vertex.
+    pub texcoords: Option<Vec<[f64; 2]>>,
+    /// The OBJ material the texture coordinates index into, written to
+    /// OBJ outputs with them.
+    pub material: Option<ObjMaterial>,
 }
 
 /// Attributes carried to a mesh ([`VertexAttributes::carried`]).
@@ -272,7 +293,11 @@ pub struct Carried {
 impl VertexAttributes {
     /// Whether there is nothing to carry.
     pub fn is_empty(&self) -> bool {
-        self.normals.is_none() && self.colours.is_none() && self.scalars.is_empty()
+        self.normals.is_none()
+            && self.colours.is_none()
+            && self.scalars.is_empty()
+            && self.texcoords.is_none()
+            && self.material.is_none()
     }
 
     /// These attributes, of `from`'s vertices, at the vertices of `to`, a
@@ -319,11 +344,17 @@ impl VertexAttributes {
                 .iter()
                 .map(|field| field.carried(from, sources))
                 .collect(),
+            texcoords: self
+                .texcoords
+                .as_ref()
+                .map(|texcoords| trim::carry(from, sources, texcoords)),
+            material: self.material.clone(),
         }
     }
 
     /// The names of what there is, for reports: "normals", "colours",
-    /// then the file's own values by their names.
+    /// "texture coordinates", "material", then the file's own values by
+    /// their names.
     pub fn names(&self) -> Vec<String> {
         let mut names = Vec::new();
         if self.normals.is_some() {
@@ -331,6 +362,12 @@ impl VertexAttributes {
         }
         if self.colours.is_some() {
             names.push("colours".to_string());
+        }
+        if self.texcoords.is_some() {
+            names.push("texture coordinates".to_string());
+        }
+        if self.material.is_some() {
+            names.push("material".to_string());
         }
         names.extend(self.scalars.iter().map(|field| field.name.clone()));
         names
@@ -388,6 +425,8 @@ pub fn read_mesh_with_attributes(
         normals: read.normals,
         colours: read.colours,
         scalars: read.scalars,
+        texcoords: read.texcoords,
+        material: read.material,
     };
     let mesh = trim::Mesh {
         vertices: read.vertices,
@@ -454,7 +493,7 @@ fn read_mesh_inner(path: &Path) -> Result<Mesh> {
 fn parse_mesh(path: &Path, bytes: &[u8]) -> Result<Mesh> {
     let mesh = match MeshInput::detect(path, bytes)? {
         MeshInput::Ply => ply::read_ply_mesh(bytes)?,
-        MeshInput::Obj => obj::read_obj(bytes)?,
+        MeshInput::Obj => obj::read_obj_mesh(bytes, path.parent().unwrap_or(Path::new("")))?,
         MeshInput::Stl => stl::read_stl(bytes)?,
         MeshInput::Gltf => {
             let dir = path.parent().unwrap_or(Path::new(""));

@@ -227,7 +227,29 @@ pub fn read_ply(bytes: &[u8]) -> Result<Mesh> {
 /// `range_grid` and no face element gets the grid's faces (see the module
 /// doc).
 pub fn read_ply_mesh(bytes: &[u8]) -> Result<Mesh> {
-    read(bytes, true, Some(PIECE_BYTES))
+    let mut mesh = read(bytes, true, Some(PIECE_BYTES))?;
+    take_texcoords(&mut mesh);
+    Ok(mesh)
+}
+
+/// MeshLab's per-vertex texture coordinates, `texture_u` and
+/// `texture_v`, as the mesh's texture coordinates (which every mesh
+/// format writes) rather than two values of the file's own.
+fn take_texcoords(mesh: &mut Mesh) {
+    let at = |name: &str| mesh.scalars.iter().position(|f| f.name == name);
+    let (Some(u), Some(v)) = (at("texture_u"), at("texture_v")) else {
+        return;
+    };
+    let finite = |c: f64| if c.is_finite() { c } else { 0.0 };
+    let uv = mesh.scalars[u]
+        .values
+        .iter()
+        .zip(&mesh.scalars[v].values)
+        .map(|(&u, &v)| [finite(u), finite(v)])
+        .collect();
+    mesh.texcoords = Some(uv);
+    mesh.scalars
+        .retain(|f| f.name != "texture_u" && f.name != "texture_v");
 }
 
 /// `piece_bytes`: the size of the pieces in which the vertex and face

@@ -100,8 +100,8 @@ impl Merger {
                 vertices: Vec::with_capacity(capacity(triangles / 2)),
                 normals: None,
                 colours: None,
-                scalars: Vec::new(),
                 faces: Some(Vec::with_capacity(capacity(triangles))),
+                ..Mesh::default()
             },
             index: HashMap::with_capacity_and_hasher(capacity(triangles / 2), Default::default()),
         }

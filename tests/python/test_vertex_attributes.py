@@ -245,7 +245,7 @@ def test_python_carry_shapes_and_errors(coloured):
         meshtrim.carry(v, f, attrs.colours, v, normals=True)
     with pytest.raises(meshtrim.MeshtrimError, match="colours"):
         meshtrim.write_mesh("/tmp/never.ply", v, f, colours=np.zeros((len(v), 2)))
-    with pytest.raises(meshtrim.MeshtrimError, match="STL holds no vertex normals or colours"):
+    with pytest.raises(meshtrim.MeshtrimError, match="STL holds no vertex normals, colours or texture coordinates"):
         meshtrim.write_mesh("/tmp/never.stl", v, f, colours=attrs.colours)
     huge = attrs.normals.copy()
     huge[7] = [1e300, 0, 0]

@@ -732,7 +732,7 @@ fn colours_are_read_by_their_type() {
 }
 
 #[test]
-fn normals_and_colours_written_read_back() {
+fn normals_colours_and_texcoords_written_read_back() {
     let vertices = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
     let faces = vec![[0, 1, 2]];
     for alpha in [false, true] {
@@ -746,13 +746,17 @@ fn normals_and_colours_written_read_back() {
                 ],
                 alpha,
             }),
-            scalars: Vec::new(),
+            texcoords: Some(vec![[0.0, 1.0], [0.5, 0.25], [1.0, -0.75]]),
+            ..Default::default()
         };
         let mut bytes = Vec::new();
         crate::io::mesh_out::write_ply(&mut bytes, &vertices, &faces, &attributes).unwrap();
         let read = read_ply_mesh(&bytes).unwrap();
         assert_eq!(read.vertices, vertices);
         assert_eq!(read.normals, attributes.normals);
+        // MeshLab's texture_u and texture_v, read as the coordinates.
+        assert_eq!(read.texcoords, attributes.texcoords);
+        assert!(read.scalars.is_empty());
         let colours = read.colours.unwrap();
         assert_eq!(colours.alpha, alpha);
         let want = attributes.colours.unwrap().rgba;

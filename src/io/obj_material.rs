@@ -1,0 +1,168 @@
+//! An OBJ output's material: its libraries and images found from the
+//! output.
+//!
+//! An OBJ names its material libraries (`mtllib`) relative to itself, and
+//! most readers (MeshLab, trimesh) look for a library's images relative
+//! to the OBJ too, not to the library; trimesh refuses any that lies
+//! outside the OBJ's directory. So an output written beside the input's
+//! libraries names them as they are; an output written elsewhere gets its
+//! own library beside it, `<name>.mtl` (the input's libraries' text), and
+//! a copy of each image, at the same path below the output's directory
+//! when the image was below the library's, else by its file name. The
+//! input's files are never modified.
+
+use std::path::{Component, Path, PathBuf};
+
+use anyhow::{Context, Result};
+
+use super::atomic::write_atomic;
+use super::ObjMaterial;
+
+/// The `mtllib` names an output OBJ at `path` writes for `material`,
+/// after writing its own library and images when it needs them.
+pub(crate) fn libraries_for_output(path: &Path, material: &ObjMaterial) -> Result<Vec<String>> {
+    let out_dir = absolute_dir(path);
+    let beside = material
+        .libraries
+        .iter()
+        .all(|library| absolute_dir(library) == out_dir);
+    if beside {
+        return Ok(material.libraries.iter().map(|l| file_name(l)).collect());
+    }
+    let mut text = String::new();
+    for library in &material.libraries {
+        // A library that cannot be read is left out: the reader of the
+        // output finds it missing, as it found the input's.
+        if let Ok(bytes) = std::fs::read(library) {
+            let from = absolute_dir(library);
+            let library_text = String::from_utf8_lossy(&bytes);
+            let copied = rebased(&library_text, |image| copy_image(&from, image, &out_dir));
+            text.push_str(&copied?);
+        }
+    }
+    let own = path.with_extension("mtl");
+    write_atomic(&own, |w| w.write_all(text.as_bytes()))?;
+    Ok(vec![file_name(&own)])
+}
+
+/// Copies the image a library in `from` names as `image` into `out_dir`
+/// and returns its name from there: the same relative path when it is
+/// below `from`, else its file name. A missing image is named as it was.
+fn copy_image(from: &Path, image: &str, out_dir: &Path) -> Result<String> {
+    let source = normalised(&from.join(image));
+    let below = Path::new(image)
+        .components()
+        .all(|c| matches!(c, Component::Normal(_) | Component::CurDir));
+    let name = match below {
+        true => image.replace('\\', "/"),
+        false => file_name(&source),
+    };
+    let target = out_dir.join(&name);
+    if !source.is_file() || same_file(&source, &target) {
+        return Ok(name);
+    }
+    let bytes = std::fs::read(&source)
+        .with_context(|| format!("cannot read the texture image {}", source.display()))?;
+    write_atomic(&target, |w| w.write_all(&bytes))?;
+    Ok(name)
+}
+
+fn same_file(a: &Path, b: &Path) -> bool {
+    match (a.canonicalize(), b.canonicalize()) {
+        (Ok(a), Ok(b)) => a == b,
+        _ => false,
+    }
+}
+
+/// A library's text with each image (the last word of a `map_…`, `bump`,
+/// `disp`, `decal`, `refl` or `norm` line) renamed by `rename`.
+fn rebased(text: &str, mut rename: impl FnMut(&str) -> Result<String>) -> Result<String> {
+    let mut out = String::with_capacity(text.len());
+    for line in super::lines(text) {
+        let mut words = line.split_whitespace();
+        let keyword = words.next().unwrap_or("");
+        let names_image = keyword.starts_with("map_")
+            || ["bump", "disp", "decal", "refl", "norm"].contains(&keyword);
+        match words.last() {
+            Some(image) if names_image => {
+                let start = line.rfind(image).unwrap_or(line.len());
+                out.push_str(&line[..start]);
+                out.push_str(&rename(image)?);
+            }
+            _ => out.push_str(line),
+        }
+        out.push('\n');
+    }
+    Ok(out)
+}
+
+/// The absolute directory a file is in.
+fn absolute_dir(file: &Path) -> PathBuf {
+    let dir = file.parent().unwrap_or(Path::new(""));
+    let dir = if dir.as_os_str().is_empty() {
+        Path::new(".")
+    } else {
+        dir
+    };
+    normalised(dir)
+}
+
+/// An absolute path without `.` and with `..` applied to the parts
+/// before it (as written, without following links).
+fn normalised(path: &Path) -> PathBuf {
+    let absolute = std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf());
+    let mut out = PathBuf::new();
+    for component in absolute.components() {
+        match component {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                out.pop();
+            }
+            other => out.push(other),
+        }
+    }
+    out
+}
+
+fn file_name(path: &Path) -> String {
+    path.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn image_names_replaced_options_kept() {
+        let text = "newmtl m\nKd 1 1 1\nmap_Kd -s 1 1 1 tex/a.png\r\nbump b.png\nmap_Ka\n";
+        let renamed = rebased(text, |image| Ok(format!("<{image}>"))).unwrap();
+        assert_eq!(
+            renamed,
+            "newmtl m\nKd 1 1 1\nmap_Kd -s 1 1 1 <tex/a.png>\nbump <b.png>\nmap_Ka\n"
+        );
+    }
+
+    #[test]
+    fn images_copied_below_the_output() {
+        let dir = tempfile::tempdir().unwrap();
+        let (input, output) = (dir.path().join("in"), dir.path().join("out"));
+        std::fs::create_dir_all(input.join("tex")).unwrap();
+        std::fs::write(input.join("tex/a.png"), b"A").unwrap();
+        std::fs::write(dir.path().join("b.png"), b"B").unwrap();
+        assert_eq!(
+            copy_image(&input, "tex/a.png", &output).unwrap(),
+            "tex/a.png"
+        );
+        assert_eq!(std::fs::read(output.join("tex/a.png")).unwrap(), b"A");
+        // Outside the library's directory: by its file name.
+        assert_eq!(copy_image(&input, "../b.png", &output).unwrap(), "b.png");
+        assert_eq!(std::fs::read(output.join("b.png")).unwrap(), b"B");
+        // Missing: named as it was, nothing written.
+        assert_eq!(copy_image(&input, "c.png", &output).unwrap(), "c.png");
+        assert!(!output.join("c.png").exists());
+        // Already there (the output beside the image): not copied onto itself.
+        assert_eq!(copy_image(&input, "../b.png", dir.path()).unwrap(), "b.png");
+    }
+}
