@@ -156,9 +156,11 @@ pub fn write_mesh_with(
     check_attributes(format, vertices.len(), attributes)
         .with_context(|| path.display().to_string())?;
     if let (MeshFormat::Obj, Some(material)) = (format, &attributes.material) {
+        check_material(material, faces.len()).with_context(|| path.display().to_string())?;
         let used = ObjMaterialLines {
             libraries: super::obj_material::libraries_for_output(path, material)?,
-            name: &material.name,
+            names: &material.names,
+            faces: &material.faces,
         };
         return write_atomic(path, |w| {
             write_obj(w, vertices, faces, attributes, Some(&used))
@@ -167,12 +169,34 @@ pub fn write_mesh_with(
     write_atomic(path, |w| format.write(w, vertices, faces, attributes))
 }
 
-/// The material lines of an OBJ: `mtllib` names and the `usemtl` name.
+/// The material lines of an OBJ: `mtllib` names, and the `usemtl` names
+/// of the faces.
 pub struct ObjMaterialLines<'a> {
     /// The libraries, as the OBJ names them.
     pub libraries: Vec<String>,
-    /// The material every face uses.
-    pub name: &'a str,
+    /// The materials' names.
+    pub names: &'a [String],
+    /// Each face's material, an index into `names`.
+    pub faces: &'a [u32],
+}
+
+/// One material per face, each one of the names.
+fn check_material(material: &super::ObjMaterial, faces: usize) -> Result<()> {
+    if material.faces.len() != faces {
+        bail!("{} face materials for {faces} faces", material.faces.len());
+    }
+    if let Some(f) = material
+        .faces
+        .iter()
+        .position(|&m| m as usize >= material.names.len())
+    {
+        bail!(
+            "face {f}'s material is {}, but there are only {} material names",
+            material.faces[f],
+            material.names.len()
+        );
+    }
+    Ok(())
 }
 
 /// Checks that `format` can hold the mesh, with a message naming the
@@ -405,7 +429,8 @@ fn format_name(format: MeshFormat) -> &'static str {
 /// shortest round-trip decimals, with an exponent for very large or small
 /// values; with colours, `v x y z r g b` as MeshLab and trimesh write
 /// them, each channel a multiple of 1/255), `vt` and `vn` lines, one per
-/// vertex, then `usemtl` and the `f` lines, 1-based, each corner's
+/// vertex, then the `f` lines (a `usemtl` before each run of faces of
+/// one material), 1-based, each corner's
 /// texture coordinate and normal those of its vertex (`f a/a/a …`,
 /// `f a/a …`, `f a//a …` or `f a b c`).
 pub fn write_obj(
@@ -445,9 +470,6 @@ pub fn write_obj(
     if let Some(normals) = &attributes.normals {
         write_vectors(w, "vn", normals)?;
     }
-    if let Some(material) = material {
-        writeln!(w, "usemtl {}", material.name)?;
-    }
     let corner = match (attributes.texcoords.is_some(), attributes.normals.is_some()) {
         (true, true) => |out: &mut Vec<u8>, v: u64| write!(out, " {v}/{v}/{v}"),
         (true, false) => |out: &mut Vec<u8>, v: u64| write!(out, " {v}/{v}"),
@@ -455,6 +477,13 @@ pub fn write_obj(
         (false, false) => |out: &mut Vec<u8>, v: u64| write!(out, " {v}"),
     };
     super::write_formatted(w, faces.len(), |out, i| {
+        if let Some(material) = material {
+            let this = material.faces[i];
+            if i == 0 || material.faces[i - 1] != this {
+                // Writing into a Vec cannot fail.
+                let _ = writeln!(out, "usemtl {}", material.names[this as usize]);
+            }
+        }
         out.push(b'f');
         for v in faces[i] {
             // Writing into a Vec cannot fail.

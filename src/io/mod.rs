@@ -146,22 +146,49 @@ pub struct Mesh {
     pub scalars: Vec<ScalarField>,
     /// Per-vertex texture coordinates (u, v), v upwards as OBJ stores it.
     pub texcoords: Option<Vec<[f64; 2]>>,
-    /// The OBJ material the faces use, when they all use one.
+    /// The OBJ materials the faces use, when every face uses one.
     pub material: Option<ObjMaterial>,
     /// Triangles as vertex indices, polygons split into fans; `None` when
     /// the file has no face element or `f` lines at all.
     pub faces: Option<Vec<[u32; 3]>>,
 }
 
-/// An OBJ material: where it is defined and its name, which the texture
-/// coordinates index into (its images).
+/// An OBJ's materials: where they are defined, their names, and which
+/// each face uses (the texture coordinates index into its images).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ObjMaterial {
     /// The material libraries (`mtllib`), as paths from the current
     /// directory.
     pub libraries: Vec<std::path::PathBuf>,
-    /// The material's name (`usemtl`).
-    pub name: String,
+    /// The materials' names (`usemtl`), in the order first used.
+    pub names: Vec<String>,
+    /// Each face's material, an index into `names`.
+    pub faces: Vec<u32>,
+}
+
+impl ObjMaterial {
+    /// The materials of `to`'s faces, made from `from` (whose faces these
+    /// are), its vertices' `sources` in `from`: each face takes the
+    /// material of the input face it lies on ([`trim::face_sources`]).
+    pub fn carried(
+        &self,
+        from: &trim::Mesh,
+        to: &trim::Mesh,
+        sources: &[trim::VertexSource],
+    ) -> ObjMaterial {
+        let faces = match self.names.len() {
+            0 | 1 => vec![0; to.faces.len()],
+            _ => trim::face_sources(from, to, sources)
+                .into_iter()
+                .map(|f| f.map_or(0, |f| self.faces[f as usize]))
+                .collect(),
+        };
+        ObjMaterial {
+            libraries: self.libraries.clone(),
+            names: self.names.clone(),
+            faces,
+        }
+    }
 }
 
 /// Vertex colours as read: red, green, blue and alpha in 0..1.
@@ -275,8 +302,8 @@ pub struct VertexAttributes {
     pub scalars: Vec<ScalarField>,
     /// Texture coordinates (u, v), one per vertex.
     pub texcoords: Option<Vec<[f64; 2]>>,
-    /// The OBJ material the texture coordinates index into, written to
-    /// OBJ outputs with them.
+    /// The OBJ materials of the faces, which the texture coordinates
+    /// index into, written to OBJ outputs with them.
     pub material: Option<ObjMaterial>,
 }
 
@@ -314,13 +341,17 @@ impl VertexAttributes {
         let Some(split) = trim::split_sources(from, to) else {
             return Carried::default();
         };
-        Carried {
-            mesh: split.split_mesh(to),
-            attributes: self.at_sources(from, &split.sources),
-        }
+        let mesh = split.split_mesh(to);
+        let mut attributes = self.at_sources(from, &split.sources);
+        attributes.material = self
+            .material
+            .as_ref()
+            .map(|material| material.carried(from, mesh.as_ref().unwrap_or(to), &split.sources));
+        Carried { mesh, attributes }
     }
 
-    /// These attributes at `sources` in `from`.
+    /// These attributes at `sources` in `from`, but the material (which
+    /// is the faces').
     fn at_sources(&self, from: &trim::Mesh, sources: &[trim::VertexSource]) -> VertexAttributes {
         VertexAttributes {
             normals: self.normals.as_ref().map(|normals| {
@@ -348,7 +379,7 @@ impl VertexAttributes {
                 .texcoords
                 .as_ref()
                 .map(|texcoords| trim::carry(from, sources, texcoords)),
-            material: self.material.clone(),
+            material: None,
         }
     }
 

@@ -13,8 +13,8 @@
 //! chart's border) or two normals (at a hard edge) becomes one vertex per
 //! pair, as glTF and PLY store them; each attribute is kept when every
 //! face corner has one. Read as a cloud ([`read_obj`]), the points are the
-//! `v` lines. The material (`mtllib`, `usemtl`) is kept when every face
-//! uses one and the same. Groups, smoothing groups, lines and points are
+//! `v` lines. The materials (`mtllib`, `usemtl`) are kept when every face
+//! is under a `usemtl`. Groups, smoothing groups, lines and points are
 //! ignored.
 
 use std::path::Path;
@@ -338,29 +338,33 @@ impl ObjText {
         })
     }
 
-    /// The one material every face uses, if any.
+    /// The faces' materials, when every face is under a `usemtl`.
     fn material(&self, dir: &Path) -> Option<ObjMaterial> {
         let faces = self.faces.as_ref().map_or(0, Vec::len);
-        // A `usemtl` is in force up to the next; faces before the first
-        // have none.
+        // A `usemtl` is in force up to the next.
         let (first, _) = self.materials.first()?;
         if faces == 0 || *first > 0 {
             return None;
         }
         let ends = self.materials.iter().skip(1).map(|(start, _)| *start);
-        let mut used = self
-            .materials
-            .iter()
-            .zip(ends.chain([faces]))
-            .filter(|((start, _), end)| end > start)
-            .map(|((_, name), _)| name);
-        let name = used.next()?;
-        if used.any(|other| other != name) {
-            return None;
+        let mut names: Vec<String> = Vec::new();
+        let mut by_face = Vec::with_capacity(faces);
+        for ((start, name), end) in self.materials.iter().zip(ends.chain([faces])) {
+            if end > *start {
+                let index = match names.iter().position(|n| n == name) {
+                    Some(i) => i,
+                    None => {
+                        names.push(name.clone());
+                        names.len() - 1
+                    }
+                };
+                by_face.resize(end, index as u32);
+            }
         }
         Some(ObjMaterial {
             libraries: library_paths(&self.libraries, dir),
-            name: name.clone(),
+            names,
+            faces: by_face,
         })
     }
 }
@@ -794,17 +798,21 @@ mod tests {
     }
 
     #[test]
-    fn the_material_is_kept_when_every_face_uses_one() {
+    fn the_materials_are_kept_when_every_face_has_one() {
         let faces = "f 1 2 3\nf 1 3 4\n";
         let with = |text: &str| mesh(&format!("{SQUARE}mtllib a.mtl\n{text}")).material;
         let material = with(&format!("g x\nusemtl skin\n{faces}usemtl skin\n")).unwrap();
-        assert_eq!(material.name, "skin");
+        assert_eq!(material.names, vec!["skin"]);
+        assert_eq!(material.faces, vec![0, 0]);
         assert_eq!(material.libraries, vec![Path::new("dir/a.mtl")]);
         // A material switched to and back before any face, or named
         // after the last, is not used.
-        let material = with("usemtl a\nusemtl skin\nf 1 2 3\nusemtl skin\nf 1 3 4\nusemtl b\n");
-        assert_eq!(material.unwrap().name, "skin");
-        assert_eq!(with("usemtl a\nf 1 2 3\nusemtl b\nf 1 3 4\n"), None);
+        let material = with(
+            "usemtl a\nusemtl skin\nf 1 2 3 4\nusemtl b\nf 1 3 4\nusemtl skin\nf 1 2 3\nusemtl c\n",
+        );
+        let material = material.unwrap();
+        assert_eq!(material.names, vec!["skin", "b"]);
+        assert_eq!(material.faces, vec![0, 0, 1, 0]);
         assert_eq!(with("f 1 2 3\nusemtl b\nf 1 3 4\n"), None);
         assert_eq!(with(faces), None);
     }

@@ -50,7 +50,9 @@ use crate::mesh::Mesh;
 use crate::spatial::closest_face::{bounds, FaceIndex, Scratch};
 use crate::spatial::PointTree;
 
+mod faces;
 mod split;
+pub use faces::face_sources;
 use split::SeamFaces;
 pub use split::{split_sources, SplitSources};
 

@@ -74,8 +74,8 @@ mod trimming;
 #[doc(hidden)]
 pub use attributes::vertex_sources_reference;
 pub use attributes::{
-    carry, carry_nearest_corner, carry_normals, carry_values, split_sources, vertex_sources,
-    SplitSources, VertexSource,
+    carry, carry_nearest_corner, carry_normals, carry_values, face_sources, split_sources,
+    vertex_sources, SplitSources, VertexSource,
 };
 /// The plain detector the fast one is tested against (same labels).
 #[doc(hidden)]
