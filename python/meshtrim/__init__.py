@@ -61,6 +61,7 @@ __all__ = [
     "write_mesh",
     "write_edges",
     "VertexAttributes",
+    "ObjMaterial",
     "write_mesh_carrying",
     "carry",
     "BatchJob",
@@ -424,14 +425,31 @@ _PLY_TYPES = {
 them."""
 
 
-def _attributes(normals, colours, alpha, fields) -> "VertexAttributes":
-    """Normals, colours and the file's own values as
-    :class:`VertexAttributes` (RGB when the file had no alpha; each value
-    in the NumPy type of its PLY type)."""
+def _attributes(normals, colours, alpha, fields, texcoords=None, material=None) -> "VertexAttributes":
+    """Normals, colours, the file's own values, texture coordinates and
+    the OBJ material as :class:`VertexAttributes` (RGB when the file had no
+    alpha; each value in the NumPy type of its PLY type)."""
     if colours is not None and not alpha:
         colours = np.ascontiguousarray(colours[:, :3])
     scalars = {name: values.astype(_PLY_TYPES[kind]) for name, kind, values in fields}
-    return VertexAttributes(normals, colours, scalars)
+    if material is not None:
+        libraries, names, faces = material
+        material = ObjMaterial(tuple(os.fspath(p) for p in libraries), tuple(names), faces)
+    return VertexAttributes(normals, colours, scalars, texcoords, material)
+
+
+class ObjMaterial(NamedTuple):
+    """An OBJ's materials: the ``libraries`` (``mtllib`` files, as paths
+    from the current directory), the materials' ``names`` (``usemtl``)
+    and, per face, its material as an index into ``names`` (``faces``,
+    ``(m,)`` uint32). :func:`write_mesh_carrying` gives each output face
+    the material of the input face it lies on, and writes an OBJ's
+    library beside it (with copies of its images) when the output is in
+    another directory than the libraries."""
+
+    libraries: tuple
+    names: tuple
+    faces: np.ndarray
 
 
 class VertexAttributes(NamedTuple):
@@ -442,25 +460,34 @@ class VertexAttributes(NamedTuple):
     by name (PLY's other vertex properties, such as MeshLab's ``quality``
     or a scanner's ``confidence``; glTF's ``_NAME`` attributes), each an
     ``(n,)`` array of the NumPy type of its stored type (``uchar``:
-    uint8, ``int``: int32, ``float``: float32 …)."""
+    uint8, ``int``: int32, ``float``: float32 …); ``texcoords``, ``(n, 2)``
+    float64 texture coordinates (u, v with v up the image, as OBJ stores
+    it: an OBJ's ``vt``, glTF's ``TEXCOORD_0`` turned up, PLY's
+    ``texture_u``/``texture_v``), and ``material``, an OBJ's
+    :class:`ObjMaterial`, each ``None`` when the file has none.""" 
 
     normals: Optional[np.ndarray]
     colours: Optional[np.ndarray]
     # Read-only, so that the one default is not shared and changed.
     scalars: Mapping[str, np.ndarray] = MappingProxyType({})
+    texcoords: Optional[np.ndarray] = None
+    material: Optional[ObjMaterial] = None
 
 
 def read_mesh(path: PathLike, *, attributes: bool = False) -> tuple:
     """``(vertices, faces)`` of a mesh file (OBJ, PLY, STL, glTF/GLB),
     polygons split into fans, as ``trim`` and ``clean`` read it; with
     ``attributes=True``, ``(vertices, faces, VertexAttributes)``: the
-    vertex normals (PLY, glTF), colours (PLY, OBJ, glTF) and the file's
-    own values (PLY's other vertex properties, glTF ``_NAME``) the CLI
-    carries to its outputs."""
-    vertices, faces, normals, colours, alpha, fields = _meshtrim.read_mesh(os.fspath(path))
+    vertex normals (PLY, OBJ, glTF), colours (PLY, OBJ, glTF), the file's
+    own values (PLY's other vertex properties, glTF ``_NAME``), texture
+    coordinates (OBJ, glTF, PLY) and an OBJ's materials, which the CLI
+    carries to its outputs. An OBJ vertex read with several texture
+    coordinates or normals (at a chart's border, a hard edge) is one
+    vertex per pair, the copies after the file's ``v`` lines."""
+    vertices, faces, normals, colours, alpha, fields, texcoords, material = _meshtrim.read_mesh(os.fspath(path))
     if not attributes:
         return vertices, faces
-    return vertices, faces, _attributes(normals, colours, alpha, fields)
+    return vertices, faces, _attributes(normals, colours, alpha, fields, texcoords, material)
 
 
 def write_mesh(
@@ -471,6 +498,8 @@ def write_mesh(
     normals: Any = None,
     colours: Any = None,
     scalars: Optional[dict] = None,
+    texcoords: Any = None,
+    material: Optional[ObjMaterial] = None,
 ) -> None:
     """Writes a mesh as the CLI writes its outputs: the format from the
     extension (.obj, .ply and .stl binary, .gltf, .glb), missing parent
@@ -482,10 +511,15 @@ def write_mesh(
     ``COLOR_0``. ``scalars`` (name: ``(n,)`` array) are values of the
     file's own, written as PLY properties of the array's type (int8 …
     uint32, float32, float64) or glTF ``_NAME`` attributes; OBJ and STL
-    hold none."""
+    hold none. ``texcoords`` ``(n, 2)`` (v up the image) are written as
+    OBJ ``vt``, PLY ``texture_u``/``texture_v`` and glTF ``TEXCOORD_0``;
+    an OBJ ``material`` (one per face) as ``mtllib`` and ``usemtl``
+    lines."""
     v = _float_rows(vertices, "vertices")
     f = _face_rows(faces, len(v))
-    _meshtrim.write_mesh(os.fspath(path), v, f, *_attribute_arrays(normals, colours, scalars or {}, len(v)))
+    arrays = _attribute_arrays(normals, colours, scalars or {}, len(v))
+    texture = _texture_arrays(texcoords, material, len(v), len(f))
+    _meshtrim.write_mesh(os.fspath(path), v, f, *arrays, *texture)
 
 
 def write_mesh_carrying(
@@ -508,8 +542,23 @@ def write_mesh_carrying(
     sv = _float_rows(source_vertices, "source_vertices")
     sf = _faces_or_none(source_faces, len(sv))
     arrays = _attribute_arrays(attributes.normals, attributes.colours, attributes.scalars, len(sv))
-    written, not_written = _meshtrim.write_mesh_carrying(os.fspath(path), v, f, sv, sf, *arrays)
+    texture = _texture_arrays(attributes.texcoords, attributes.material, len(sv), len(sf))
+    written, not_written = _meshtrim.write_mesh_carrying(os.fspath(path), v, f, sv, sf, *arrays, *texture)
     return written, not_written
+
+
+def _texture_arrays(texcoords: Any, material: Optional[ObjMaterial], vertices: int, faces: int) -> tuple:
+    """Texture coordinates of `vertices` vertices and a material of
+    `faces` faces as the native layer takes them, each checked."""
+    t = None if texcoords is None else _per_vertex(texcoords, "texcoords", vertices, (2,))
+    if material is None:
+        return t, None
+    libraries, names, per_face = material
+    a = np.asarray(per_face)
+    if a.shape != (faces,) or (a.size and (not np.issubdtype(a.dtype, np.integer) or a.min() < 0)):
+        raise MeshtrimError(f"material.faces: expected {faces} non-negative integers, got shape {a.shape} of {a.dtype}")
+    m = ([os.fspath(p) for p in libraries], [str(n) for n in names], np.ascontiguousarray(a, dtype=np.uint32))
+    return t, m
 
 
 def _attribute_arrays(normals: Any, colours: Any, scalars: Mapping, vertices: int) -> tuple:

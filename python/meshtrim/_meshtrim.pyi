@@ -54,9 +54,20 @@ Fields = list[Tuple[str, str, npt.NDArray[np.float64]]]
 def read_cloud(
     path: str | PathLike[str], scan: Optional[int] = None
 ) -> Tuple[Points, Optional[Points], Optional[npt.NDArray[np.float64]], bool, Fields]: ...
+Material = Tuple[list[str], list[str], npt.NDArray[np.uint32]]
+
 def read_mesh(
     path: str | PathLike[str],
-) -> Tuple[Points, Faces, Optional[Points], Optional[npt.NDArray[np.float64]], bool, Fields]: ...
+) -> Tuple[
+    Points,
+    Faces,
+    Optional[Points],
+    Optional[npt.NDArray[np.float64]],
+    bool,
+    Fields,
+    Optional[npt.NDArray[np.float64]],
+    Optional[Material],
+]: ...
 def write_mesh(
     path: str | PathLike[str],
     vertices: Points,
@@ -64,6 +75,8 @@ def write_mesh(
     normals: Optional[Points],
     colours: Optional[npt.NDArray[np.float64]],
     scalars: Fields,
+    texcoords: Optional[npt.NDArray[np.float64]],
+    material: Optional[Material],
 ) -> None: ...
 def write_mesh_carrying(
     path: str | PathLike[str],
@@ -74,6 +87,8 @@ def write_mesh_carrying(
     normals: Optional[Points],
     colours: Optional[npt.NDArray[np.float64]],
     scalars: Fields,
+    texcoords: Optional[npt.NDArray[np.float64]],
+    material: Optional[Material],
 ) -> Tuple[list[str], list[str]]: ...
 def carry(
     vertices: Points,

@@ -91,34 +91,37 @@ fn without_gil<T: Send>(
 }
 
 /// The rows of an `(n, 3)` array (one copy).
-fn rows<T: numpy::Element + Copy>(
+fn rows<T: numpy::Element + Copy, const N: usize>(
     array: &PyReadonlyArray2<'_, T>,
     name: &str,
-) -> PyResult<Vec<[T; 3]>> {
+) -> PyResult<Vec<[T; N]>> {
     rows_or_message(array, name).map_err(MeshtrimError::new_err)
 }
 
 /// [`rows`], its error as the message alone.
-fn rows_or_message<T: numpy::Element + Copy>(
+fn rows_or_message<T: numpy::Element + Copy, const N: usize>(
     array: &PyReadonlyArray2<'_, T>,
     name: &str,
-) -> Result<Vec<[T; 3]>, String> {
-    if array.shape()[1] != 3 {
+) -> Result<Vec<[T; N]>, String> {
+    if array.shape()[1] != N {
         return Err(format!(
-            "{name}: expected an array of shape (n, 3), got {:?}",
+            "{name}: expected an array of shape (n, {N}), got {:?}",
             array.shape()
         ));
     }
     Ok(match array.as_slice() {
-        Ok(flat) => flat.chunks_exact(3).map(|r| [r[0], r[1], r[2]]).collect(),
+        Ok(flat) => flat
+            .chunks_exact(N)
+            .map(|r| std::array::from_fn(|k| r[k]))
+            .collect(),
         Err(_) => strided_rows(array.as_array()),
     })
 }
 
-fn strided_rows<T: Copy>(view: ArrayView2<'_, T>) -> Vec<[T; 3]> {
+fn strided_rows<T: Copy, const N: usize>(view: ArrayView2<'_, T>) -> Vec<[T; N]> {
     view.rows()
         .into_iter()
-        .map(|r| [r[0], r[1], r[2]])
+        .map(|r| std::array::from_fn(|k| r[k]))
         .collect()
 }
 
@@ -457,7 +460,16 @@ type MeshRead<'py> = (
     Option<ColourArray<'py>>,
     bool,
     FieldArrays<'py>,
+    Option<Bound<'py, PyArray2<f64>>>,
+    Option<MaterialOut<'py>>,
 );
+
+/// An OBJ's materials: its libraries' paths, the names, each face's
+/// index into the names.
+type MaterialOut<'py> = (Vec<PathBuf>, Vec<String>, Bound<'py, PyArray1<u32>>);
+
+/// The same, as `write_mesh` takes it.
+type MaterialIn<'py> = (Vec<PathBuf>, Vec<String>, PyReadonlyArray1<'py, u32>);
 
 /// A mesh's vertices, faces and vertex attributes, read as `trim` and
 /// `clean` read a mesh.
@@ -471,6 +483,15 @@ fn read_mesh(py: Python<'_>, path: PathBuf) -> PyResult<MeshRead<'_>> {
         attributes.normals.as_deref(),
         attributes.colours.as_ref(),
     )?;
+    let texcoords = attributes
+        .texcoords
+        .as_ref()
+        .map(|t| PyArray1::from_slice(py, t.as_flattened()).reshape([t.len(), 2]))
+        .transpose()?;
+    let material = attributes.material.map(|m| {
+        let faces = PyArray1::from_vec(py, m.faces);
+        (m.libraries, m.names, faces)
+    });
     Ok((
         points_array(py, &mesh.vertices)?,
         faces_array(py, &mesh.faces)?,
@@ -478,6 +499,8 @@ fn read_mesh(py: Python<'_>, path: PathBuf) -> PyResult<MeshRead<'_>> {
         colours,
         alpha,
         field_arrays(py, &attributes.scalars),
+        texcoords,
+        material,
     ))
 }
 
@@ -485,7 +508,8 @@ fn read_mesh(py: Python<'_>, path: PathBuf) -> PyResult<MeshRead<'_>> {
 /// atomically), with per-vertex normals, colours (RGB or RGBA in 0..1)
 /// and values of the file's own (name, PLY type name, values) when given.
 #[pyfunction]
-#[pyo3(signature = (path, vertices, faces, normals, colours, scalars))]
+#[pyo3(signature = (path, vertices, faces, normals, colours, scalars, texcoords, material))]
+#[allow(clippy::too_many_arguments)]
 fn write_mesh(
     py: Python<'_>,
     path: PathBuf,
@@ -494,9 +518,11 @@ fn write_mesh(
     normals: Option<PyReadonlyArray2<'_, f64>>,
     colours: Option<PyReadonlyArray2<'_, f64>>,
     scalars: Vec<(String, String, PyReadonlyArray1<'_, f64>)>,
+    texcoords: Option<PyReadonlyArray2<'_, f64>>,
+    material: Option<MaterialIn<'_>>,
 ) -> PyResult<()> {
     let mesh = mesh_of(&vertices, &faces)?;
-    let attributes = attributes_of(normals, colours, scalars)?;
+    let attributes = attributes_of(normals, colours, scalars, texcoords, material)?;
     without_gil(py, || {
         meshtrim::io::write_mesh_with(&path, &mesh.vertices, &mesh.faces, &attributes)
     })
@@ -507,7 +533,7 @@ fn write_mesh(
 /// as the CLI writes its outputs: the attributes the format holds carried
 /// to it. The names of those written and of those not written.
 #[pyfunction]
-#[pyo3(signature = (path, vertices, faces, from_vertices, from_faces, normals, colours, scalars))]
+#[pyo3(signature = (path, vertices, faces, from_vertices, from_faces, normals, colours, scalars, texcoords, material))]
 #[allow(clippy::too_many_arguments)]
 fn write_mesh_carrying(
     py: Python<'_>,
@@ -519,10 +545,21 @@ fn write_mesh_carrying(
     normals: Option<PyReadonlyArray2<'_, f64>>,
     colours: Option<PyReadonlyArray2<'_, f64>>,
     scalars: Vec<(String, String, PyReadonlyArray1<'_, f64>)>,
+    texcoords: Option<PyReadonlyArray2<'_, f64>>,
+    material: Option<MaterialIn<'_>>,
 ) -> PyResult<(Vec<String>, Vec<String>)> {
     let out = mesh_of(&vertices, &faces)?;
     let from = mesh_of(&from_vertices, &from_faces)?;
-    let attributes = attributes_of(normals, colours, scalars)?;
+    if let Some((_, _, faces)) = &material {
+        if faces.len() != from.faces.len() {
+            return Err(MeshtrimError::new_err(format!(
+                "material: {} face materials for {} source faces",
+                faces.len(),
+                from.faces.len()
+            )));
+        }
+    }
+    let attributes = attributes_of(normals, colours, scalars, texcoords, material)?;
     let written = without_gil(py, || {
         meshtrim::io::mesh_out::write_mesh_carrying(&path, &out, &from, attributes)
     })?;
@@ -534,12 +571,20 @@ fn attributes_of(
     normals: Option<PyReadonlyArray2<'_, f64>>,
     colours: Option<PyReadonlyArray2<'_, f64>>,
     scalars: Vec<(String, String, PyReadonlyArray1<'_, f64>)>,
+    texcoords: Option<PyReadonlyArray2<'_, f64>>,
+    material: Option<MaterialIn<'_>>,
 ) -> PyResult<meshtrim::io::VertexAttributes> {
+    let material = material.map(|(libraries, names, faces)| meshtrim::io::ObjMaterial {
+        libraries,
+        names,
+        faces: faces.as_array().to_vec(),
+    });
     Ok(meshtrim::io::VertexAttributes {
         normals: normals.map(|n| rows(&n, "normals")).transpose()?,
         colours: colours.map(|c| colours_of(&c)).transpose()?,
         scalars: fields_of(scalars)?,
-        ..Default::default()
+        texcoords: texcoords.map(|t| rows(&t, "texcoords")).transpose()?,
+        material,
     })
 }
 

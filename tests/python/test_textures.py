@@ -225,3 +225,28 @@ def test_each_face_keeps_its_material(tmp_path):
         wrong += int((on_right != (colour == (30, 30, 200))).sum())
     assert sum(len(h.faces) for h in by_material.values()) == report["faces_out"]
     assert wrong <= 10, wrong
+
+
+def test_the_python_package_carries_the_texture_as_the_cli_does(textured, tmp_path):
+    """read_mesh gives the split vertices, their texture coordinates and
+    the material; clean then write_mesh_carrying write the CLI's bytes
+    (the OBJ, its library and the image)."""
+    import meshtrim
+
+    directory, _ = textured
+    v, f, attributes = meshtrim.read_mesh(directory / "face.obj", attributes=True)
+    assert attributes.texcoords.shape == (len(v), 2)
+    assert attributes.material.names == ("material_0",)
+    assert attributes.material.faces.shape == (len(f),)
+    assert attributes.material.libraries[0].endswith("face.obj.mtl")
+    out_v, out_f, _ = meshtrim.clean(v, f)
+    written, not_written = meshtrim.write_mesh_carrying(tmp_path / "py" / "face.obj", out_v, out_f, v, f, attributes)
+    assert written == ["normals", "texture coordinates", "material"] and not_written == [], (written, not_written)
+    run_meshtrim("clean", directory / "face.obj", tmp_path / "cli" / "face.obj")
+    for name in ["face.obj", "face.mtl", "face_tex.png"]:
+        assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes(), name
+    # A material of the wrong length is refused, naming it.
+    wrong = attributes._replace(material=attributes.material._replace(faces=attributes.material.faces[1:]))
+    with pytest.raises(meshtrim.MeshtrimError, match="material.faces: expected"):
+        meshtrim.write_mesh_carrying(tmp_path / "bad.obj", out_v, out_f, v, f, wrong)
+    assert not (tmp_path / "bad.obj").exists()
