@@ -13,7 +13,7 @@
 
 use std::path::{Component, Path, PathBuf};
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 
 use super::atomic::write_atomic;
 use super::ObjMaterial;
@@ -29,20 +29,34 @@ pub(crate) fn libraries_for_output(path: &Path, material: &ObjMaterial) -> Resul
     if beside {
         return Ok(material.libraries.iter().map(|l| file_name(l)).collect());
     }
+    let own = path.with_extension("mtl");
+    if let Some(input) = material.libraries.iter().find(|l| same_file(l, &own)) {
+        bail!(
+            "{}: the output's material library would replace the input's {}: write the output to another name or directory",
+            own.display(),
+            input.display()
+        );
+    }
     let mut text = String::new();
+    // A library that cannot be read is named as it was: the reader of the
+    // output finds it missing, as it found the input's.
+    let mut missing = Vec::new();
     for library in &material.libraries {
-        // A library that cannot be read is left out: the reader of the
-        // output finds it missing, as it found the input's.
-        if let Ok(bytes) = std::fs::read(library) {
-            let from = absolute_dir(library);
-            let library_text = String::from_utf8_lossy(&bytes);
-            let copied = rebased(&library_text, |image| copy_image(&from, image, &out_dir));
-            text.push_str(&copied?);
+        match std::fs::read(library) {
+            Ok(bytes) => {
+                let from = absolute_dir(library);
+                let library_text = String::from_utf8_lossy(&bytes);
+                let copied = rebased(&library_text, |image| copy_image(&from, image, &out_dir));
+                text.push_str(&copied?);
+            }
+            Err(_) => missing.push(file_name(library)),
         }
     }
-    let own = path.with_extension("mtl");
+    if missing.len() == material.libraries.len() {
+        return Ok(missing);
+    }
     write_atomic(&own, |w| w.write_all(text.as_bytes()))?;
-    Ok(vec![file_name(&own)])
+    Ok([file_name(&own)].into_iter().chain(missing).collect())
 }
 
 /// Copies the image a library in `from` names as `image` into `out_dir`

@@ -1,0 +1,180 @@
+//! End-to-end: a textured OBJ (texture coordinates, two materials, a
+//! library naming an image) cleaned by the `meshtrim` binary keeps its
+//! texture, its library and image found from the output.
+
+use std::path::{Path, PathBuf};
+
+mod common;
+use common::meshtrim;
+
+const JAGGED: &str = concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/fixtures/meshes/blade_jagged.stl"
+);
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+/// The fixture as an OBJ under `dir/in/scan.obj`: `vt` from x and y, the
+/// faces left of the middle under `left`, the others under `right`, and
+/// `libraries` as its `mtllib` lines. Returns its path, the welded
+/// fixture and the middle x.
+fn textured_fixture(dir: &Path, libraries: &[&str]) -> (PathBuf, trim::Mesh, f64) {
+    let read = meshtrim::io::read_mesh(Path::new(JAGGED)).unwrap();
+    let mesh = trim::Mesh {
+        vertices: read.vertices,
+        faces: read.faces.unwrap(),
+    };
+    let mut xs: Vec<f64> = mesh.vertices.iter().map(|p| p[0]).collect();
+    xs.sort_by(f64::total_cmp);
+    let middle = xs[xs.len() / 2];
+    let mut text: String = libraries.iter().map(|l| format!("mtllib {l}\n")).collect();
+    for [x, y, z] in &mesh.vertices {
+        text += &format!(
+            "v {x:?} {y:?} {z:?}\nvt {:?} {:?}\n",
+            x / 1000.0,
+            y / 1000.0
+        );
+    }
+    let mut material = "";
+    for face in &mesh.faces {
+        let centre = face
+            .iter()
+            .map(|&v| mesh.vertices[v as usize][0])
+            .sum::<f64>()
+            / 3.0;
+        let this = if centre > middle { "right" } else { "left" };
+        if this != material {
+            text += &format!("usemtl {this}\n");
+            material = this;
+        }
+        let [a, b, c] = face.map(|v| v + 1);
+        text += &format!("f {a}/{a} {b}/{b} {c}/{c}\n");
+    }
+    let input = dir.join("in");
+    std::fs::create_dir_all(input.join("tex")).unwrap();
+    std::fs::write(input.join("scan.obj"), text).unwrap();
+    (input.join("scan.obj"), mesh, middle)
+}
+
+fn library(dir: &Path) {
+    let text = "newmtl left\nKd 1 0 0\nmap_Kd tex/left.png\n\nnewmtl right\nKd 0 0 1\nmap_Kd -bm 1 tex/right.png\n";
+    std::fs::write(dir.join("in/scan.mtl"), text).unwrap();
+    std::fs::write(dir.join("in/tex/left.png"), b"left image").unwrap();
+    std::fs::write(dir.join("in/tex/right.png"), b"right image").unwrap();
+}
+
+fn clean(input: &Path, output: &Path) -> String {
+    let run = meshtrim(&["clean", s(input), s(output)], None);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    String::from_utf8(run.stdout).unwrap()
+}
+
+/// Cleaned into another directory: the output's own library with the
+/// images copied below it, each face under its side's material, a `vt`
+/// per vertex; the input's files untouched.
+#[test]
+fn a_textured_obj_keeps_its_materials_library_and_images() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, _, middle) = textured_fixture(dir.path(), &["scan.mtl"]);
+    library(dir.path());
+    let before = std::fs::read(&input).unwrap();
+    let output = dir.path().join("out/cleaned.obj");
+    let report = clean(&input, &output);
+    assert!(
+        report.contains("vertex attributes    texture coordinates, material"),
+        "{report}"
+    );
+    assert_eq!(std::fs::read(&input).unwrap(), before);
+    let out = dir.path().join("out");
+    assert_eq!(
+        std::fs::read(out.join("tex/left.png")).unwrap(),
+        b"left image"
+    );
+    assert_eq!(
+        std::fs::read(out.join("tex/right.png")).unwrap(),
+        b"right image"
+    );
+    let mtl = std::fs::read_to_string(out.join("cleaned.mtl")).unwrap();
+    assert!(mtl.contains("map_Kd -bm 1 tex/right.png\n"), "{mtl}");
+    let text = std::fs::read_to_string(&output).unwrap();
+    assert!(text.contains("\nmtllib cleaned.mtl\n"), "{}", &text[..200]);
+
+    // Read back as a mesh: every face's material is its side's, but for
+    // a few new faces laid across the middle (measured: none).
+    let written = meshtrim::io::read_mesh(&output).unwrap();
+    let material = written.material.unwrap();
+    assert_eq!(material.libraries, vec![out.join("cleaned.mtl")]);
+    let faces = written.faces.unwrap();
+    let mut across = 0;
+    for (face, &m) in faces.iter().zip(&material.faces) {
+        let centre = face
+            .iter()
+            .map(|&v| written.vertices[v as usize][0])
+            .sum::<f64>()
+            / 3.0;
+        let side = if centre > middle { "right" } else { "left" };
+        across += usize::from(material.names[m as usize] != side);
+    }
+    assert!(across <= 4, "{across} faces on the other side's material");
+    // The texture coordinates are still x / 1000 and y / 1000 on kept
+    // vertices (new ones blend their face's; measured 2,757 of 2,998 exact).
+    let uv = written.texcoords.unwrap();
+    let exact = written
+        .vertices
+        .iter()
+        .zip(&uv)
+        .filter(|(p, t)| **t == [p[0] / 1000.0, p[1] / 1000.0])
+        .count();
+    assert!(exact > written.vertices.len() * 9 / 10, "{exact}");
+}
+
+/// Beside the input's library, the output names it and writes nothing
+/// else; a library that cannot be read is named as it was.
+#[test]
+fn beside_its_library_the_output_shares_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, _, _) = textured_fixture(dir.path(), &["scan.mtl"]);
+    library(dir.path());
+    let output = dir.path().join("in/cleaned.obj");
+    clean(&input, &output);
+    let text = std::fs::read_to_string(&output).unwrap();
+    assert!(text.contains("\nmtllib scan.mtl\n"));
+    assert!(!dir.path().join("in/cleaned.mtl").exists());
+
+    let (input, _, _) = textured_fixture(dir.path(), &["nowhere.mtl"]);
+    let output = dir.path().join("elsewhere/cleaned.obj");
+    clean(&input, &output);
+    let text = std::fs::read_to_string(&output).unwrap();
+    assert!(text.contains("\nmtllib nowhere.mtl\n"));
+    assert!(!dir.path().join("elsewhere/cleaned.mtl").exists());
+}
+
+/// An output whose own library would be one of the input's is refused,
+/// naming both, and nothing is written.
+#[test]
+fn the_input_library_is_never_replaced() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, _, _) = textured_fixture(dir.path(), &["cleaned.mtl", "../other/b.mtl"]);
+    std::fs::create_dir_all(dir.path().join("other")).unwrap();
+    std::fs::write(dir.path().join("in/cleaned.mtl"), "newmtl left\n").unwrap();
+    std::fs::write(dir.path().join("other/b.mtl"), "newmtl right\n").unwrap();
+    let output = dir.path().join("in/cleaned.obj");
+    let run = meshtrim(&["clean", s(&input), s(&output)], None);
+    assert_eq!(run.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        stderr.contains("the output's material library would replace the input's"),
+        "{stderr}"
+    );
+    assert!(!output.exists());
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("in/cleaned.mtl")).unwrap(),
+        "newmtl left\n"
+    );
+}
