@@ -585,6 +585,7 @@ fn attributes_of(
         scalars: fields_of(scalars)?,
         texcoords: texcoords.map(|t| rows(&t, "texcoords")).transpose()?,
         material,
+        gltf_materials: None,
     })
 }
 

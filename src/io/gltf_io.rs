@@ -45,6 +45,8 @@ use byteorder::{ByteOrder, LittleEndian};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::Mode;
 
+use super::gltf_materials::{self, NO_MATERIAL};
+use super::hash::HashMap;
 use super::ply::Scalar;
 use super::{
     is_written_name, show, unit_channel, Colours, Mesh, Point3, ScalarField, VertexAttributes,
@@ -81,12 +83,17 @@ pub fn read_gltf(bytes: &[u8], dir: &Path) -> Result<Mesh> {
     let mut colours = Some(Colours::default());
     let mut texcoords = Some(Vec::new());
     let mut fields = None;
-    for Instance {
-        node,
-        mesh: m,
-        world,
-    } in &instances
-    {
+    let mut face_materials = Vec::new();
+    // Where the vertices of each instance's primitives start, by their
+    // accessors: primitives that share every vertex accessor (a mesh
+    // split by material over one vertex buffer) share their vertices.
+    let mut read_at: HashMap<(usize, Vec<(String, usize)>), usize> = HashMap::default();
+    for (k, instance) in instances.iter().enumerate() {
+        let Instance {
+            node,
+            mesh: m,
+            world,
+        } = instance;
         for primitive in m.primitives() {
             let at = || {
                 format!(
@@ -97,7 +104,23 @@ pub fn read_gltf(bytes: &[u8], dir: &Path) -> Result<Mesh> {
                     primitive.index()
                 )
             };
-            add_primitive(&primitive, &buffers, world, &mut mesh).with_context(at)?;
+            let mut accessors: Vec<(String, usize)> = primitive
+                .attributes()
+                .map(|(semantic, accessor)| (format!("{semantic:?}"), accessor.index()))
+                .collect();
+            accessors.sort();
+            let shared = read_at.get(&(k, accessors.clone())).copied();
+            let base =
+                add_primitive(&primitive, &buffers, world, &mut mesh, shared).with_context(at)?;
+            let material = primitive
+                .material()
+                .index()
+                .map_or(NO_MATERIAL, |m| m as u32);
+            face_materials.resize(mesh.faces.as_ref().map_or(0, Vec::len), material);
+            if shared.is_some() {
+                continue;
+            }
+            read_at.insert((k, accessors), base);
             add_normals(&primitive, &buffers, world, &mut normals).with_context(at)?;
             add_colours(&primitive, &buffers, &mut colours).with_context(at)?;
             add_texcoords(&primitive, &buffers, &mut texcoords).with_context(at)?;
@@ -108,6 +131,7 @@ pub fn read_gltf(bytes: &[u8], dir: &Path) -> Result<Mesh> {
     mesh.colours = colours;
     mesh.texcoords = texcoords;
     mesh.scalars = fields.unwrap_or_default();
+    mesh.gltf_materials = gltf_materials::read(bytes, &gltf, &buffers, dir, face_materials)?;
     Ok(mesh)
 }
 
@@ -602,22 +626,10 @@ fn load_buffers<'a>(gltf: &'a gltf::Gltf, dir: &Path) -> Result<Vec<Cow<'a, [u8]
                 "buffer {i} has an empty URI: it needs the name of a file beside the \
                  document or a base64 data: URI"
             ),
-            gltf::buffer::Source::Uri(uri) if uri.starts_with("data:") => {
-                Cow::Owned(decode_data_uri(uri).with_context(|| format!("buffer {i}"))?)
-            }
-            gltf::buffer::Source::Uri(uri) => {
-                refuse_schemes(uri).with_context(|| format!("buffer {i}"))?;
-                // A relative reference, resolved against the document's
-                // directory as RFC 3986 does: `../shared/mesh.bin` (asset
-                // pipelines share buffers that way) and a path-absolute
-                // `/data/mesh.bin` name files on this machine. Only a
-                // regular file is read, and only `byteLength` bytes of it.
-                let path = dir.join(percent_decode(uri));
-                Cow::Owned(
-                    read_buffer_file(&path, buffer.length())
-                        .with_context(|| format!("buffer {i}: cannot read '{}'", path.display()))?,
-                )
-            }
+            gltf::buffer::Source::Uri(uri) => Cow::Owned(
+                uri_bytes(uri, dir, Some(buffer.length()))
+                    .with_context(|| format!("buffer {i}"))?,
+            ),
         };
         if data.len() < buffer.length() {
             bail!(
@@ -629,6 +641,20 @@ fn load_buffers<'a>(gltf: &'a gltf::Gltf, dir: &Path) -> Result<Vec<Cow<'a, [u8]
         out.push(data);
     }
     Ok(out)
+}
+
+/// The data a URI names: a base64 `data:` URI, or a file relative to the
+/// document's directory `dir` as RFC 3986 resolves it (`../shared/mesh.bin`,
+/// as asset pipelines share buffers, and a path-absolute `/data/mesh.bin`
+/// name files on this machine). Only a regular file is read, and only its
+/// first `length` bytes when given.
+pub(crate) fn uri_bytes(uri: &str, dir: &Path, length: Option<usize>) -> Result<Vec<u8>> {
+    if uri.starts_with("data:") {
+        return decode_data_uri(uri);
+    }
+    refuse_schemes(uri)?;
+    let path = dir.join(percent_decode(uri));
+    read_regular_file(&path, length).with_context(|| format!("cannot read '{}'", path.display()))
 }
 
 /// A URI with a scheme (RFC 3986: a letter, then letters, digits, `+`,
@@ -655,20 +681,21 @@ fn refuse_schemes(uri: &str) -> Result<()> {
     bail!("URI '{uri}' is not supported: only files relative to the document and base64 data: URIs are read")
 }
 
-/// The first `length` bytes of an external buffer file, which must be a
-/// regular file. The URI comes from the document and may name anything: a
-/// FIFO's opening waits for a writer forever, and a device such as
-/// `/dev/zero` (an absolute or `..` path) never ends, so a whole-file read
-/// would hang or fill the memory. Bytes past `length` are not needed.
-fn read_buffer_file(path: &Path, length: usize) -> Result<Vec<u8>> {
+/// The first `length` bytes (all when `None`) of an external file, which
+/// must be a regular file. The URI comes from the document and may name
+/// anything: a FIFO's opening waits for a writer forever, and a device
+/// such as `/dev/zero` (an absolute or `..` path) never ends, so reading
+/// it would hang or fill the memory. Bytes past `length` are not needed.
+fn read_regular_file(path: &Path, length: Option<usize>) -> Result<Vec<u8>> {
     use std::io::Read;
     // Checked before opening: opening a FIFO blocks.
     if !std::fs::metadata(path)?.is_file() {
         bail!("not a regular file");
     }
     let mut data = Vec::new();
+    let limit = length.map_or(u64::MAX, |l| l as u64);
     std::fs::File::open(path)?
-        .take(length as u64)
+        .take(limit)
         .read_to_end(&mut data)?;
     Ok(data)
 }
@@ -815,7 +842,8 @@ fn add_primitive(
     buffers: &[Cow<[u8]>],
     world: &Matrix,
     mesh: &mut Mesh,
-) -> Result<()> {
+    shared: Option<usize>,
+) -> Result<usize> {
     if primitive.mode() != Mode::Triangles {
         bail!(
             "mode {} is not supported, only TRIANGLES",
@@ -836,8 +864,12 @@ fn add_primitive(
             positions.dimensions()
         );
     }
-    let base = mesh.vertices.len();
     let count = positions.count();
+    if let Some(base) = shared {
+        add_faces(primitive, buffers, world, base, count, mesh)?;
+        return Ok(base);
+    }
+    let base = mesh.vertices.len();
     let new_total = base
         .checked_add(count)
         .filter(|&n| n <= u32::MAX as usize + 1)
@@ -857,7 +889,20 @@ fn add_primitive(
         mesh.vertices.push(p);
     }
     debug_assert_eq!(mesh.vertices.len(), new_total);
+    add_faces(primitive, buffers, world, base, count, mesh)?;
+    Ok(base)
+}
 
+/// Appends the primitive's triangles, its `count` vertices being the
+/// mesh's from `base` on.
+fn add_faces(
+    primitive: &gltf::Primitive,
+    buffers: &[Cow<[u8]>],
+    world: &Matrix,
+    base: usize,
+    count: usize,
+    mesh: &mut Mesh,
+) -> Result<()> {
     let corners: Vec<u32> = match primitive.indices() {
         Some(indices) => read_indices(&indices, buffers, count)?,
         None => (0..count as u32).collect(),
@@ -1067,31 +1112,49 @@ fn document(
             "type": "SCALAR"
         }));
     }
-    let start = bin.len();
-    for v in faces.iter().flatten() {
-        bin.extend_from_slice(&v.to_le_bytes());
+    // One primitive per material (the faces grouped), or one for all.
+    let groups = match &attributes.gltf_materials {
+        Some(materials) => materials.groups(),
+        None => vec![(NO_MATERIAL, (0..faces.len() as u32).collect())],
+    };
+    let mut primitives = Vec::new();
+    for (material, group) in groups {
+        let start = bin.len();
+        for &f in &group {
+            for v in faces[f as usize] {
+                bin.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+        let indices_view = add_view(&bin, start, 34963, None);
+        let mut primitive = serde_json::json!({
+            "attributes": primitive_attributes, "indices": accessors.len(), "mode": 4
+        });
+        if material != NO_MATERIAL {
+            primitive["material"] = material.into();
+        }
+        primitives.push(primitive);
+        accessors.push(serde_json::json!({
+            "bufferView": indices_view, "componentType": 5125, "count": 3 * group.len(),
+            "type": "SCALAR"
+        }));
     }
-    let indices_view = add_view(&bin, start, 34963, None);
-    let indices = accessors.len();
-    accessors.push(serde_json::json!({
-        "bufferView": indices_view, "componentType": 5125, "count": 3 * faces.len(), "type": "SCALAR"
-    }));
-    let mut buffer = serde_json::json!({ "byteLength": bin.len() });
-    if let Some(uri) = uri {
-        buffer["uri"] = uri.into();
-    }
-    let json = serde_json::json!({
+    let mut json = serde_json::json!({
         "asset": { "version": "2.0", "generator": "meshtrim" },
         "scene": 0,
         "scenes": [{ "nodes": [0] }],
         "nodes": [{ "mesh": 0 }],
-        "meshes": [{ "primitives": [{
-            "attributes": primitive_attributes, "indices": indices, "mode": 4
-        }] }],
+        "meshes": [{ "primitives": primitives }],
         "accessors": accessors,
-        "bufferViews": views,
-        "buffers": [buffer]
     });
+    if let Some(materials) = &attributes.gltf_materials {
+        gltf_materials::write(materials, &mut json, &mut views, &mut bin);
+    }
+    let mut buffer = serde_json::json!({ "byteLength": bin.len() });
+    if let Some(uri) = uri {
+        buffer["uri"] = uri.into();
+    }
+    json["bufferViews"] = views.into();
+    json["buffers"] = serde_json::json!([buffer]);
     (json, bin)
 }
 
@@ -1171,6 +1234,63 @@ mod tests {
             vec![[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.5]],
             vec![[0, 1, 2], [0, 2, 3]],
         )
+    }
+
+    /// Materials, textures, samplers and an image (its bytes embedded)
+    /// written and read back as they were, the faces grouped by material
+    /// (one primitive each, those without one last); an extension is
+    /// declared again only where the JSON names it.
+    #[test]
+    fn materials_round_trip() {
+        use serde_json::json;
+        let v = vec![[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.]];
+        let f = vec![[0, 1, 2], [0, 2, 3], [1, 2, 3], [0, 1, 3]];
+        let materials = gltf_materials::GltfMaterials {
+            materials: vec![
+                json!({"name": "a", "pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}),
+                json!({"name": "b", "extensions": {"KHR_materials_unlit": {}}}),
+            ],
+            textures: vec![json!({"source": 0, "sampler": 0})],
+            samplers: vec![json!({"magFilter": 9729})],
+            images: vec![gltf_materials::GltfImage {
+                json: json!({"name": "picture"}),
+                mime_type: "image/png".to_string(),
+                bytes: b"\x89PNG, three bytes short".to_vec(),
+            }],
+            extensions: [
+                vec![
+                    "KHR_materials_unlit".into(),
+                    "KHR_draco_mesh_compression".into(),
+                ],
+                Vec::new(),
+            ],
+            faces: vec![1, NO_MATERIAL, 0, 1],
+        };
+        let attributes = VertexAttributes {
+            gltf_materials: Some(materials.clone()),
+            ..VertexAttributes::default()
+        };
+        for glb in [true, false] {
+            let mut bytes = Vec::new();
+            if glb {
+                write_glb(&mut bytes, &v, &f, &attributes).unwrap();
+                assert_eq!(bytes.len() % 4, 0);
+            } else {
+                write_gltf(&mut bytes, &v, &f, &attributes).unwrap();
+            }
+            let mesh = read_gltf(&bytes, Path::new(".")).unwrap();
+            assert_eq!(mesh.faces.unwrap(), vec![f[2], f[0], f[3], f[1]]);
+            let read = mesh.gltf_materials.unwrap();
+            assert_eq!(read.faces, vec![0, 1, 1, NO_MATERIAL]);
+            assert_eq!(read.materials, materials.materials);
+            assert_eq!(read.textures, materials.textures);
+            assert_eq!(read.samplers, materials.samplers);
+            assert_eq!(read.images, materials.images);
+            assert_eq!(
+                read.extensions,
+                [vec!["KHR_materials_unlit".to_string()], Vec::new()]
+            );
+        }
     }
 
     #[test]

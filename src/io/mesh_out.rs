@@ -100,6 +100,7 @@ impl MeshFormat {
             scalars,
             texcoords,
             material,
+            gltf_materials,
         } = attributes;
         let mut held = VertexAttributes::default();
         let mut not_held = VertexAttributes::default();
@@ -110,10 +111,15 @@ impl MeshFormat {
         side.normals = normals;
         side.colours = colours;
         side.texcoords = texcoords;
-        // Only OBJ names an OBJ material; the others keep the coordinates.
+        // Each format holds its own kind of material; the others keep the
+        // coordinates only.
         match self {
             MeshFormat::Obj => held.material = material,
             _ => not_held.material = material,
+        }
+        match self {
+            MeshFormat::Glb | MeshFormat::Gltf => held.gltf_materials = gltf_materials,
+            _ => not_held.gltf_materials = gltf_materials,
         }
         let (fields, others) = scalars.into_iter().partition(|f| self.holds_field(f));
         held.scalars = fields;

@@ -19,6 +19,7 @@ pub mod e57;
 pub mod edges_out;
 pub(crate) mod float_text;
 pub mod gltf_io;
+pub mod gltf_materials;
 mod hash;
 pub mod labels;
 pub mod las;
@@ -148,6 +149,8 @@ pub struct Mesh {
     pub texcoords: Option<Vec<[f64; 2]>>,
     /// The OBJ materials the faces use, when every face uses one.
     pub material: Option<ObjMaterial>,
+    /// A glTF file's materials and each face's.
+    pub gltf_materials: Option<gltf_materials::GltfMaterials>,
     /// Triangles as vertex indices, polygons split into fans; `None` when
     /// the file has no face element or `f` lines at all.
     pub faces: Option<Vec<[u32; 3]>>,
@@ -176,19 +179,34 @@ impl ObjMaterial {
         to: &trim::Mesh,
         sources: &[trim::VertexSource],
     ) -> ObjMaterial {
-        let faces = match self.names.len() {
-            0 | 1 => vec![0; to.faces.len()],
-            _ => trim::face_sources(from, to, sources)
-                .into_iter()
-                .map(|f| f.map_or(0, |f| self.faces[f as usize]))
-                .collect(),
-        };
         ObjMaterial {
             libraries: self.libraries.clone(),
             names: self.names.clone(),
-            faces,
+            faces: carried_face_values(&self.faces, from, to, sources, 0),
         }
     }
+}
+
+/// Per-face values of `from` at the faces of `to`, made from it (its
+/// vertices' `sources` in `from`): each face the value of the input face
+/// it lies on ([`trim::face_sources`]), `none` where it lies on none.
+/// When `from`'s faces all have one value, so do `to`'s, with no search.
+fn carried_face_values(
+    values: &[u32],
+    from: &trim::Mesh,
+    to: &trim::Mesh,
+    sources: &[trim::VertexSource],
+    none: u32,
+) -> Vec<u32> {
+    if let Some(&first) = values.first() {
+        if values.iter().all(|&v| v == first) {
+            return vec![first; to.faces.len()];
+        }
+    }
+    trim::face_sources(from, to, sources)
+        .into_iter()
+        .map(|f| f.map_or(none, |f| values[f as usize]))
+        .collect()
 }
 
 /// Vertex colours as read: red, green, blue and alpha in 0..1.
@@ -305,6 +323,8 @@ pub struct VertexAttributes {
     /// The OBJ materials of the faces, which the texture coordinates
     /// index into, written to OBJ outputs with them.
     pub material: Option<ObjMaterial>,
+    /// A glTF file's materials and each face's, written to glTF outputs.
+    pub gltf_materials: Option<gltf_materials::GltfMaterials>,
 }
 
 /// Attributes carried to a mesh ([`VertexAttributes::carried`]).
@@ -325,6 +345,7 @@ impl VertexAttributes {
             && self.scalars.is_empty()
             && self.texcoords.is_none()
             && self.material.is_none()
+            && self.gltf_materials.is_none()
     }
 
     /// These attributes, of `from`'s vertices, at the vertices of `to`, a
@@ -343,15 +364,20 @@ impl VertexAttributes {
         };
         let mesh = split.split_mesh(to);
         let mut attributes = self.at_sources(from, &split.sources);
+        let out = mesh.as_ref().unwrap_or(to);
         attributes.material = self
             .material
             .as_ref()
-            .map(|material| material.carried(from, mesh.as_ref().unwrap_or(to), &split.sources));
+            .map(|material| material.carried(from, out, &split.sources));
+        attributes.gltf_materials = self
+            .gltf_materials
+            .as_ref()
+            .map(|materials| materials.carried(from, out, &split.sources));
         Carried { mesh, attributes }
     }
 
-    /// These attributes at `sources` in `from`, but the material (which
-    /// is the faces').
+    /// These attributes at `sources` in `from`, but the materials (which
+    /// are the faces').
     fn at_sources(&self, from: &trim::Mesh, sources: &[trim::VertexSource]) -> VertexAttributes {
         VertexAttributes {
             normals: self.normals.as_ref().map(|normals| {
@@ -380,6 +406,7 @@ impl VertexAttributes {
                 .as_ref()
                 .map(|texcoords| trim::carry(from, sources, texcoords)),
             material: None,
+            gltf_materials: None,
         }
     }
 
@@ -397,7 +424,7 @@ impl VertexAttributes {
         if self.texcoords.is_some() {
             names.push("texture coordinates".to_string());
         }
-        if self.material.is_some() {
+        if self.material.is_some() || self.gltf_materials.is_some() {
             names.push("material".to_string());
         }
         names.extend(self.scalars.iter().map(|field| field.name.clone()));
@@ -458,6 +485,7 @@ pub fn read_mesh_with_attributes(
         scalars: read.scalars,
         texcoords: read.texcoords,
         material: read.material,
+        gltf_materials: read.gltf_materials,
     };
     let mesh = trim::Mesh {
         vertices: read.vertices,

@@ -333,8 +333,8 @@ impl ObjText {
             colours,
             texcoords,
             material,
-            scalars: Vec::new(),
             faces: Some(faces),
+            ..Mesh::default()
         })
     }
 
