@@ -26,13 +26,17 @@
 //! types (otherwise the mesh is read without them); application-specific
 //! scalar attributes (`_NAME`) as the file's own values ([`ScalarField`]);
 //! the other attributes (more texture coordinate sets, tangents, joints)
-//! and the materials are not.
+//! are not. Primitives of one node that share every vertex accessor share
+//! their vertices. Each face keeps its primitive's material, and the
+//! materials, textures, samplers and images are kept to be written again
+//! ([`super::gltf_materials`]).
 //!
 //! Writing: one mesh with one primitive, `f32` positions with the `min` and
 //! `max` bounds the spec requires, `u32` indices, and with the vertex
 //! attributes given, unit `f32` `NORMAL`s, `COLOR_0` as normalised
 //! unsigned bytes RGBA, `f32` `TEXCOORD_0` and the file's own values as
-//! `_NAME` ([`holds_field`]).
+//! `_NAME` ([`holds_field`]); with a glTF input's materials, one primitive
+//! per material over those accessors.
 
 use std::borrow::Cow;
 use std::collections::HashSet;
