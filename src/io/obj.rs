@@ -196,6 +196,13 @@ impl ObjText {
     /// Adds a polygon as a fan of triangles from its first corner.
     fn add_fan(&mut self, corners: &[Corner]) {
         let faces = self.faces.get_or_insert_with(Vec::new);
+        let positions_only = corners.iter().all(|c| c[1] == NONE && c[2] == NONE);
+        if positions_only && self.corner_texcoords.is_none() && self.corner_normals.is_none() {
+            for w in 1..corners.len().saturating_sub(1) {
+                faces.push([corners[0][0], corners[w][0], corners[w + 1][0]]);
+            }
+            return;
+        }
         let before = faces.len();
         for w in 1..corners.len().saturating_sub(1) {
             let fan = [corners[0], corners[w], corners[w + 1]];
@@ -274,8 +281,10 @@ impl ObjText {
             ),
         ];
         for (refs, n, one, many) in lists {
+            // A vertex is never NONE; the others are where a corner has none.
+            let none_allowed = one != "vertex";
             for (t, face) in refs.unwrap_or_default().iter().enumerate() {
-                let missing = |&&v: &&u32| (one == "vertex" || v != NONE) && v as usize >= n;
+                let missing = |&&v: &&u32| !(none_allowed && v == NONE) && v as usize >= n;
                 if let Some(&v) = face.iter().find(missing) {
                     // As written: 1-based, and in u64, where u32::MAX + 1 fits.
                     let written = u64::from(v) + 1;
@@ -605,15 +614,16 @@ type Corner = [u32; 3];
 /// negative (counted back from the latest of its kind, `defined` of each
 /// so far).
 fn parse_corner(word: &str, defined: Counts) -> Result<Corner> {
+    // Most corners are a vertex alone.
+    if !word.contains('/') {
+        return Ok([reference(word, word, defined[0], 0)?, NONE, NONE]);
+    }
     let mut parts = word.split('/');
     let mut corner = [NONE; 3];
-    for (k, kind) in ["vertex", "texture coordinate", "normal"]
-        .into_iter()
-        .enumerate()
-    {
+    for k in 0..3 {
         match parts.next() {
             Some("") if k > 0 => {}
-            Some(part) => corner[k] = reference(part, word, defined[k], kind)?,
+            Some(part) => corner[k] = reference(part, word, defined[k], k)?,
             None if k > 0 => {}
             None => bail!("'{word}' is not a vertex reference"),
         }
@@ -624,22 +634,21 @@ fn parse_corner(word: &str, defined: Counts) -> Result<Corner> {
     Ok(corner)
 }
 
-/// One 1-based or negative reference to the `defined` elements of `kind`
-/// so far; 0-based on return.
-fn reference(part: &str, word: &str, defined: usize, kind: &str) -> Result<u32> {
+/// What a corner's references refer to, by their place in it.
+const KINDS: [&str; 3] = ["vertex", "texture coordinate", "normal"];
+
+/// One 1-based or negative reference to the `defined` elements of kind
+/// `k` ([`KINDS`]) so far; 0-based on return.
+fn reference(part: &str, word: &str, defined: usize, k: usize) -> Result<u32> {
     let n: i64 = part
         .parse()
         .map_err(|_| anyhow!("'{word}' is not a vertex reference"))?;
     let index = if n < 0 { defined as i64 + n } else { n - 1 };
     // A vertex may be u32::MAX (and is then found missing with the
     // count); for the others it stands for "none".
-    let last = if kind == "vertex" {
-        u32::MAX
-    } else {
-        u32::MAX - 1
-    };
+    let last = if k == 0 { u32::MAX } else { u32::MAX - 1 };
     if n == 0 || index < 0 || index > i64::from(last) {
-        bail!("face refers to {kind} {n}, which does not exist");
+        bail!("face refers to {} {n}, which does not exist", KINDS[k]);
     }
     Ok(index as u32)
 }
