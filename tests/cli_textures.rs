@@ -76,8 +76,8 @@ fn clean(input: &Path, output: &Path) -> String {
 }
 
 /// Cleaned into another directory: the output's own library with the
-/// images copied below it, each face under its side's material, a `vt`
-/// per vertex; the input's files untouched.
+/// images copied into its own folder, each face under its side's
+/// material, a `vt` per vertex; the input's files untouched.
 #[test]
 fn a_textured_obj_keeps_its_materials_library_and_images() {
     let dir = tempfile::tempdir().unwrap();
@@ -92,16 +92,20 @@ fn a_textured_obj_keeps_its_materials_library_and_images() {
     );
     assert_eq!(std::fs::read(&input).unwrap(), before);
     let out = dir.path().join("out");
+    let images = out.join("cleaned_textures/tex");
     assert_eq!(
-        std::fs::read(out.join("tex/left.png")).unwrap(),
+        std::fs::read(images.join("left.png")).unwrap(),
         b"left image"
     );
     assert_eq!(
-        std::fs::read(out.join("tex/right.png")).unwrap(),
+        std::fs::read(images.join("right.png")).unwrap(),
         b"right image"
     );
     let mtl = std::fs::read_to_string(out.join("cleaned.mtl")).unwrap();
-    assert!(mtl.contains("map_Kd -bm 1 tex/right.png\n"), "{mtl}");
+    assert!(
+        mtl.contains("map_Kd -bm 1 cleaned_textures/tex/right.png\n"),
+        "{mtl}"
+    );
     let text = std::fs::read_to_string(&output).unwrap();
     assert!(text.contains("\nmtllib cleaned.mtl\n"), "{}", &text[..200]);
 
@@ -177,4 +181,25 @@ fn the_input_library_is_never_replaced() {
         std::fs::read_to_string(dir.path().join("in/cleaned.mtl")).unwrap(),
         "newmtl left\n"
     );
+}
+
+/// Two textured scans whose images have the same names, cleaned into one
+/// directory (as a batch writes them): each output keeps its own images.
+#[test]
+fn outputs_side_by_side_keep_their_own_images() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    for (name, bytes) in [("a", &b"image of a"[..]), ("b", &b"image of b"[..])] {
+        let scan = dir.path().join(name);
+        let (input, _, _) = textured_fixture(&scan, &["scan.mtl"]);
+        library(&scan);
+        std::fs::write(scan.join("in/tex/left.png"), bytes).unwrap();
+        clean(&input, &out.join(format!("{name}.obj")));
+    }
+    for (name, bytes) in [("a", &b"image of a"[..]), ("b", &b"image of b"[..])] {
+        let mtl = std::fs::read_to_string(out.join(format!("{name}.mtl"))).unwrap();
+        let image = format!("{name}_textures/tex/left.png");
+        assert!(mtl.contains(&format!("map_Kd {image}\n")), "{mtl}");
+        assert_eq!(std::fs::read(out.join(image)).unwrap(), bytes);
+    }
 }

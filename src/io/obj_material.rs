@@ -7,9 +7,10 @@
 //! outside the OBJ's directory. So an output written beside the input's
 //! libraries names them as they are; an output written elsewhere gets its
 //! own library beside it, `<name>.mtl` (the input's libraries' text), and
-//! a copy of each image, at the same path below the output's directory
-//! when the image was below the library's, else by its file name. The
-//! input's files are never modified.
+//! a copy of each image in a directory of its own, `<name>_textures/`, at
+//! the same path below it when the image was below the library's, else by
+//! its file name: outputs written side by side (a batch) never share or
+//! overwrite an image. The input's files are never modified.
 
 use std::path::{Component, Path, PathBuf};
 
@@ -30,6 +31,12 @@ pub(crate) fn libraries_for_output(path: &Path, material: &ObjMaterial) -> Resul
         return Ok(material.libraries.iter().map(|l| file_name(l)).collect());
     }
     let own = path.with_extension("mtl");
+    // The images go into a directory of the output's own, so outputs
+    // written side by side (a batch) never share or overwrite one.
+    let stem = path
+        .file_stem()
+        .map_or(String::new(), |s| s.to_string_lossy().into_owned());
+    let folder = format!("{stem}_textures");
     if let Some(input) = material.libraries.iter().find(|l| same_file(l, &own)) {
         bail!(
             "{}: the output's material library would replace the input's {}: write the output to another name or directory",
@@ -46,7 +53,9 @@ pub(crate) fn libraries_for_output(path: &Path, material: &ObjMaterial) -> Resul
             Ok(bytes) => {
                 let from = absolute_dir(library);
                 let library_text = String::from_utf8_lossy(&bytes);
-                let copied = rebased(&library_text, |image| copy_image(&from, image, &out_dir));
+                let copied = rebased(&library_text, |image| {
+                    copy_image(&from, image, &out_dir, &folder)
+                });
                 text.push_str(&copied?);
             }
             Err(_) => missing.push(file_name(library)),
@@ -59,20 +68,24 @@ pub(crate) fn libraries_for_output(path: &Path, material: &ObjMaterial) -> Resul
     Ok([file_name(&own)].into_iter().chain(missing).collect())
 }
 
-/// Copies the image a library in `from` names as `image` into `out_dir`
-/// and returns its name from there: the same relative path when it is
-/// below `from`, else its file name. A missing image is named as it was.
-fn copy_image(from: &Path, image: &str, out_dir: &Path) -> Result<String> {
+/// Copies the image a library in `from` names as `image` into the
+/// directory `folder` of `out_dir`, and returns its name from `out_dir`:
+/// `folder/` then the same relative path when the image is below `from`,
+/// else its file name. A missing image is named as it was.
+fn copy_image(from: &Path, image: &str, out_dir: &Path, folder: &str) -> Result<String> {
     let source = normalised(&from.join(image));
+    if !source.is_file() {
+        return Ok(image.to_string());
+    }
     let below = Path::new(image)
         .components()
         .all(|c| matches!(c, Component::Normal(_) | Component::CurDir));
     let name = match below {
-        true => image.replace('\\', "/"),
-        false => file_name(&source),
+        true => format!("{folder}/{}", image.replace('\\', "/")),
+        false => format!("{folder}/{}", file_name(&source)),
     };
     let target = out_dir.join(&name);
-    if !source.is_file() || same_file(&source, &target) {
+    if same_file(&source, &target) {
         return Ok(name);
     }
     let bytes = std::fs::read(&source)
@@ -159,24 +172,26 @@ mod tests {
     }
 
     #[test]
-    fn images_copied_below_the_output() {
+    fn images_copied_into_the_outputs_folder() {
         let dir = tempfile::tempdir().unwrap();
         let (input, output) = (dir.path().join("in"), dir.path().join("out"));
         std::fs::create_dir_all(input.join("tex")).unwrap();
         std::fs::write(input.join("tex/a.png"), b"A").unwrap();
         std::fs::write(dir.path().join("b.png"), b"B").unwrap();
+        let copy = |image: &str| copy_image(&input, image, &output, "scan_textures").unwrap();
+        assert_eq!(copy("tex/a.png"), "scan_textures/tex/a.png");
         assert_eq!(
-            copy_image(&input, "tex/a.png", &output).unwrap(),
-            "tex/a.png"
+            std::fs::read(output.join("scan_textures/tex/a.png")).unwrap(),
+            b"A"
         );
-        assert_eq!(std::fs::read(output.join("tex/a.png")).unwrap(), b"A");
         // Outside the library's directory: by its file name.
-        assert_eq!(copy_image(&input, "../b.png", &output).unwrap(), "b.png");
-        assert_eq!(std::fs::read(output.join("b.png")).unwrap(), b"B");
+        assert_eq!(copy("../b.png"), "scan_textures/b.png");
+        assert_eq!(
+            std::fs::read(output.join("scan_textures/b.png")).unwrap(),
+            b"B"
+        );
         // Missing: named as it was, nothing written.
-        assert_eq!(copy_image(&input, "c.png", &output).unwrap(), "c.png");
-        assert!(!output.join("c.png").exists());
-        // Already there (the output beside the image): not copied onto itself.
-        assert_eq!(copy_image(&input, "../b.png", dir.path()).unwrap(), "b.png");
+        assert_eq!(copy("c.png"), "c.png");
+        assert!(!output.join("scan_textures/c.png").exists());
     }
 }

@@ -99,13 +99,15 @@ def test_a_textured_obj_is_cleaned_with_its_texture(textured, tmp_path):
     assert "texture coordinates" in report["vertex_attributes"], report
     assert "material" in report["vertex_attributes"], report
     assert digest(directory) == before, "the input's files are untouched"
-    # The output's own library, beside it, with a copy of the image.
-    assert {p.name for p in out.parent.iterdir()} == {"face.obj", "face.mtl", "face_tex.png"}
-    assert (out.parent / "face_tex.png").read_bytes() == (directory / "face_tex.png").read_bytes()
+    # The output's own library, beside it, with a copy of the image in
+    # the output's own folder.
+    assert {p.name for p in out.parent.iterdir()} == {"face.obj", "face.mtl", "face_textures"}
+    image = out.parent / "face_textures" / "face_tex.png"
+    assert image.read_bytes() == (directory / "face_tex.png").read_bytes()
 
     corners_in, uv_in = wedges(directory / "face.obj")[:2]
     corners, uv, textures = wedges(out)
-    assert textures == ["face_tex.png"], textures
+    assert textures == ["face_textures/face_tex.png"], textures
     by_corners = {c.tobytes(): w for c, w in zip(corners_in, uv_in)}
     kept = [i for i, c in enumerate(corners) if c.tobytes() in by_corners]
     assert len(kept) > 0.9 * len(corners)
@@ -243,7 +245,7 @@ def test_the_python_package_carries_the_texture_as_the_cli_does(textured, tmp_pa
     written, not_written = meshtrim.write_mesh_carrying(tmp_path / "py" / "face.obj", out_v, out_f, v, f, attributes)
     assert written == ["normals", "texture coordinates", "material"] and not_written == [], (written, not_written)
     run_meshtrim("clean", directory / "face.obj", tmp_path / "cli" / "face.obj")
-    for name in ["face.obj", "face.mtl", "face_tex.png"]:
+    for name in ["face.obj", "face.mtl", "face_textures/face_tex.png"]:
         assert (tmp_path / "py" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes(), name
     # A material of the wrong length is refused, naming it.
     wrong = attributes._replace(material=attributes.material._replace(faces=attributes.material.faces[1:]))
