@@ -1240,6 +1240,20 @@ mod tests {
         )
     }
 
+    /// The mesh written as GLB and as glTF, each read back.
+    fn written_and_read(v: &[Point3], f: &[[u32; 3]], attributes: &VertexAttributes) -> [Mesh; 2] {
+        [true, false].map(|glb| {
+            let mut bytes = Vec::new();
+            if glb {
+                write_glb(&mut bytes, v, f, attributes).unwrap();
+                assert_eq!(bytes.len() % 4, 0);
+            } else {
+                write_gltf(&mut bytes, v, f, attributes).unwrap();
+            }
+            read_gltf(&bytes, Path::new(".")).unwrap()
+        })
+    }
+
     /// Materials, textures, samplers and an image (its bytes embedded)
     /// written and read back as they were, the faces grouped by material
     /// (one primitive each, those without one last); an extension is
@@ -1274,15 +1288,7 @@ mod tests {
             gltf_materials: Some(materials.clone()),
             ..VertexAttributes::default()
         };
-        for glb in [true, false] {
-            let mut bytes = Vec::new();
-            if glb {
-                write_glb(&mut bytes, &v, &f, &attributes).unwrap();
-                assert_eq!(bytes.len() % 4, 0);
-            } else {
-                write_gltf(&mut bytes, &v, &f, &attributes).unwrap();
-            }
-            let mesh = read_gltf(&bytes, Path::new(".")).unwrap();
+        for mesh in written_and_read(&v, &f, &attributes) {
             assert_eq!(mesh.faces.unwrap(), vec![f[2], f[0], f[3], f[1]]);
             let read = mesh.gltf_materials.unwrap();
             assert_eq!(read.faces, vec![0, 1, 1, NO_MATERIAL]);
@@ -1334,15 +1340,7 @@ mod tests {
             texcoords: Some(vec![[0.0, 0.0], [0.5, 0.25], [1.0, 0.75], [-2.0, 3.0]]),
             ..VertexAttributes::default()
         };
-        for glb in [true, false] {
-            let mut bytes = Vec::new();
-            if glb {
-                write_glb(&mut bytes, &v, &f, &attributes).unwrap();
-                assert_eq!(bytes.len() % 4, 0);
-            } else {
-                write_gltf(&mut bytes, &v, &f, &attributes).unwrap();
-            }
-            let mesh = read_gltf(&bytes, Path::new(".")).unwrap();
+        for mesh in written_and_read(&v, &f, &attributes) {
             let normals = mesh.normals.unwrap();
             // Written as unit f32 vectors; a zero normal as +z.
             let want = [
@@ -1383,13 +1381,8 @@ mod tests {
             scalars: scalars.clone(),
             ..VertexAttributes::default()
         };
-        for glb in [true, false] {
-            let mut bytes = Vec::new();
-            match glb {
-                true => write_glb(&mut bytes, &v, &f, &attributes).unwrap(),
-                false => write_gltf(&mut bytes, &v, &f, &attributes).unwrap(),
-            }
-            let mut read = read_gltf(&bytes, Path::new(".")).unwrap().scalars;
+        for mesh in written_and_read(&v, &f, &attributes) {
+            let mut read = mesh.scalars;
             read.sort_by(|a, b| a.name.cmp(&b.name));
             let kinds: Vec<_> = read.iter().map(|f| (f.name.as_str(), f.kind)).collect();
             assert_eq!(

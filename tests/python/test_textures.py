@@ -189,6 +189,44 @@ def test_a_gltf_scan_keeps_its_texture_coordinates(textured, tmp_path):
     assert np.mean(np.abs(got - want).max(axis=1) < 1e-6) > 0.99
 
 
+COLOURS = {"left": (200, 30, 30), "right": (30, 30, 200)}
+"""The halves' images' colours."""
+
+
+def halves(material):
+    """face000's left and right halves as a trimesh scene of two meshes,
+    each with a material `material(name, image)` over an image of its
+    colour (16 × 8 pixels); and the middle x."""
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(str(shared_data("meshlab_scans/face000.ply")))
+    v, f = ms.current_mesh().vertex_matrix(), ms.current_mesh().face_matrix()
+    middle = np.median(v[:, 0])
+    right = v[f].mean(axis=1)[:, 0] > middle
+    scene = trimesh.Scene()
+    for name, side in [("left", ~right), ("right", right)]:
+        half = trimesh.Trimesh(v, f[side], process=False)
+        half.remove_unreferenced_vertices()
+        image = PIL.Image.new("RGB", (16, 8), COLOURS[name])
+        half.visual = trimesh.visual.TextureVisuals(uv=half.vertices[:, :2] / 1000.0, material=material(name, image))
+        scene.add_geometry(half, geom_name=name)
+    return scene, middle
+
+
+def faces_on_the_other_side(parts, middle, image_of):
+    """How many faces of `parts` (meshes by material) lie on the other
+    side of the middle than their material's image says, and how many
+    faces there are."""
+    wrong, faces = 0, 0
+    for part in parts:
+        image = image_of(part.visual.material)
+        assert image.size == (16, 8)
+        is_right = image.getpixel((0, 0))[:3] == COLOURS["right"]
+        on_right = part.triangles_center[:, 0] > middle
+        wrong += int((on_right != is_right).sum())
+        faces += len(part.faces)
+    return wrong, faces
+
+
 def test_each_face_keeps_its_material(tmp_path):
     """Two materials, each with its own image (the scan's left and right
     halves, exported by trimesh as two objects, so the vertices along the
@@ -196,20 +234,7 @@ def test_each_face_keeps_its_material(tmp_path):
     material of the input face it lies on. Measured: 6 of 165,989 faces
     take the material of the other side of the middle, new faces laid
     across it where it meets the border."""
-    ms = pymeshlab.MeshSet()
-    ms.load_new_mesh(str(shared_data("meshlab_scans/face000.ply")))
-    v, f = ms.current_mesh().vertex_matrix(), ms.current_mesh().face_matrix()
-    middle = np.median(v[:, 0])
-    right = v[f].mean(axis=1)[:, 0] > middle
-    scene = trimesh.Scene()
-    for name, side, colour in [("left", ~right, (200, 30, 30)), ("right", right, (30, 30, 200))]:
-        half = trimesh.Trimesh(v, f[side], process=False)
-        half.remove_unreferenced_vertices()
-        image = PIL.Image.new("RGB", (32, 32), colour)
-        half.visual = trimesh.visual.TextureVisuals(
-            uv=half.vertices[:, :2] / 1000.0, material=trimesh.visual.material.SimpleMaterial(image=image)
-        )
-        scene.add_geometry(half, geom_name=name)
+    scene, middle = halves(lambda name, image: trimesh.visual.material.SimpleMaterial(image=image))
     text, assets = trimesh.exchange.obj.export_obj(scene, include_texture=True, return_texture=True, mtl_name="scan.mtl")
     (tmp_path / "scan.obj").write_text(text)
     for name, data in assets.items():
@@ -220,12 +245,8 @@ def test_each_face_keeps_its_material(tmp_path):
     assert report["seam_edges_stitched"] == 415, report
     by_material = trimesh.load(str(out), process=False, group_material=True).geometry
     assert len(by_material) == 2
-    wrong = 0
-    for half in by_material.values():
-        colour = half.visual.material.image.getpixel((0, 0))
-        on_right = half.triangles_center[:, 0] > middle
-        wrong += int((on_right != (colour == (30, 30, 200))).sum())
-    assert sum(len(h.faces) for h in by_material.values()) == report["faces_out"]
+    wrong, faces = faces_on_the_other_side(by_material.values(), middle, lambda m: m.image)
+    assert faces == report["faces_out"]
     assert wrong <= 10, wrong
 
 
@@ -260,20 +281,9 @@ def test_a_gltf_scan_keeps_its_materials_and_images(tmp_path):
     material, and the materials and images are the input's (trimesh reads
     the same pixels). Measured: 6 of 165,989 faces take the other half's
     material, as with the OBJ."""
-    ms = pymeshlab.MeshSet()
-    ms.load_new_mesh(str(shared_data("meshlab_scans/face000.ply")))
-    v, f = ms.current_mesh().vertex_matrix(), ms.current_mesh().face_matrix()
-    middle = np.median(v[:, 0])
-    right = v[f].mean(axis=1)[:, 0] > middle
-    scene = trimesh.Scene()
-    colours = {"left": (200, 30, 30), "right": (30, 30, 200)}
-    for name, side in [("left", ~right), ("right", right)]:
-        half = trimesh.Trimesh(v, f[side], process=False)
-        half.remove_unreferenced_vertices()
-        image = PIL.Image.new("RGB", (16, 8), colours[name])
-        material = trimesh.visual.material.PBRMaterial(name=name, baseColorTexture=image)
-        half.visual = trimesh.visual.TextureVisuals(uv=half.vertices[:, :2] / 1000.0, material=material)
-        scene.add_geometry(half, geom_name=name)
+    scene, middle = halves(
+        lambda name, image: trimesh.visual.material.PBRMaterial(name=name, baseColorTexture=image)
+    )
     glb = tmp_path / "scan.glb"
     scene.export(str(glb))
     out = tmp_path / "out.glb"
@@ -281,13 +291,7 @@ def test_a_gltf_scan_keeps_its_materials_and_images(tmp_path):
     assert "material" in report["vertex_attributes"], report
     cleaned = trimesh.load(str(out), process=False)
     assert len(cleaned.geometry) == 2, list(cleaned.geometry)
-    wrong, faces = 0, 0
-    for part in cleaned.geometry.values():
-        image = part.visual.material.baseColorTexture
-        assert image.size == (16, 8)
-        is_right = image.getpixel((0, 0))[:3] == colours["right"]
-        on_right = part.triangles_center[:, 0] > middle
-        wrong += int((on_right != is_right).sum())
-        faces += len(part.faces)
+    parts = cleaned.geometry.values()
+    wrong, faces = faces_on_the_other_side(parts, middle, lambda m: m.baseColorTexture)
     assert faces == report["faces_out"]
     assert wrong <= 10, wrong

@@ -97,22 +97,11 @@ mod tests {
 
     /// A wavy grid of `n` × `n` squares, two faces each.
     fn sheet(n: u32, rng: &mut ChaCha8Rng) -> Mesh {
-        let mut vertices = Vec::new();
-        for j in 0..=n {
-            for i in 0..=n {
-                let z = 0.05 * rng.random::<f64>();
-                vertices.push([f64::from(i), f64::from(j), z]);
-            }
+        let mut mesh = crate::mesh::tests::grid(n);
+        for p in &mut mesh.vertices {
+            p[2] = 0.05 * rng.random::<f64>();
         }
-        let at = |i: u32, j: u32| j * (n + 1) + i;
-        let mut faces = Vec::new();
-        for j in 0..n {
-            for i in 0..n {
-                faces.push([at(i, j), at(i + 1, j), at(i + 1, j + 1)]);
-                faces.push([at(i, j), at(i + 1, j + 1), at(i, j + 1)]);
-            }
-        }
-        Mesh { vertices, faces }
+        mesh
     }
 
     /// Some faces kept (in other turns and order), some split at a random
