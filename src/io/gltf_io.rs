@@ -328,32 +328,43 @@ fn add_colours(
             return Ok(());
         }
     };
-    let (bytes, scale) = match (accessor.data_type(), accessor.normalized()) {
-        (DataType::F32, _) => (4, 1.0),
-        (DataType::U8, true) => (1, 1.0 / 255.0),
-        (DataType::U16, true) => (2, 1.0 / 65535.0),
-        _ => {
-            *colours = None;
-            return Ok(());
-        }
+    let Some((bytes, scale)) = unit_components(&accessor) else {
+        *colours = None;
+        return Ok(());
     };
     check_count(&accessor, primitive, "COLOR_0")?;
     let (data, stride) = accessor_data(&accessor, buffers, channels * bytes, "COLOR_0")?;
-    let value = |b: &[u8]| match bytes {
-        4 => f64::from(LittleEndian::read_f32(b)),
-        2 => f64::from(LittleEndian::read_u16(b)),
-        _ => f64::from(b[0]),
-    };
     list.alpha |= channels == 4;
     for i in 0..accessor.count() {
         let record = &data[i * stride..];
         let mut rgba = [1.0; 4];
         for (c, slot) in rgba.iter_mut().enumerate().take(channels) {
-            *slot = unit_channel(value(&record[c * bytes..]) * scale);
+            *slot = unit_channel(component(&record[c * bytes..], bytes, scale));
         }
         list.rgba.push(rgba);
     }
     Ok(())
+}
+
+/// The size and scale of an accessor's components when they are floats,
+/// or normalised unsigned bytes or shorts (as `COLOR_0` and `TEXCOORD_0`
+/// may be); `None` for another type.
+fn unit_components(accessor: &gltf::Accessor) -> Option<(usize, f64)> {
+    match (accessor.data_type(), accessor.normalized()) {
+        (DataType::F32, _) => Some((4, 1.0)),
+        (DataType::U8, true) => Some((1, 1.0 / 255.0)),
+        (DataType::U16, true) => Some((2, 1.0 / 65535.0)),
+        _ => None,
+    }
+}
+
+/// The component of `size` bytes at the start of `b`, scaled.
+fn component(b: &[u8], size: usize, scale: f64) -> f64 {
+    match size {
+        4 => f64::from(LittleEndian::read_f32(b)) * scale,
+        2 => f64::from(LittleEndian::read_u16(b)) * scale,
+        _ => f64::from(b[0]) * scale,
+    }
 }
 
 /// Appends the primitive's `TEXCOORD_0` (float, or normalised unsigned
@@ -371,29 +382,16 @@ fn add_texcoords(
         *texcoords = None;
         return Ok(());
     };
-    let (bytes, scale) = match (accessor.data_type(), accessor.normalized()) {
-        (DataType::F32, _) => (4, 1.0),
-        (DataType::U8, true) => (1, 1.0 / 255.0),
-        (DataType::U16, true) => (2, 1.0 / 65535.0),
-        _ => {
-            *texcoords = None;
-            return Ok(());
-        }
-    };
-    if accessor.dimensions() != Dimensions::Vec2 {
+    let components = unit_components(&accessor);
+    let (Some((bytes, scale)), Dimensions::Vec2) = (components, accessor.dimensions()) else {
         *texcoords = None;
         return Ok(());
-    }
+    };
     check_count(&accessor, primitive, "TEXCOORD_0")?;
     let (data, stride) = accessor_data(&accessor, buffers, 2 * bytes, "TEXCOORD_0")?;
-    let value = |b: &[u8]| match bytes {
-        4 => f64::from(LittleEndian::read_f32(b)),
-        2 => f64::from(LittleEndian::read_u16(b)) * scale,
-        _ => f64::from(b[0]) * scale,
-    };
     for i in 0..accessor.count() {
         let record = &data[i * stride..];
-        let [u, v] = [0, bytes].map(|o| value(&record[o..]));
+        let [u, v] = [0, bytes].map(|o| component(&record[o..], bytes, scale));
         // A NaN coordinate has no place on the image: the image's corner.
         let finite = |c: f64| if c.is_finite() { c } else { 0.0 };
         list.push([finite(u), 1.0 - finite(v)]);
