@@ -4,7 +4,8 @@
 
 Builds nothing: it runs `target/release/meshtrim` (build it first) on
 mutated copies of the fixtures and of files it derives from them (every
-cloud and mesh format meshtrim reads), in a temporary directory.
+cloud and mesh format meshtrim reads, and textured OBJ and GLB meshes),
+in a temporary directory.
 
 - `bytes`: random byte changes, truncations, insertions (`nan`, `1e400`,
   NUL, blanks) and repeated stretches of the files themselves; read by
@@ -94,11 +95,13 @@ def derive_sources(work):
     for ext in ("stl", "obj", "gltf", "glb", "ply"):
         run(["clean", JAGGED, os.path.join(work, f"mesh.{ext}")])
     write_ascii_meshes(work)
+    write_textured_meshes(work)
     clouds = [CLOUD] + [os.path.join(work, n) for n in
                         ("cloud.csv", "cloud.xyz", "cloud.pts", "cloud.obj", "cloud_ascii.pcd",
                          "cloud_binary.pcd", "cloud.las", "cloud.laz", "cloud.e57")]
     meshes = [JAGGED, POISSON] + [os.path.join(work, f"mesh.{e}") for e in ("stl", "obj", "gltf", "glb", "ply")]
-    meshes += [os.path.join(work, n) for n in ("mesh_ascii.stl", "mesh_ascii.ply")]
+    meshes += [os.path.join(work, n) for n in
+               ("mesh_ascii.stl", "mesh_ascii.ply", "mesh_textured.obj", "mesh_textured.glb")]
     return clouds, meshes
 
 
@@ -131,6 +134,37 @@ def write_e57_cloud(work, xyz):
         data = {"cartesianX": block[:, 0], "cartesianY": block[:, 1], "cartesianZ": block[:, 2]}
         e57.write_scan_raw(data, rotation=np.array([1.0, 0, 0, 0]), translation=np.array(translation))
     e57.close()
+
+
+def write_textured_meshes(work):
+    """The OBJ written by `clean` with texture coordinates and normals per
+    corner (a chart border down the middle, where corners read two), two
+    materials and their library and image; and as a GLB with two
+    materials and an embedded image, written by trimesh."""
+    import trimesh
+    from PIL import Image
+
+    vertices, faces = read_obj(os.path.join(work, "mesh.obj"))
+    middle = sorted(v[0] for v in vertices)[len(vertices) // 2]
+    Image.new("RGB", (8, 8), (200, 30, 30)).save(os.path.join(work, "texture.png"))
+    with open(os.path.join(work, "mesh_textured.mtl"), "w") as f:
+        f.write("newmtl left\nmap_Kd texture.png\nnewmtl right\nKd 0 0 1\n")
+    lines = ["mtllib mesh_textured.mtl"]
+    lines += ["v %r %r %r" % tuple(v) for v in vertices]
+    lines += ["vt %r %r" % (v[0] / 100, v[1] / 100) for v in vertices]
+    lines += ["vt %r %r" % (v[0] / 100 + 0.5, v[1] / 100) for v in vertices]
+    lines += ["vn 0 0 1", "vn 0 0.6 0.8"]
+    n = len(vertices)
+    for face in faces:
+        corners = [int(c.split("/")[0]) for c in face]
+        right = sum(vertices[c - 1][0] for c in corners) > 3 * middle
+        lines.append("usemtl " + ("right" if right else "left"))
+        shift, normal = (n, 2) if right else (0, 1)
+        lines.append("f " + " ".join(f"{c}/{c + shift}/{normal}" for c in corners))
+    with open(os.path.join(work, "mesh_textured.obj"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+    scene = trimesh.load(os.path.join(work, "mesh_textured.obj"), process=False, group_material=True)
+    scene.export(os.path.join(work, "mesh_textured.glb"))
 
 
 def write_ascii_meshes(work):
