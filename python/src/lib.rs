@@ -586,6 +586,7 @@ fn attributes_of(
         texcoords: texcoords.map(|t| rows(&t, "texcoords")).transpose()?,
         material,
         gltf_materials: None,
+        ply_textures: None,
     })
 }
 

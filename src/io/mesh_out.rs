@@ -101,6 +101,7 @@ impl MeshFormat {
             texcoords,
             material,
             gltf_materials,
+            ply_textures,
         } = attributes;
         let mut held = VertexAttributes::default();
         let mut not_held = VertexAttributes::default();
@@ -120,6 +121,10 @@ impl MeshFormat {
         match self {
             MeshFormat::Glb | MeshFormat::Gltf => held.gltf_materials = gltf_materials,
             _ => not_held.gltf_materials = gltf_materials,
+        }
+        match self {
+            MeshFormat::Ply => held.ply_textures = ply_textures,
+            _ => not_held.ply_textures = ply_textures,
         }
         let (fields, others) = scalars.into_iter().partition(|f| self.holds_field(f));
         held.scalars = fields;
@@ -170,6 +175,12 @@ pub fn write_mesh_with(
         };
         return write_atomic(path, |w| {
             write_obj(w, vertices, faces, attributes, Some(&used))
+        });
+    }
+    if let (MeshFormat::Ply, Some(files)) = (format, &attributes.ply_textures) {
+        let names = super::obj_material::images_for_output(path, files)?;
+        return write_atomic(path, |w| {
+            write_ply_with(w, vertices, faces, attributes, &names)
         });
     }
     write_atomic(path, |w| format.write(w, vertices, faces, attributes))
@@ -526,6 +537,20 @@ pub fn write_ply(
     faces: &[[u32; 3]],
     attributes: &VertexAttributes,
 ) -> std::io::Result<()> {
+    write_ply_with(w, vertices, faces, attributes, &[])
+}
+
+/// [`write_ply`] with MeshLab's `comment TextureFile` lines naming
+/// `textures`, and then, with texture coordinates, each face's corners'
+/// as MeshLab's `list uchar float texcoord` (which MeshLab draws the
+/// texture by).
+fn write_ply_with(
+    w: &mut dyn Write,
+    vertices: &[Point3],
+    faces: &[[u32; 3]],
+    attributes: &VertexAttributes,
+    textures: &[String],
+) -> std::io::Result<()> {
     let mut properties = String::from("property double x\nproperty double y\nproperty double z\n");
     if attributes.normals.is_some() {
         properties.push_str("property float nx\nproperty float ny\nproperty float nz\n");
@@ -543,11 +568,23 @@ pub fn write_ply(
     for field in &attributes.scalars {
         properties.push_str(&format!("property {} {}\n", field.kind.name(), field.name));
     }
+    let comments: String = textures
+        .iter()
+        .map(|name| format!("comment TextureFile {name}\n"))
+        .collect();
+    let wedges = match &attributes.texcoords {
+        Some(texcoords) if !textures.is_empty() => Some(texcoords),
+        _ => None,
+    };
+    let face_properties = match wedges {
+        Some(_) => "property list uchar int vertex_indices\nproperty list uchar float texcoord\n",
+        None => "property list uchar int vertex_indices\n",
+    };
     write!(
         w,
-        "ply\nformat binary_little_endian 1.0\ncomment written by meshtrim\n\
+        "ply\nformat binary_little_endian 1.0\ncomment written by meshtrim\n{comments}\
          element vertex {}\n{properties}\
-         element face {}\nproperty list uchar int vertex_indices\nend_header\n",
+         element face {}\n{face_properties}end_header\n",
         vertices.len(),
         faces.len()
     )?;
@@ -581,6 +618,14 @@ pub fn write_ply(
         out.push(3);
         for v in faces[i] {
             out.extend((v as i32).to_le_bytes());
+        }
+        if let Some(texcoords) = wedges {
+            out.push(6);
+            for v in faces[i] {
+                for c in texcoords[v as usize] {
+                    out.extend((c as f32).to_le_bytes());
+                }
+            }
         }
     })
 }

@@ -15,6 +15,7 @@
 //! other format a non-finite coordinate is an error.
 
 pub mod atomic;
+mod corners;
 pub mod e57;
 pub mod edges_out;
 pub(crate) mod float_text;
@@ -151,6 +152,9 @@ pub struct Mesh {
     pub material: Option<ObjMaterial>,
     /// A glTF file's materials and each face's.
     pub gltf_materials: Option<gltf_materials::GltfMaterials>,
+    /// A PLY file's texture images (MeshLab's `comment TextureFile`), as
+    /// paths from the current directory.
+    pub ply_textures: Option<Vec<std::path::PathBuf>>,
     /// Triangles as vertex indices, polygons split into fans; `None` when
     /// the file has no face element or `f` lines at all.
     pub faces: Option<Vec<[u32; 3]>>,
@@ -325,6 +329,8 @@ pub struct VertexAttributes {
     pub material: Option<ObjMaterial>,
     /// A glTF file's materials and each face's, written to glTF outputs.
     pub gltf_materials: Option<gltf_materials::GltfMaterials>,
+    /// A PLY file's texture images, written to PLY outputs.
+    pub ply_textures: Option<Vec<std::path::PathBuf>>,
 }
 
 /// Attributes carried to a mesh ([`VertexAttributes::carried`]).
@@ -346,6 +352,7 @@ impl VertexAttributes {
             && self.texcoords.is_none()
             && self.material.is_none()
             && self.gltf_materials.is_none()
+            && self.ply_textures.is_none()
     }
 
     /// These attributes, of `from`'s vertices, at the vertices of `to`, a
@@ -407,6 +414,7 @@ impl VertexAttributes {
                 .map(|texcoords| trim::carry(from, sources, texcoords)),
             material: None,
             gltf_materials: None,
+            ply_textures: self.ply_textures.clone(),
         }
     }
 
@@ -424,7 +432,7 @@ impl VertexAttributes {
         if self.texcoords.is_some() {
             names.push("texture coordinates".to_string());
         }
-        if self.material.is_some() || self.gltf_materials.is_some() {
+        if self.material.is_some() || self.gltf_materials.is_some() || self.ply_textures.is_some() {
             names.push("material".to_string());
         }
         names.extend(self.scalars.iter().map(|field| field.name.clone()));
@@ -486,6 +494,7 @@ pub fn read_mesh_with_attributes(
         texcoords: read.texcoords,
         material: read.material,
         gltf_materials: read.gltf_materials,
+        ply_textures: read.ply_textures,
     };
     let mesh = trim::Mesh {
         vertices: read.vertices,
@@ -551,7 +560,14 @@ fn read_mesh_inner(path: &Path) -> Result<Mesh> {
 /// the directory of its buffers).
 fn parse_mesh(path: &Path, bytes: &[u8]) -> Result<Mesh> {
     let mesh = match MeshInput::detect(path, bytes)? {
-        MeshInput::Ply => ply::read_ply_mesh(bytes)?,
+        MeshInput::Ply => {
+            let mut mesh = ply::read_ply_mesh(bytes)?;
+            let dir = path.parent().unwrap_or(Path::new(""));
+            if let Some(files) = mesh.ply_textures.as_mut() {
+                files.iter_mut().for_each(|f| *f = dir.join(&*f));
+            }
+            mesh
+        }
         MeshInput::Obj => obj::read_obj_mesh(bytes, path.parent().unwrap_or(Path::new("")))?,
         MeshInput::Stl => stl::read_stl(bytes)?,
         MeshInput::Gltf => {

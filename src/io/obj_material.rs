@@ -33,10 +33,7 @@ pub(crate) fn libraries_for_output(path: &Path, material: &ObjMaterial) -> Resul
     let own = path.with_extension("mtl");
     // The images go into a directory of the output's own, so outputs
     // written side by side (a batch) never share or overwrite one.
-    let stem = path
-        .file_stem()
-        .map_or(String::new(), |s| s.to_string_lossy().into_owned());
-    let folder = format!("{stem}_textures");
+    let folder = own_folder(path);
     if let Some(input) = material.libraries.iter().find(|l| same_file(l, &own)) {
         bail!(
             "{}: the output's material library would replace the input's {}: write the output to another name or directory",
@@ -66,6 +63,29 @@ pub(crate) fn libraries_for_output(path: &Path, material: &ObjMaterial) -> Resul
     }
     write_atomic(&own, |w| w.write_all(text.as_bytes()))?;
     Ok([file_name(&own)].into_iter().chain(missing).collect())
+}
+
+/// The names an output at `path` gives `images` (a PLY's texture files):
+/// their file names when they are in the output's directory, else the
+/// names of their copies in the output's own folder (see the module doc).
+pub(crate) fn images_for_output(path: &Path, images: &[PathBuf]) -> Result<Vec<String>> {
+    let out_dir = absolute_dir(path);
+    if images.iter().all(|image| absolute_dir(image) == out_dir) {
+        return Ok(images.iter().map(|image| file_name(image)).collect());
+    }
+    let folder = own_folder(path);
+    images
+        .iter()
+        .map(|image| copy_image(&absolute_dir(image), &file_name(image), &out_dir, &folder))
+        .collect()
+}
+
+/// The folder an output's copied images go in: `<name>_textures`.
+fn own_folder(path: &Path) -> String {
+    let stem = path
+        .file_stem()
+        .map_or(String::new(), |s| s.to_string_lossy().into_owned());
+    format!("{stem}_textures")
 }
 
 /// Copies the image a library in `from` names as `image` into the

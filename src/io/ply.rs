@@ -47,6 +47,7 @@
 //! tests compare the two readings on random files, errors included.
 
 use std::io::Write;
+use std::path::PathBuf;
 
 use anyhow::{anyhow, bail, Result};
 use byteorder::{BigEndian, ByteOrder, LittleEndian, WriteBytesExt};
@@ -215,6 +216,8 @@ struct Header {
     /// `obj_info num_cols` and `obj_info num_rows`, as written; parsed
     /// only when a range grid is read.
     grid_size: [Option<String>; 2],
+    /// MeshLab's `comment TextureFile NAME` lines' names, in order.
+    texture_files: Vec<String>,
 }
 
 /// Reads a PLY file: vertices, optional normals and optional faces. A
@@ -240,6 +243,13 @@ fn take_texcoords(mesh: &mut Mesh) {
     let (Some(u), Some(v)) = (at("texture_u"), at("texture_v")) else {
         return;
     };
+    // Per-corner coordinates, when the file has them too, were read
+    // already (the vertices split by them): they are kept.
+    if mesh.texcoords.is_some() {
+        mesh.scalars
+            .retain(|f| f.name != "texture_u" && f.name != "texture_v");
+        return;
+    }
     let finite = |c: f64| if c.is_finite() { c } else { 0.0 };
     let uv = mesh.scalars[u]
         .values
@@ -291,6 +301,7 @@ fn parse_header(bytes: &[u8]) -> Result<Header> {
     let mut elements: Vec<Element> = Vec::new();
     let mut lines = 0;
     let mut grid_size = [None, None];
+    let mut texture_files = Vec::new();
     for (i, line) in header_lines.enumerate() {
         lines = i + 1;
         let at = |what: String| anyhow!("malformed PLY header: line {}: {what}", i + 1);
@@ -305,6 +316,10 @@ fn parse_header(bytes: &[u8]) -> Result<Header> {
             ["format", name, _version] => encoding = Some(parse_encoding(name).map_err(at)?),
             ["obj_info", "num_cols", n] => grid_size[0] = Some(n.to_string()),
             ["obj_info", "num_rows", n] => grid_size[1] = Some(n.to_string()),
+            ["comment", "TextureFile", _, ..] => {
+                let name = line.trim_start()["comment".len()..].trim_start();
+                texture_files.push(name["TextureFile".len()..].trim().to_string());
+            }
             ["comment", ..] | ["obj_info", ..] | [] => {}
             ["element", name, count] => elements.push(Element {
                 name: name.to_string(),
@@ -329,6 +344,7 @@ fn parse_header(bytes: &[u8]) -> Result<Header> {
         body_start: end.1,
         lines,
         grid_size,
+        texture_files,
     })
 }
 
@@ -846,15 +862,19 @@ impl<B: ByteOrder> Values for BinaryValues<'_, B> {
 struct Record {
     scalars: Vec<f64>,
     list: Vec<f64>,
+    /// The items of a second list asked for ([`read_element_lists`]).
+    second: Vec<f64>,
 }
 
 /// What the body reader keeps from an element.
 enum Role {
     /// The vertex element's columns the reader keeps.
     Vertex(VertexColumns),
-    /// Index of the vertex index list property.
+    /// Index of the vertex index list property, and of MeshLab's
+    /// per-corner texture coordinates (`texcoord`, u and v per corner).
     Face {
         list: usize,
+        texcoord: Option<usize>,
     },
     /// Index of a range grid's vertex index list property.
     RangeGrid {
@@ -865,6 +885,8 @@ enum Role {
 
 fn read_body(header: &Header, values: &mut dyn Values, grid: bool) -> Result<Mesh> {
     let mut mesh = Mesh::default();
+    // MeshLab's per-corner texture coordinates, read with a mesh only.
+    let mut corner_texcoords = None;
     let mut vertex_count = None;
     let mut range_grid = None;
     for element in &header.elements {
@@ -876,7 +898,15 @@ fn read_body(header: &Header, values: &mut dyn Values, grid: bool) -> Result<Mes
                 vertex_count = Some(element.count);
                 read_vertices(element, values, &columns, &mut mesh)?;
             }
-            Role::Face { list } => {
+            Role::Face {
+                list,
+                texcoord: Some(texcoord),
+            } if grid => {
+                let faces = mesh.faces.get_or_insert_with(Vec::new);
+                let uv = read_textured_faces(element, values, [list, texcoord], faces)?;
+                corner_texcoords = Some(uv);
+            }
+            Role::Face { list, .. } => {
                 let faces = mesh.faces.get_or_insert_with(Vec::new);
                 read_faces(element, values, list, faces)?;
             }
@@ -898,7 +928,85 @@ fn read_body(header: &Header, values: &mut dyn Values, grid: bool) -> Result<Mes
             mesh.faces = Some(grid_faces(&entries, cols, rows, &mesh.vertices));
         }
     }
+    if let Some(uv) = corner_texcoords {
+        split_by_texcoords(&mut mesh, uv)?;
+    }
+    if grid && !header.texture_files.is_empty() {
+        let files = header.texture_files.iter().map(PathBuf::from).collect();
+        mesh.ply_textures = Some(files);
+    }
     Ok(mesh)
+}
+
+/// Reads faces with MeshLab's `texcoord` list (u, v per corner), each
+/// polygon split into a fan as [`read_faces`] does; returns the texture
+/// coordinates of each triangle's corners, or `None` when a face's list
+/// does not hold two per corner (then none is kept).
+fn read_textured_faces(
+    element: &Element,
+    values: &mut dyn Values,
+    lists: [usize; 2],
+    faces: &mut Vec<[u32; 3]>,
+) -> Result<Option<Vec<[f64; 2]>>> {
+    let mut uv = Some(Vec::new());
+    read_element_lists(element, values, lists, |i, record| {
+        let corners: Vec<u32> = record
+            .list
+            .iter()
+            .map(|&v| face_index(i, v))
+            .collect::<Result<_>>()?;
+        let texcoords = &record.second;
+        if texcoords.len() != 2 * corners.len() {
+            uv = None;
+        }
+        let at = |k: usize| [texcoords[2 * k], texcoords[2 * k + 1]];
+        for w in 1..corners.len().saturating_sub(1) {
+            faces.push([corners[0], corners[w], corners[w + 1]]);
+            if let Some(uv) = uv.as_mut() {
+                uv.extend([at(0), at(w), at(w + 1)]);
+            }
+        }
+        Ok(())
+    })?;
+    Ok(uv)
+}
+
+/// A vertex index read as a float, checked.
+fn face_index(face: usize, v: f64) -> Result<u32> {
+    if v.fract() == 0.0 && (0.0..=f64::from(u32::MAX)).contains(&v) {
+        Ok(v as u32)
+    } else {
+        Err(anyhow!("face {face} has a bad vertex index {v}"))
+    }
+}
+
+/// The mesh's vertices split by the texture coordinates their corners
+/// read (`uv`, three per triangle), as the OBJ reader splits them, the
+/// coordinates kept per vertex; a non-finite one reads as 0. Nothing when
+/// `uv` is `None`.
+fn split_by_texcoords(mesh: &mut Mesh, uv: Option<Vec<[f64; 2]>>) -> Result<()> {
+    let (Some(uv), Some(faces)) = (uv, mesh.faces.as_mut()) else {
+        return Ok(());
+    };
+    let uv: Vec<[f64; 2]> = uv
+        .into_iter()
+        .map(|t| t.map(|c| if c.is_finite() { c } else { 0.0 }))
+        .collect();
+    let refs: Vec<[u32; 3]> = (0..faces.len() as u32)
+        .map(|f| [3 * f, 3 * f + 1, 3 * f + 2])
+        .collect();
+    let refs = super::corners::by_value(refs, &uv);
+    let split = super::corners::split_corners(mesh.vertices.len(), faces, Some(&refs), None)?;
+    mesh.vertices = split.extend(std::mem::take(&mut mesh.vertices));
+    mesh.normals = mesh.normals.take().map(|n| split.extend(n));
+    if let Some(colours) = mesh.colours.as_mut() {
+        colours.rgba = split.extend(std::mem::take(&mut colours.rgba));
+    }
+    for field in &mut mesh.scalars {
+        field.values = split.extend(std::mem::take(&mut field.values));
+    }
+    mesh.texcoords = Some(split.read(&uv, 0, [0.0; 2]));
+    Ok(())
 }
 
 /// Reads past an element the caller does not use. One without properties
@@ -942,7 +1050,11 @@ fn role_of(element: &Element, grid: bool) -> Result<Role> {
                 matches!(p, Property::List { .. })
                     && matches!(p.name(), "vertex_indices" | "vertex_index")
             });
-            Ok(list.map_or(Role::Skip, |list| Role::Face { list }))
+            let texcoord = element
+                .properties
+                .iter()
+                .position(|p| matches!(p, Property::List { .. }) && p.name() == "texcoord");
+            Ok(list.map_or(Role::Skip, |list| Role::Face { list, texcoord }))
         }
         "range_grid" if grid => {
             let list = element.properties.iter().position(|p| {
@@ -1175,14 +1287,7 @@ fn read_faces(
     }
     faces.reserve(capacity(element.count));
     read_element(element, values, Some(list), |i, record| {
-        let index = |v: f64| {
-            if v.fract() == 0.0 && (0.0..=f64::from(u32::MAX)).contains(&v) {
-                Ok(v as u32)
-            } else {
-                Err(anyhow!("face {i} has a bad vertex index {v}"))
-            }
-        };
-        let corners = record.list.iter().map(|&v| index(v));
+        let corners = record.list.iter().map(|&v| face_index(i, v));
         let corners: Vec<u32> = corners.collect::<Result<_>>()?;
         // A fan from the first corner; faces with fewer than three corners
         // enclose nothing and are dropped.
@@ -1327,12 +1432,32 @@ fn read_element(
     element: &Element,
     values: &mut dyn Values,
     wanted_list: Option<usize>,
+    keep: impl FnMut(usize, &Record) -> Result<()>,
+) -> Result<()> {
+    read_records(element, values, [wanted_list, None], keep)
+}
+
+/// [`read_element`] keeping the items of two lists, the second's in
+/// [`Record::second`].
+fn read_element_lists(
+    element: &Element,
+    values: &mut dyn Values,
+    [first, second]: [usize; 2],
+    keep: impl FnMut(usize, &Record) -> Result<()>,
+) -> Result<()> {
+    read_records(element, values, [Some(first), Some(second)], keep)
+}
+
+fn read_records(
+    element: &Element,
+    values: &mut dyn Values,
+    wanted: [Option<usize>; 2],
     mut keep: impl FnMut(usize, &Record) -> Result<()>,
 ) -> Result<()> {
     let mut record = Record::default();
     for i in 0..element.count {
         values.begin_record();
-        if !read_record(element, values, wanted_list, &mut record)? {
+        if !read_record(element, values, wanted, &mut record)? {
             return Err(truncated(element.count, &element.name, i));
         }
         values.end_record(&element.name, i)?;
@@ -1345,11 +1470,12 @@ fn read_element(
 fn read_record(
     element: &Element,
     values: &mut dyn Values,
-    wanted_list: Option<usize>,
+    [wanted_list, second_list]: [Option<usize>; 2],
     record: &mut Record,
 ) -> Result<bool> {
     record.scalars.clear();
     record.list.clear();
+    record.second.clear();
     for (k, property) in element.properties.iter().enumerate() {
         match *property {
             Property::Scalar { ty, .. } => match values.next(ty)? {
@@ -1368,6 +1494,8 @@ fn read_record(
                     };
                     if wanted_list == Some(k) {
                         record.list.push(v);
+                    } else if second_list == Some(k) {
+                        record.second.push(v);
                     }
                 }
             }

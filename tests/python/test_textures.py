@@ -295,3 +295,35 @@ def test_a_gltf_scan_keeps_its_materials_and_images(tmp_path):
     wrong, faces = faces_on_the_other_side(parts, middle, lambda m: m.baseColorTexture)
     assert faces == report["faces_out"]
     assert wrong <= 10, wrong
+
+
+def test_a_meshlab_ply_keeps_its_texture(textured, tmp_path):
+    """The textured scan as PyMeshLab writes it in PLY: a `texcoord` list
+    per face and `comment TextureFile`. Read by meshtrim as the OBJ is
+    (a vertex split where its corners read two coordinates), cleaned to a
+    PLY elsewhere: PyMeshLab finds the copied image and reads the same
+    per-corner coordinates on every kept face (f32, as both files store
+    them), and the seam is stitched as in the OBJ."""
+    directory, the_map = textured
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(str(directory / "face.obj"))
+    source = tmp_path / "in" / "face.ply"
+    source.parent.mkdir()
+    ms.save_current_mesh(str(source), save_vertex_color=False, save_face_color=False)
+    (source.parent / "face_tex.png").write_bytes((directory / "face_tex.png").read_bytes())
+    assert b"comment TextureFile face_tex.png" in source.read_bytes()[:400]
+    out = tmp_path / "out" / "face.ply"
+    report = json.loads(run_meshtrim("clean", source, out, "--json").stdout)
+    assert report["seam_edges_stitched"] == 415, report
+    assert {p.name for p in out.parent.iterdir()} == {"face.ply", "face_textures"}
+
+    corners_in, uv_in, _ = wedges(source)
+    corners, uv, textures = wedges(out)
+    assert textures == ["face_textures/face_tex.png"], textures
+    by_corners = {c.tobytes(): w for c, w in zip(corners_in, uv_in)}
+    kept = [i for i, c in enumerate(corners) if c.tobytes() in by_corners]
+    assert len(kept) > 0.9 * len(corners)
+    assert all(np.array_equal(uv[i], by_corners[corners[i].tobytes()]) for i in kept)
+    error = chart_error(corners, uv, the_map)
+    assert np.percentile(error, 99) < 2e-3, np.percentile(error, 99)
+    assert (error > SCALE * SHIFT / 4).sum() <= 10, (error > SCALE * SHIFT / 4).sum()

@@ -905,3 +905,34 @@ fn own_values_written_read_back() {
     // Compared as text: NaN is read back as NaN.
     assert_eq!(format!("{:?}", read.scalars), format!("{scalars:?}"));
 }
+
+/// MeshLab's textured PLY: a `texcoord` list per face (u, v per corner)
+/// and `comment TextureFile`. A vertex whose corners read two
+/// coordinates is split (the copy after the file's vertices), the
+/// coordinates kept per vertex; a list without two values per corner
+/// keeps none, and a cloud reading ignores them.
+#[test]
+fn per_corner_texture_coordinates_split_vertices() {
+    let text = |second_face: &str| {
+        format!(
+            "ply\nformat ascii 1.0\ncomment TextureFile skin.png\nelement vertex 4\n\
+             property float x\nproperty float y\nproperty float z\nelement face 2\n\
+             property list uchar int vertex_indices\nproperty list uchar float texcoord\n\
+             end_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2 6 0 0 0.5 0 0.5 0.5\n{second_face}\n"
+        )
+    };
+    // Vertex 0 is read with (0, 0) and (0.75, 0): it is split.
+    let mesh = read_ply_mesh(text("3 0 2 3 6 0.75 0 0.5 0.5 0 0.5").as_bytes()).unwrap();
+    assert_eq!(mesh.vertices.len(), 5);
+    assert_eq!(mesh.vertices[4], [0.0; 3]);
+    assert_eq!(mesh.faces.unwrap(), vec![[0, 1, 2], [4, 2, 3]]);
+    assert_eq!(
+        mesh.texcoords.unwrap(),
+        vec![[0.0, 0.0], [0.5, 0.0], [0.5, 0.5], [0.0, 0.5], [0.75, 0.0]]
+    );
+    assert_eq!(mesh.ply_textures, Some(vec![PathBuf::from("skin.png")]));
+    let short = read_ply_mesh(text("3 0 2 3 4 0.75 0 0.5 0.5").as_bytes()).unwrap();
+    assert_eq!((short.vertices.len(), short.texcoords), (4, None));
+    let cloud = read_ply(text("3 0 2 3 6 0.75 0 0.5 0.5 0 0.5").as_bytes()).unwrap();
+    assert_eq!((cloud.vertices.len(), cloud.texcoords), (4, None));
+}
