@@ -7,7 +7,10 @@
 //! properties (faces, `range_grid`) are skipped by their real sizes. From the
 //! `vertex` element it keeps x, y, z and, when all three are present, the
 //! normal nx, ny, nz; from the `face` element the `vertex_indices` (or
-//! `vertex_index`) list, split into triangle fans.
+//! `vertex_index`) list, split into triangle fans. Read as a mesh, MeshLab's
+//! textured form too: a face's `texcoord` list (u, v per corner) splits
+//! the vertices read with two coordinates (`io/corners.rs`), and each
+//! `comment TextureFile` names an image.
 //!
 //! # Range grids
 //!
