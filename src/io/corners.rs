@@ -29,18 +29,19 @@ pub(crate) fn by_value<const N: usize>(
     refs
 }
 
-/// The vertices after splitting: each `v` keeps its index for the first
-/// pair of references its corners read; each other pair is a copy.
+/// The vertices after splitting: each file vertex keeps its index for the
+/// first pair of references its corners read; each other pair is a copy
+/// (after the file's vertices).
 pub(crate) struct SplitVertices {
-    /// Per `v`, the (texture coordinate, normal) pair it kept, `None` for
-    /// a `v` no face uses.
+    /// Per file vertex, the (texture coordinate, normal) pair it kept,
+    /// `None` for a vertex no face uses.
     pub(crate) kept: Vec<Option<[u32; 2]>>,
-    /// Per copy, its `v` and its pair.
+    /// Per copy, its file vertex and its pair.
     pub(crate) copies: Vec<(u32, [u32; 2])>,
 }
 
 impl SplitVertices {
-    /// Per-`v` values followed by their copies' values.
+    /// Per-vertex values of the file followed by their copies' values.
     pub(crate) fn extend<T: Copy>(&self, mut values: Vec<T>) -> Vec<T> {
         let copied: Vec<T> = self
             .copies
@@ -52,7 +53,7 @@ impl SplitVertices {
     }
 
     /// The values the vertices read through their pairs' element `k`
-    /// (0: texture coordinate, 1: normal); `unused` for a `v` no face
+    /// (0: texture coordinate, 1: normal); `unused` for a vertex no face
     /// uses.
     pub(crate) fn read<T: Copy>(&self, values: &[T], k: usize, unused: T) -> Vec<T> {
         let at = |pair: [u32; 2]| values[pair[k] as usize];
@@ -64,9 +65,9 @@ impl SplitVertices {
     }
 }
 
-/// Renames the corners of `faces` to split vertices: a corner whose `v`
-/// was first read with another (texture coordinate, normal) pair goes to
-/// the copy for its pair. With neither list, nothing is split.
+/// Renames the corners of `faces` to split vertices: a corner whose
+/// vertex was first read with another (texture coordinate, normal) pair
+/// goes to the copy for its pair. With neither list, nothing is split.
 pub(crate) fn split_corners(
     vertices: usize,
     faces: &mut [[u32; 3]],
