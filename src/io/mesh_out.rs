@@ -177,10 +177,19 @@ pub fn write_mesh_with(
             write_obj(w, vertices, faces, attributes, Some(&used))
         });
     }
-    if let (MeshFormat::Ply, Some(files)) = (format, &attributes.ply_textures) {
-        let names = super::obj_material::images_for_output(path, files)?;
+    if let (MeshFormat::Ply, Some(textures)) = (format, &attributes.ply_textures) {
+        if textures.faces.len() != faces.len() {
+            bail!(
+                "{}: {} face texture numbers for {} faces",
+                path.display(),
+                textures.faces.len(),
+                faces.len()
+            );
+        }
+        let names = super::obj_material::images_for_output(path, &textures.files)?;
+        let numbers = (textures.files.len() > 1).then_some(textures.faces.as_slice());
         return write_atomic(path, |w| {
-            write_ply_with(w, vertices, faces, attributes, &names)
+            write_ply_with(w, vertices, faces, attributes, (&names, numbers))
         });
     }
     write_atomic(path, |w| format.write(w, vertices, faces, attributes))
@@ -537,19 +546,20 @@ pub fn write_ply(
     faces: &[[u32; 3]],
     attributes: &VertexAttributes,
 ) -> std::io::Result<()> {
-    write_ply_with(w, vertices, faces, attributes, &[])
+    write_ply_with(w, vertices, faces, attributes, (&[], None))
 }
 
 /// [`write_ply`] with MeshLab's `comment TextureFile` lines naming
 /// `textures`, and then, with texture coordinates, each face's corners'
 /// as MeshLab's `list uchar float texcoord` (which MeshLab draws the
-/// texture by).
+/// texture by), and each face's texture number (`int texnumber`) when
+/// given.
 fn write_ply_with(
     w: &mut dyn Write,
     vertices: &[Point3],
     faces: &[[u32; 3]],
     attributes: &VertexAttributes,
-    textures: &[String],
+    (textures, numbers): (&[String], Option<&[u32]>),
 ) -> std::io::Result<()> {
     let mut properties = String::from("property double x\nproperty double y\nproperty double z\n");
     if attributes.normals.is_some() {
@@ -576,10 +586,13 @@ fn write_ply_with(
         Some(texcoords) if !textures.is_empty() => Some(texcoords),
         _ => None,
     };
-    let face_properties = match wedges {
-        Some(_) => "property list uchar int vertex_indices\nproperty list uchar float texcoord\n",
-        None => "property list uchar int vertex_indices\n",
-    };
+    let mut face_properties = String::from("property list uchar int vertex_indices\n");
+    if wedges.is_some() {
+        face_properties.push_str("property list uchar float texcoord\n");
+    }
+    if numbers.is_some() {
+        face_properties.push_str("property int texnumber\n");
+    }
     write!(
         w,
         "ply\nformat binary_little_endian 1.0\ncomment written by meshtrim\n{comments}\
@@ -626,6 +639,9 @@ fn write_ply_with(
                     out.extend((c as f32).to_le_bytes());
                 }
             }
+        }
+        if let Some(numbers) = numbers {
+            out.extend((numbers[i] as i32).to_le_bytes());
         }
     })
 }

@@ -154,7 +154,7 @@ pub struct Mesh {
     pub gltf_materials: Option<gltf_materials::GltfMaterials>,
     /// A PLY file's texture images (MeshLab's `comment TextureFile`), as
     /// paths from the current directory.
-    pub ply_textures: Option<Vec<std::path::PathBuf>>,
+    pub ply_textures: Option<ply::PlyTextures>,
     /// Triangles as vertex indices, polygons split into fans; `None` when
     /// the file has no face element or `f` lines at all.
     pub faces: Option<Vec<[u32; 3]>>,
@@ -195,7 +195,7 @@ impl ObjMaterial {
 /// vertices' `sources` in `from`): each face the value of the input face
 /// it lies on ([`trim::face_sources`]), `none` where it lies on none.
 /// When `from`'s faces all have one value, so do `to`'s, with no search.
-fn carried_face_values(
+pub(crate) fn carried_face_values(
     values: &[u32],
     from: &trim::Mesh,
     to: &trim::Mesh,
@@ -330,7 +330,7 @@ pub struct VertexAttributes {
     /// A glTF file's materials and each face's, written to glTF outputs.
     pub gltf_materials: Option<gltf_materials::GltfMaterials>,
     /// A PLY file's texture images, written to PLY outputs.
-    pub ply_textures: Option<Vec<std::path::PathBuf>>,
+    pub ply_textures: Option<ply::PlyTextures>,
 }
 
 /// Attributes carried to a mesh ([`VertexAttributes::carried`]).
@@ -380,6 +380,10 @@ impl VertexAttributes {
             .gltf_materials
             .as_ref()
             .map(|materials| materials.carried(from, out, &split.sources));
+        attributes.ply_textures = self
+            .ply_textures
+            .as_ref()
+            .map(|textures| textures.carried(from, out, &split.sources));
         Carried { mesh, attributes }
     }
 
@@ -414,7 +418,7 @@ impl VertexAttributes {
                 .map(|texcoords| trim::carry(from, sources, texcoords)),
             material: None,
             gltf_materials: None,
-            ply_textures: self.ply_textures.clone(),
+            ply_textures: None,
         }
     }
 
@@ -563,8 +567,8 @@ fn parse_mesh(path: &Path, bytes: &[u8]) -> Result<Mesh> {
         MeshInput::Ply => {
             let mut mesh = ply::read_ply_mesh(bytes)?;
             let dir = path.parent().unwrap_or(Path::new(""));
-            if let Some(files) = mesh.ply_textures.as_mut() {
-                files.iter_mut().for_each(|f| *f = dir.join(&*f));
+            if let Some(textures) = mesh.ply_textures.as_mut() {
+                textures.files.iter_mut().for_each(|f| *f = dir.join(&*f));
             }
             mesh
         }

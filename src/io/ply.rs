@@ -9,8 +9,9 @@
 //! normal nx, ny, nz; from the `face` element the `vertex_indices` (or
 //! `vertex_index`) list, split into triangle fans. Read as a mesh, MeshLab's
 //! textured form too: a face's `texcoord` list (u, v per corner) splits
-//! the vertices read with two coordinates (`io/corners.rs`), and each
-//! `comment TextureFile` names an image.
+//! the vertices read with two coordinates (`io/corners.rs`), each
+//! `comment TextureFile` names an image, and a face's `texnumber` its
+//! image ([`PlyTextures`]).
 //!
 //! # Range grids
 //!
@@ -221,6 +222,32 @@ struct Header {
     grid_size: [Option<String>; 2],
     /// MeshLab's `comment TextureFile NAME` lines' names, in order.
     texture_files: Vec<String>,
+}
+
+/// A PLY's texture images (MeshLab's `comment TextureFile`) and each
+/// face's (its `texnumber`).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PlyTextures {
+    /// The images, as paths from the current directory.
+    pub files: Vec<PathBuf>,
+    /// Each face's image, an index into `files`.
+    pub faces: Vec<u32>,
+}
+
+impl PlyTextures {
+    /// The images of `to`'s faces, made from `from` (whose faces these
+    /// are), its vertices' `sources` in `from` ([`trim::face_sources`]).
+    pub fn carried(
+        &self,
+        from: &trim::Mesh,
+        to: &trim::Mesh,
+        sources: &[trim::VertexSource],
+    ) -> PlyTextures {
+        PlyTextures {
+            files: self.files.clone(),
+            faces: super::carried_face_values(&self.faces, from, to, sources, 0),
+        }
+    }
 }
 
 /// Reads a PLY file: vertices, optional normals and optional faces. A
@@ -878,6 +905,8 @@ enum Role {
     Face {
         list: usize,
         texcoord: Option<usize>,
+        /// MeshLab's per-face texture number.
+        texnumber: Option<usize>,
     },
     /// Index of a range grid's vertex index list property.
     RangeGrid {
@@ -888,8 +917,10 @@ enum Role {
 
 fn read_body(header: &Header, values: &mut dyn Values, grid: bool) -> Result<Mesh> {
     let mut mesh = Mesh::default();
-    // MeshLab's per-corner texture coordinates, read with a mesh only.
+    // MeshLab's per-corner texture coordinates and per-face texture
+    // numbers, read with a mesh only.
     let mut corner_texcoords = None;
+    let mut texture_numbers = None;
     let mut vertex_count = None;
     let mut range_grid = None;
     for element in &header.elements {
@@ -904,10 +935,13 @@ fn read_body(header: &Header, values: &mut dyn Values, grid: bool) -> Result<Mes
             Role::Face {
                 list,
                 texcoord: Some(texcoord),
+                texnumber,
             } if grid => {
                 let faces = mesh.faces.get_or_insert_with(Vec::new);
-                let uv = read_textured_faces(element, values, [list, texcoord], faces)?;
-                corner_texcoords = Some(uv);
+                let read =
+                    read_textured_faces(element, values, [list, texcoord], texnumber, faces)?;
+                corner_texcoords = Some(read.texcoords);
+                texture_numbers = read.numbers;
             }
             Role::Face { list, .. } => {
                 let faces = mesh.faces.get_or_insert_with(Vec::new);
@@ -935,23 +969,44 @@ fn read_body(header: &Header, values: &mut dyn Values, grid: bool) -> Result<Mes
         split_by_texcoords(&mut mesh, uv)?;
     }
     if grid && !header.texture_files.is_empty() {
-        let files = header.texture_files.iter().map(PathBuf::from).collect();
-        mesh.ply_textures = Some(files);
+        let files: Vec<PathBuf> = header.texture_files.iter().map(PathBuf::from).collect();
+        let count = mesh.faces.as_ref().map_or(0, Vec::len);
+        // A face's texture number names one of the files; any other (as
+        // MeshLab's -1 for none) reads the first.
+        let faces = match texture_numbers {
+            Some(numbers) if numbers.len() == count => numbers
+                .into_iter()
+                .map(|n| if n < files.len() as u32 { n } else { 0 })
+                .collect(),
+            _ => vec![0; count],
+        };
+        mesh.ply_textures = Some(PlyTextures { files, faces });
     }
     Ok(mesh)
 }
 
-/// Reads faces with MeshLab's `texcoord` list (u, v per corner), each
-/// polygon split into a fan as [`read_faces`] does; returns the texture
-/// coordinates of each triangle's corners, or `None` when a face's list
-/// does not hold two per corner (then none is kept).
+/// What [`read_textured_faces`] reads besides the faces.
+struct TexturedFaces {
+    /// The texture coordinates of each triangle's corners, `None` when a
+    /// face's list does not hold two per corner (then none is kept).
+    texcoords: Option<Vec<[f64; 2]>>,
+    /// Each triangle's texture number, when the faces have one (−1 and
+    /// other non-indices as `u32::MAX`).
+    numbers: Option<Vec<u32>>,
+}
+
+/// Reads faces with MeshLab's `texcoord` list (u, v per corner) and,
+/// when given, its `texnumber`, each polygon split into a fan as
+/// [`read_faces`] does.
 fn read_textured_faces(
     element: &Element,
     values: &mut dyn Values,
     lists: [usize; 2],
+    texnumber: Option<usize>,
     faces: &mut Vec<[u32; 3]>,
-) -> Result<Option<Vec<[f64; 2]>>> {
+) -> Result<TexturedFaces> {
     let mut uv = Some(Vec::new());
+    let mut numbers = texnumber.map(|_| Vec::new());
     read_element_lists(element, values, lists, |i, record| {
         let corners: Vec<u32> = record
             .list
@@ -963,15 +1018,27 @@ fn read_textured_faces(
             uv = None;
         }
         let at = |k: usize| [texcoords[2 * k], texcoords[2 * k + 1]];
+        let number = texnumber.map(|k| record.scalars[k]).map(|n| {
+            match n.fract() == 0.0 && (0.0..f64::from(u32::MAX)).contains(&n) {
+                true => n as u32,
+                false => u32::MAX,
+            }
+        });
         for w in 1..corners.len().saturating_sub(1) {
             faces.push([corners[0], corners[w], corners[w + 1]]);
             if let Some(uv) = uv.as_mut() {
                 uv.extend([at(0), at(w), at(w + 1)]);
             }
+            if let (Some(numbers), Some(n)) = (numbers.as_mut(), number) {
+                numbers.push(n);
+            }
         }
         Ok(())
     })?;
-    Ok(uv)
+    Ok(TexturedFaces {
+        texcoords: uv,
+        numbers,
+    })
 }
 
 /// A vertex index read as a float, checked.
@@ -1057,7 +1124,12 @@ fn role_of(element: &Element, grid: bool) -> Result<Role> {
                 .properties
                 .iter()
                 .position(|p| matches!(p, Property::List { .. }) && p.name() == "texcoord");
-            Ok(list.map_or(Role::Skip, |list| Role::Face { list, texcoord }))
+            let texnumber = find("texnumber");
+            Ok(list.map_or(Role::Skip, |list| Role::Face {
+                list,
+                texcoord,
+                texnumber,
+            }))
         }
         "range_grid" if grid => {
             let list = element.properties.iter().position(|p| {

@@ -327,3 +327,34 @@ def test_a_meshlab_ply_keeps_its_texture(textured, tmp_path):
     error = chart_error(corners, uv, the_map)
     assert np.percentile(error, 99) < 2e-3, np.percentile(error, 99)
     assert (error > SCALE * SHIFT / 4).sum() <= 10, (error > SCALE * SHIFT / 4).sum()
+
+
+def test_a_meshlab_ply_with_two_textures_keeps_each_faces(tmp_path):
+    """The two-material halves as PyMeshLab saves them in PLY (two
+    `TextureFile`s and a `texnumber` per face): cleaned to PLY, each face
+    keeps its half's image. Read back by PyMeshLab and saved by it as an
+    OBJ, which trimesh groups by material: 6 of 165,989 faces are on the
+    other half's image, as with the OBJ input."""
+    scene, middle = halves(lambda name, image: trimesh.visual.material.SimpleMaterial(image=image))
+    text, assets = trimesh.exchange.obj.export_obj(scene, include_texture=True, return_texture=True, mtl_name="scan.mtl")
+    (tmp_path / "scan.obj").write_text(text)
+    for name, data in assets.items():
+        (tmp_path / name).write_bytes(data)
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(str(tmp_path / "scan.obj"))
+    source = tmp_path / "scan.ply"
+    ms.save_current_mesh(str(source), save_face_color=False)
+    header = source.read_bytes()[:600]
+    assert header.count(b"comment TextureFile") == 2 and b"texnumber" in header, header
+
+    out = tmp_path / "out" / "scan.ply"
+    report = json.loads(run_meshtrim("clean", source, out, "--json").stdout)
+    assert "material" in report["vertex_attributes"], report
+    back = pymeshlab.MeshSet()
+    back.load_new_mesh(str(out))
+    assert len(back.current_mesh().textures()) == 2
+    back.save_current_mesh(str(tmp_path / "out" / "back.obj"))
+    by_material = trimesh.load(str(tmp_path / "out" / "back.obj"), process=False, group_material=True).geometry
+    wrong, faces = faces_on_the_other_side(by_material.values(), middle, lambda m: m.image)
+    assert faces == report["faces_out"]
+    assert wrong <= 10, wrong

@@ -930,9 +930,35 @@ fn per_corner_texture_coordinates_split_vertices() {
         mesh.texcoords.unwrap(),
         vec![[0.0, 0.0], [0.5, 0.0], [0.5, 0.5], [0.0, 0.5], [0.75, 0.0]]
     );
-    assert_eq!(mesh.ply_textures, Some(vec![PathBuf::from("skin.png")]));
+    let textures = mesh.ply_textures.unwrap();
+    assert_eq!(
+        (textures.files, textures.faces),
+        (vec![PathBuf::from("skin.png")], vec![0, 0])
+    );
     let short = read_ply_mesh(text("3 0 2 3 4 0.75 0 0.5 0.5").as_bytes()).unwrap();
     assert_eq!((short.vertices.len(), short.texcoords), (4, None));
     let cloud = read_ply(text("3 0 2 3 6 0.75 0 0.5 0.5 0 0.5").as_bytes()).unwrap();
     assert_eq!((cloud.vertices.len(), cloud.texcoords), (4, None));
+}
+
+/// MeshLab's `texnumber`: each face's image among the `TextureFile`s,
+/// kept per triangle of its fan; a number naming no file (MeshLab's −1)
+/// reads the first.
+#[test]
+fn texture_numbers_name_each_faces_image() {
+    let text = "ply\nformat ascii 1.0\ncomment TextureFile a.png\ncomment TextureFile b b.png\n\
+                element vertex 4\nproperty float x\nproperty float y\nproperty float z\n\
+                element face 3\nproperty list uchar int vertex_indices\n\
+                property list uchar float texcoord\nproperty int texnumber\nend_header\n\
+                0 0 0\n1 0 0\n1 1 0\n0 1 0\n\
+                4 0 1 2 3 8 0 0 1 0 1 1 0 1 1\n3 0 1 2 6 0 0 1 0 1 1 -1\n3 0 2 3 6 0 0 1 1 0 1 7\n";
+    let textures = read_ply_mesh(text.as_bytes())
+        .unwrap()
+        .ply_textures
+        .unwrap();
+    assert_eq!(
+        textures.files,
+        [PathBuf::from("a.png"), PathBuf::from("b b.png")]
+    );
+    assert_eq!(textures.faces, vec![1, 1, 0, 0]);
 }
