@@ -112,7 +112,9 @@ fn a_textured_obj_keeps_its_materials_library_and_images() {
     // Read back as a mesh: every face's material is its side's, but for
     // a few new faces laid across the middle (measured: none).
     let written = meshtrim::io::read_mesh(&output).unwrap();
-    let material = written.material.unwrap();
+    let Some(meshtrim::io::Materials::Obj(material)) = written.materials else {
+        panic!("no OBJ materials read back");
+    };
     assert_eq!(material.libraries, vec![out.join("cleaned.mtl")]);
     let faces = written.faces.unwrap();
     let mut across = 0;

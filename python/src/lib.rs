@@ -488,10 +488,15 @@ fn read_mesh(py: Python<'_>, path: PathBuf) -> PyResult<MeshRead<'_>> {
         .as_ref()
         .map(|t| PyArray1::from_slice(py, t.as_flattened()).reshape([t.len(), 2]))
         .transpose()?;
-    let material = attributes.material.map(|m| {
-        let faces = PyArray1::from_vec(py, m.faces);
-        (m.libraries, m.names, faces)
-    });
+    // The package gives an OBJ's materials; the other kinds stay with the
+    // CLI.
+    let material = match attributes.materials {
+        Some(meshtrim::io::Materials::Obj(m)) => {
+            let faces = PyArray1::from_vec(py, m.faces);
+            Some((m.libraries, m.names, faces))
+        }
+        _ => None,
+    };
     Ok((
         points_array(py, &mesh.vertices)?,
         faces_array(py, &mesh.faces)?,
@@ -574,19 +579,19 @@ fn attributes_of(
     texcoords: Option<PyReadonlyArray2<'_, f64>>,
     material: Option<MaterialIn<'_>>,
 ) -> PyResult<meshtrim::io::VertexAttributes> {
-    let material = material.map(|(libraries, names, faces)| meshtrim::io::ObjMaterial {
-        libraries,
-        names,
-        faces: faces.as_array().to_vec(),
+    let materials = material.map(|(libraries, names, faces)| {
+        meshtrim::io::Materials::Obj(meshtrim::io::ObjMaterial {
+            libraries,
+            names,
+            faces: faces.as_array().to_vec(),
+        })
     });
     Ok(meshtrim::io::VertexAttributes {
         normals: normals.map(|n| rows(&n, "normals")).transpose()?,
         colours: colours.map(|c| colours_of(&c)).transpose()?,
         scalars: fields_of(scalars)?,
         texcoords: texcoords.map(|t| rows(&t, "texcoords")).transpose()?,
-        material,
-        gltf_materials: None,
-        ply_textures: None,
+        materials,
     })
 }
 

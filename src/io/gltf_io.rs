@@ -53,7 +53,8 @@ use super::gltf_materials::{self, NO_MATERIAL};
 use super::hash::HashMap;
 use super::ply::Scalar;
 use super::{
-    is_written_name, show, unit_channel, Colours, Mesh, Point3, ScalarField, VertexAttributes,
+    is_written_name, show, unit_channel, Colours, Materials, Mesh, Point3, ScalarField,
+    VertexAttributes,
 };
 
 /// Whether the bytes are a GLB container (the `glTF` magic).
@@ -135,7 +136,8 @@ pub fn read_gltf(bytes: &[u8], dir: &Path) -> Result<Mesh> {
     mesh.colours = colours;
     mesh.texcoords = texcoords;
     mesh.scalars = fields.unwrap_or_default();
-    mesh.gltf_materials = gltf_materials::read(bytes, &gltf, &buffers, dir, face_materials)?;
+    mesh.materials =
+        gltf_materials::read(bytes, &gltf, &buffers, dir, face_materials)?.map(Materials::Gltf);
     Ok(mesh)
 }
 
@@ -1115,7 +1117,11 @@ fn document(
         }));
     }
     // One primitive per material (the faces grouped), or one for all.
-    let groups = match &attributes.gltf_materials {
+    let gltf_materials = match &attributes.materials {
+        Some(Materials::Gltf(materials)) => Some(materials),
+        _ => None,
+    };
+    let groups = match gltf_materials {
         Some(materials) => materials.groups(),
         None => vec![(NO_MATERIAL, (0..faces.len() as u32).collect())],
     };
@@ -1148,7 +1154,7 @@ fn document(
         "meshes": [{ "primitives": primitives }],
         "accessors": accessors,
     });
-    if let Some(materials) = &attributes.gltf_materials {
+    if let Some(materials) = gltf_materials {
         gltf_materials::write(materials, &mut json, &mut views, &mut bin);
     }
     let mut buffer = serde_json::json!({ "byteLength": bin.len() });
@@ -1283,12 +1289,14 @@ mod tests {
             faces: vec![1, NO_MATERIAL, 0, 1],
         };
         let attributes = VertexAttributes {
-            gltf_materials: Some(materials.clone()),
+            materials: Some(Materials::Gltf(materials.clone())),
             ..VertexAttributes::default()
         };
         for mesh in written_and_read(&v, &f, &attributes) {
             assert_eq!(mesh.faces.unwrap(), vec![f[2], f[0], f[3], f[1]]);
-            let read = mesh.gltf_materials.unwrap();
+            let Some(Materials::Gltf(read)) = mesh.materials else {
+                panic!("no glTF materials read back");
+            };
             assert_eq!(read.faces, vec![0, 1, 1, NO_MATERIAL]);
             assert_eq!(read.materials, materials.materials);
             assert_eq!(read.textures, materials.textures);

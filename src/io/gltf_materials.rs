@@ -51,20 +51,6 @@ pub struct GltfImage {
 }
 
 impl GltfMaterials {
-    /// The materials of `to`'s faces, made from `from` (whose faces these
-    /// are), its vertices' `sources` in `from` ([`trim::face_sources`]).
-    pub fn carried(
-        &self,
-        from: &trim::Mesh,
-        to: &trim::Mesh,
-        sources: &[trim::VertexSource],
-    ) -> GltfMaterials {
-        GltfMaterials {
-            faces: super::carried_face_values(&self.faces, from, to, sources, NO_MATERIAL),
-            ..self.clone()
-        }
-    }
-
     /// The faces grouped by material, in the order of the materials (the
     /// faces without one last), each group in face order.
     pub(crate) fn groups(&self) -> Vec<(u32, Vec<u32>)> {

@@ -20,7 +20,9 @@ use anyhow::{anyhow, bail, Context, Result};
 
 use super::atomic::write_atomic;
 use super::float_text::push_f64_debug;
-use super::{gltf_io, show, stl, write_formatted, Point3, ScalarField, VertexAttributes};
+use super::{
+    gltf_io, show, stl, write_formatted, Materials, Point3, ScalarField, VertexAttributes,
+};
 
 /// The mesh formats meshtrim writes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -99,9 +101,7 @@ impl MeshFormat {
             colours,
             scalars,
             texcoords,
-            material,
-            gltf_materials,
-            ply_textures,
+            materials,
         } = attributes;
         let mut held = VertexAttributes::default();
         let mut not_held = VertexAttributes::default();
@@ -114,17 +114,15 @@ impl MeshFormat {
         side.texcoords = texcoords;
         // Each format holds its own kind of material; the others keep the
         // coordinates only.
-        match self {
-            MeshFormat::Obj => held.material = material,
-            _ => not_held.material = material,
-        }
-        match self {
-            MeshFormat::Glb | MeshFormat::Gltf => held.gltf_materials = gltf_materials,
-            _ => not_held.gltf_materials = gltf_materials,
-        }
-        match self {
-            MeshFormat::Ply => held.ply_textures = ply_textures,
-            _ => not_held.ply_textures = ply_textures,
+        let own_kind = matches!(
+            (&materials, self),
+            (Some(Materials::Obj(_)), MeshFormat::Obj)
+                | (Some(Materials::Gltf(_)), MeshFormat::Glb | MeshFormat::Gltf)
+                | (Some(Materials::Ply(_)), MeshFormat::Ply)
+        );
+        match own_kind {
+            true => held.materials = materials,
+            false => not_held.materials = materials,
         }
         let (fields, others) = scalars.into_iter().partition(|f| self.holds_field(f));
         held.scalars = fields;
@@ -166,7 +164,7 @@ pub fn write_mesh_with(
     check_mesh(format, vertices, faces).with_context(|| path.display().to_string())?;
     check_attributes(format, vertices.len(), attributes)
         .with_context(|| path.display().to_string())?;
-    if let (MeshFormat::Obj, Some(material)) = (format, &attributes.material) {
+    if let (MeshFormat::Obj, Some(Materials::Obj(material))) = (format, &attributes.materials) {
         check_material(material, faces.len()).with_context(|| path.display().to_string())?;
         let used = ObjMaterialLines {
             libraries: super::obj_material::libraries_for_output(path, material)?,
@@ -177,7 +175,7 @@ pub fn write_mesh_with(
             write_obj(w, vertices, faces, attributes, Some(&used))
         });
     }
-    if let (MeshFormat::Ply, Some(textures)) = (format, &attributes.ply_textures) {
+    if let (MeshFormat::Ply, Some(Materials::Ply(textures))) = (format, &attributes.materials) {
         if textures.faces.len() != faces.len() {
             bail!(
                 "{}: {} face texture numbers for {} faces",

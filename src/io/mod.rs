@@ -148,13 +148,8 @@ pub struct Mesh {
     pub scalars: Vec<ScalarField>,
     /// Per-vertex texture coordinates (u, v), v upwards as OBJ stores it.
     pub texcoords: Option<Vec<[f64; 2]>>,
-    /// The OBJ materials the faces use, when every face uses one.
-    pub material: Option<ObjMaterial>,
-    /// A glTF file's materials and each face's.
-    pub gltf_materials: Option<gltf_materials::GltfMaterials>,
-    /// A PLY file's texture images (MeshLab's `comment TextureFile`), as
-    /// paths from the current directory.
-    pub ply_textures: Option<ply::PlyTextures>,
+    /// The faces' materials, in the file's own kind ([`Materials`]).
+    pub materials: Option<Materials>,
     /// Triangles as vertex indices, polygons split into fans; `None` when
     /// the file has no face element or `f` lines at all.
     pub faces: Option<Vec<[u32; 3]>>,
@@ -173,7 +168,36 @@ pub struct ObjMaterial {
     pub faces: Vec<u32>,
 }
 
-impl ObjMaterial {
+/// The faces' materials, each format's own kind, each with a material
+/// per face; written only to a file of its format.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Materials {
+    /// An OBJ's `mtllib` and `usemtl`.
+    Obj(ObjMaterial),
+    /// A glTF's materials, textures, samplers and images.
+    Gltf(gltf_materials::GltfMaterials),
+    /// A PLY's texture images (MeshLab's `comment TextureFile`).
+    Ply(ply::PlyTextures),
+}
+
+impl Materials {
+    /// Each face's material.
+    fn faces_mut(&mut self) -> &mut Vec<u32> {
+        match self {
+            Materials::Obj(m) => &mut m.faces,
+            Materials::Gltf(m) => &mut m.faces,
+            Materials::Ply(m) => &mut m.faces,
+        }
+    }
+
+    /// The material of a face on no input face.
+    fn none(&self) -> u32 {
+        match self {
+            Materials::Gltf(_) => gltf_materials::NO_MATERIAL,
+            Materials::Obj(_) | Materials::Ply(_) => 0,
+        }
+    }
+
     /// The materials of `to`'s faces, made from `from` (whose faces these
     /// are), its vertices' `sources` in `from`: each face takes the
     /// material of the input face it lies on ([`trim::face_sources`]).
@@ -182,12 +206,11 @@ impl ObjMaterial {
         from: &trim::Mesh,
         to: &trim::Mesh,
         sources: &[trim::VertexSource],
-    ) -> ObjMaterial {
-        ObjMaterial {
-            libraries: self.libraries.clone(),
-            names: self.names.clone(),
-            faces: carried_face_values(&self.faces, from, to, sources, 0),
-        }
+    ) -> Materials {
+        let mut out = self.clone();
+        let faces = out.faces_mut();
+        *faces = carried_face_values(faces, from, to, sources, self.none());
+        out
     }
 }
 
@@ -195,7 +218,7 @@ impl ObjMaterial {
 /// vertices' `sources` in `from`): each face the value of the input face
 /// it lies on ([`trim::face_sources`]), `none` where it lies on none.
 /// When `from`'s faces all have one value, so do `to`'s, with no search.
-pub(crate) fn carried_face_values(
+fn carried_face_values(
     values: &[u32],
     from: &trim::Mesh,
     to: &trim::Mesh,
@@ -324,13 +347,9 @@ pub struct VertexAttributes {
     pub scalars: Vec<ScalarField>,
     /// Texture coordinates (u, v), one per vertex.
     pub texcoords: Option<Vec<[f64; 2]>>,
-    /// The OBJ materials of the faces, which the texture coordinates
-    /// index into, written to OBJ outputs with them.
-    pub material: Option<ObjMaterial>,
-    /// A glTF file's materials and each face's, written to glTF outputs.
-    pub gltf_materials: Option<gltf_materials::GltfMaterials>,
-    /// A PLY file's texture images, written to PLY outputs.
-    pub ply_textures: Option<ply::PlyTextures>,
+    /// The faces' materials, which the texture coordinates index into,
+    /// written to outputs of their format.
+    pub materials: Option<Materials>,
 }
 
 /// Attributes carried to a mesh ([`VertexAttributes::carried`]).
@@ -350,9 +369,7 @@ impl VertexAttributes {
             && self.colours.is_none()
             && self.scalars.is_empty()
             && self.texcoords.is_none()
-            && self.material.is_none()
-            && self.gltf_materials.is_none()
-            && self.ply_textures.is_none()
+            && self.materials.is_none()
     }
 
     /// These attributes, of `from`'s vertices, at the vertices of `to`, a
@@ -372,18 +389,10 @@ impl VertexAttributes {
         let mesh = split.split_mesh(to);
         let mut attributes = self.at_sources(from, &split.sources);
         let out = mesh.as_ref().unwrap_or(to);
-        attributes.material = self
-            .material
-            .as_ref()
-            .map(|material| material.carried(from, out, &split.sources));
-        attributes.gltf_materials = self
-            .gltf_materials
+        attributes.materials = self
+            .materials
             .as_ref()
             .map(|materials| materials.carried(from, out, &split.sources));
-        attributes.ply_textures = self
-            .ply_textures
-            .as_ref()
-            .map(|textures| textures.carried(from, out, &split.sources));
         Carried { mesh, attributes }
     }
 
@@ -416,9 +425,7 @@ impl VertexAttributes {
                 .texcoords
                 .as_ref()
                 .map(|texcoords| trim::carry(from, sources, texcoords)),
-            material: None,
-            gltf_materials: None,
-            ply_textures: None,
+            materials: None,
         }
     }
 
@@ -436,7 +443,7 @@ impl VertexAttributes {
         if self.texcoords.is_some() {
             names.push("texture coordinates".to_string());
         }
-        if self.material.is_some() || self.gltf_materials.is_some() || self.ply_textures.is_some() {
+        if self.materials.is_some() {
             names.push("material".to_string());
         }
         names.extend(self.scalars.iter().map(|field| field.name.clone()));
@@ -496,9 +503,7 @@ pub fn read_mesh_with_attributes(
         colours: read.colours,
         scalars: read.scalars,
         texcoords: read.texcoords,
-        material: read.material,
-        gltf_materials: read.gltf_materials,
-        ply_textures: read.ply_textures,
+        materials: read.materials,
     };
     let mesh = trim::Mesh {
         vertices: read.vertices,
@@ -567,7 +572,7 @@ fn parse_mesh(path: &Path, bytes: &[u8]) -> Result<Mesh> {
         MeshInput::Ply => {
             let mut mesh = ply::read_ply_mesh(bytes)?;
             let dir = path.parent().unwrap_or(Path::new(""));
-            if let Some(textures) = mesh.ply_textures.as_mut() {
+            if let Some(Materials::Ply(textures)) = mesh.materials.as_mut() {
                 textures.files.iter_mut().for_each(|f| *f = dir.join(&*f));
             }
             mesh

@@ -339,7 +339,7 @@ impl ObjText {
             normals,
             colours,
             texcoords,
-            material,
+            materials: material.map(super::Materials::Obj),
             faces: Some(faces),
             ..Mesh::default()
         })
@@ -711,7 +711,10 @@ mod tests {
     #[test]
     fn the_materials_are_kept_when_every_face_has_one() {
         let faces = "f 1 2 3\nf 1 3 4\n";
-        let with = |text: &str| mesh(&format!("{SQUARE}mtllib a.mtl\n{text}")).material;
+        let with = |text: &str| match mesh(&format!("{SQUARE}mtllib a.mtl\n{text}")).materials {
+            Some(crate::io::Materials::Obj(material)) => Some(material),
+            _ => None,
+        };
         let material = with(&format!("g x\nusemtl skin\n{faces}usemtl skin\n")).unwrap();
         assert_eq!(material.names, vec!["skin"]);
         assert_eq!(material.faces, vec![0, 0]);

@@ -234,22 +234,6 @@ pub struct PlyTextures {
     pub faces: Vec<u32>,
 }
 
-impl PlyTextures {
-    /// The images of `to`'s faces, made from `from` (whose faces these
-    /// are), its vertices' `sources` in `from` ([`trim::face_sources`]).
-    pub fn carried(
-        &self,
-        from: &trim::Mesh,
-        to: &trim::Mesh,
-        sources: &[trim::VertexSource],
-    ) -> PlyTextures {
-        PlyTextures {
-            files: self.files.clone(),
-            faces: super::carried_face_values(&self.faces, from, to, sources, 0),
-        }
-    }
-}
-
 /// Reads a PLY file: vertices, optional normals and optional faces. A
 /// `range_grid` is skipped: this is the point-cloud reader.
 pub fn read_ply(bytes: &[u8]) -> Result<Mesh> {
@@ -980,7 +964,7 @@ fn read_body(header: &Header, values: &mut dyn Values, grid: bool) -> Result<Mes
                 .collect(),
             _ => vec![0; count],
         };
-        mesh.ply_textures = Some(PlyTextures { files, faces });
+        mesh.materials = Some(super::Materials::Ply(PlyTextures { files, faces }));
     }
     Ok(mesh)
 }

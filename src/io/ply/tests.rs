@@ -930,7 +930,9 @@ fn per_corner_texture_coordinates_split_vertices() {
         mesh.texcoords.unwrap(),
         vec![[0.0, 0.0], [0.5, 0.0], [0.5, 0.5], [0.0, 0.5], [0.75, 0.0]]
     );
-    let textures = mesh.ply_textures.unwrap();
+    let Some(crate::io::Materials::Ply(textures)) = mesh.materials else {
+        panic!("no texture files read");
+    };
     assert_eq!(
         (textures.files, textures.faces),
         (vec![PathBuf::from("skin.png")], vec![0, 0])
@@ -952,10 +954,11 @@ fn texture_numbers_name_each_faces_image() {
                 property list uchar float texcoord\nproperty int texnumber\nend_header\n\
                 0 0 0\n1 0 0\n1 1 0\n0 1 0\n\
                 4 0 1 2 3 8 0 0 1 0 1 1 0 1 1\n3 0 1 2 6 0 0 1 0 1 1 -1\n3 0 2 3 6 0 0 1 1 0 1 7\n";
-    let textures = read_ply_mesh(text.as_bytes())
-        .unwrap()
-        .ply_textures
-        .unwrap();
+    let Some(crate::io::Materials::Ply(textures)) =
+        read_ply_mesh(text.as_bytes()).unwrap().materials
+    else {
+        panic!("no texture files read");
+    };
     assert_eq!(
         textures.files,
         [PathBuf::from("a.png"), PathBuf::from("b b.png")]
