@@ -10,7 +10,8 @@
 //! a copy of each image in a directory of its own, `<name>_textures/`, at
 //! the same path below it when the image was below the library's, else by
 //! its file name: outputs written side by side (a batch) never share or
-//! overwrite an image. The input's files are never modified.
+//! overwrite an image. The input's files are never modified. A PLY's
+//! texture files follow the same rule ([`images_for_output`]).
 
 use std::path::{Component, Path, PathBuf};
 
@@ -31,9 +32,6 @@ pub(crate) fn libraries_for_output(path: &Path, material: &ObjMaterial) -> Resul
         return Ok(material.libraries.iter().map(|l| file_name(l)).collect());
     }
     let own = path.with_extension("mtl");
-    // The images go into a directory of the output's own, so outputs
-    // written side by side (a batch) never share or overwrite one.
-    let folder = own_folder(path);
     if let Some(input) = material.libraries.iter().find(|l| same_file(l, &own)) {
         bail!(
             "{}: the output's material library would replace the input's {}: write the output to another name or directory",
@@ -41,6 +39,9 @@ pub(crate) fn libraries_for_output(path: &Path, material: &ObjMaterial) -> Resul
             input.display()
         );
     }
+    // The images go into a directory of the output's own, so outputs
+    // written side by side (a batch) never share or overwrite one.
+    let folder = own_folder(path);
     let mut text = String::new();
     // A library that cannot be read is named as it was: the reader of the
     // output finds it missing, as it found the input's.
