@@ -20,6 +20,7 @@ use anyhow::{anyhow, bail, Context, Result};
 
 use super::atomic::write_atomic;
 use super::float_text::push_f64_debug;
+use super::simple_material::SimpleMaterials;
 use super::{
     gltf_io, show, stl, write_formatted, Materials, Point3, ScalarField, VertexAttributes,
 };
@@ -112,22 +113,61 @@ impl MeshFormat {
         side.normals = normals;
         side.colours = colours;
         side.texcoords = texcoords;
-        // Each format holds its own kind of material; the others keep the
-        // coordinates only.
-        let own_kind = matches!(
-            (&materials, self),
-            (Some(Materials::Obj(_)), MeshFormat::Obj)
-                | (Some(Materials::Gltf(_)), MeshFormat::Glb | MeshFormat::Gltf)
-                | (Some(Materials::Ply(_)), MeshFormat::Ply)
-        );
-        match own_kind {
-            true => held.materials = materials,
-            false => not_held.materials = materials,
+        let mut left = Vec::new();
+        if let Some(materials) = materials {
+            let (written, not_written) = self.materials_for(materials);
+            match written {
+                Ok(materials) => held.materials = Some(materials),
+                Err(materials) => not_held.materials = Some(materials),
+            }
+            left = not_written;
         }
         let (fields, others) = scalars.into_iter().partition(|f| self.holds_field(f));
         held.scalars = fields;
         not_held.scalars = others;
-        (held, not_held.names())
+        let mut not_written = not_held.names();
+        not_written.extend(left);
+        (held, not_written)
+    }
+
+    /// Whether the format writes `materials` as they are: its own kind,
+    /// or simple materials (OBJ, and PLY when one has an image).
+    fn holds_as_they_are(self, materials: &Materials) -> bool {
+        match (self, materials) {
+            (MeshFormat::Obj, Materials::Obj(_) | Materials::Simple(_))
+            | (MeshFormat::Glb | MeshFormat::Gltf, Materials::Gltf(_))
+            | (MeshFormat::Ply, Materials::Ply(_)) => true,
+            (MeshFormat::Ply, Materials::Simple(simple)) => simple.has_image(),
+            _ => false,
+        }
+    }
+
+    /// `materials` as the format holds them: its own kind as they are,
+    /// another's made simple ([`SimpleMaterials`]) and, for glTF, glTF's
+    /// from those; `Err` with them when the format holds none (STL, and
+    /// PLY, which holds images only, when none has one). And the names of
+    /// the parts left out.
+    fn materials_for(self, materials: Materials) -> (Result<Materials, Materials>, Vec<String>) {
+        if self.holds_as_they_are(&materials) {
+            return (Ok(materials), Vec::new());
+        }
+        let simple = match &materials {
+            _ if self == MeshFormat::Stl => return (Err(materials), Vec::new()),
+            Materials::Obj(material) => SimpleMaterials::from_obj(material),
+            Materials::Gltf(gltf) => SimpleMaterials::from_gltf(gltf),
+            Materials::Ply(textures) => SimpleMaterials::from_ply(textures),
+            Materials::Simple(simple) => simple.clone(),
+        };
+        match self {
+            MeshFormat::Glb | MeshFormat::Gltf => {
+                let (gltf, left) = simple.to_gltf();
+                (Ok(Materials::Gltf(gltf)), left)
+            }
+            _ if self.holds_as_they_are(&Materials::Simple(simple.clone())) => {
+                (Ok(Materials::Simple(simple)), Vec::new())
+            }
+            _ => (Err(materials), Vec::new()),
+        }
     }
 }
 
@@ -164,33 +204,61 @@ pub fn write_mesh_with(
     check_mesh(format, vertices, faces).with_context(|| path.display().to_string())?;
     check_attributes(format, vertices.len(), attributes)
         .with_context(|| path.display().to_string())?;
-    if let (MeshFormat::Obj, Some(Materials::Obj(material))) = (format, &attributes.materials) {
-        check_material(material, faces.len()).with_context(|| path.display().to_string())?;
-        let used = ObjMaterialLines {
-            libraries: super::obj_material::libraries_for_output(path, material)?,
-            names: &material.names,
-            faces: &material.faces,
-        };
-        return write_atomic(path, |w| {
-            write_obj(w, vertices, faces, attributes, Some(&used))
-        });
+    if let Some(materials) = &attributes.materials {
+        materials
+            .check(faces.len())
+            .with_context(|| path.display().to_string())?;
     }
-    if let (MeshFormat::Ply, Some(Materials::Ply(textures))) = (format, &attributes.materials) {
-        if textures.faces.len() != faces.len() {
-            bail!(
-                "{}: {} face texture numbers for {} faces",
-                path.display(),
-                textures.faces.len(),
-                faces.len()
-            );
+    // Materials of another format's kind (given from Python) are made
+    // this format's here; the CLI's come made by `split_attributes`.
+    let converted;
+    let attributes = match &attributes.materials {
+        Some(materials) if !format.holds_as_they_are(materials) => {
+            converted = VertexAttributes {
+                materials: format.materials_for(materials.clone()).0.ok(),
+                ..attributes.clone()
+            };
+            &converted
         }
-        let names = super::obj_material::images_for_output(path, &textures.files)?;
-        let numbers = (textures.files.len() > 1).then_some(textures.faces.as_slice());
-        return write_atomic(path, |w| {
-            write_ply_with(w, vertices, faces, attributes, (&names, numbers))
-        });
+        _ => attributes,
+    };
+    match (format, &attributes.materials) {
+        (MeshFormat::Obj, Some(Materials::Obj(material))) => {
+            let used = ObjMaterialLines {
+                libraries: super::obj_material::libraries_for_output(path, material)?,
+                names: &material.names,
+                faces: &material.faces,
+            };
+            write_atomic(path, |w| {
+                write_obj(w, vertices, faces, attributes, Some(&used))
+            })
+        }
+        (MeshFormat::Obj, Some(Materials::Simple(simple))) => {
+            let names: Vec<String> = simple.materials.iter().map(|m| m.name.clone()).collect();
+            let used = ObjMaterialLines {
+                libraries: vec![simple.write_obj_library(path)?],
+                names: &names,
+                faces: &simple.faces,
+            };
+            write_atomic(path, |w| {
+                write_obj(w, vertices, faces, attributes, Some(&used))
+            })
+        }
+        (MeshFormat::Ply, Some(Materials::Ply(textures))) => {
+            let names = super::obj_material::images_for_output(path, &textures.files)?;
+            let numbers = (textures.files.len() > 1).then_some(textures.faces.as_slice());
+            write_atomic(path, |w| {
+                write_ply_with(w, vertices, faces, attributes, (&names, numbers))
+            })
+        }
+        (MeshFormat::Ply, Some(Materials::Simple(simple))) => {
+            let (names, numbers) = simple.write_ply_textures(path)?;
+            write_atomic(path, |w| {
+                write_ply_with(w, vertices, faces, attributes, (&names, numbers.as_deref()))
+            })
+        }
+        _ => write_atomic(path, |w| format.write(w, vertices, faces, attributes)),
     }
-    write_atomic(path, |w| format.write(w, vertices, faces, attributes))
 }
 
 /// The material lines of an OBJ: `mtllib` names, and the `usemtl` names
@@ -202,25 +270,6 @@ pub struct ObjMaterialLines<'a> {
     pub names: &'a [String],
     /// Each face's material, an index into `names`.
     pub faces: &'a [u32],
-}
-
-/// One material per face, each one of the names.
-fn check_material(material: &super::ObjMaterial, faces: usize) -> Result<()> {
-    if material.faces.len() != faces {
-        bail!("{} face materials for {faces} faces", material.faces.len());
-    }
-    if let Some(f) = material
-        .faces
-        .iter()
-        .position(|&m| m as usize >= material.names.len())
-    {
-        bail!(
-            "face {f}'s material is {}, but there are only {} material names",
-            material.faces[f],
-            material.names.len()
-        );
-    }
-    Ok(())
 }
 
 /// Checks that `format` can hold the mesh, with a message naming the

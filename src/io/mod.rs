@@ -29,6 +29,7 @@ pub mod obj;
 mod obj_material;
 pub mod pcd;
 pub mod ply;
+pub mod simple_material;
 pub mod stl;
 pub mod text;
 mod text_lines;
@@ -169,7 +170,8 @@ pub struct ObjMaterial {
 }
 
 /// The faces' materials, each format's own kind, each with a material
-/// per face; written only to a file of its format.
+/// per face; written as they are to a file of their format, and made
+/// [`simple_material::SimpleMaterials`] for another.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Materials {
     /// An OBJ's `mtllib` and `usemtl`.
@@ -178,6 +180,9 @@ pub enum Materials {
     Gltf(gltf_materials::GltfMaterials),
     /// A PLY's texture images (MeshLab's `comment TextureFile`).
     Ply(ply::PlyTextures),
+    /// Another format's materials, made what every format holds, for an
+    /// output of another format than the input's.
+    Simple(simple_material::SimpleMaterials),
 }
 
 impl Materials {
@@ -187,14 +192,44 @@ impl Materials {
             Materials::Obj(m) => &mut m.faces,
             Materials::Gltf(m) => &mut m.faces,
             Materials::Ply(m) => &mut m.faces,
+            Materials::Simple(m) => &mut m.faces,
         }
+    }
+
+    /// Checks there is a material per face (of `faces`), each one of
+    /// those given (a PLY's texture number may name none: it reads the
+    /// first; a glTF face may have none).
+    pub fn check(&self, faces: usize) -> anyhow::Result<()> {
+        let (face_materials, count) = match self {
+            Materials::Obj(m) => (&m.faces, m.names.len()),
+            Materials::Gltf(m) => (&m.faces, m.materials.len()),
+            Materials::Ply(m) => (&m.faces, usize::MAX),
+            Materials::Simple(m) => (&m.faces, m.materials.len()),
+        };
+        if face_materials.len() != faces {
+            anyhow::bail!("{} face materials for {faces} faces", face_materials.len());
+        }
+        let none = self.none();
+        let named = |m: u32| (m as usize) < count || (m == none && self.none_allowed());
+        if let Some(f) = face_materials.iter().position(|&m| !named(m)) {
+            anyhow::bail!(
+                "face {f}'s material is {}, but there are only {count} materials",
+                face_materials[f]
+            );
+        }
+        Ok(())
+    }
+
+    /// Whether a face may have no material.
+    fn none_allowed(&self) -> bool {
+        matches!(self, Materials::Gltf(_))
     }
 
     /// The material of a face on no input face.
     fn none(&self) -> u32 {
         match self {
             Materials::Gltf(_) => gltf_materials::NO_MATERIAL,
-            Materials::Obj(_) | Materials::Ply(_) => 0,
+            Materials::Obj(_) | Materials::Ply(_) | Materials::Simple(_) => 0,
         }
     }
 

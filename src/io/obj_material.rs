@@ -82,7 +82,7 @@ pub(crate) fn images_for_output(path: &Path, images: &[PathBuf]) -> Result<Vec<S
 }
 
 /// The folder an output's copied images go in: `<name>_textures`.
-fn own_folder(path: &Path) -> String {
+pub(super) fn own_folder(path: &Path) -> String {
     let stem = path
         .file_stem()
         .map_or(String::new(), |s| s.to_string_lossy().into_owned());
@@ -93,7 +93,7 @@ fn own_folder(path: &Path) -> String {
 /// directory `folder` of `out_dir`, and returns its name from `out_dir`:
 /// `folder/` then the same relative path when the image is below `from`,
 /// else its file name. A missing image is named as it was.
-fn copy_image(from: &Path, image: &str, out_dir: &Path, folder: &str) -> Result<String> {
+pub(super) fn copy_image(from: &Path, image: &str, out_dir: &Path, folder: &str) -> Result<String> {
     let source = normalised(&from.join(image));
     if !source.is_file() {
         return Ok(image.to_string());
@@ -105,14 +105,19 @@ fn copy_image(from: &Path, image: &str, out_dir: &Path, folder: &str) -> Result<
         true => format!("{folder}/{}", image.replace('\\', "/")),
         false => format!("{folder}/{}", file_name(&source)),
     };
-    let target = out_dir.join(&name);
-    if same_file(&source, &target) {
-        return Ok(name);
-    }
-    let bytes = std::fs::read(&source)
-        .with_context(|| format!("cannot read the texture image {}", source.display()))?;
-    write_atomic(&target, |w| w.write_all(&bytes))?;
+    copy_file(&source, &out_dir.join(&name))?;
     Ok(name)
+}
+
+/// Copies the image `source` to `target` (nothing to do when they are
+/// one file).
+pub(super) fn copy_file(source: &Path, target: &Path) -> Result<()> {
+    if same_file(source, target) {
+        return Ok(());
+    }
+    let bytes = std::fs::read(source)
+        .with_context(|| format!("cannot read the texture image {}", source.display()))?;
+    write_atomic(target, |w| w.write_all(&bytes))
 }
 
 fn same_file(a: &Path, b: &Path) -> bool {
@@ -145,7 +150,7 @@ fn rebased(text: &str, mut rename: impl FnMut(&str) -> Result<String>) -> Result
 }
 
 /// The absolute directory a file is in.
-fn absolute_dir(file: &Path) -> PathBuf {
+pub(super) fn absolute_dir(file: &Path) -> PathBuf {
     let dir = file.parent().unwrap_or(Path::new(""));
     let dir = if dir.as_os_str().is_empty() {
         Path::new(".")
@@ -172,7 +177,7 @@ fn normalised(path: &Path) -> PathBuf {
     out
 }
 
-fn file_name(path: &Path) -> String {
+pub(super) fn file_name(path: &Path) -> String {
     path.file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default()
