@@ -112,21 +112,13 @@ fn a_textured_obj_keeps_its_materials_library_and_images() {
     // Read back as a mesh: every face's material is its side's, but for
     // a few new faces laid across the middle (measured: none).
     let written = meshtrim::io::read_mesh(&output).unwrap();
-    let Some(meshtrim::io::Materials::Obj(material)) = written.materials else {
+    let Some(meshtrim::io::Materials::Obj(material)) = &written.materials else {
         panic!("no OBJ materials read back");
     };
     assert_eq!(material.libraries, vec![out.join("cleaned.mtl")]);
-    let faces = written.faces.unwrap();
-    let mut across = 0;
-    for (face, &m) in faces.iter().zip(&material.faces) {
-        let centre = face
-            .iter()
-            .map(|&v| written.vertices[v as usize][0])
-            .sum::<f64>()
-            / 3.0;
-        let side = if centre > middle { "right" } else { "left" };
-        across += usize::from(material.names[m as usize] != side);
-    }
+    let across = faces_across(&written, middle, |f| {
+        &material.names[material.faces[f] as usize]
+    });
     assert!(across <= 4, "{across} faces on the other side's material");
     // The texture coordinates are still x / 1000 and y / 1000 on kept
     // vertices (new ones blend their face's; measured 2,757 of 2,998 exact).
@@ -138,6 +130,91 @@ fn a_textured_obj_keeps_its_materials_library_and_images() {
         .filter(|(p, t)| **t == [p[0] / 1000.0, p[1] / 1000.0])
         .count();
     assert!(exact > written.vertices.len() * 9 / 10, "{exact}");
+}
+
+/// How many faces of `mesh` lie on the other side of `middle` than the
+/// name `side_of` gives each (its material's, or its image's) says.
+fn faces_across<'a>(
+    mesh: &meshtrim::io::Mesh,
+    middle: f64,
+    side_of: impl Fn(usize) -> &'a str,
+) -> usize {
+    let faces = mesh.faces.as_ref().unwrap();
+    let mut across = 0;
+    for (f, face) in faces.iter().enumerate() {
+        let centre = face
+            .iter()
+            .map(|&v| mesh.vertices[v as usize][0])
+            .sum::<f64>()
+            / 3.0;
+        let side = if centre > middle { "right" } else { "left" };
+        across += usize::from(!side_of(f).contains(side));
+    }
+    across
+}
+
+/// Cleaned to PLY and to GLB, the OBJ's materials are made the output
+/// format's: PLY's texture files (each face's number naming its side's
+/// image, copied into the output's folder) and glTF's materials (named
+/// as the MTL's, the PNG image embedded). The other image is no PNG or
+/// JPEG, which glTF cannot hold: the report names it.
+#[test]
+fn a_textured_obj_converted_keeps_each_faces_image() {
+    let dir = tempfile::tempdir().unwrap();
+    let (input, _, middle) = textured_fixture(dir.path(), &["scan.mtl"]);
+    library(dir.path());
+    let png = b"\x89PNG\r\n\x1a\n left image";
+    std::fs::write(dir.path().join("in/tex/left.png"), png).unwrap();
+    let out = dir.path().join("out");
+
+    let report = clean(&input, &out.join("scan.ply"));
+    assert!(
+        report.contains("vertex attributes    texture coordinates, material"),
+        "{report}"
+    );
+    let written = meshtrim::io::read_mesh(&out.join("scan.ply")).unwrap();
+    let Some(meshtrim::io::Materials::Ply(textures)) = &written.materials else {
+        panic!("no PLY texture files read back");
+    };
+    let images = out.join("scan_textures");
+    let mut files = textures.files.clone();
+    files.sort();
+    assert_eq!(files, [images.join("left.png"), images.join("right.png")]);
+    assert_eq!(
+        std::fs::read(images.join("right.png")).unwrap(),
+        b"right image"
+    );
+    let files = |f: usize| textures.files[textures.faces[f] as usize].to_str().unwrap();
+    let across = faces_across(&written, middle, files);
+    assert!(across <= 4, "{across} faces on the other side's image");
+
+    let report = clean(&input, &out.join("scan.glb"));
+    assert!(
+        report.contains(
+            "texture image right.png not written: the output's format does not hold them"
+        ),
+        "{report}"
+    );
+    let written = meshtrim::io::read_mesh(&out.join("scan.glb")).unwrap();
+    let Some(meshtrim::io::Materials::Gltf(gltf)) = &written.materials else {
+        panic!("no glTF materials read back");
+    };
+    let names: Vec<&str> = gltf
+        .materials
+        .iter()
+        .map(|m| m["name"].as_str().unwrap())
+        .collect();
+    let mut sorted = names.clone();
+    sorted.sort();
+    assert_eq!(sorted, ["left", "right"]);
+    // The left material's image only, in the buffer.
+    let left = names.iter().position(|&n| n == "left").unwrap();
+    let texture = &gltf.materials[left]["pbrMetallicRoughness"]["baseColorTexture"];
+    assert_eq!(texture["index"], 0);
+    assert_eq!(gltf.images.len(), 1);
+    assert_eq!(gltf.images[0].bytes, png);
+    let across = faces_across(&written, middle, |f| names[gltf.faces[f] as usize]);
+    assert!(across <= 4, "{across} faces on the other side's material");
 }
 
 /// Beside the input's library, the output names it and writes nothing

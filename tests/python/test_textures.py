@@ -21,7 +21,7 @@ import pymeshlab
 import pytest
 import trimesh
 
-from meshtrim_cli import run_meshtrim, shared_data
+from meshtrim_cli import ROOT, run_meshtrim, shared_data
 
 SCALE, SHIFT = 0.7, 0.25
 """The flat map: uv = SCALE * ((x, y) - lowest) / extent, plus SHIFT along
@@ -220,6 +220,55 @@ def halves(material):
     return scene, middle
 
 
+def halves_as_obj(path):
+    """The halves (`halves`) as trimesh exports them in OBJ, with
+    `scan.mtl` and an image per material beside `path`; the middle x."""
+    scene, middle = halves(lambda name, image: trimesh.visual.material.SimpleMaterial(image=image))
+    text, assets = trimesh.exchange.obj.export_obj(scene, include_texture=True, return_texture=True, mtl_name="scan.mtl")
+    path.write_text(text)
+    for name, data in assets.items():
+        (path.parent / name).write_bytes(data)
+    return middle
+
+
+def halves_as_glb(path):
+    """The halves as trimesh exports them in GLB, two meshes with a
+    PBR material each, the images embedded; the middle x."""
+    scene, middle = halves(
+        lambda name, image: trimesh.visual.material.PBRMaterial(name=name, baseColorTexture=image)
+    )
+    scene.export(str(path))
+    return middle
+
+
+def halves_as_ply(path):
+    """The halves as PyMeshLab saves trimesh's OBJ of them in PLY: two
+    `comment TextureFile`s and a `texnumber` per face; the middle x."""
+    middle = halves_as_obj(path.with_suffix(".obj"))
+    ms = pymeshlab.MeshSet()
+    ms.load_new_mesh(str(path.with_suffix(".obj")))
+    ms.save_current_mesh(str(path), save_face_color=False)
+    header = path.read_bytes()[:600]
+    assert header.count(b"comment TextureFile") == 2 and b"texnumber" in header, header
+    return middle
+
+
+def parts_by_material(path):
+    """The mesh in `path` as meshes by material, as trimesh reads them,
+    and how to find a part's image from its material: a GLB by trimesh
+    itself, an OBJ grouped by material, and a PLY by PyMeshLab (which
+    reads MeshLab's texture files) then saved by it as an OBJ."""
+    if path.suffix == ".glb":
+        return trimesh.load(str(path), process=False).geometry.values(), lambda m: m.baseColorTexture
+    if path.suffix == ".ply":
+        ms = pymeshlab.MeshSet()
+        ms.load_new_mesh(str(path))
+        assert len(ms.current_mesh().textures()) == 2, ms.current_mesh().textures()
+        path = path.with_name(path.stem + "_by_meshlab.obj")
+        ms.save_current_mesh(str(path))
+    return trimesh.load(str(path), process=False, group_material=True).geometry.values(), lambda m: m.image
+
+
 def faces_on_the_other_side(parts, middle, image_of):
     """How many faces of `parts` (meshes by material) lie on the other
     side of the middle than their material's image says, and how many
@@ -242,11 +291,7 @@ def test_each_face_keeps_its_material(tmp_path):
     material of the input face it lies on. Measured: 6 of 165,989 faces
     take the material of the other side of the middle, new faces laid
     across it where it meets the border."""
-    scene, middle = halves(lambda name, image: trimesh.visual.material.SimpleMaterial(image=image))
-    text, assets = trimesh.exchange.obj.export_obj(scene, include_texture=True, return_texture=True, mtl_name="scan.mtl")
-    (tmp_path / "scan.obj").write_text(text)
-    for name, data in assets.items():
-        (tmp_path / name).write_bytes(data)
+    middle = halves_as_obj(tmp_path / "scan.obj")
 
     out = tmp_path / "out" / "scan.obj"
     report = json.loads(run_meshtrim("clean", tmp_path / "scan.obj", out, "--json").stdout)
@@ -334,11 +379,7 @@ def test_a_meshlab_ply_with_two_textures_keeps_each_faces(tmp_path):
     keeps its half's image. Read back by PyMeshLab and saved by it as an
     OBJ, which trimesh groups by material: 6 of 165,989 faces are on the
     other half's image, as with the OBJ input."""
-    scene, middle = halves(lambda name, image: trimesh.visual.material.SimpleMaterial(image=image))
-    text, assets = trimesh.exchange.obj.export_obj(scene, include_texture=True, return_texture=True, mtl_name="scan.mtl")
-    (tmp_path / "scan.obj").write_text(text)
-    for name, data in assets.items():
-        (tmp_path / name).write_bytes(data)
+    middle = halves_as_obj(tmp_path / "scan.obj")
     ms = pymeshlab.MeshSet()
     ms.load_new_mesh(str(tmp_path / "scan.obj"))
     source = tmp_path / "scan.ply"
@@ -357,3 +398,78 @@ def test_a_meshlab_ply_with_two_textures_keeps_each_faces(tmp_path):
     wrong, faces = faces_on_the_other_side(by_material.values(), middle, lambda m: m.image)
     assert faces == report["faces_out"]
     assert wrong <= 10, wrong
+
+
+WRITERS = {"obj": halves_as_obj, "glb": halves_as_glb, "ply": halves_as_ply}
+
+
+@pytest.mark.parametrize(
+    "source, target", [("obj", "glb"), ("obj", "ply"), ("glb", "obj"), ("glb", "ply"), ("ply", "obj"), ("ply", "glb")]
+)
+def test_materials_are_carried_to_another_format(source, target, tmp_path):
+    """The two-material halves, written by trimesh (OBJ, GLB) or
+    PyMeshLab (PLY), cleaned to another format: the materials are made the
+    output's kind (MTL with the images in the output's folder, glTF's
+    materials with the images embedded, MeshLab's texture files), and read
+    back by trimesh and PyMeshLab each face is on its half's image but
+    for the new faces laid across the middle. Measured: 6 of 165,989
+    faces, for every pair of formats, as without a change of format."""
+    middle = WRITERS[source](tmp_path / f"scan.{source}")
+    out = tmp_path / "out" / f"scan.{target}"
+    report = json.loads(run_meshtrim("clean", tmp_path / f"scan.{source}", out, "--json").stdout)
+    assert report["vertex_attributes"] == ["texture coordinates", "material"], report
+    parts, image_of = parts_by_material(out)
+    assert len(parts) == 2, parts
+    wrong, faces = faces_on_the_other_side(parts, middle, image_of)
+    assert faces == report["faces_out"]
+    assert wrong <= 10, wrong
+    # OBJ and PLY name their images, copied or written into the output's
+    # folder; glTF embeds them.
+    folder = out.parent / "scan_textures"
+    assert len(list(folder.iterdir()) if folder.exists() else []) == (0 if target == "glb" else 2)
+
+
+def two_colour_obj(path):
+    """The jagged blade fixture as an OBJ of two colour materials (`Kd`,
+    and `d` on one, no texture coordinates), as CAD systems export parts:
+    `red` left of the middle, `blue` (half opaque) right of it. Returns
+    the middle x."""
+    mesh = trimesh.load(str(ROOT / "fixtures" / "meshes" / "blade_jagged.stl"), process=True)
+    middle = np.median(mesh.vertices[:, 0])
+    right = mesh.triangles_center[:, 0] > middle
+    lines = ["mtllib colours.mtl"] + [f"v {x!r} {y!r} {z!r}" for x, y, z in mesh.vertices.tolist()]
+    for name, side in [("red", ~right), ("blue", right)]:
+        lines.append(f"usemtl {name}")
+        lines += [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in mesh.faces[side]]
+    path.write_text("\n".join(lines) + "\n")
+    (path.parent / "colours.mtl").write_text("newmtl red\nKd 1 0 0\n\nnewmtl blue\nKd 0 0 1\nd 0.5\n")
+    return middle
+
+
+def test_colour_materials_are_carried_to_gltf(tmp_path):
+    """Colour materials cleaned to GLB: trimesh reads each material's base
+    colour and opacity (the MTL's `Kd` and `d`) and each face on its
+    side's (measured: none across). PLY holds texture images only: the
+    report says the material is not written. From Python, write_mesh
+    makes the same materials of read_mesh's `material` for a GLB."""
+    import meshtrim
+
+    middle = two_colour_obj(tmp_path / "parts.obj")
+    colours = {(255, 0, 0, 255): "red", (0, 0, 255, 128): "blue"}
+
+    def colour_sides(path):
+        wrong = 0
+        for part in trimesh.load(str(path), process=False).geometry.values():
+            name = colours[tuple(part.visual.material.baseColorFactor)]
+            wrong += int(((part.triangles_center[:, 0] > middle) != (name == "blue")).sum())
+        return wrong
+
+    report = json.loads(run_meshtrim("clean", tmp_path / "parts.obj", tmp_path / "parts.glb", "--json").stdout)
+    assert report["vertex_attributes"] == ["material"], report
+    assert colour_sides(tmp_path / "parts.glb") <= 4
+    report = json.loads(run_meshtrim("clean", tmp_path / "parts.obj", tmp_path / "parts.ply", "--json").stdout)
+    assert report["vertex_attributes_not_written"] == ["material"], report
+
+    v, f, attributes = meshtrim.read_mesh(tmp_path / "parts.obj", attributes=True)
+    meshtrim.write_mesh(tmp_path / "direct.glb", v, f, material=attributes.material)
+    assert colour_sides(tmp_path / "direct.glb") == 0
