@@ -2,16 +2,18 @@
 //!
 //! | extension | what is written |
 //! |---|---|
-//! | `.obj` | `v x y z` with the shortest decimals that read back to the same `f64`, `f a b c` 1-based; vertex colours, normals, texture coordinates and an OBJ input's materials |
-//! | `.ply` | binary little-endian, `double x y z`, faces as `list uchar int vertex_indices`; normals, colours, texture coordinates and the file's own values |
+//! | `.obj` | `v x y z` with the shortest decimals that read back to the same `f64`, `f a b c` 1-based; vertex colours, normals, texture coordinates and materials |
+//! | `.ply` | binary little-endian, `double x y z`, faces as `list uchar int vertex_indices`; normals, colours, texture coordinates, texture images (MeshLab's) and the file's own values |
 //! | `.stl` | binary, 80-byte header naming meshtrim, `f32` normals and corners |
-//! | `.glb` | binary glTF 2.0, one mesh, one primitive (one per material of a glTF input), `f32` positions, `u32` indices; normals, colours, texture coordinates and the own values `f32` holds as `_NAME` |
+//! | `.glb` | binary glTF 2.0, one mesh, one primitive (one per material), `f32` positions, `u32` indices; normals, colours, texture coordinates, materials and the own values `f32` holds as `_NAME` |
 //! | `.gltf` | glTF 2.0 JSON with the same data in an embedded base64 data URI |
 //!
 //! STL and glTF store coordinates as `f32`, so they lose precision beyond
 //! about 7 significant digits; OBJ and PLY keep `f64` exactly. Output is
 //! written atomically ([`super::atomic::write_atomic`]), and the bytes
-//! depend only on the mesh (no dates, no hash-map order).
+//! depend only on the mesh (no dates, no hash-map order). Materials of
+//! another format's kind are made the output's
+//! ([`super::simple_material`]).
 
 use std::io::Write;
 use std::path::Path;
