@@ -192,7 +192,7 @@ def write_ascii_meshes(work):
 def commands(path, is_mesh, work):
     out = lambda name: os.path.join(work, name)
     if is_mesh:
-        return [["clean", path, out("clean.ply")], ["clean", path, out("repaired.ply"), "--repair"],
+        return [["clean", path, out("clean.ply")], ["clean", path, out("repaired.glb"), "--repair"],
                 [path, CLOUD, out("trim.ply")],
                 ["detect", path, "-o", out("d.csv")], ["mesh", path, out("m.ply")]]
     return [["detect", path, "-o", out("d.csv")], ["edges", path, "-o", out("e.json")],
