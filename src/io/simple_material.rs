@@ -82,6 +82,16 @@ impl Image {
 
 const WHITE: [f64; 4] = [1.0; 4];
 
+impl SimpleMaterial {
+    fn new(name: String, colour: [f64; 4], image: Option<Image>) -> Self {
+        SimpleMaterial {
+            name,
+            colour,
+            image,
+        }
+    }
+}
+
 impl SimpleMaterials {
     /// An OBJ's materials, from the `newmtl` blocks of its libraries (the
     /// first library defining a name wins; a material no library defines,
@@ -93,16 +103,18 @@ impl SimpleMaterials {
                 continue;
             };
             let dir = library.parent().unwrap_or(Path::new(""));
-            for (name, parsed) in mtl_materials(&String::from_utf8_lossy(&bytes), dir) {
-                defined.entry(name).or_insert(parsed);
+            for parsed in mtl_materials(&String::from_utf8_lossy(&bytes), dir) {
+                defined.entry(parsed.name.clone()).or_insert(parsed);
             }
         }
         let materials = material
             .names
             .iter()
             .map(|name| {
-                let (colour, image) = defined.get(name).cloned().unwrap_or((WHITE, None));
-                (name.clone(), colour, image)
+                defined
+                    .get(name)
+                    .cloned()
+                    .unwrap_or_else(|| SimpleMaterial::new(name.clone(), WHITE, None))
             })
             .collect();
         SimpleMaterials::named(materials, material.faces.clone())
@@ -127,13 +139,13 @@ impl SimpleMaterials {
                 let colour = colour_of(&pbr["baseColorFactor"]).unwrap_or(WHITE);
                 let image =
                     base_colour_image(&pbr["baseColorTexture"], gltf).map(|i| images[i].clone());
-                (name, colour, image)
+                SimpleMaterial::new(name, colour, image)
             })
             .collect();
         let mut faces = gltf.faces.clone();
         if faces.contains(&NO_MATERIAL) {
             let default = materials.len() as u32;
-            materials.push(("default".to_string(), WHITE, None));
+            materials.push(SimpleMaterial::new("default".to_string(), WHITE, None));
             for f in faces.iter_mut().filter(|f| **f == NO_MATERIAL) {
                 *f = default;
             }
@@ -149,11 +161,8 @@ impl SimpleMaterials {
             .iter()
             .map(|file| {
                 let stem = file.file_stem().map(|s| s.to_string_lossy().into_owned());
-                (
-                    stem.unwrap_or_default(),
-                    WHITE,
-                    Some(Image::File(file.clone())),
-                )
+                let image = Some(Image::File(file.clone()));
+                SimpleMaterial::new(stem.unwrap_or_default(), WHITE, image)
             })
             .collect();
         let count = textures.files.len() as u32;
@@ -166,17 +175,11 @@ impl SimpleMaterials {
     }
 
     /// Materials with `faces`, their names made distinct words.
-    fn named(materials: Vec<(String, [f64; 4], Option<Image>)>, faces: Vec<u32>) -> Self {
-        let names = distinct_words(materials.iter().map(|(name, ..)| name.as_str()), "material");
-        let materials = materials
-            .into_iter()
-            .zip(names)
-            .map(|((_, colour, image), name)| SimpleMaterial {
-                name,
-                colour,
-                image,
-            })
-            .collect();
+    fn named(mut materials: Vec<SimpleMaterial>, faces: Vec<u32>) -> Self {
+        let names = distinct_words(materials.iter().map(|m| m.name.as_str()), "material");
+        for (material, name) in materials.iter_mut().zip(names) {
+            material.name = name;
+        }
         SimpleMaterials { materials, faces }
     }
 
@@ -355,7 +358,7 @@ fn distinct_file_name(name: &str, taken: &mut std::collections::BTreeSet<String>
 /// The materials an MTL library's text defines: each `newmtl`'s name,
 /// colour and `map_Kd` image (a path from `dir`, the library's
 /// directory).
-fn mtl_materials(text: &str, dir: &Path) -> Vec<(String, ([f64; 4], Option<Image>))> {
+fn mtl_materials(text: &str, dir: &Path) -> Vec<SimpleMaterial> {
     struct Block {
         name: String,
         kd: Option<[f64; 3]>,
@@ -407,7 +410,7 @@ fn mtl_materials(text: &str, dir: &Path) -> Vec<(String, ([f64; 4], Option<Image
                 Some(_) => [1.0; 3],
                 None => block.kd.unwrap_or([1.0; 3]).map(|c| c.clamp(0.0, 1.0)),
             };
-            (block.name, ([r, g, b, opacity], image))
+            SimpleMaterial::new(block.name, [r, g, b, opacity], image)
         })
         .collect()
 }
@@ -526,11 +529,7 @@ mod tests {
     const PNG: &[u8] = b"\x89PNG\r\n\x1a\n rest of a png";
 
     fn material(name: &str, colour: [f64; 4], image: Option<Image>) -> SimpleMaterial {
-        SimpleMaterial {
-            name: name.to_string(),
-            colour,
-            image,
-        }
+        SimpleMaterial::new(name.to_string(), colour, image)
     }
 
     #[test]
@@ -539,14 +538,15 @@ mod tests {
                     NEWMTL textured\nkd 0.4 0.4 0.4\nd 0.5\nmap_Kd -s 1 1 1 tex/a b.png\n\
                     newmtl grey\nKd 0.5\n";
         let parsed = mtl_materials(text, Path::new("lib"));
-        let names: Vec<&str> = parsed.iter().map(|(name, _)| name.as_str()).collect();
+        let names: Vec<&str> = parsed.iter().map(|m| m.name.as_str()).collect();
         assert_eq!(names, ["plain red", "textured", "grey"]);
-        assert_eq!(parsed[0].1, ([1.0, 0.0, 0.0, 0.75], None));
+        let colour_and_image = |m: &SimpleMaterial| (m.colour, m.image.clone());
+        assert_eq!(colour_and_image(&parsed[0]), ([1.0, 0.0, 0.0, 0.75], None));
         // An image's material is white: viewers draw `map_Kd` as it is.
         // The image is the line's last word, from the library's directory.
         let image = Some(Image::File(Path::new("lib").join("b.png")));
-        assert_eq!(parsed[1].1, ([1.0, 1.0, 1.0, 0.5], image));
-        assert_eq!(parsed[2].1, ([0.5, 0.5, 0.5, 1.0], None));
+        assert_eq!(colour_and_image(&parsed[1]), ([1.0, 1.0, 1.0, 0.5], image));
+        assert_eq!(colour_and_image(&parsed[2]), ([0.5, 0.5, 0.5, 1.0], None));
     }
 
     #[test]
