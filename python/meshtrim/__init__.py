@@ -15,6 +15,9 @@ same Rust library, with the same results bit for bit:
 - :func:`carry`: per-vertex values (normals, colours, anything) carried
   from a mesh to the mesh :func:`trim`, :func:`clean` or :func:`mesh`
   made from it, as the CLI carries normals and colours;
+  :func:`carry_faces` per-face values, as the CLI carries materials;
+  :func:`split_seams` the output's vertices split where the input's are
+  (texture charts), as the CLI writes them;
 - :func:`batch_plan`: which meshes ``meshtrim batch`` would take, where
   each output goes and which cloud trims it, for running a batch on
   another scheduler (Dask, say).
@@ -64,6 +67,9 @@ __all__ = [
     "ObjMaterial",
     "write_mesh_carrying",
     "carry",
+    "split_seams",
+    "SplitMesh",
+    "carry_faces",
     "BatchJob",
     "batch_plan",
 ]
@@ -625,18 +631,124 @@ def carry(
     """
     v = _float_rows(vertices, "vertices")
     f = _faces_or_none(faces, len(v))
-    given = np.asarray(values)
-    labels = given.dtype.kind in "biu"
-    nearest = labels if nearest is None else bool(nearest)
-    values = given.astype(np.float64)
-    flat = values.ndim == 1
-    table = np.ascontiguousarray(values.reshape(-1, 1) if flat else values)
-    if table.ndim != 2 or table.shape[0] != len(v):
-        raise MeshtrimError(f"values: expected an array of shape ({len(v)},) or ({len(v)}, k), got {values.shape}")
+    table = _Table(values, len(v), nearest)
     to = _float_rows(out_vertices, "out_vertices")
-    out = _meshtrim.carry(v, f, table, to, _faces_or_none(out_faces, len(to)), bool(normals), nearest)
-    out = out[:, 0] if flat else out
-    return out.astype(given.dtype) if labels and nearest else out
+    out = _meshtrim.carry(v, f, table.rows, to, _faces_or_none(out_faces, len(to)), bool(normals), table.nearest)
+    return table.restored(out)
+
+
+class _Table:
+    """Per-vertex values as the native module carries them: float64 rows,
+    whether from the nearest corner (by default for integers), and how to
+    give the carried rows back in the values' shape and type."""
+
+    def __init__(self, values: Any, vertices: int, nearest: Optional[bool] = None, name: str = "values"):
+        self.given = np.asarray(values)
+        self.labels = self.given.dtype.kind in "biu"
+        self.nearest = self.labels if nearest is None else bool(nearest)
+        as_float = self.given.astype(np.float64)
+        self.flat = as_float.ndim == 1
+        self.rows = np.ascontiguousarray(as_float.reshape(-1, 1) if self.flat else as_float)
+        if self.rows.ndim != 2 or self.rows.shape[0] != vertices:
+            raise MeshtrimError(
+                f"{name}: expected an array of shape ({vertices},) or ({vertices}, k), got {self.given.shape}"
+            )
+
+    def restored(self, out: np.ndarray) -> np.ndarray:
+        out = out[:, 0] if self.flat else out
+        return out.astype(self.given.dtype) if self.labels and self.nearest else out
+
+
+class SplitMesh(NamedTuple):
+    """A mesh split along its input's seams (:func:`split_seams`), with
+    the values carried to it."""
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    values: list
+    face_values: list
+    normals: Optional[np.ndarray]
+
+
+def split_seams(
+    vertices: Any,
+    faces: Any,
+    out_vertices: Any,
+    out_faces: Any,
+    *,
+    values: Sequence = (),
+    face_values: Sequence = (),
+    normals: Any = None,
+    fill: Any = 0,
+) -> SplitMesh:
+    """The mesh ``out_vertices``, ``out_faces``, made from the mesh
+    ``vertices``, ``faces`` by :func:`trim`, :func:`clean` or
+    :func:`mesh`, with its vertices split where the input's are along a
+    seam (a texture chart's border, a crease stored with two normals), as
+    the CLI writes its outputs, the copies after the mesh's own vertices
+    (the same mesh when none is split); with per-vertex ``values``
+    (texture coordinates, colours: each as :func:`carry` takes it),
+    ``normals`` and per-face ``face_values`` (as :func:`carry_faces`
+    takes them) carried to it as the CLI carries its attributes, each copy
+    its own side's. :func:`clean` stitches a mesh's seams (it cleans the
+    surface, not its charts): this is how its output keeps a texture.
+
+    >>> out_v, out_f, _ = meshtrim.clean(v, f)
+    >>> split = meshtrim.split_seams(v, f, out_v, out_f, values=[texcoords], face_values=[material_ids])
+    >>> uv, ids = split.values[0], split.face_values[0]
+    """
+    v = _float_rows(vertices, "vertices")
+    f = _face_rows(faces, len(v))
+    to = _float_rows(out_vertices, "out_vertices")
+    tables = [_Table(array, len(v), name=f"values[{i}]") for i, array in enumerate(values)]
+    if normals is not None:
+        tables.append(_Table(normals, len(v), name="normals"))
+    faces_given = [_face_table(array, len(f), f"face_values[{i}]") for i, array in enumerate(face_values)]
+    native = [(t.rows, t is tables[-1] and normals is not None, t.nearest) for t in tables]
+    split_v, split_f, carried, sources = _meshtrim.split_seams(v, f, to, _face_rows(out_faces, len(to)), native)
+    carried = [t.restored(out) for t, out in zip(tables, carried)]
+    return SplitMesh(
+        split_v,
+        split_f,
+        carried[: len(values)],
+        [_by_face(given, sources, fill) for given in faces_given],
+        carried[-1] if normals is not None else None,
+    )
+
+
+def _face_table(values: Any, faces: int, name: str) -> np.ndarray:
+    """Per-face values, ``(m,)`` or ``(m, k)``, checked."""
+    given = np.asarray(values)
+    if given.ndim not in (1, 2) or given.shape[0] != faces:
+        raise MeshtrimError(f"{name}: expected an array of shape ({faces},) or ({faces}, k), got {given.shape}")
+    return given
+
+
+def _by_face(given: np.ndarray, sources: np.ndarray, fill: Any) -> np.ndarray:
+    """The rows of ``given`` of each face's source face, ``fill`` for none."""
+    out = given[np.maximum(sources, 0)]
+    out[sources < 0] = fill
+    return out
+
+
+def carry_faces(vertices: Any, faces: Any, values: Any, out_vertices: Any, out_faces: Any, *, fill: Any = 0) -> np.ndarray:
+    """Per-face ``values`` of the mesh ``vertices``, ``faces`` (material
+    or texture numbers, segment labels, face colours: ``(m,)`` or
+    ``(m, k)``, any dtype) at the faces of a mesh made from it by
+    :func:`trim`, :func:`clean` or :func:`mesh` (``out_vertices``,
+    ``out_faces``), as the CLI carries an OBJ's materials: a face kept
+    from the input takes its own row, any other the row of the input
+    face, among those its corners lie on, nearest its centroid; ``fill``
+    where it lies on none. For a mesh with seams, :func:`split_seams`
+    carries per-face values to the split output.
+
+    >>> ids = meshtrim.carry_faces(v, f, material_ids, out_v, out_f)
+    """
+    v = _float_rows(vertices, "vertices")
+    f = _face_rows(faces, len(v))
+    given = _face_table(values, len(f), "values")
+    to = _float_rows(out_vertices, "out_vertices")
+    return _by_face(given, _meshtrim.face_sources(v, f, to, _face_rows(out_faces, len(to))), fill)
 
 
 def _faces_or_none(faces: Any, vertices: int) -> np.ndarray:

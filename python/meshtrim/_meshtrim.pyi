@@ -99,6 +99,19 @@ def carry(
     normals: bool,
     nearest: bool,
 ) -> npt.NDArray[np.float64]: ...
+def split_seams(
+    vertices: Points,
+    faces: npt.NDArray[np.uint32],
+    to: Points,
+    to_faces: npt.NDArray[np.uint32],
+    tables: list[Tuple[npt.NDArray[np.float64], bool, bool]],
+) -> Tuple[Points, npt.NDArray[np.int64], list[npt.NDArray[np.float64]], npt.NDArray[np.int64]]: ...
+def face_sources(
+    vertices: Points,
+    faces: npt.NDArray[np.uint32],
+    to: Points,
+    to_faces: npt.NDArray[np.uint32],
+) -> npt.NDArray[np.int64]: ...
 def write_edges(
     path: str | PathLike[str],
     points: Points,

@@ -7,7 +7,11 @@ new ``TriangleMesh`` out (the inputs are not changed).
 Each mesh function takes :func:`meshtrim.trim`'s options as keywords, and
 with ``report=True`` returns ``(mesh, report)``. The input's vertex normals
 and colours, when it has them, are carried to the new mesh
-(:func:`meshtrim.carry`; from a cloud, each vertex's nearest point's).
+(:func:`meshtrim.carry`; from a cloud, each vertex's nearest point's). A
+textured mesh keeps its texture: each corner's texture coordinates are
+carried, split along the charts' borders as the input's were
+(:func:`meshtrim.split_seams`), with its images and each triangle's
+material (:func:`meshtrim.carry_faces`).
 """
 
 from __future__ import annotations
@@ -25,12 +29,42 @@ def _arrays(mesh: o3d.geometry.TriangleMesh) -> tuple:
 
 
 def _result(vertices: np.ndarray, faces: np.ndarray, report: dict, with_report: bool, source):
+    texture = _split_by_texture(source) if isinstance(source, o3d.geometry.TriangleMesh) else None
+    split = None
+    if texture is not None:
+        # The seams the texture coordinates split stay split, each side
+        # with its own coordinates.
+        split_v, split_f, uv = texture
+        ids = np.asarray(source.triangle_material_ids)
+        face_values = [ids] if len(ids) == len(split_f) else []
+        split = meshtrim.split_seams(split_v, split_f, vertices, faces, values=[uv], face_values=face_values)
+        vertices, faces = split.vertices, split.faces
     out = o3d.geometry.TriangleMesh(
         o3d.utility.Vector3dVector(vertices),
         o3d.utility.Vector3iVector(faces.astype(np.int32)),
     )
     _carry_attributes(source, out)
+    if split is not None:
+        out.triangle_uvs = o3d.utility.Vector2dVector(split.values[0][faces].reshape(-1, 2))
+        out.textures = list(source.textures)
+        if split.face_values:
+            out.triangle_material_ids = o3d.utility.IntVector(split.face_values[0].astype(np.int32))
     return (out, report) if with_report else out
+
+
+def _split_by_texture(mesh: o3d.geometry.TriangleMesh):
+    """A textured mesh (a texture coordinate per triangle corner) as one
+    vertex per (vertex, texture coordinate) pair its corners read:
+    ``(vertices, faces, texcoords)``; ``None`` without texture
+    coordinates."""
+    faces = np.asarray(mesh.triangles)
+    uvs = np.asarray(mesh.triangle_uvs)
+    if len(faces) == 0 or uvs.shape != (3 * len(faces), 2):
+        return None
+    keys = np.column_stack([faces.reshape(-1).astype(np.float64), uvs])
+    pairs, corners = np.unique(keys, axis=0, return_inverse=True)
+    vertices = np.asarray(mesh.vertices)[pairs[:, 0].astype(np.int64)]
+    return vertices, corners.reshape(-1, 3), pairs[:, 1:]
 
 
 def _carry_attributes(source, out: o3d.geometry.TriangleMesh) -> None:

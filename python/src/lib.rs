@@ -638,24 +638,92 @@ fn carry<'py>(
     normals: bool,
     nearest: bool,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let from = mesh_of(&vertices, &faces)?;
-    let to = Mesh {
-        vertices: rows(&to, "to")?,
-        faces: rows(&to_faces, "to_faces")?,
-    };
-    let [rows_in, width] = [values.shape()[0], values.shape()[1]];
-    if rows_in != from.vertices.len() {
-        return Err(MeshtrimError::new_err(format!(
-            "values: {rows_in} rows for {} vertices",
-            from.vertices.len()
-        )));
+    let (from, to) = mesh_pair(&vertices, &faces, &to, &to_faces)?;
+    let table = Table::new(&values, normals, nearest, from.vertices.len())?;
+    let carried = without_gil(py, || {
+        let Some(sources) = library::vertex_sources(&from, &to) else {
+            anyhow::bail!("vertices: there are none to carry values from");
+        };
+        Ok(table.carried(&from, &sources))
+    })?;
+    table.array(py, carried, to.vertices.len())
+}
+
+/// Per-vertex values to carry, by columns, and how: blended, as normals,
+/// or from the nearest corner.
+struct Table {
+    columns: Vec<Vec<f64>>,
+    normals: bool,
+    nearest: bool,
+}
+
+impl Table {
+    /// `values`, one row per vertex of a mesh of `vertices` vertices,
+    /// checked (three columns for normals).
+    fn new(
+        values: &PyReadonlyArray2<'_, f64>,
+        normals: bool,
+        nearest: bool,
+        vertices: usize,
+    ) -> PyResult<Table> {
+        let [rows_in, width] = [values.shape()[0], values.shape()[1]];
+        if rows_in != vertices {
+            return Err(MeshtrimError::new_err(format!(
+                "values: {rows_in} rows for {vertices} vertices"
+            )));
+        }
+        if normals && width != 3 {
+            return Err(MeshtrimError::new_err(format!(
+                "values: normals have 3 columns, these have {width}"
+            )));
+        }
+        let columns = (0..width)
+            .map(|c| values.as_array().column(c).to_vec())
+            .collect();
+        Ok(Table {
+            columns,
+            normals,
+            nearest,
+        })
     }
-    if normals && width != 3 {
-        return Err(MeshtrimError::new_err(format!(
-            "values: normals have 3 columns, these have {width}"
-        )));
+
+    /// The values at `sources` in `from`, row after row.
+    fn carried(&self, from: &Mesh, sources: &[library::VertexSource]) -> Vec<f64> {
+        if self.normals {
+            let rows: Vec<Point3> = (0..from.vertices.len())
+                .map(|i| [0, 1, 2].map(|c| self.columns[c][i]))
+                .collect();
+            return library::carry_normals(from, sources, &rows)
+                .as_flattened()
+                .to_vec();
+        }
+        let carried: Vec<Vec<f64>> = self
+            .columns
+            .iter()
+            .map(|column| match self.nearest {
+                true => library::carry_nearest_corner(from, sources, column),
+                false => library::carry_values(from, sources, column),
+            })
+            .collect();
+        (0..sources.len())
+            .flat_map(|i| carried.iter().map(move |column| column[i]))
+            .collect()
     }
-    for (name, mesh) in [("faces", &from), ("to_faces", &to)] {
+
+    /// `rows` carried rows as an `(rows, k)` array.
+    fn array<'py>(
+        &self,
+        py: Python<'py>,
+        carried: Vec<f64>,
+        rows: usize,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        PyArray1::from_vec(py, carried).reshape([rows, self.columns.len()])
+    }
+}
+
+/// Checks that each named mesh's faces name its vertices.
+fn check_faces<const N: usize>(meshes: [(&str, &Mesh); N]) -> PyResult<()> {
+    for (name, mesh) in meshes {
         let count = mesh.vertices.len();
         if let Some(&v) = mesh.faces.iter().flatten().find(|&&v| v as usize >= count) {
             return Err(MeshtrimError::new_err(format!(
@@ -663,35 +731,114 @@ fn carry<'py>(
             )));
         }
     }
-    let normal_rows = if normals {
-        rows(&values, "values")?
-    } else {
-        Vec::new()
+    Ok(())
+}
+
+/// The meshes `from` (`vertices`, `faces`) and `to` (`to`, `to_faces`),
+/// their faces checked.
+fn mesh_pair(
+    vertices: &PyReadonlyArray2<'_, f64>,
+    faces: &PyReadonlyArray2<'_, u32>,
+    to: &PyReadonlyArray2<'_, f64>,
+    to_faces: &PyReadonlyArray2<'_, u32>,
+) -> PyResult<(Mesh, Mesh)> {
+    let from = mesh_of(vertices, faces)?;
+    let to = Mesh {
+        vertices: rows(to, "to")?,
+        faces: rows(to_faces, "to_faces")?,
     };
-    let columns: Vec<Vec<f64>> = (0..width)
-        .map(|c| values.as_array().column(c).to_vec())
-        .collect();
-    let count = to.vertices.len();
-    let carried = without_gil(py, || {
-        let Some(sources) = library::vertex_sources(&from, &to) else {
-            anyhow::bail!("vertices: there are none to carry values from");
+    check_faces([("faces", &from), ("to_faces", &to)])?;
+    Ok((from, to))
+}
+
+/// The mesh `to`, `to_faces` made from `vertices`, `faces`, with its
+/// vertices split where the input's are along a seam, as the CLI writes
+/// its outputs (the copies after its vertices; the same mesh when none
+/// is), each of `tables` (per-vertex values: `(values, normals,
+/// nearest)` as `carry` takes them) carried to it, and for each of its
+/// faces the input face it lies on (−1 for none), all by the sources the
+/// CLI carries its attributes by.
+#[pyfunction]
+#[allow(clippy::type_complexity)]
+fn split_seams<'py>(
+    py: Python<'py>,
+    vertices: PyReadonlyArray2<'py, f64>,
+    faces: PyReadonlyArray2<'py, u32>,
+    to: PyReadonlyArray2<'py, f64>,
+    to_faces: PyReadonlyArray2<'py, u32>,
+    tables: Vec<(PyReadonlyArray2<'py, f64>, bool, bool)>,
+) -> PyResult<(
+    Points<'py>,
+    Faces<'py>,
+    Vec<Bound<'py, PyArray2<f64>>>,
+    Bound<'py, PyArray1<i64>>,
+)> {
+    let (from, to) = mesh_pair(&vertices, &faces, &to, &to_faces)?;
+    let tables = tables
+        .iter()
+        .map(|(values, normals, nearest)| {
+            Table::new(values, *normals, *nearest, from.vertices.len())
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    let (split, carried, face_sources) = without_gil(py, || {
+        let Some(split) = library::split_sources(&from, &to) else {
+            anyhow::bail!("vertices: there are none to take seams from");
         };
-        if normals {
-            let carried = library::carry_normals(&from, &sources, &normal_rows);
-            return Ok(carried.as_flattened().to_vec());
-        }
-        let carried: Vec<Vec<f64>> = columns
+        let mesh = split.split_mesh(&to).unwrap_or(to);
+        let carried: Vec<Vec<f64>> = tables
             .iter()
-            .map(|column| match nearest {
-                true => library::carry_nearest_corner(&from, &sources, column),
-                false => library::carry_values(&from, &sources, column),
-            })
+            .map(|table| table.carried(&from, &split.sources))
             .collect();
-        Ok((0..count)
-            .flat_map(|i| carried.iter().map(move |column| column[i]))
-            .collect())
+        let face_sources = match from.faces.is_empty() {
+            true => vec![None; mesh.faces.len()],
+            false => library::face_sources(&from, &mesh, &split.sources),
+        };
+        Ok((mesh, carried, face_sources))
     })?;
-    PyArray1::from_vec(py, carried).reshape([count, width])
+    let arrays = tables
+        .iter()
+        .zip(carried)
+        .map(|(table, carried)| table.array(py, carried, split.vertices.len()))
+        .collect::<PyResult<Vec<_>>>()?;
+    let face_sources = face_sources
+        .into_iter()
+        .map(|f| f.map_or(-1, i64::from))
+        .collect();
+    Ok((
+        points_array(py, &split.vertices)?,
+        faces_array(py, &split.faces)?,
+        arrays,
+        PyArray1::from_vec(py, face_sources),
+    ))
+}
+
+/// For each face of `to`, `to_faces` (made from `vertices`, `faces`), the
+/// input face it lies on (`library::face_sources`), −1 for none.
+#[pyfunction]
+fn face_sources<'py>(
+    py: Python<'py>,
+    vertices: PyReadonlyArray2<'py, f64>,
+    faces: PyReadonlyArray2<'py, u32>,
+    to: PyReadonlyArray2<'py, f64>,
+    to_faces: PyReadonlyArray2<'py, u32>,
+) -> PyResult<Bound<'py, PyArray1<i64>>> {
+    let (from, to) = mesh_pair(&vertices, &faces, &to, &to_faces)?;
+    if from.faces.is_empty() {
+        return Err(MeshtrimError::new_err(
+            "faces: there are none to take values from",
+        ));
+    }
+    let sources = without_gil(py, || {
+        let Some(sources) = library::vertex_sources(&from, &to) else {
+            anyhow::bail!("vertices: there are none to take values from");
+        };
+        Ok(library::face_sources(&from, &to, &sources))
+    })?;
+    let indices = sources
+        .into_iter()
+        .map(|f| f.map_or(-1, i64::from))
+        .collect();
+    Ok(PyArray1::from_vec(py, indices))
 }
 
 /// The batch's list of work, as `meshtrim batch INPUTS --out-dir OUT_DIR
@@ -846,5 +993,7 @@ fn _meshtrim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(write_edges_py, m)?)?;
     m.add_function(wrap_pyfunction!(batch_plan, m)?)?;
     m.add_function(wrap_pyfunction!(carry, m)?)?;
+    m.add_function(wrap_pyfunction!(split_seams, m)?)?;
+    m.add_function(wrap_pyfunction!(face_sources, m)?)?;
     Ok(())
 }

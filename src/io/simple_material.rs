@@ -154,9 +154,10 @@ impl SimpleMaterials {
     }
 
     /// A PLY's texture files, a white material each, named after its
-    /// file; a face numbering no file takes the first, as on reading.
+    /// file; a face numbering no file takes the first, as on reading (a
+    /// white `default` without files).
     pub fn from_ply(textures: &PlyTextures) -> SimpleMaterials {
-        let materials = textures
+        let mut materials: Vec<SimpleMaterial> = textures
             .files
             .iter()
             .map(|file| {
@@ -165,6 +166,9 @@ impl SimpleMaterials {
                 SimpleMaterial::new(stem.unwrap_or_default(), WHITE, image)
             })
             .collect();
+        if materials.is_empty() {
+            materials.push(SimpleMaterial::new("default".to_string(), WHITE, None));
+        }
         let count = textures.files.len() as u32;
         let faces = textures
             .faces
@@ -384,16 +388,26 @@ fn mtl_materials(text: &str, dir: &Path) -> Vec<SimpleMaterial> {
         let Some(block) = blocks.last_mut() else {
             continue;
         };
-        let numbers: Vec<f64> = words.clone().map_while(|w| w.parse().ok()).collect();
+        let rest: Vec<&str> = words.collect();
+        // The line's numbers, when every word is a finite one.
+        let numbers: Vec<f64> = rest
+            .iter()
+            .map_while(|w| w.parse::<f64>().ok().filter(|v| v.is_finite()))
+            .collect();
+        let numbers = if numbers.len() == rest.len() {
+            numbers
+        } else {
+            Vec::new()
+        };
         match keyword.as_str() {
             "kd" => match numbers[..] {
-                [r, g, b, ..] => block.kd = Some([r, g, b]),
+                [r, g, b] => block.kd = Some([r, g, b]),
                 [grey] => block.kd = Some([grey; 3]),
                 _ => {}
             },
             "d" => block.opacity = numbers.first().copied(),
             "tr" => block.transparency = numbers.first().copied(),
-            "map_kd" => block.image = words.last().map(str::to_string),
+            "map_kd" => block.image = rest.last().map(|w| w.to_string()),
             _ => {}
         }
     }
@@ -415,11 +429,12 @@ fn mtl_materials(text: &str, dir: &Path) -> Vec<SimpleMaterial> {
         .collect()
 }
 
-/// A glTF colour factor: four numbers.
+/// A glTF colour factor: four numbers, each held to 0..1.
 fn colour_of(value: &Value) -> Option<[f64; 4]> {
     let items = value.as_array()?;
     let numbers: Vec<f64> = items.iter().filter_map(Value::as_f64).collect();
-    <[f64; 4]>::try_from(numbers).ok()
+    let colour = <[f64; 4]>::try_from(numbers).ok()?;
+    Some(colour.map(|c| c.clamp(0.0, 1.0)))
 }
 
 /// The image a glTF material's `baseColorTexture` samples through the
@@ -536,10 +551,10 @@ mod tests {
     fn mtl_blocks_give_name_colour_opacity_and_image() {
         let text = "# lib\nKd 0 1 0\nnewmtl plain red\nKd 1 0 0\nTr 0.25\n\
                     NEWMTL textured\nkd 0.4 0.4 0.4\nd 0.5\nmap_Kd -s 1 1 1 tex/a b.png\n\
-                    newmtl grey\nKd 0.5\n";
+                    newmtl grey\nKd 0.5\nd nan\n\nnewmtl odd\nKd 1 nan 0\nd 2\nnewmtl held\nKd 2 0.5 -1\n";
         let parsed = mtl_materials(text, Path::new("lib"));
         let names: Vec<&str> = parsed.iter().map(|m| m.name.as_str()).collect();
-        assert_eq!(names, ["plain red", "textured", "grey"]);
+        assert_eq!(names, ["plain red", "textured", "grey", "odd", "held"]);
         let colour_and_image = |m: &SimpleMaterial| (m.colour, m.image.clone());
         assert_eq!(colour_and_image(&parsed[0]), ([1.0, 0.0, 0.0, 0.75], None));
         // An image's material is white: viewers draw `map_Kd` as it is.
@@ -547,6 +562,9 @@ mod tests {
         let image = Some(Image::File(Path::new("lib").join("b.png")));
         assert_eq!(colour_and_image(&parsed[1]), ([1.0, 1.0, 1.0, 0.5], image));
         assert_eq!(colour_and_image(&parsed[2]), ([0.5, 0.5, 0.5, 1.0], None));
+        // A colour not finite is none; out of range, held to 0..1.
+        assert_eq!(colour_and_image(&parsed[3]), (WHITE, None));
+        assert_eq!(colour_and_image(&parsed[4]), ([1.0, 0.5, 0.0, 1.0], None));
     }
 
     #[test]

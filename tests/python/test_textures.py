@@ -81,12 +81,19 @@ def chart_error(corners, uv, the_map):
 
 def assert_texture_kept(source, out, the_map):
     """As PyMeshLab reads them: the output names the image copied into its
-    folder; every face kept from the source has its corners' exact
-    coordinates; the new ones are on their chart's flat map (0.002 at the
-    99th percentile) but for at most 10 faces that read both charts."""
-    corners_in, uv_in, _ = wedges(source)
+    folder, and its faces' coordinates are kept (`assert_wedges_kept`)."""
     corners, uv, textures = wedges(out)
     assert textures == ["face_textures/face_tex.png"], textures
+    assert_wedges_kept(wedges(source)[:2], (corners, uv), the_map)
+
+
+def assert_wedges_kept(source, out, the_map):
+    """Of the faces' corners and their texture coordinates (`(corners,
+    uv)`, `(m, 3, 3)` and `(m, 3, 2)`), every face kept from the source
+    has its corners' exact coordinates; the new ones are on their chart's
+    flat map (0.002 at the 99th percentile) but for at most 10 faces that
+    read both charts."""
+    (corners_in, uv_in), (corners, uv) = source, out
     by_corners = {c.tobytes(): w for c, w in zip(corners_in, uv_in)}
     kept = [i for i, c in enumerate(corners) if c.tobytes() in by_corners]
     assert len(kept) > 0.9 * len(corners)
@@ -473,3 +480,70 @@ def test_colour_materials_are_carried_to_gltf(tmp_path):
     v, f, attributes = meshtrim.read_mesh(tmp_path / "parts.obj", attributes=True)
     meshtrim.write_mesh(tmp_path / "direct.glb", v, f, material=attributes.material)
     assert colour_sides(tmp_path / "direct.glb") == 0
+
+
+def test_split_seams_gives_what_the_cli_writes(tmp_path):
+    """From Python, clean then split_seams (texture coordinates, the
+    materials per face) make the mesh write_mesh_carrying writes, as the
+    CLI does: the same vertices, faces, coordinates and materials, bit
+    for bit, read back from its OBJ. carry_faces carries per-face values
+    of any shape and type to an output without seams."""
+    import meshtrim
+
+    halves_as_obj(tmp_path / "scan.obj")
+    v, f, attributes = meshtrim.read_mesh(tmp_path / "scan.obj", attributes=True)
+    out_v, out_f, _ = meshtrim.clean(v, f)
+    split = meshtrim.split_seams(
+        v, f, out_v, out_f, values=[attributes.texcoords], face_values=[attributes.material.faces]
+    )
+    assert len(split.vertices) > len(out_v) and len(split.faces) == len(out_f)
+
+    meshtrim.write_mesh_carrying(tmp_path / "out" / "scan.obj", out_v, out_f, v, f, attributes._replace(normals=None))
+    written_v, written_f, written = meshtrim.read_mesh(tmp_path / "out" / "scan.obj", attributes=True)
+    assert np.array_equal(written_v, split.vertices) and np.array_equal(written_f, split.faces)
+    assert np.array_equal(written.texcoords, split.values[0])
+    names = np.array(attributes.material.names)
+    assert np.array_equal(np.array(written.material.names)[written.material.faces], names[split.face_values[0]])
+
+    rows = np.stack([np.arange(len(f)), -np.arange(len(f))], axis=1).astype(np.int16)
+    carried = meshtrim.carry_faces(v, f, rows, out_v, out_f)
+    assert carried.dtype == np.int16 and carried.shape == (len(out_f), 2)
+    assert np.array_equal(carried[:, 0], -carried[:, 1])
+    with pytest.raises(meshtrim.MeshtrimError, match="values: expected an array of shape"):
+        meshtrim.carry_faces(v, f, rows[1:], out_v, out_f)
+    with pytest.raises(meshtrim.MeshtrimError, match=r"values\[0\]: expected an array of shape"):
+        meshtrim.split_seams(v, f, out_v, out_f, values=[attributes.texcoords[1:]])
+
+
+def test_trimesh_and_open3d_keep_a_texture(textured):
+    """The adapters keep a textured mesh's texture: trimesh's (a vertex
+    per (v, vt) pair, `TextureVisuals`) and Open3D's (a texture coordinate
+    per triangle corner, its images and material ids) cleaned, every face
+    kept has its corners' exact coordinates, the new ones are on their
+    chart's map, and the material and image are the input's."""
+    import open3d as o3d
+
+    import meshtrim
+
+    directory, the_map = textured
+    loaded = trimesh.load(str(directory / "face.obj"), process=False)
+    cleaned = meshtrim.trimesh.clean(loaded)
+    assert cleaned.visual.kind == "texture" and cleaned.visual.material is loaded.visual.material
+    assert_wedges_kept(
+        (loaded.vertices[loaded.faces], loaded.visual.uv[loaded.faces]),
+        (cleaned.vertices[cleaned.faces], cleaned.visual.uv[cleaned.faces]),
+        the_map,
+    )
+
+    mesh = o3d.io.read_triangle_mesh(str(directory / "face.obj"))
+    # Open3D reads the image after an empty one (material 0, none).
+    assert mesh.has_triangle_uvs() and [np.asarray(t).shape for t in mesh.textures] == [(), (256, 256, 4)]
+    out = meshtrim.open3d.clean(mesh)
+
+    def corners_and_uv(m):
+        faces = np.asarray(m.triangles)
+        return np.asarray(m.vertices)[faces], np.asarray(m.triangle_uvs).reshape(-1, 3, 2)
+
+    assert_wedges_kept(corners_and_uv(mesh), corners_and_uv(out), the_map)
+    assert len(out.textures) == 2 and np.array_equal(np.asarray(out.textures[1]), np.asarray(mesh.textures[1]))
+    assert set(np.asarray(out.triangle_material_ids)) == set(np.asarray(mesh.triangle_material_ids)) == {1}
