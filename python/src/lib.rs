@@ -800,15 +800,11 @@ fn split_seams<'py>(
         .zip(carried)
         .map(|(table, carried)| table.array(py, carried, split.vertices.len()))
         .collect::<PyResult<Vec<_>>>()?;
-    let face_sources = face_sources
-        .into_iter()
-        .map(|f| f.map_or(-1, i64::from))
-        .collect();
     Ok((
         points_array(py, &split.vertices)?,
         faces_array(py, &split.faces)?,
         arrays,
-        PyArray1::from_vec(py, face_sources),
+        face_index_array(py, face_sources),
     ))
 }
 
@@ -834,11 +830,13 @@ fn face_sources<'py>(
         };
         Ok(library::face_sources(&from, &to, &sources))
     })?;
-    let indices = sources
-        .into_iter()
-        .map(|f| f.map_or(-1, i64::from))
-        .collect();
-    Ok(PyArray1::from_vec(py, indices))
+    Ok(face_index_array(py, sources))
+}
+
+/// Face indices as an array, −1 for none.
+fn face_index_array(py: Python<'_>, faces: Vec<Option<u32>>) -> Bound<'_, PyArray1<i64>> {
+    let indices = faces.into_iter().map(|f| f.map_or(-1, i64::from)).collect();
+    PyArray1::from_vec(py, indices)
 }
 
 /// The batch's list of work, as `meshtrim batch INPUTS --out-dir OUT_DIR

@@ -165,9 +165,8 @@ impl MeshFormat {
                 let (gltf, left) = simple.to_gltf();
                 (Ok(Materials::Gltf(gltf)), left)
             }
-            _ if self.holds_as_they_are(&Materials::Simple(simple.clone())) => {
-                (Ok(Materials::Simple(simple)), Vec::new())
-            }
+            MeshFormat::Obj => (Ok(Materials::Simple(simple)), Vec::new()),
+            MeshFormat::Ply if simple.has_image() => (Ok(Materials::Simple(simple)), Vec::new()),
             _ => (Err(materials), Vec::new()),
         }
     }
