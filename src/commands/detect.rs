@@ -11,7 +11,7 @@ use crate::commands::args::{bpd_options, parse_k, ViewArgs};
 use crate::console;
 use crate::io::atomic::write_atomic;
 use crate::io::labels::{LabelFormat, Labelled};
-use crate::io::{read_cloud_with, Cloud, CloudOptions, Point3};
+use crate::io::{read_cloud_with, Cloud, CloudOptions, Format, Point3};
 use crate::report::{same_file, shown};
 use crate::stages::{detect, millis};
 
@@ -107,7 +107,7 @@ pub fn run(args: &Args) -> Result<()> {
     let (detection, mut summary) =
         detect_in_memory(&cloud.points, &args.bpd_options(), true, &name)?;
     if let Some((path, format)) = &output {
-        write_labels(path, *format, &cloud, &detection)?;
+        write_labels(path, *format, &args.cloud, &cloud, &detection)?;
     }
     summary.file = Some(name);
     summary.read_ms = millis(read_time);
@@ -140,6 +140,7 @@ fn check_output(out: &Path, input: &Path) -> Result<(PathBuf, LabelFormat)> {
 fn write_labels(
     path: &Path,
     format: LabelFormat,
+    input: &Path,
     cloud: &Cloud,
     detection: &Detection,
 ) -> Result<()> {
@@ -149,6 +150,7 @@ fn write_labels(
         beta: &detection.beta,
         scale_offset: cloud.scale_offset,
         grid: cloud.grid.as_deref(),
+        las_source: (cloud.format == Format::Las).then_some(input),
     };
     write_atomic(path, |w| format.write(w, data))
 }

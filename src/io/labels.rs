@@ -25,6 +25,9 @@ pub struct Labelled<'a> {
     /// Each point's scan, row and column, when the input had them (E57):
     /// written by the CSV and PLY outputs.
     pub grid: Option<&'a [GridIndex]>,
+    /// The LAS or LAZ file the points were read from, whose point records
+    /// a LAS or LAZ output writes again with the labels added.
+    pub las_source: Option<&'a std::path::Path>,
 }
 
 impl Labelled<'_> {
@@ -66,6 +69,16 @@ impl LabelFormat {
         match self {
             LabelFormat::Ply => write_ply(w, data),
             LabelFormat::Csv => write_csv(w, data),
+            LabelFormat::Las | LabelFormat::Laz if data.las_source.is_some() => {
+                let source = data.las_source.map(std::fs::read).transpose()?;
+                super::las::write_labels_las_over(
+                    w,
+                    source.unwrap_or_default(),
+                    data.boundary,
+                    data.beta,
+                    self == LabelFormat::Laz,
+                )
+            }
             LabelFormat::Las | LabelFormat::Laz => {
                 let frame = data
                     .scale_offset
@@ -178,6 +191,7 @@ mod tests {
             beta: &beta,
             scale_offset: None,
             grid: None,
+            las_source: None,
         };
         write_ply(&mut out, data).unwrap();
         assert_eq!(ply::read_ply(&out).unwrap().vertices, points);
@@ -197,6 +211,7 @@ mod tests {
             beta: &beta,
             scale_offset: None,
             grid: None,
+            las_source: None,
         };
         write_csv(&mut out, data).unwrap();
         let s = String::from_utf8(out.clone()).unwrap();
@@ -228,6 +243,7 @@ mod tests {
             beta: &beta,
             scale_offset: None,
             grid: Some(&grid),
+            las_source: None,
         };
         let mut csv = Vec::new();
         write_csv(&mut csv, data).unwrap();

@@ -22,12 +22,14 @@
 //! `detect -o OUT.las` writes the points back on the same grid.
 //!
 //! **Writing** (`meshtrim detect CLOUD -o OUT.las|OUT.laz`): the points in
-//! input order, LAS 1.4 point format 0, with two extra-bytes dimensions,
-//! `boundary` (uint8, 1 = boundary) and `beta` (float64), which laspy, PDAL
-//! and CloudCompare read as scalar fields. The input's scale and offset
-//! when it was LAS or LAZ; otherwise, per axis, the offset is the middle of
-//! the points' range and the scale the finest power of ten whose grid
-//! spans that range in 32-bit integers.
+//! input order, LAS 1.4, with two extra-bytes dimensions, `boundary`
+//! (uint8, 1 = boundary) and `beta` (float64), which laspy, PDAL and
+//! CloudCompare read as scalar fields. From a LAS or LAZ input, its point
+//! records byte for byte, the labels appended, with its point format,
+//! scale, offset, VLRs and EVLRs ([`write_labels_las_over`]); from another
+//! format, point format 0 on a grid per axis whose offset is the middle of
+//! the points' range and whose scale is the finest power of ten spanning
+//! that range in 32-bit integers.
 
 use std::io::{Cursor, Write};
 use std::sync::Arc;
@@ -458,6 +460,120 @@ fn labels_las_bytes(
     Ok(cursor.into_inner())
 }
 
+/// Writes the LAS or LAZ file whose bytes are `source` (the points the
+/// labels are of, in file order) again, LAZ when `compressed`: each point
+/// record as it was (intensity, returns, classification, GPS time,
+/// colour, its own extra bytes), with `boundary` and `beta` added as two
+/// more extra-bytes dimensions; the header's VLRs and EVLRs (the
+/// coordinate system among them), scale and offset kept; LAS 1.4.
+pub fn write_labels_las_over(
+    w: &mut dyn Write,
+    source: Vec<u8>,
+    boundary: &[bool],
+    beta: &[f64],
+    compressed: bool,
+) -> std::io::Result<()> {
+    let bytes =
+        relabelled_las_bytes(source, boundary, beta, compressed).map_err(std::io::Error::other)?;
+    w.write_all(&bytes)
+}
+
+fn relabelled_las_bytes(
+    source: Vec<u8>,
+    boundary: &[bool],
+    beta: &[f64],
+    compressed: bool,
+) -> Result<Vec<u8>> {
+    let mut reader = las::Reader::new(Cursor::new(source))
+        .map_err(|e| anyhow!("cannot read the input's LAS header again: {e}"))?;
+    let input = reader.header().clone();
+    let total = input.number_of_points();
+    if total != boundary.len() as u64 {
+        bail!(
+            "the input now holds {total} points, not the {} labelled",
+            boundary.len()
+        );
+    }
+    let own_extra_bytes = input.point_format().extra_bytes;
+    let mut builder = Builder::from(input.clone());
+    builder.version = las::Version::new(1, 4);
+    builder.generating_software = "meshtrim detect".to_string();
+    builder.point_format.extra_bytes = own_extra_bytes
+        .checked_add(EXTRA_BYTES_LEN)
+        .context("the input's point records are too long to add the labels to")?;
+    builder.point_format.is_compressed = compressed;
+    // The LAZ item list is the writer's to make for the output.
+    builder.vlrs.retain(|vlr| vlr.user_id != LASZIP_USER_ID);
+    add_label_descriptors(&mut builder.vlrs, own_extra_bytes);
+    let header = builder.into_header().context("LAS header")?;
+    let format = *header.point_format();
+    let transforms = *header.transforms();
+    let mut writer = las::Writer::new(Cursor::new(Vec::new()), header).context("LAS writer")?;
+    // The records are copied as they are, a chunk at a time, the labels
+    // appended to each: no field is decoded and encoded again.
+    let mut data = PointDataBuilder::new().for_header(&input).build();
+    let chunk = (CHUNK_BYTES / u64::from(input.point_format().len()).max(1)).max(1);
+    let mut done = 0usize;
+    while (done as u64) < total {
+        let read = reader
+            .fill_points(chunk, &mut data)
+            .map_err(|e| anyhow!("point data of the input from point {done}: {e}"))?;
+        if read == 0 || done + data.len() > boundary.len() {
+            bail!("the input's point data no longer holds the {total} points labelled");
+        }
+        let mut bytes = Vec::with_capacity(data.len() * usize::from(format.len()));
+        for (k, record) in data.raw_bytes().chunks_exact(data.record_len()).enumerate() {
+            bytes.extend_from_slice(record);
+            bytes.push(u8::from(boundary[done + k]));
+            bytes.extend_from_slice(&beta[done + k].to_le_bytes());
+        }
+        let slab = PointDataBuilder::new()
+            .with_format(format)
+            .with_transforms(transforms)
+            .build_from_bytes(bytes)
+            .context("labelled point records")?;
+        writer
+            .write_points(&slab)
+            .context("writing the labelled points")?;
+        done += data.len();
+    }
+    let cursor = writer.into_inner().context("finishing the LAS file")?;
+    Ok(cursor.into_inner())
+}
+
+/// The user id of the VLR describing a LAZ file's compressed items.
+const LASZIP_USER_ID: &str = "laszip encoded";
+
+/// Adds `boundary` and `beta` to the Extra Bytes VLR after the
+/// descriptors of the records' `own` extra bytes; without such a VLR,
+/// makes one, the own bytes described as undocumented runs (data type 0,
+/// the length in the options byte, as the standard has it).
+fn add_label_descriptors(vlrs: &mut Vec<Vlr>, own: u16) {
+    let ours = extra_bytes_vlr();
+    let existing = vlrs
+        .iter_mut()
+        .find(|vlr| vlr.user_id == ours.user_id && vlr.record_id == ours.record_id);
+    match existing {
+        Some(vlr) => vlr.data.extend_from_slice(&ours.data),
+        None => {
+            let mut vlr = ours;
+            // Runs of at most 255 bytes, the most one options byte says.
+            let mut undocumented = Vec::new();
+            let mut left = own;
+            while left > 0 {
+                let run = left.min(255);
+                let mut descriptor = [0u8; 192];
+                descriptor[3] = run as u8;
+                descriptor[4..4 + 7].copy_from_slice(b"unnamed");
+                undocumented.extend_from_slice(&descriptor);
+                left -= run;
+            }
+            vlr.data.splice(0..0, undocumented);
+            vlrs.push(vlr);
+        }
+    }
+}
+
 /// Bytes of the two extra dimensions per point: uint8 + float64.
 const EXTRA_BYTES_LEN: u16 = 9;
 
@@ -537,6 +653,89 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A LAS file of format 1 (GPS time) whose records carry `own` extra
+    /// bytes, undescribed, and a VLR of its own.
+    fn survey(own: u16, compressed: bool) -> Vec<u8> {
+        let mut builder = Builder::from((1, 2));
+        builder.point_format = las::point::Format::new(1).unwrap();
+        builder.point_format.extra_bytes = own;
+        builder.point_format.is_compressed = compressed;
+        builder.vlrs.push(Vlr {
+            user_id: "LASF_Projection".to_string(),
+            record_id: 2112,
+            description: "OGC WKT".to_string(),
+            data: b"PROJCS[]".to_vec(),
+        });
+        let header = builder.into_header().unwrap();
+        let mut writer = las::Writer::new(Cursor::new(Vec::new()), header).unwrap();
+        for i in 0..300u16 {
+            writer
+                .write_point(las::Point {
+                    x: f64::from(i) * 0.01,
+                    y: f64::from(i % 17) * 0.01,
+                    z: 1.0,
+                    intensity: i,
+                    gps_time: Some(f64::from(i) * 0.5),
+                    extra_bytes: (0..own).map(|k| (i + k) as u8).collect(),
+                    ..Default::default()
+                })
+                .unwrap();
+        }
+        writer.into_inner().unwrap().into_inner()
+    }
+
+    /// The records of a LAS file's points, decompressed.
+    fn records(bytes: Vec<u8>) -> (las::Header, Vec<Vec<u8>>) {
+        let mut reader = las::Reader::new(Cursor::new(bytes)).unwrap();
+        let header = reader.header().clone();
+        let data = reader.read_all().unwrap();
+        let records = data
+            .raw_bytes()
+            .chunks_exact(data.record_len())
+            .map(<[u8]>::to_vec);
+        (header, records.collect())
+    }
+
+    #[test]
+    fn a_las_input_is_written_again_with_its_records_and_the_labels() {
+        let boundary: Vec<bool> = (0..300).map(|i| i % 4 == 0).collect();
+        let beta: Vec<f64> = (0..300).map(|i| f64::from(i) / 7.0).collect();
+        for (own, compressed) in [(0, false), (3, true), (3, false)] {
+            let source = survey(own, compressed);
+            let (_, before) = records(source.clone());
+            for out_compressed in [false, true] {
+                let bytes =
+                    relabelled_las_bytes(source.clone(), &boundary, &beta, out_compressed).unwrap();
+                let (header, after) = records(bytes);
+                assert_eq!(header.version(), las::Version::new(1, 4));
+                assert_eq!(header.point_format().to_u8().unwrap(), 1);
+                assert_eq!(header.point_format().extra_bytes, own + EXTRA_BYTES_LEN);
+                for (i, (a, b)) in after.iter().zip(&before).enumerate() {
+                    assert_eq!(&a[..b.len()], &b[..], "point {i}'s record");
+                    assert_eq!(a[b.len()], u8::from(boundary[i]));
+                    assert_eq!(a[b.len() + 1..], beta[i].to_le_bytes());
+                }
+                assert_eq!(after.len(), 300);
+                let vlr = |id: u16| header.vlrs().iter().find(|v| v.record_id == id).cloned();
+                assert_eq!(vlr(2112).unwrap().data, b"PROJCS[]");
+                // The own bytes, undescribed in the input, as one
+                // undocumented run (type 0, its length in the options).
+                let descriptors = vlr(4).unwrap().data;
+                assert_eq!(descriptors.len(), 192 * (2 + usize::from(own > 0)));
+                if own > 0 {
+                    assert_eq!((descriptors[2], descriptors[3]), (0, 3));
+                }
+                assert_eq!(&descriptors[descriptors.len() - 188..][..4], b"beta");
+            }
+        }
+        // A file with other points than those labelled is refused.
+        let error = relabelled_las_bytes(survey(0, false), &boundary[1..], &beta[1..], false);
+        assert!(error
+            .unwrap_err()
+            .to_string()
+            .contains("not the 299 labelled"));
     }
 
     #[test]

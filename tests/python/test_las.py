@@ -1,8 +1,9 @@
 """LAS and LAZ clouds written by laspy (with the lazrs codec), the
 format's reference library, read by meshtrim: coordinates exactly as
 laspy reads them, labels identical to the same points given as a double
-PLY; labels written as LAS/LAZ read back by laspy as scalar fields; bad
-files refused with a clear error and nothing written."""
+PLY; labels written as LAS/LAZ read back by laspy as scalar fields, a
+LAS input's point records and coordinate system kept; bad files refused
+with a clear error and nothing written."""
 
 from __future__ import annotations
 
@@ -85,6 +86,60 @@ def test_labels_written_as_las_read_back_by_laspy(tmp_path, ext):
     again = tmp_path / f"again.{ext}"
     run_meshtrim("detect", cloud, "-o", again)
     assert again.read_bytes() == out.read_bytes()
+
+
+def survey_las(path, point_format, version):
+    """The blade as a survey's LAS or LAZ by laspy: every field of its
+    point format filled (intensity, returns, classification, GPS time,
+    colour where the format has them), an extra-bytes dimension of its
+    own (`reflectance`) and its coordinate system as a WKT VLR."""
+    points = blade_points()
+    n = len(points)
+    rng = np.random.default_rng(point_format)
+    header = laspy.LasHeader(point_format=point_format, version=version)
+    header.offsets, header.scales = OFFSET, SCALE
+    header.add_extra_dim(laspy.ExtraBytesParams(name="reflectance", type=np.float32))
+    header.vlrs.append(laspy.VLR("LASF_Projection", 2112, "OGC WKT", b'PROJCS["UTM 32N"]\0'))
+    las = laspy.LasData(header)
+    las.x, las.y, las.z = points[:, 0], points[:, 1], points[:, 2]
+    las.intensity = rng.integers(0, 65536, n)
+    las.number_of_returns = np.full(n, 3)
+    las.return_number = rng.integers(1, 4, n)
+    las.classification = rng.integers(0, 32, n)
+    las.point_source_id = rng.integers(0, 65536, n)
+    if "gps_time" in las.point_format.dimension_names:
+        las.gps_time = rng.random(n) * 1e5
+    if "red" in las.point_format.dimension_names:
+        for channel in ("red", "green", "blue"):
+            las[channel] = rng.integers(0, 65536, n)
+    las.reflectance = rng.random(n).astype(np.float32)
+    las.write(str(path))
+
+
+@pytest.mark.parametrize("point_format, version, ext", [(3, "1.2", "laz"), (1, "1.3", "las"), (7, "1.4", "laz"), (8, "1.4", "las")])
+def test_a_survey_keeps_its_point_records(tmp_path, point_format, version, ext):
+    """Labels written as LAS or LAZ from a LAS or LAZ input keep each
+    point's record as it was (every field of the point format and the
+    file's own extra bytes, as laspy reads them), its scale and offset and
+    its coordinate system VLR, with `boundary` and `beta` added after its
+    own extra dimensions: LAS 1.4, the input's point format."""
+    cloud = tmp_path / f"survey.{'laz' if ext == 'las' else 'las'}"
+    survey_las(cloud, point_format, version)
+    out = tmp_path / f"labels.{ext}"
+    run_meshtrim("detect", cloud, "-o", out)
+    run_meshtrim("detect", cloud, "-o", tmp_path / "labels.csv")
+    _, boundary, beta = labels_csv(tmp_path / "labels.csv")
+    source, las = laspy.read(str(cloud)), laspy.read(str(out))
+    assert (las.header.version.major, las.header.version.minor) == (1, 4)
+    assert las.point_format.id == point_format
+    assert np.array_equal(las.header.offsets, OFFSET) and np.array_equal(las.header.scales, SCALE)
+    for name in source.point_format.dimension_names:
+        assert np.array_equal(np.asarray(las[name]), np.asarray(source[name])), name
+    assert list(las.point_format.extra_dimension_names) == ["reflectance", "boundary", "beta"]
+    assert np.array_equal(np.asarray(las.boundary) == 1, boundary)
+    assert np.array_equal(np.asarray(las.beta), beta)
+    wkt = [vlr for vlr in las.header.vlrs if vlr.record_id == 2112]
+    assert len(wkt) == 1 and wkt[0].record_data_bytes().startswith(b'PROJCS["UTM 32N"]'), las.header.vlrs
 
 
 def test_labels_of_another_format_on_a_fine_grid(tmp_path):
