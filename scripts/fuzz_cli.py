@@ -195,7 +195,9 @@ def commands(path, is_mesh, work):
         return [["clean", path, out("clean.ply")], ["clean", path, out("repaired.glb"), "--repair"],
                 [path, CLOUD, out("trim.ply")],
                 ["detect", path, "-o", out("d.csv")], ["mesh", path, out("m.ply")]]
-    return [["detect", path, "-o", out("d.csv")], ["edges", path, "-o", out("e.json")],
+    # A LAS or LAZ input's labels go to LAS, which reads its records again.
+    labels = "d.laz" if path.endswith((".las", ".laz")) else "d.csv"
+    return [["detect", path, "-o", out(labels)], ["edges", path, "-o", out("e.json")],
             ["mesh", path, out("m.ply")], [POISSON, path, out("trim.ply")]]
 
 
