@@ -46,7 +46,7 @@ from typing import Any, Mapping, NamedTuple, Optional, Sequence, Union
 import numpy as np
 
 from . import _meshtrim
-from ._meshtrim import MeshtrimError
+from ._meshtrim import FileMaterials, MeshtrimError
 
 __all__ = [
     "MeshtrimError",
@@ -65,6 +65,7 @@ __all__ = [
     "write_edges",
     "VertexAttributes",
     "ObjMaterial",
+    "FileMaterials",
     "write_mesh_carrying",
     "carry",
     "split_seams",
@@ -438,7 +439,7 @@ def _attributes(normals, colours, alpha, fields, texcoords=None, material=None) 
     if colours is not None and not alpha:
         colours = np.ascontiguousarray(colours[:, :3])
     scalars = {name: values.astype(_PLY_TYPES[kind]) for name, kind, values in fields}
-    if material is not None:
+    if isinstance(material, tuple):
         libraries, names, faces = material
         material = ObjMaterial(tuple(os.fspath(p) for p in libraries), tuple(names), faces)
     return VertexAttributes(normals, colours, scalars, texcoords, material)
@@ -470,14 +471,17 @@ class VertexAttributes(NamedTuple):
     float64 texture coordinates (u, v with v up the image, as OBJ stores
     it: an OBJ's ``vt``, glTF's ``TEXCOORD_0`` turned up, PLY's
     ``texture_u``/``texture_v``), and ``material``, an OBJ's
-    :class:`ObjMaterial`, each ``None`` when the file has none.""" 
+    :class:`ObjMaterial` or a glTF's materials or a PLY's texture images
+    as a :class:`FileMaterials` (``kind``, ``names``, ``faces``;
+    ``with_faces(faces)`` the same materials on other faces), each
+    ``None`` when the file has none.""" 
 
     normals: Optional[np.ndarray]
     colours: Optional[np.ndarray]
     # Read-only, so that the one default is not shared and changed.
     scalars: Mapping[str, np.ndarray] = MappingProxyType({})
     texcoords: Optional[np.ndarray] = None
-    material: Optional[ObjMaterial] = None
+    material: Optional[Union[ObjMaterial, "FileMaterials"]] = None
 
 
 def read_mesh(path: PathLike, *, attributes: bool = False) -> tuple:
@@ -505,7 +509,7 @@ def write_mesh(
     colours: Any = None,
     scalars: Optional[dict] = None,
     texcoords: Any = None,
-    material: Optional[ObjMaterial] = None,
+    material: Optional[Union[ObjMaterial, FileMaterials]] = None,
 ) -> None:
     """Writes a mesh as the CLI writes its outputs: the format from the
     extension (.obj, .ply and .stl binary, .gltf, .glb), missing parent
@@ -553,12 +557,16 @@ def write_mesh_carrying(
     return written, not_written
 
 
-def _texture_arrays(texcoords: Any, material: Optional[ObjMaterial], vertices: int, faces: int) -> tuple:
+def _texture_arrays(texcoords: Any, material: Any, vertices: int, faces: int) -> tuple:
     """Texture coordinates of `vertices` vertices and a material of
     `faces` faces as the native layer takes them, each checked."""
     t = None if texcoords is None else _per_vertex(texcoords, "texcoords", vertices, (2,))
     if material is None:
         return t, None
+    if isinstance(material, FileMaterials):
+        if len(material.faces) != faces:
+            raise MeshtrimError(f"material.faces: expected {faces} faces' materials, got {len(material.faces)}")
+        return t, material
     libraries, names, per_face = material
     a = np.asarray(per_face)
     if a.shape != (faces,) or (a.size and (not np.issubdtype(a.dtype, np.integer) or a.min() < 0)):

@@ -20,6 +20,15 @@ LoopTuple = Tuple[bool, npt.NDArray[np.int64], Points, list[Tuple[bool, Points]]
 
 class MeshtrimError(ValueError): ...
 
+class FileMaterials:
+    @property
+    def kind(self) -> str: ...
+    @property
+    def names(self) -> list[str]: ...
+    @property
+    def faces(self) -> npt.NDArray[np.uint32]: ...
+    def with_faces(self, faces: npt.NDArray[np.uint32]) -> FileMaterials: ...
+
 def detect(
     points: Points, k: int, anisotropy: bool, view_along: Vector, view_from: Vector
 ) -> Tuple[Labels, str]: ...
@@ -54,7 +63,7 @@ Fields = list[Tuple[str, str, npt.NDArray[np.float64]]]
 def read_cloud(
     path: str | PathLike[str], scan: Optional[int] = None
 ) -> Tuple[Points, Optional[Points], Optional[npt.NDArray[np.float64]], bool, Fields]: ...
-Material = Tuple[list[str], list[str], npt.NDArray[np.uint32]]
+Material = Tuple[list[str], list[str], npt.NDArray[np.uint32]] | FileMaterials
 
 def read_mesh(
     path: str | PathLike[str],

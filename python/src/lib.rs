@@ -464,12 +464,94 @@ type MeshRead<'py> = (
     Option<MaterialOut<'py>>,
 );
 
-/// An OBJ's materials: its libraries' paths, the names, each face's
-/// index into the names.
-type MaterialOut<'py> = (Vec<PathBuf>, Vec<String>, Bound<'py, PyArray1<u32>>);
+/// A mesh's materials as read: an OBJ's libraries' paths, the names and
+/// each face's index into the names; another format's as an object.
+#[derive(IntoPyObject)]
+enum MaterialOut<'py> {
+    Obj(Vec<PathBuf>, Vec<String>, Bound<'py, PyArray1<u32>>),
+    File(FileMaterials),
+}
 
-/// The same, as `write_mesh` takes it.
-type MaterialIn<'py> = (Vec<PathBuf>, Vec<String>, PyReadonlyArray1<'py, u32>);
+/// A material as `write_mesh` takes it: an OBJ's (libraries, names,
+/// faces), or another format's as `read_mesh` gave it.
+#[derive(FromPyObject)]
+enum MaterialIn<'py> {
+    File(PyRef<'py, FileMaterials>),
+    Obj(Vec<PathBuf>, Vec<String>, PyReadonlyArray1<'py, u32>),
+}
+
+impl MaterialIn<'_> {
+    /// The number of faces it gives a material.
+    fn face_count(&self) -> usize {
+        match self {
+            MaterialIn::File(m) => m.materials.face_count(),
+            MaterialIn::Obj(_, _, faces) => faces.len(),
+        }
+    }
+
+    fn into_materials(self) -> meshtrim::io::Materials {
+        match self {
+            MaterialIn::File(m) => m.materials.clone(),
+            MaterialIn::Obj(libraries, names, faces) => {
+                meshtrim::io::Materials::Obj(meshtrim::io::ObjMaterial {
+                    libraries,
+                    names,
+                    faces: faces.as_array().to_vec(),
+                })
+            }
+        }
+    }
+}
+
+/// A glTF file's materials (with their images) or a PLY file's texture
+/// images, as read with its mesh: carried and written by
+/// `write_mesh_carrying` and `write_mesh` as the CLI writes them.
+#[pyclass(frozen, module = "meshtrim._meshtrim")]
+struct FileMaterials {
+    materials: meshtrim::io::Materials,
+}
+
+#[pymethods]
+impl FileMaterials {
+    /// "gltf" or "ply".
+    #[getter]
+    fn kind(&self) -> &'static str {
+        match self.materials {
+            meshtrim::io::Materials::Gltf(_) => "gltf",
+            _ => "ply",
+        }
+    }
+
+    /// The materials' names (glTF's, `material_<i>` where none is given),
+    /// or the texture images' paths (PLY).
+    #[getter]
+    fn names(&self) -> Vec<String> {
+        self.materials.names()
+    }
+
+    /// Each face's material, an index into `names` (glTF's faces without
+    /// a material 4294967295).
+    #[getter]
+    fn faces<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u32>> {
+        PyArray1::from_slice(py, self.materials.faces())
+    }
+
+    /// The same materials with `faces` as each face's.
+    fn with_faces(&self, faces: PyReadonlyArray1<'_, u32>) -> FileMaterials {
+        let mut materials = self.materials.clone();
+        materials.set_faces(faces.as_array().to_vec());
+        FileMaterials { materials }
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "FileMaterials(kind={:?}, names={:?}, faces=<{} faces>)",
+            self.kind(),
+            self.names(),
+            self.materials.face_count()
+        )
+    }
+}
 
 /// A mesh's vertices, faces and vertex attributes, read as `trim` and
 /// `clean` read a mesh.
@@ -488,14 +570,15 @@ fn read_mesh(py: Python<'_>, path: PathBuf) -> PyResult<MeshRead<'_>> {
         .as_ref()
         .map(|t| PyArray1::from_slice(py, t.as_flattened()).reshape([t.len(), 2]))
         .transpose()?;
-    // The package gives an OBJ's materials; the other kinds stay with the
-    // CLI.
+    // An OBJ's materials as arrays and names; another format's as an
+    // object the writers take back.
     let material = match attributes.materials {
         Some(meshtrim::io::Materials::Obj(m)) => {
             let faces = PyArray1::from_vec(py, m.faces);
-            Some((m.libraries, m.names, faces))
+            Some(MaterialOut::Obj(m.libraries, m.names, faces))
         }
-        _ => None,
+        Some(materials) => Some(MaterialOut::File(FileMaterials { materials })),
+        None => None,
     };
     Ok((
         points_array(py, &mesh.vertices)?,
@@ -555,11 +638,11 @@ fn write_mesh_carrying(
 ) -> PyResult<(Vec<String>, Vec<String>)> {
     let out = mesh_of(&vertices, &faces)?;
     let from = mesh_of(&from_vertices, &from_faces)?;
-    if let Some((_, _, faces)) = &material {
-        if faces.len() != from.faces.len() {
+    if let Some(material) = &material {
+        if material.face_count() != from.faces.len() {
             return Err(MeshtrimError::new_err(format!(
                 "material: {} face materials for {} source faces",
-                faces.len(),
+                material.face_count(),
                 from.faces.len()
             )));
         }
@@ -579,13 +662,7 @@ fn attributes_of(
     texcoords: Option<PyReadonlyArray2<'_, f64>>,
     material: Option<MaterialIn<'_>>,
 ) -> PyResult<meshtrim::io::VertexAttributes> {
-    let materials = material.map(|(libraries, names, faces)| {
-        meshtrim::io::Materials::Obj(meshtrim::io::ObjMaterial {
-            libraries,
-            names,
-            faces: faces.as_array().to_vec(),
-        })
-    });
+    let materials = material.map(MaterialIn::into_materials);
     Ok(meshtrim::io::VertexAttributes {
         normals: normals.map(|n| rows(&n, "normals")).transpose()?,
         colours: colours.map(|c| colours_of(&c)).transpose()?,
@@ -991,6 +1068,7 @@ fn _meshtrim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(write_edges_py, m)?)?;
     m.add_function(wrap_pyfunction!(batch_plan, m)?)?;
     m.add_function(wrap_pyfunction!(carry, m)?)?;
+    m.add_class::<FileMaterials>()?;
     m.add_function(wrap_pyfunction!(split_seams, m)?)?;
     m.add_function(wrap_pyfunction!(face_sources, m)?)?;
     Ok(())

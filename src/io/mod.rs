@@ -196,15 +196,51 @@ impl Materials {
         }
     }
 
+    /// Each face's material.
+    pub fn faces(&self) -> &[u32] {
+        match self {
+            Materials::Obj(m) => &m.faces,
+            Materials::Gltf(m) => &m.faces,
+            Materials::Ply(m) => &m.faces,
+            Materials::Simple(m) => &m.faces,
+        }
+    }
+
+    /// The number of faces given a material.
+    pub fn face_count(&self) -> usize {
+        self.faces().len()
+    }
+
+    /// Gives the faces `faces` as their materials.
+    pub fn set_faces(&mut self, faces: Vec<u32>) {
+        *self.faces_mut() = faces;
+    }
+
+    /// The materials' names: an OBJ's `usemtl` names, a glTF's material
+    /// names (`material_<i>` where one has none), a PLY's texture images'
+    /// paths, the simple materials' names.
+    pub fn names(&self) -> Vec<String> {
+        match self {
+            Materials::Obj(m) => m.names.clone(),
+            Materials::Gltf(m) => (m.materials.iter().enumerate())
+                .map(|(i, json)| match json["name"].as_str() {
+                    Some(name) => name.to_string(),
+                    None => format!("material_{i}"),
+                })
+                .collect(),
+            Materials::Ply(m) => m.files.iter().map(|f| f.display().to_string()).collect(),
+            Materials::Simple(m) => m.materials.iter().map(|m| m.name.clone()).collect(),
+        }
+    }
+
     /// Checks there is a material per face (of `faces`), each one of
     /// those given (a PLY's texture number may name none: it reads the
     /// first; a glTF face may have none).
     pub fn check(&self, faces: usize) -> anyhow::Result<()> {
-        let (face_materials, count) = match self {
-            Materials::Obj(m) => (&m.faces, m.names.len()),
-            Materials::Gltf(m) => (&m.faces, m.materials.len()),
-            Materials::Ply(m) => (&m.faces, usize::MAX),
-            Materials::Simple(m) => (&m.faces, m.materials.len()),
+        let face_materials = self.faces();
+        let count = match self {
+            Materials::Ply(_) => usize::MAX,
+            _ => self.names().len(),
         };
         if face_materials.len() != faces {
             anyhow::bail!("{} face materials for {faces} faces", face_materials.len());
