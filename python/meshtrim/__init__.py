@@ -625,7 +625,10 @@ def carry(
     its closest point on the input surface (from a cloud, the nearest
     point's row). Where input vertices share a position (a seam), the
     output faces say which is which: give ``out_faces`` for meshes with
-    seams. ``values`` is ``(n,)`` or ``(n, k)``: colours, a quality,
+    seams. :func:`clean` stitches seams, so one output vertex stands for
+    both sides; :func:`split_seams` splits the output again and carries
+    each side its own values (texture coordinates across a chart's
+    border). ``values`` is ``(n,)`` or ``(n, k)``: colours, a quality,
     texture coordinates. With ``normals=True`` (``k`` = 3) rows blend as
     normals do: the direction, at the blended length. Integer (and bool)
     values, labels or flags, are not blended: a new vertex takes the row
