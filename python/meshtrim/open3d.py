@@ -8,10 +8,10 @@ Each mesh function takes :func:`meshtrim.trim`'s options as keywords, and
 with ``report=True`` returns ``(mesh, report)``. The input's vertex normals
 and colours, when it has them, are carried to the new mesh
 (:func:`meshtrim.carry`; from a cloud, each vertex's nearest point's). A
-textured mesh keeps its texture: each corner's texture coordinates are
-carried, split along the charts' borders as the input's were
-(:func:`meshtrim.split_seams`), with its images and each triangle's
-material (:func:`meshtrim.carry_faces`).
+textured mesh keeps its texture: each corner's texture coordinates and
+each triangle's material are carried, the vertices split along the
+charts' borders as the input's were (:func:`meshtrim.split_seams`), with
+its images.
 """
 
 from __future__ import annotations
