@@ -540,6 +540,54 @@ fn meshes_without_a_cloud_are_cleaned_like_meshtrim_clean() {
     }
 }
 
+/// `--to` writes every output in one format: the bytes `meshtrim clean`
+/// and `meshtrim trim` write to that extension; two inputs of one stem
+/// that would share an output are refused before any work; an unknown
+/// format is a usage error.
+#[test]
+fn to_writes_every_output_in_one_format() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::create_dir_all(d.join("scans/sub")).unwrap();
+    std::fs::copy(JAGGED, d.join("scans/sub/j.stl")).unwrap();
+    pair(d, "scans/t");
+    assert_ok(&batch(d, &["scans", "--out-dir", "out", "--to", "glb"]));
+    assert_eq!(
+        files_below(&d.join("out")),
+        ["sub/j.glb", "t.glb"].map(PathBuf::from)
+    );
+    let single = |args: &[&str], name: &str| {
+        let out = d.join(name);
+        let mut args = args.to_vec();
+        args.push(out.to_str().unwrap());
+        assert_ok(
+            &Command::new(env!("CARGO_BIN_EXE_meshtrim"))
+                .args(&args)
+                .output()
+                .unwrap(),
+        );
+        std::fs::read(out).unwrap()
+    };
+    let cleaned = single(&["clean", JAGGED], "clean.glb");
+    assert!(std::fs::read(d.join("out/sub/j.glb")).unwrap() == cleaned);
+    let trimmed = single(&[MESH, CLOUD], "trim.glb");
+    assert!(std::fs::read(d.join("out/t.glb")).unwrap() == trimmed);
+
+    // j.ply beside j.stl: both to j.stl.
+    std::fs::copy(MESH, d.join("scans/sub/j.ply")).unwrap();
+    let run = batch(d, &["scans/sub", "--out-dir", "again", "--to", "stl"]);
+    let stderr = text(&run.stderr);
+    assert_eq!(run.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("would both be written to again/j.stl"),
+        "{stderr}"
+    );
+    assert!(!d.join("again").exists(), "nothing processed");
+
+    let run = batch(d, &["scans", "--out-dir", "out", "--to", "xyz"]);
+    assert_eq!(run.status.code(), Some(2), "{}", text(&run.stderr));
+}
+
 #[test]
 fn an_unknown_report_format_is_refused_up_front() {
     let dir = tempfile::tempdir().unwrap();

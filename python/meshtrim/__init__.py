@@ -780,15 +780,20 @@ class BatchJob(NamedTuple):
 
 
 def batch_plan(
-    inputs: Union[PathLike, Sequence[PathLike]], out_dir: PathLike, *, cloud_dir: Optional[PathLike] = None
+    inputs: Union[PathLike, Sequence[PathLike]],
+    out_dir: PathLike,
+    *,
+    cloud_dir: Optional[PathLike] = None,
+    to: Optional[str] = None,
 ) -> list:
     """The work ``meshtrim batch INPUTS --out-dir OUT_DIR [--cloud-dir
-    CLOUD_DIR]`` would do, decided as it decides it before processing
+    CLOUD_DIR] [--to EXT]`` would do, decided as it decides it before processing
     anything: ``inputs`` (files, directories walked recursively, glob
     patterns) expanded, sorted and de-duplicated, each mesh paired with
     its clouds by name (``S.cloud.EXT``, or ``S.EXT`` with a cloud-only
     extension such as ``.e57``, ``.laz`` or ``.xyz``), outputs mirrored
-    below ``out_dir`` and checked (two meshes with one output, or an
+    below ``out_dir`` (with the extension ``to``, a mesh format's, when
+    given) and checked (two meshes with one output, or an
     output that is an input, raise :class:`MeshtrimError`). A list of
     :class:`BatchJob`, sorted by input path; nothing is read but
     directory listings and PLY/OBJ headers, nothing written."""
@@ -798,5 +803,5 @@ def batch_plan(
     cloud = None if cloud_dir is None else os.fspath(cloud_dir)
     return [
         BatchJob(Path(i), Path(o), tuple(Path(c) for c in clouds))
-        for i, o, clouds in _meshtrim.batch_plan(args, os.fspath(out_dir), cloud)
+        for i, o, clouds in _meshtrim.batch_plan(args, os.fspath(out_dir), cloud, to)
     ]

@@ -917,16 +917,17 @@ fn face_index_array(py: Python<'_>, faces: Vec<Option<u32>>) -> Bound<'_, PyArra
 }
 
 /// The batch's list of work, as `meshtrim batch INPUTS --out-dir OUT_DIR
-/// [--cloud-dir CLOUD_DIR]` makes it before processing anything: per mesh
+/// [--cloud-dir CLOUD_DIR] [--to EXT]` makes it before processing anything: per mesh
 /// (sorted by path), its output and the clouds paired with it (none:
 /// cleaned; one: trimmed with it; several: the batch fails that mesh).
 #[pyfunction]
-#[pyo3(signature = (inputs, out_dir, cloud_dir=None))]
+#[pyo3(signature = (inputs, out_dir, cloud_dir=None, to=None))]
 fn batch_plan(
     py: Python<'_>,
     inputs: Vec<PathBuf>,
     out_dir: PathBuf,
     cloud_dir: Option<PathBuf>,
+    to: Option<String>,
 ) -> PyResult<Vec<(PathBuf, PathBuf, Vec<PathBuf>)>> {
     let jobs = without_gil(py, || {
         commands::batch::plan(&commands::batch::Inputs {
@@ -934,6 +935,7 @@ fn batch_plan(
             out_dir: &out_dir,
             cloud_dir: cloud_dir.as_deref(),
             report: None,
+            to: to.as_deref(),
         })
     })?;
     Ok(jobs

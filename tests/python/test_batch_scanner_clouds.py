@@ -80,6 +80,10 @@ def test_batch_plan_pairs_the_scanners_files(scans):
         meshtrim.BatchJob(d / "m.ply", out / "m.ply", (d / "m.e57",)),
         meshtrim.BatchJob(d / "sub" / "c.ply", out / "sub" / "c.ply", (d / "sub" / "c.cloud.las",)),
     ]
+    # Every output in one format (--to).
+    assert [j.output for j in meshtrim.batch_plan(d, out, to="glb")] == [
+        out / "a.glb", out / "b.glb", out / "d.glb", out / "e.glb", out / "m.glb", out / "sub" / "c.glb"
+    ]
     # A glob pattern and a file argument, as the CLI takes them.
     assert [j.input for j in meshtrim.batch_plan([str(d / "*.ply"), d / "d.stl"], out)] == [
         d / "a.ply",
@@ -99,6 +103,8 @@ def test_batch_plan_refuses_what_the_batch_refuses(scans):
     # Outputs into the inputs' own folder would overwrite them.
     with pytest.raises(meshtrim.MeshtrimError, match="overwrite"):
         meshtrim.batch_plan(d, d)
+    with pytest.raises(meshtrim.MeshtrimError, match="cannot write meshes as '.xyz'"):
+        meshtrim.batch_plan(d, scans / "out", to="xyz")
 
 
 def test_batch_trims_with_the_scanners_files(scans, tmp_path):

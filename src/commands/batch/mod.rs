@@ -41,9 +41,15 @@ pub struct Args {
     #[arg(required = true, value_name = "INPUTS")]
     pub inputs: Vec<PathBuf>,
     /// Where the outputs go: the input's path below the directory argument
-    /// it was found in (or its file name), same extension.
+    /// it was found in (or its file name), same extension (or --to's).
     #[arg(long, value_name = "DIR")]
     pub out_dir: PathBuf,
+    /// Write every output in this mesh format (obj, ply, stl, glb, gltf)
+    /// instead of its input's: a folder of textured OBJ scans to GLB, or
+    /// of PLY to STL for CAM. Texture coordinates and materials are made
+    /// the format's, as one command's output to another extension is.
+    #[arg(long, value_name = "EXT", value_parser = ["obj", "ply", "stl", "glb", "gltf"])]
+    pub to: Option<String>,
     /// Look for the clouds here (mirroring the inputs' sub-directories)
     /// instead of beside the meshes.
     #[arg(long, value_name = "DIR")]
@@ -87,6 +93,7 @@ pub fn run(args: &Args) -> Result<()> {
         out_dir: &args.out_dir,
         cloud_dir: args.cloud_dir.as_deref(),
         report: args.report.as_deref(),
+        to: args.to.as_deref(),
     })?;
     let inputs = jobs.len();
     let jobs: Vec<Job> = match args.shard {

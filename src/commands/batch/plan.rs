@@ -88,12 +88,19 @@ pub struct Inputs<'a> {
     pub cloud_dir: Option<&'a Path>,
     /// The report file, checked against the inputs too.
     pub report: Option<&'a Path>,
+    /// The outputs' extension (a mesh format's) instead of the inputs'.
+    pub to: Option<&'a str>,
 }
 
 /// The whole batch (every shard), sorted by input path: expands the
 /// arguments, pairs meshes with clouds and refuses, before any work, two
 /// inputs sharing an output and outputs that would overwrite an input.
 pub fn plan(inputs: &Inputs) -> Result<Vec<Job>> {
+    if let Some(extension) = inputs.to {
+        if !MESH_EXTENSIONS.contains(&extension.to_ascii_lowercase().as_str()) {
+            bail!("cannot write meshes as '.{extension}': the extension must be one of obj, ply, stl, glb, gltf");
+        }
+    }
     if let Some(dir) = inputs.cloud_dir {
         if !dir.is_dir() {
             bail!("{}: --cloud-dir is not a directory", dir.display());
@@ -105,7 +112,10 @@ pub fn plan(inputs: &Inputs) -> Result<Vec<Job>> {
         .into_iter()
         .map(|f| {
             let cloud = clouds.find(&f, inputs.cloud_dir)?;
-            let output = inputs.out_dir.join(&f.rel);
+            let mut output = inputs.out_dir.join(&f.rel);
+            if let Some(extension) = inputs.to {
+                output.set_extension(extension);
+            }
             Ok(Job {
                 input: f.path,
                 output,
