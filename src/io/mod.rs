@@ -239,8 +239,10 @@ impl Materials {
     pub fn check(&self, faces: usize) -> anyhow::Result<()> {
         let face_materials = self.faces();
         let count = match self {
+            Materials::Obj(m) => m.names.len(),
+            Materials::Gltf(m) => m.materials.len(),
             Materials::Ply(_) => usize::MAX,
-            _ => self.names().len(),
+            Materials::Simple(m) => m.materials.len(),
         };
         if face_materials.len() != faces {
             anyhow::bail!("{} face materials for {faces} faces", face_materials.len());

@@ -1002,12 +1002,7 @@ fn read_textured_faces(
             uv = None;
         }
         let at = |k: usize| [texcoords[2 * k], texcoords[2 * k + 1]];
-        let number = texnumber.map(|k| record.scalars[k]).map(|n| {
-            match n.fract() == 0.0 && (0.0..f64::from(u32::MAX)).contains(&n) {
-                true => n as u32,
-                false => u32::MAX,
-            }
-        });
+        let number = texnumber.map(|k| whole_u32(record.scalars[k]).unwrap_or(u32::MAX));
         for w in 1..corners.len().saturating_sub(1) {
             faces.push([corners[0], corners[w], corners[w + 1]]);
             if let Some(uv) = uv.as_mut() {
@@ -1027,11 +1022,12 @@ fn read_textured_faces(
 
 /// A vertex index read as a float, checked.
 fn face_index(face: usize, v: f64) -> Result<u32> {
-    if v.fract() == 0.0 && (0.0..=f64::from(u32::MAX)).contains(&v) {
-        Ok(v as u32)
-    } else {
-        Err(anyhow!("face {face} has a bad vertex index {v}"))
-    }
+    whole_u32(v).ok_or_else(|| anyhow!("face {face} has a bad vertex index {v}"))
+}
+
+/// A value read as a float that is a whole `u32` (an index, a count).
+fn whole_u32(v: f64) -> Option<u32> {
+    (v.fract() == 0.0 && (0.0..=f64::from(u32::MAX)).contains(&v)).then_some(v as u32)
 }
 
 /// The mesh's vertices split by the texture coordinates their corners
@@ -1363,9 +1359,7 @@ fn read_faces(
 /// first).
 fn faces_from_fans(fans: &Fans, count: usize, faces: &mut Vec<[u32; 3]>) -> Result<()> {
     let (first_line, fans) = (fans.first_line, &fans.triangles);
-    let index =
-        |v: f64| (v.fract() == 0.0 && (0.0..=f64::from(u32::MAX)).contains(&v)).then_some(v as u32);
-    let is_bad = |v: &f64| index(*v).is_none();
+    let is_bad = |v: &f64| whole_u32(*v).is_none();
     if let Some(t) = fans.par_iter().position_first(|c| c.iter().any(is_bad)) {
         let face = t / (fans.len() / count);
         let v = fans[t].iter().copied().find(is_bad).unwrap_or_default();
@@ -1564,7 +1558,7 @@ fn read_record(
 }
 
 fn list_len(n: f64, element: &Element, values: &dyn Values) -> Result<usize> {
-    if n.fract() == 0.0 && (0.0..=f64::from(u32::MAX)).contains(&n) {
+    if let Some(n) = whole_u32(n) {
         Ok(n as usize)
     } else {
         bail!(
