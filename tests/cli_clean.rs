@@ -53,6 +53,41 @@ fn cleans_the_fixture_and_reports() {
     };
     assert!(mesh.is_edge_manifold());
     assert_eq!(mesh.boundary_loops().len(), 4);
+    // The deviations are the plain measure's, both ways, on the files.
+    let read = meshtrim::io::read_mesh(Path::new(JAGGED)).unwrap();
+    let input = trim::Mesh {
+        vertices: read.vertices,
+        faces: read.faces.unwrap(),
+    };
+    for (key, surface, measured) in [
+        ("input_to_output", &mesh, &input),
+        ("output_to_input", &input, &mesh),
+    ] {
+        let plain = trim::surface_deviation_reference(surface, measured);
+        let reported = &json[key];
+        assert_eq!(reported["vertices"].as_u64(), Some(plain.vertices as u64));
+        assert!(plain.vertices > 100, "{key}: {plain:?}");
+        let max = reported["max"].as_f64().unwrap();
+        assert!(
+            (max - plain.max).abs() < 1e-9,
+            "{key}: {reported} {plain:?}"
+        );
+        let mean = reported["mean"].as_f64().unwrap();
+        assert!(
+            (mean - plain.mean).abs() < 1e-9,
+            "{key}: {reported} {plain:?}"
+        );
+    }
+    assert!(
+        stdout.contains(
+            "removed vertices     up to 0.6877 from the output's surface (mean 0.02907 over 246)"
+        ),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("new vertices         up to 4.026 off the input's surface"),
+        "{stdout}"
+    );
 }
 
 #[test]
@@ -337,6 +372,8 @@ fn a_closed_mesh_is_written_unchanged_and_reports_no_new_angle() {
     let stdout = String::from_utf8_lossy(&run.stdout);
     assert!(stdout.contains("0 removed, 0 new"), "{stdout}");
     assert!(stdout.contains("none (no new faces)"), "{stdout}");
+    assert!(stdout.contains("removed vertices     none"), "{stdout}");
+    assert!(stdout.contains("new vertices         none"), "{stdout}");
     assert!(
         stdout.contains("warning              no border: a closed mesh has nothing to clean"),
         "{stdout}"

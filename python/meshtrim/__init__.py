@@ -71,6 +71,7 @@ __all__ = [
     "split_seams",
     "SplitMesh",
     "carry_faces",
+    "deviation",
     "BatchJob",
     "batch_plan",
 ]
@@ -760,6 +761,30 @@ def carry_faces(vertices: Any, faces: Any, values: Any, out_vertices: Any, out_f
     given = _face_table(values, len(f), "values")
     to = _float_rows(out_vertices, "out_vertices")
     return _by_face(given, _meshtrim.face_sources(v, f, to, _face_rows(out_faces, len(to))), fill)
+
+
+def deviation(vertices: Any, faces: Any, surface_vertices: Any, surface_faces: Any = None) -> dict:
+    """How far the vertices of one mesh (``vertices``, ``faces``) lie from
+    the surface of another (``surface_vertices``, ``surface_faces``; a
+    cloud without faces: its nearest point), as ``clean``'s report
+    measures the scan against the cleaned mesh and back: a vertex at
+    exactly a vertex of the surface is on it and not measured; every other
+    one takes the distance to its closest point on the surface's faces.
+    Returns ``{"vertices": measured, "max": ..., "mean": ..., "at":
+    (x, y, z) of the farthest, or None}``; the one-sided Hausdorff
+    distance over vertices that MeshLab's Hausdorff filter gives when it
+    samples vertices.
+
+    >>> cut_back = meshtrim.deviation(scan_v, scan_f, clean_v, clean_f)["max"]
+    """
+    v = _float_rows(vertices, "vertices")
+    f = _faces_or_none(faces, len(v))
+    sv = _float_rows(surface_vertices, "surface_vertices")
+    sf = _faces_or_none(surface_faces, len(sv))
+    measured = json.loads(_meshtrim.deviation(v, f, sv, sf))
+    at = measured.get("at")
+    measured["at"] = None if at is None else tuple(at)
+    return measured
 
 
 def _faces_or_none(faces: Any, vertices: int) -> np.ndarray:

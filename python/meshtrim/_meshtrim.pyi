@@ -121,6 +121,12 @@ def face_sources(
     to: Points,
     to_faces: npt.NDArray[np.uint32],
 ) -> npt.NDArray[np.int64]: ...
+def deviation(
+    vertices: Points,
+    faces: npt.NDArray[np.uint32],
+    surface: Points,
+    surface_faces: npt.NDArray[np.uint32],
+) -> str: ...
 def write_edges(
     path: str | PathLike[str],
     points: Points,

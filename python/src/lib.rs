@@ -910,6 +910,33 @@ fn face_sources<'py>(
     Ok(face_index_array(py, sources))
 }
 
+/// How far the vertices of `vertices`, `faces` lie from the surface
+/// `surface`, `surface_faces` (`library::surface_deviation`), as the
+/// JSON `clean`'s report gives.
+#[pyfunction]
+fn deviation<'py>(
+    py: Python<'py>,
+    vertices: PyReadonlyArray2<'py, f64>,
+    faces: PyReadonlyArray2<'py, u32>,
+    surface: PyReadonlyArray2<'py, f64>,
+    surface_faces: PyReadonlyArray2<'py, u32>,
+) -> PyResult<String> {
+    let (mesh, surface) = mesh_pair(&vertices, &faces, &surface, &surface_faces)?;
+    for (name, m) in [("vertices", &mesh), ("surface_vertices", &surface)] {
+        if let Some(v) = m
+            .vertices
+            .iter()
+            .position(|p| !p.iter().all(|c| c.is_finite()))
+        {
+            return Err(MeshtrimError::new_err(format!(
+                "{name}: vertex {v} has a coordinate that is not finite"
+            )));
+        }
+    }
+    let measured = without_gil(py, || Ok(library::surface_deviation(&surface, &mesh)))?;
+    to_json(&commands::clean::Deviation::from(measured))
+}
+
 /// Face indices as an array, −1 for none.
 fn face_index_array(py: Python<'_>, faces: Vec<Option<u32>>) -> Bound<'_, PyArray1<i64>> {
     let indices = faces.into_iter().map(|f| f.map_or(-1, i64::from)).collect();
@@ -1073,5 +1100,6 @@ fn _meshtrim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<FileMaterials>()?;
     m.add_function(wrap_pyfunction!(split_seams, m)?)?;
     m.add_function(wrap_pyfunction!(face_sources, m)?)?;
+    m.add_function(wrap_pyfunction!(deviation, m)?)?;
     Ok(())
 }

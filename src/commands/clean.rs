@@ -15,7 +15,7 @@ use trim::{clean_mesh, CleanOptions, CleanReport};
 use crate::commands::args::StageArgs;
 use crate::io::mesh_out::write_mesh_carrying;
 use crate::io::read_mesh_with_attributes;
-use crate::report::shown;
+use crate::report::{shown, significant};
 use crate::stages::{millis, Stages};
 
 /// Arguments of `meshtrim clean`.
@@ -139,6 +139,16 @@ pub struct Report {
     /// for a scan seen from one side, lower for a surface wrapping round
     /// an object (see [`WRAPS_BELOW`]).
     pub area_facing_one_way: f64,
+    /// How far the input's vertices not in the output (the jagged border,
+    /// and what the new border cut away) lie from the output's surface
+    /// (not measured by `batch`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub input_to_output: Option<Deviation>,
+    /// How far the output's new vertices lie from the input's surface:
+    /// where the new border runs out past the old border vertices, or
+    /// bridges a notch (not measured by `batch`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub output_to_input: Option<Deviation>,
     /// The input's vertex attributes written to the output ("normals",
     /// "colours"), carried to the new vertices from the input's surface.
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -152,8 +162,52 @@ pub struct Report {
     pub resolution_ms: f64,
     /// Border replacement time, ms.
     pub clean_ms: f64,
+    /// Time to measure the two deviations, ms.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub deviation_ms: Option<f64>,
     /// Writing time, ms.
     pub write_ms: f64,
+}
+
+/// How far the vertices of one mesh lie from the other's surface
+/// ([`trim::surface_deviation`]).
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct Deviation {
+    /// Vertices measured: those not at a vertex of the other mesh.
+    pub vertices: usize,
+    /// The largest distance (0 when none was measured).
+    pub max: f64,
+    /// The mean distance over the vertices measured.
+    pub mean: f64,
+    /// The farthest vertex, if any was measured.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub at: Option<[f64; 3]>,
+}
+
+impl From<trim::Deviation> for Deviation {
+    fn from(d: trim::Deviation) -> Self {
+        Deviation {
+            vertices: d.vertices,
+            max: d.max,
+            mean: d.mean,
+            at: d.at,
+        }
+    }
+}
+
+impl Deviation {
+    /// "up to MAX (mean MEAN over N)", or "none" when nothing was measured.
+    fn shown(&self, what: &str) -> String {
+        if self.vertices == 0 {
+            return "none".to_string();
+        }
+        format!(
+            "up to {} {what} (mean {} over {})",
+            significant(self.max, 4),
+            significant(self.mean, 4),
+            self.vertices
+        )
+    }
 }
 
 /// Loops left unchanged.
@@ -170,11 +224,15 @@ pub struct LeftLoops {
 /// Runs `meshtrim clean`.
 pub fn run(args: &Args) -> Result<()> {
     crate::report::check_outputs(&args.output, args.report.as_deref(), &[&args.input])?;
+    let job = Job {
+        stages: &args.stages.stages(),
+        repair: args.repair,
+        measured: true,
+    };
     let report = clean(
         &args.input,
         &args.output,
-        &args.stages.stages(),
-        args.repair,
+        &job,
         "`clean` smooths the border of a mesh",
     )?;
     crate::report::emit(&report, args.report.as_deref(), args.json)
@@ -190,7 +248,13 @@ pub fn clean_file(
     no_faces: &str,
 ) -> Result<CleanOutcome> {
     crate::report::check_outputs(output, None, &[input])?;
-    let r = clean(input, output, stages, repair, no_faces)?;
+    // A batch reports no deviation: it costs a tenth of a small file's time.
+    let job = Job {
+        stages,
+        repair,
+        measured: false,
+    };
+    let r = clean(input, output, &job, no_faces)?;
     Ok(CleanOutcome {
         loops_in: r.loops_in,
         loops: r.loops_smoothed,
@@ -204,19 +268,25 @@ pub fn clean_file(
     })
 }
 
-/// Reads, finds the local resolution, cleans, writes.
-fn clean(
-    input: &Path,
-    output: &Path,
-    stages: &Stages,
+/// How to clean one file.
+struct Job<'a> {
+    stages: &'a Stages,
+    /// `--repair`.
     repair: bool,
-    no_faces: &str,
-) -> Result<Report> {
+    /// Whether the deviations between input and output are measured.
+    measured: bool,
+}
+
+/// Reads, finds the local resolution, cleans, writes.
+fn clean(input: &Path, output: &Path, job: &Job, no_faces: &str) -> Result<Report> {
     let started = Instant::now();
     let (mesh, attributes) = read_mesh_with_attributes(input, no_faces)?;
     let read_time = started.elapsed();
     let name = input.display().to_string();
-    let (out, mut report) = clean_in_memory(&mesh, stages, repair, &name)?;
+    let (out, mut report) = unmeasured(&mesh, job.stages, job.repair, &name)?;
+    if job.measured {
+        report.measure(&mesh, &out);
+    }
     let started = Instant::now();
     let carried = write_mesh_carrying(output, &out, &mesh, attributes)?;
     report.vertex_attributes = carried.written;
@@ -229,11 +299,23 @@ fn clean(
 }
 
 /// Cleans `mesh` in memory: everything `meshtrim clean` does between
-/// reading and writing (`repair` as `--repair`), and what the Python
-/// package runs. Errors begin with `name` (the file's path, or the
-/// argument's name). The report names no file and has no read or write
-/// time.
+/// reading and writing (`repair` as `--repair`), the deviations
+/// included, and what the Python package runs. Errors begin with `name`
+/// (the file's path, or the argument's name). The report names no file
+/// and has no read or write time.
 pub fn clean_in_memory(
+    mesh: &trim::Mesh,
+    stages: &Stages,
+    repair: bool,
+    name: &str,
+) -> Result<(trim::Mesh, Report)> {
+    let (out, mut report) = unmeasured(mesh, stages, repair, name)?;
+    report.measure(mesh, &out);
+    Ok((out, report))
+}
+
+/// [`clean_in_memory`] without the deviations.
+fn unmeasured(
     mesh: &trim::Mesh,
     stages: &Stages,
     repair: bool,
@@ -317,6 +399,9 @@ impl Report {
             area_in: r.area_in,
             area_out: r.area_out,
             area_facing_one_way: r.area_facing_one_way,
+            input_to_output: None,
+            output_to_input: None,
+            deviation_ms: None,
             vertex_attributes: Vec::new(),
             vertex_attributes_not_written: Vec::new(),
             read_ms: 0.0,
@@ -328,6 +413,14 @@ impl Report {
 }
 
 impl Report {
+    /// Measures how far each of `input` and `output` lies from the other.
+    fn measure(&mut self, input: &trim::Mesh, output: &trim::Mesh) {
+        let started = Instant::now();
+        self.input_to_output = Some(trim::surface_deviation(output, input).into());
+        self.output_to_input = Some(trim::surface_deviation(input, output).into());
+        self.deviation_ms = Some(millis(started.elapsed()));
+    }
+
     /// What to do instead, when the mesh is not a scan's border to clean.
     fn warning(&self) -> Option<String> {
         if self.loops_in == 0 {
@@ -401,6 +494,31 @@ impl crate::report::Table for Report {
             ("write time", format!("{:.1} ms", self.write_ms)),
             ("output", shown(&self.output)),
         ];
+        if let Some(ms) = self.deviation_ms {
+            let after_clean = 1 + rows.iter().position(|r| r.0 == "clean time").unwrap_or(0);
+            rows.insert(after_clean, ("deviation time", format!("{ms:.1} ms")));
+        }
+        let deviations = [
+            (
+                "removed vertices",
+                self.input_to_output,
+                "from the output's surface",
+            ),
+            (
+                "new vertices",
+                self.output_to_input,
+                "off the input's surface",
+            ),
+        ];
+        let after_area = 1 + rows
+            .iter()
+            .position(|r| r.0 == "area in / out")
+            .unwrap_or(0);
+        for (at, (label, deviation, what)) in deviations.into_iter().enumerate() {
+            if let Some(d) = deviation {
+                rows.insert(after_area + at, (label, d.shown(what)));
+            }
+        }
         let attributes = [&self.vertex_attributes, &self.vertex_attributes_not_written];
         crate::report::add_attributes_row(
             &mut rows,

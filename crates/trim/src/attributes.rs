@@ -146,7 +146,7 @@ fn sources_and_seams<'a>(
 
 /// A ball around a point the closest input face is asked for, holding
 /// that face: its centre and radius.
-type Ball = (Point3, f64);
+pub(crate) type Ball = (Point3, f64);
 
 /// The points whose closest input face is asked for (each new output
 /// vertex, and the centroid of its first output face), each with a
@@ -181,7 +181,11 @@ fn query_balls(
 /// output's edges to a kept vertex that is a corner of an input face
 /// (which lies on the input surface, so a point is no farther from the
 /// surface than from it). None (no entry) where no path leads to one.
-fn surface_distance_bounds(from: &Mesh, to: &Mesh, exact: &[Option<u32>]) -> HashMap<u32, f64> {
+pub(crate) fn surface_distance_bounds(
+    from: &Mesh,
+    to: &Mesh,
+    exact: &[Option<u32>],
+) -> HashMap<u32, f64> {
     let mut on_surface = vec![false; from.vertices.len()];
     for &v in from.faces.iter().flatten() {
         on_surface[v as usize] = true;
@@ -227,28 +231,41 @@ fn surface_distance_bounds(from: &Mesh, to: &Mesh, exact: &[Option<u32>]) -> Has
 
 /// The input faces that may be the closest to a ball's centre: those
 /// whose bounding box meets some ball (each face ever closest to a centre
-/// is among them, as it lies within the ball), and faces larger than the
-/// widest ball, kept unasked. `None` when the balls are too large for a
+/// is among them, as it lies within the ball), and faces larger than a
+/// grid cell, kept unasked. `None` when the balls are too large for a
 /// list to pay (one unbounded, or wider than a quarter of the input's
-/// diagonal): then every face.
-fn faces_within_reach(from: &Mesh, balls: &[Ball], diagonal: f64) -> Option<Vec<u32>> {
+/// diagonal, or so many wide ones that listing them costs more than the
+/// faces): then every face.
+pub(crate) fn faces_within_reach(from: &Mesh, balls: &[Ball], diagonal: f64) -> Option<Vec<u32>> {
     // Rounding in the bounds and in the distances: a hair more reach.
     let reach = |r: f64| r * (1.0 + 1e-6) + 1e-9 * diagonal;
-    let widest = balls.iter().map(|b| reach(b.1)).fold(0.0, f64::max);
+    let mut reaches: Vec<f64> = balls.iter().map(|b| reach(b.1)).collect();
+    let widest = reaches.iter().copied().fold(0.0, f64::max);
     if !(widest.is_finite() && widest > 0.0 && widest <= 0.25 * diagonal) {
         return None;
     }
-    // A face no more than `widest` from its box's centre to any side that
-    // meets a ball has that centre within the ball's box grown by
-    // `widest`: each ball is listed in the cells that grown box overlaps
-    // (at most three a side), and a face looks in its centre's cell only.
-    let size = 2.0 * widest;
+    // Cells twice the median reach: a few wide balls (a vertex whose path
+    // to the surface is long) span many cells rather than making every
+    // cell hold every ball. A face no more than `margin` from its box's
+    // centre to any side that meets a ball has that centre within the
+    // ball's box grown by `margin`: each ball is listed in the cells that
+    // grown box overlaps, and a face looks in its centre's cell only.
+    let middle = reaches.len() / 2;
+    let median = *reaches.select_nth_unstable_by(middle, f64::total_cmp).1;
+    let size = 2.0 * median;
+    let margin = median;
     let cell_of = |p: Point3| p.map(|c| (c / size).floor() as i64);
     let mut grid: HashMap<[i64; 3], Vec<usize>> = HashMap::default();
+    let mut listed = 0usize;
     for (b, &(centre, r)) in balls.iter().enumerate() {
-        let grown = reach(r) + widest;
+        let grown = reach(r) + margin;
         let lo = cell_of(centre.map(|c| c - grown));
         let hi = cell_of(centre.map(|c| c + grown));
+        let cells: i64 = (0..3).map(|k| hi[k] - lo[k] + 1).product();
+        listed += cells as usize;
+        if listed > from.faces.len().max(1 << 16) {
+            return None;
+        }
         for x in lo[0]..=hi[0] {
             for y in lo[1]..=hi[1] {
                 for z in lo[2]..=hi[2] {
@@ -259,7 +276,7 @@ fn faces_within_reach(from: &Mesh, balls: &[Ball], diagonal: f64) -> Option<Vec<
     }
     let near = |face: &[u32; 3]| {
         let (low, high) = bounds(face.iter().map(|&v| from.vertices[v as usize]));
-        if (0..3).any(|k| high[k] - low[k] > 2.0 * widest) {
+        if (0..3).any(|k| high[k] - low[k] > 2.0 * margin) {
             return true;
         }
         let middle = [0, 1, 2].map(|k| 0.5 * (low[k] + high[k]));
@@ -300,7 +317,7 @@ fn own_face_if_as_near(from: &Mesh, p: Point3, [closest, own]: [u32; 2], tie: f6
 
 /// The length of the diagonal of the mesh's bounding box (a mesh with
 /// faces has vertices, so the box is not empty).
-fn diagonal(mesh: &Mesh) -> f64 {
+pub(crate) fn diagonal(mesh: &Mesh) -> f64 {
     let (low, high) = bounds(mesh.vertices.iter().copied());
     norm2(sub(high, low)).sqrt()
 }
@@ -577,13 +594,15 @@ pub fn carry_normals(from: &Mesh, sources: &[VertexSource], normals: &[Point3]) 
 
 /// Exact bit patterns of a position (so -0.0 and 0.0 differ, as they do
 /// in the files).
-fn bits(p: &Point3) -> [u64; 3] {
+pub(crate) fn bits(p: &Point3) -> [u64; 3] {
     p.map(f64::to_bits)
 }
 
 /// The first input vertex at each position, and the positions several
 /// input vertices share.
-fn vertex_at_position(vertices: &[Point3]) -> (HashMap<[u64; 3], u32>, HashSet<[u64; 3]>) {
+pub(crate) fn vertex_at_position(
+    vertices: &[Point3],
+) -> (HashMap<[u64; 3], u32>, HashSet<[u64; 3]>) {
     let mut map = HashMap::default();
     map.reserve(vertices.len());
     let mut shared = HashSet::default();
@@ -629,7 +648,7 @@ fn triangle(from: &Mesh, face: u32) -> Triangle {
 
 /// The squared distance from `p` to `face`, and the weights of its
 /// closest point there.
-fn closest_on_face(from: &Mesh, face: u32, p: Point3) -> (f64, [f64; 3]) {
+pub(crate) fn closest_on_face(from: &Mesh, face: u32, p: Point3) -> (f64, [f64; 3]) {
     let query = Vector::new(p[0], p[1], p[2]);
     let (projection, location) =
         triangle(from, face).project_local_point_and_get_location(query, false);

@@ -59,6 +59,7 @@ mod bspline;
 mod clean;
 mod cloud;
 mod delaunay;
+mod deviation;
 mod edges;
 mod error;
 mod frame;
@@ -88,6 +89,10 @@ pub use bspline::{interpolate as interpolate_bspline, BSpline};
 pub use clean::{clean_mesh, CleanOptions, CleanReport, LeftLoops, LeftReason, SEEN_FROM_ONE_SIDE};
 pub use cloud::Point3;
 pub use delaunay::{delaunay_mesh, delaunay_mesh_with_report, DelaunayOptions, DelaunayReport};
+/// The plain deviation the fast one is tested against (same distances).
+#[doc(hidden)]
+pub use deviation::surface_deviation_reference;
+pub use deviation::{surface_deviation, Deviation};
 pub use edges::{reconstruct_edges, Edge, EdgeOptions, Edges, Loop, LoopSource};
 pub use error::{CleanError, CloudError, DelaunayError, MeshError, Placement, TrimError};
 pub use frame::{fit_plane, Frame};
