@@ -381,10 +381,16 @@ fn bad_files_fail_alone_and_the_reports_say_why() {
             "write_ms",
             "total_ms",
             "repaired",
-            "cloud"
+            "cloud",
+            "removed_max",
+            "new_max"
         ]
     );
     assert_eq!(rows.len(), 5, "{rows:?}");
+    // Not measured without --deviation.
+    assert!(rows[1..]
+        .iter()
+        .all(|r| r[14].is_empty() && r[15].is_empty()));
     // The cloud each trimmed file was paired with; none for a clean.
     let clouds: Vec<&str> = rows[1..].iter().map(|r| r[13].as_str()).collect();
     assert_eq!(
@@ -586,6 +592,47 @@ fn to_writes_every_output_in_one_format() {
 
     let run = batch(d, &["scans", "--out-dir", "out", "--to", "xyz"]);
     assert_eq!(run.status.code(), Some(2), "{}", text(&run.stderr));
+}
+
+#[test]
+fn deviation_reports_how_far_each_cleaned_scan_moved() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::create_dir_all(d.join("scans")).unwrap();
+    std::fs::copy(JAGGED, d.join("scans/j.stl")).unwrap();
+    pair(d, "scans/t");
+    let args = ["scans", "--out-dir", "out", "--deviation", "--report"];
+    let run = batch(d, &[&args[..], &["r.csv"]].concat());
+    assert_ok(&run);
+    let clean = Command::new(env!("CARGO_BIN_EXE_meshtrim"))
+        .args(["clean", JAGGED, d.join("c.stl").to_str().unwrap(), "--json"])
+        .output()
+        .unwrap();
+    assert_ok(&clean);
+    let cleaned: serde_json::Value = serde_json::from_slice(&clean.stdout).unwrap();
+    let rows = parse_csv(&std::fs::read_to_string(d.join("r.csv")).unwrap());
+    let (j, t) = (&rows[1], &rows[2]);
+    assert_eq!(
+        (j[0].as_str(), t[0].as_str()),
+        ("scans/j.stl", "scans/t.ply")
+    );
+    // The cleaned file's are `clean`'s maxima; a trimmed file has none.
+    for (column, key) in [(14, "input_to_output"), (15, "output_to_input")] {
+        let reported: f64 = j[column].parse().unwrap();
+        assert_eq!(reported, cleaned[key]["max"].as_f64().unwrap(), "{key}");
+        assert!(t[column].is_empty(), "{t:?}");
+    }
+    let stdout = text(&run.stdout);
+    assert!(
+        stdout.contains("faces 5768→5759  moved: removed≤0.6877 new≤4.026  "),
+        "{stdout}"
+    );
+    let run = batch(d, &[&args[..], &["r.json"]].concat());
+    assert_ok(&run);
+    let report = json_report(&d.join("r.json"));
+    let files = &report["files"];
+    assert_eq!(files[0]["new_max"], cleaned["output_to_input"]["max"]);
+    assert!(files[1].get("new_max").is_none(), "{}", files[1]);
 }
 
 #[test]

@@ -7,6 +7,7 @@ use anyhow::{bail, Result};
 use serde::Serialize;
 
 use crate::io::atomic::write_atomic;
+use crate::report::significant;
 
 /// Whether a mesh was cleaned or trimmed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -68,6 +69,10 @@ pub struct Outcome {
     pub write_ms: f64,
     /// Faces `--repair` removed or turned (none for a trim).
     pub repaired: Option<usize>,
+    /// With `--deviation`, for a cleaned file: the largest distances of
+    /// the removed vertices from the output and of the new ones from the
+    /// input.
+    pub deviation: Option<[f64; 2]>,
     /// What the user should know about the file (a closed mesh cleaned).
     pub note: Option<&'static str>,
 }
@@ -103,6 +108,14 @@ pub struct Row {
     /// Faces `--repair` removed or turned to make the mesh manifold and
     /// oriented (cleaned files only).
     pub repaired: Option<usize>,
+    /// With `--deviation`, for a cleaned file: the largest distance of its
+    /// removed vertices from the output.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub removed_max: Option<f64>,
+    /// With `--deviation`, for a cleaned file: the largest distance of its
+    /// new vertices from the input.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub new_max: Option<f64>,
     /// The cloud a trimmed file was paired with (none for a clean, or
     /// when several clouds matched: the error names them).
     pub cloud: Option<String>,
@@ -121,9 +134,17 @@ impl Row {
             Some(n) if n > 0 => format!("  repaired={n}"),
             _ => String::new(),
         };
+        let moved = match (self.removed_max, self.new_max) {
+            (Some(removed), Some(new)) => format!(
+                "  moved: removed≤{} new≤{}",
+                significant(removed, 4),
+                significant(new, 4)
+            ),
+            _ => String::new(),
+        };
         match self.status {
             Status::Ok => format!(
-                "ok      {mode:<5}  {}  loops={}  faces {}→{}{repaired}  {secs:.2} s{note}",
+                "ok      {mode:<5}  {}  loops={}  faces {}→{}{repaired}{moved}  {secs:.2} s{note}",
                 self.input,
                 self.loops.unwrap_or(0),
                 self.faces_in.unwrap_or(0),
@@ -139,7 +160,7 @@ impl Row {
     }
 
     /// The row's CSV fields, in [`CSV_HEADER`] order.
-    fn csv_fields(&self) -> [String; 14] {
+    fn csv_fields(&self) -> [String; 16] {
         let opt = |v: Option<String>| v.unwrap_or_default();
         [
             self.input.clone(),
@@ -156,13 +177,15 @@ impl Row {
             self.total_ms.to_string(),
             opt(self.repaired.map(|v| v.to_string())),
             opt(self.cloud.clone()),
+            opt(self.removed_max.map(|v| v.to_string())),
+            opt(self.new_max.map(|v| v.to_string())),
         ]
     }
 }
 
 /// The CSV columns (new ones go last, so that columns read by position
 /// keep theirs).
-pub const CSV_HEADER: [&str; 14] = [
+pub const CSV_HEADER: [&str; 16] = [
     "input",
     "output",
     "mode",
@@ -177,6 +200,8 @@ pub const CSV_HEADER: [&str; 14] = [
     "total_ms",
     "repaired",
     "cloud",
+    "removed_max",
+    "new_max",
 ];
 
 /// The report formats, by the file's extension.
@@ -284,7 +309,7 @@ impl Totals<'_> {
     }
 }
 
-/// The CSV report. Written by hand: twelve columns and RFC 4180 quoting
+/// The CSV report. Written by hand: a few columns and RFC 4180 quoting
 /// are a few lines, not worth a dependency.
 fn csv(rows: &[Row]) -> String {
     let mut out = CSV_HEADER.join(",") + "\n";
