@@ -91,6 +91,63 @@ fn cleans_the_fixture_and_reports() {
 }
 
 #[test]
+fn max_deviation_holds_the_new_border_to_the_old() {
+    let dir = tempfile::tempdir().unwrap();
+    let (free, held) = (dir.path().join("free.ply"), dir.path().join("held.ply"));
+    let report = |out: &Path, extra: &[&str]| {
+        let run = meshtrim(
+            &[&["clean", JAGGED, s(out), "--json"], extra].concat(),
+            None,
+        );
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        serde_json::from_slice::<serde_json::Value>(&run.stdout).unwrap()
+    };
+    let (free, held) = (
+        report(&free, &[]),
+        report(&held, &["--max-deviation", "1.5"]),
+    );
+    // Unbounded, the fixture's new border runs up to 4.03 off the scan.
+    assert!(
+        free["output_to_input"]["max"].as_f64().unwrap() > 4.0,
+        "{free}"
+    );
+    assert!(free.get("max_deviation").is_none() && free.get("vertices_held").is_none());
+    assert_eq!(held["max_deviation"], 1.5);
+    assert!(held["vertices_held"].as_u64().unwrap() > 0, "{held}");
+    assert!(
+        held["output_to_input"]["max"].as_f64().unwrap() <= 1.5 + 1e-9,
+        "{held}"
+    );
+    assert!(
+        held["input_to_output"]["max"].as_f64().unwrap() <= 1.5 + 1e-9,
+        "{held}"
+    );
+    assert_eq!(held["loops_smoothed"], 4);
+    for bad in ["0", "-1", "nan", "inf", "wide"] {
+        let run = meshtrim(
+            &[
+                "clean",
+                JAGGED,
+                s(&dir.path().join("x.ply")),
+                "--max-deviation",
+                bad,
+            ],
+            None,
+        );
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(2), "{bad}: {stderr}");
+        assert!(
+            stderr.contains("is not a distance: give a number above zero"),
+            "{stderr}"
+        );
+    }
+}
+
+#[test]
 fn same_bytes_whatever_the_threads() {
     let dir = tempfile::tempdir().unwrap();
     // The fixture, and the fixture with a fin stood on one of its edges,

@@ -206,6 +206,17 @@ def _vector(value: Vector, name: str) -> Optional[tuple]:
     return v
 
 
+def _distance(value: Any, name: str) -> float:
+    """A positive finite number."""
+    try:
+        d = float(value)
+    except (TypeError, ValueError):
+        raise MeshtrimError(f"{name}: {value!r} is not a number") from None
+    if not (np.isfinite(d) and d > 0):
+        raise MeshtrimError(f"{name}: {d} is not a distance: give a number above zero, in the mesh's units")
+    return d
+
+
 def _k(k: Any) -> int:
     if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or not 0 <= k < 2**31:
         raise MeshtrimError(f"k: expected a whole number, got {k!r}")
@@ -327,6 +338,7 @@ def clean(
     view_along: Vector = None,
     view_from: Vector = None,
     repair: bool = False,
+    max_deviation: Optional[float] = None,
 ) -> tuple:
     """Replaces a triangulated scan's jagged border by its smoothed edge
     (``meshtrim clean``): the mesh's own vertices are the cloud. Returns
@@ -340,12 +352,16 @@ def clean(
     border, a triangle soup) are stitched first (``seam_edges_stitched``
     in the report), and the mesh returned is the stitched one;
     :func:`write_mesh_carrying` splits it again where the input was split,
-    as the CLI writes it.
+    as the CLI writes it. ``max_deviation`` (the CLI's
+    ``--max-deviation``) keeps the new border within that distance of the
+    old one. The report's ``input_to_output`` and ``output_to_input``
+    say how far the scan moved (see :func:`deviation`).
     """
     k, anisotropy, along, from_ = _options(k, anisotropy, view_along, view_from)
     v = _float_rows(vertices, "vertices")
     f = _face_rows(faces, len(v))
-    out_v, out_f, report = _meshtrim.clean(v, f, k, anisotropy, bool(offset), along, from_, bool(repair))
+    bound = None if max_deviation is None else _distance(max_deviation, "max_deviation")
+    out_v, out_f, report = _meshtrim.clean(v, f, k, anisotropy, bool(offset), along, from_, bool(repair), bound)
     return out_v, out_f, json.loads(report)
 
 

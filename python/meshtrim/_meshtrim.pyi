@@ -57,6 +57,7 @@ def clean(
     view_along: Vector,
     view_from: Vector,
     repair: bool,
+    max_deviation: float | None,
 ) -> Tuple[Points, Faces, str]: ...
 Fields = list[Tuple[str, str, npt.NDArray[np.float64]]]
 

@@ -326,7 +326,7 @@ fn mesh_py<'py>(
 
 /// The cleaned mesh and the report as JSON.
 #[pyfunction]
-#[pyo3(name = "clean", signature = (vertices, faces, k, anisotropy, offset, view_along, view_from, repair))]
+#[pyo3(name = "clean", signature = (vertices, faces, k, anisotropy, offset, view_along, view_from, repair, max_deviation))]
 #[allow(clippy::too_many_arguments)] // the CLI's options, as keywords
 fn clean_py<'py>(
     py: Python<'py>,
@@ -338,7 +338,17 @@ fn clean_py<'py>(
     view_along: Option<[f64; 3]>,
     view_from: Option<[f64; 3]>,
     repair: bool,
+    max_deviation: Option<f64>,
 ) -> PyResult<MeshResult<'py>> {
+    if let Some(d) = max_deviation.filter(|d| !(d.is_finite() && *d > 0.0)) {
+        return Err(MeshtrimError::new_err(format!(
+            "max_deviation: {d} is not a distance: give a number above zero, in the mesh's units"
+        )));
+    }
+    let choices = commands::clean::Choices {
+        repair,
+        max_deviation,
+    };
     let stages = Options {
         k,
         anisotropy,
@@ -349,7 +359,7 @@ fn clean_py<'py>(
     .stages()?;
     let mesh = mesh_of(&vertices, &faces)?;
     let (out, report) = without_gil(py, || {
-        commands::clean::clean_in_memory(&mesh, &stages, repair, "mesh")
+        commands::clean::clean_in_memory(&mesh, &stages, choices, "mesh")
     })?;
     mesh_result(py, &out, &report)
 }

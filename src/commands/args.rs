@@ -176,6 +176,16 @@ pub(crate) fn parse_scale(text: &str) -> Result<f64, String> {
     }
 }
 
+/// A distance above zero (`--max-deviation`).
+pub(crate) fn parse_distance(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(d) if d.is_finite() && d > 0.0 => Ok(d),
+        _ => Err(format!(
+            "'{text}' is not a distance: give a number above zero, in the mesh's units"
+        )),
+    }
+}
+
 /// Three finite numbers separated by commas.
 pub(crate) fn parse_vector(text: &str) -> Result<[f64; 3], String> {
     let parts: Vec<&str> = text.split(',').map(str::trim).collect();

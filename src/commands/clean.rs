@@ -36,6 +36,12 @@ pub struct Args {
     /// faces wound against their neighbours are turned over.
     #[arg(long)]
     pub repair: bool,
+    /// Keep the new border within this distance of the old one (in the
+    /// mesh's units): where the smoothed border would bridge a notch or
+    /// cut off a corner farther than this, it follows the scan's border
+    /// at this distance instead.
+    #[arg(long, value_name = "D", value_parser = crate::commands::args::parse_distance, allow_hyphen_values = true)]
+    pub max_deviation: Option<f64>,
     /// Detection and edge options.
     #[command(flatten)]
     pub stages: StageArgs,
@@ -153,6 +159,13 @@ pub struct Report {
     /// bridges a notch (not measured by `batch`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub output_to_input: Option<Deviation>,
+    /// `--max-deviation`, when given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_deviation: Option<f64>,
+    /// With `--max-deviation`: smoothed border vertices held back to that
+    /// distance from the old border.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub vertices_held: Option<usize>,
     /// The input's vertex attributes written to the output ("normals",
     /// "colours"), carried to the new vertices from the input's surface.
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -230,7 +243,10 @@ pub fn run(args: &Args) -> Result<()> {
     crate::report::check_outputs(&args.output, args.report.as_deref(), &[&args.input])?;
     let job = Job {
         stages: &args.stages.stages(),
-        repair: args.repair,
+        choices: Choices {
+            repair: args.repair,
+            max_deviation: args.max_deviation,
+        },
         measured: true,
     };
     let report = clean(
@@ -242,21 +258,21 @@ pub fn run(args: &Args) -> Result<()> {
     crate::report::emit(&report, args.report.as_deref(), args.json)
 }
 
-/// Cleans one file without printing (the unit of `batch`); `repair` as
-/// `clean --repair`; `measured`: whether the deviations are measured (they
-/// cost about a tenth of a small file's time). `no_faces` is the advice
-/// for a file without faces.
+/// Cleans one file without printing (the unit of `batch`); `choices` as
+/// `clean`'s; `measured`: whether the deviations are measured (they cost
+/// about a tenth of a small file's time). `no_faces` is the advice for a
+/// file without faces.
 pub fn clean_file(
     input: &Path,
     output: &Path,
     stages: &Stages,
-    [repair, measured]: [bool; 2],
+    (choices, measured): (Choices, bool),
     no_faces: &str,
 ) -> Result<CleanOutcome> {
     crate::report::check_outputs(output, None, &[input])?;
     let job = Job {
         stages,
-        repair,
+        choices,
         measured,
     };
     let r = clean(input, output, &job, no_faces)?;
@@ -277,11 +293,19 @@ pub fn clean_file(
     })
 }
 
+/// What `clean` is asked for beyond detection's options.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Choices {
+    /// `--repair`.
+    pub repair: bool,
+    /// `--max-deviation`.
+    pub max_deviation: Option<f64>,
+}
+
 /// How to clean one file.
 struct Job<'a> {
     stages: &'a Stages,
-    /// `--repair`.
-    repair: bool,
+    choices: Choices,
     /// Whether the deviations between input and output are measured.
     measured: bool,
 }
@@ -292,7 +316,7 @@ fn clean(input: &Path, output: &Path, job: &Job, no_faces: &str) -> Result<Repor
     let (mesh, attributes) = read_mesh_with_attributes(input, no_faces)?;
     let read_time = started.elapsed();
     let name = input.display().to_string();
-    let (out, mut report) = unmeasured(&mesh, job.stages, job.repair, &name)?;
+    let (out, mut report) = unmeasured(&mesh, job.stages, job.choices, &name)?;
     if job.measured {
         report.measure(&mesh, &out);
     }
@@ -308,17 +332,17 @@ fn clean(input: &Path, output: &Path, job: &Job, no_faces: &str) -> Result<Repor
 }
 
 /// Cleans `mesh` in memory: everything `meshtrim clean` does between
-/// reading and writing (`repair` as `--repair`), the deviations
+/// reading and writing (`choices` as its options), the deviations
 /// included, and what the Python package runs. Errors begin with `name`
 /// (the file's path, or the argument's name). The report names no file
 /// and has no read or write time.
 pub fn clean_in_memory(
     mesh: &trim::Mesh,
     stages: &Stages,
-    repair: bool,
+    choices: Choices,
     name: &str,
 ) -> Result<(trim::Mesh, Report)> {
-    let (out, mut report) = unmeasured(mesh, stages, repair, name)?;
+    let (out, mut report) = unmeasured(mesh, stages, choices, name)?;
     report.measure(mesh, &out);
     Ok((out, report))
 }
@@ -327,9 +351,10 @@ pub fn clean_in_memory(
 fn unmeasured(
     mesh: &trim::Mesh,
     stages: &Stages,
-    repair: bool,
+    choices: Choices,
     name: &str,
 ) -> Result<(trim::Mesh, Report)> {
+    let repair = choices.repair;
     let started = Instant::now();
     // Only β is needed: the mesh knows its border (BPD's labels would be
     // thrown away). On a large mesh it is found only where the cleanup
@@ -341,15 +366,20 @@ fn unmeasured(
     let options = CleanOptions {
         offset: stages.edges.offset,
         repair,
+        max_deviation: choices.max_deviation,
     };
     let (out, cleaned) = clean_mesh(mesh, &beta, &options)
         .map_err(|e| refused_unless_repaired(e, repair))
         .with_context(|| name.to_string())?;
-    let report = Report::new(
+    let mut report = Report::new(
         mesh.vertices.len(),
         &cleaned,
         [resolution_time, started.elapsed()],
     );
+    if choices.max_deviation.is_some() {
+        report.max_deviation = choices.max_deviation;
+        report.vertices_held = Some(cleaned.vertices_held);
+    }
     Ok((out, report))
 }
 
@@ -410,6 +440,8 @@ impl Report {
             area_facing_one_way: r.area_facing_one_way,
             input_to_output: None,
             output_to_input: None,
+            max_deviation: None,
+            vertices_held: None,
             deviation_ms: None,
             vertex_attributes: Vec::new(),
             vertex_attributes_not_written: Vec::new(),
@@ -527,6 +559,13 @@ impl crate::report::Table for Report {
             if let Some(d) = deviation {
                 rows.insert(after_area + at, (label, d.shown(what)));
             }
+        }
+        if let (Some(max), Some(held)) = (self.max_deviation, self.vertices_held) {
+            let held = format!(
+                "{} ({held} smoothed border vertices held back to it)",
+                significant(max, 4)
+            );
+            rows.insert(after_area, ("max deviation", held));
         }
         let attributes = [&self.vertex_attributes, &self.vertex_attributes_not_written];
         crate::report::add_attributes_row(

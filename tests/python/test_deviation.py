@@ -94,3 +94,27 @@ def test_cleans_report_is_the_deviation_both_ways():
 def test_bad_input_is_a_clear_error(args, message):
     with pytest.raises(meshtrim.MeshtrimError, match=message.replace("(", r"\(").replace(")", r"\)")):
         meshtrim.deviation(*args)
+
+
+def test_clean_holds_the_border_to_max_deviation(tmp_path):
+    """`clean(..., max_deviation=)` is `clean --max-deviation`: the same
+    arrays and report, the new vertices within the bound; a bound that is
+    no positive number is refused."""
+    import subprocess
+
+    from meshtrim_cli import MESHTRIM
+
+    v, f = meshtrim.read_mesh(JAGGED)
+    out_v, out_f, report = meshtrim.clean(v, f, max_deviation=1.5)
+    assert report["max_deviation"] == 1.5 and report["vertices_held"] > 0, report
+    assert report["output_to_input"]["max"] <= 1.5 + 1e-9, report
+    out = tmp_path / "held.ply"
+    cli = subprocess.run([str(MESHTRIM), "clean", str(JAGGED), str(out), "--max-deviation", "1.5", "--json"], capture_output=True, text=True)
+    assert cli.returncode == 0, cli.stderr
+    cli_report = json.loads(cli.stdout)
+    for key in ("input_to_output", "output_to_input", "vertices_held", "faces_out"):
+        assert cli_report[key] == report[key], key
+    assert np.array_equal(meshtrim.read_mesh(out)[0], out_v)
+    for bad in (0, -1.0, float("nan"), "wide"):
+        with pytest.raises(meshtrim.MeshtrimError, match="max_deviation"):
+            meshtrim.clean(v, f, max_deviation=bad)

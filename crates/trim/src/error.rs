@@ -323,4 +323,7 @@ pub enum CleanError {
         /// Faces of the mesh.
         faces: usize,
     },
+    /// The bound on how far the border may move is not a positive number.
+    #[error("max_deviation must be a positive finite distance, got {0}")]
+    MaxDeviation(f64),
 }

@@ -23,7 +23,7 @@ use anyhow::{anyhow, bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
-use super::clean::{clean_file, WRAPS_BELOW};
+use super::clean::{clean_file, Choices, WRAPS_BELOW};
 use super::trim::{trim_file, TrimSettings};
 use crate::commands::args::StageArgs;
 use crate::console;
@@ -83,6 +83,10 @@ pub struct Args {
     /// are not measured.
     #[arg(long)]
     pub deviation: bool,
+    /// Keep each cleaned scan's new border within this distance of its old
+    /// one (as `clean --max-deviation`).
+    #[arg(long, value_name = "D", value_parser = crate::commands::args::parse_distance, allow_hyphen_values = true)]
+    pub max_deviation: Option<f64>,
     /// Detection and edge options.
     #[command(flatten)]
     pub stages: StageArgs,
@@ -141,7 +145,10 @@ fn process_all(jobs: &[Job], args: &Args) -> Result<Vec<Row>> {
         .context("cannot start the worker threads")?;
     let settings = FileSettings {
         skip_existing: args.skip_existing,
-        repair: args.repair,
+        choices: Choices {
+            repair: args.repair,
+            max_deviation: args.max_deviation,
+        },
         deviation: args.deviation,
         stages: args.stages.stages(),
         cloud_scale: args.cloud_scale,
@@ -179,8 +186,8 @@ fn batch_bar(files: usize) -> ProgressBar {
 struct FileSettings {
     /// Skip a file whose output exists.
     skip_existing: bool,
-    /// Repair meshes before cleaning them (`--repair`).
-    repair: bool,
+    /// `--repair` and `--max-deviation`.
+    choices: Choices,
     /// Measure how far each cleaned scan moved (`--deviation`).
     deviation: bool,
     /// Detection's and edge reconstruction's options.
@@ -265,7 +272,7 @@ const WRAPS: &str = "it wraps round an object, as an envelope cut open does: to 
 /// its output atomically.
 fn work(job: &Job, settings: &FileSettings) -> Result<Outcome> {
     let FileSettings {
-        repair,
+        choices,
         deviation,
         ref stages,
         cloud_scale,
@@ -277,7 +284,7 @@ fn work(job: &Job, settings: &FileSettings) -> Result<Outcome> {
                 &job.input,
                 &job.output,
                 stages,
-                [repair, deviation],
+                (choices, deviation),
                 NO_FACES,
             )?;
             Ok(Outcome {

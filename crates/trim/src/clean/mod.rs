@@ -65,6 +65,7 @@ mod band;
 mod gap;
 mod rounds;
 mod strip;
+mod tolerance;
 mod unfold;
 
 use align::place_along;
@@ -158,6 +159,11 @@ pub struct CleanOptions {
     /// wound against their neighbours: see [`ManifoldRepair`]) rather than
     /// refusing it.
     pub repair: bool,
+    /// The farthest each smoothed loop vertex may lie from the border
+    /// vertex it was smoothed from (in the mesh's units): where it would
+    /// lie farther (a notch bridged, a corner cut off), the loop follows
+    /// the border at that distance. None: as smooth as β makes it.
+    pub max_deviation: Option<f64>,
 }
 
 impl Default for CleanOptions {
@@ -165,6 +171,7 @@ impl Default for CleanOptions {
         Self {
             offset: true,
             repair: false,
+            max_deviation: None,
         }
     }
 }
@@ -318,6 +325,9 @@ pub struct CleanReport {
     /// vertex the input did not pinch (it runs through a neck one vertex
     /// wide): the faces of the smaller piece's fan there.
     pub pinch_faces_dropped: usize,
+    /// Smoothed loop vertices moved back to
+    /// [`CleanOptions::max_deviation`] from the border they replace.
+    pub vertices_held: usize,
 }
 
 /// Replaces the jagged border of `mesh` by its smoothed boundary (see the
@@ -339,6 +349,12 @@ fn clean_with(
 ) -> Result<(Mesh, CleanReport), CleanError> {
     mesh.validate()?;
     check_resolution_length(mesh, beta)?;
+    if let Some(max) = options
+        .max_deviation
+        .filter(|m| !(m.is_finite() && *m > 0.0))
+    {
+        return Err(CleanError::MaxDeviation(max));
+    }
     let faces_in = mesh.faces.len();
     let (kept, dropped, edges) = without_empty_faces(mesh);
     // Seams stitched, so that they do not look like borders; a seam's
@@ -377,9 +393,10 @@ fn clean_with(
     check_cleanable(mesh, &edges)?;
     let borders = boundary_loops_of(&edges);
     drop(edges);
-    let rings = smoothed_loops(mesh, beta, &borders, options);
+    let (rings, vertices_held) = smoothed_loops(mesh, beta, &borders, options);
     let mut report = CleanReport {
         loops_in: borders.len(),
+        vertices_held,
         faces_in,
         seam_edges_stitched,
         slivers_dropped: dropped.slivers,
@@ -393,7 +410,11 @@ fn clean_with(
     let view = (report.area_facing_one_way >= SEEN_FROM_ONE_SIDE)
         .then(|| mesh.mean_normal())
         .flatten();
-    let replaced = replace_in_rounds(mesh, beta, &borders, &rings, view);
+    let shaping = Shaping {
+        view,
+        max_deviation: options.max_deviation,
+    };
+    let replaced = replace_in_rounds(mesh, beta, &borders, &rings, shaping);
     // Small loops a strip absorbed count as replaced.
     report.loops_smoothed = replaced.replaced.iter().filter(|&&r| r).count();
     report.loops_too_small = (0..borders.len())
@@ -427,17 +448,18 @@ fn check_resolution_length(mesh: &Mesh, beta: &dyn PointResolution) -> Result<()
 }
 
 /// Step 2: each border loop smoothed (corners, FFT edges and, with
-/// `options.offset`, the outward offset) and evened out, in parallel;
+/// `options.offset`, the outward offset), held within
+/// `options.max_deviation` of its border, and evened out, in parallel;
 /// None for loops of fewer than [`MIN_LOOP_POINTS`] vertices, too small
-/// to smooth.
+/// to smooth. Also how many vertices the bound held back.
 fn smoothed_loops(
     mesh: &Mesh,
     beta: &dyn PointResolution,
     borders: &[Vec<u32>],
     options: &CleanOptions,
-) -> Vec<Option<Ring>> {
+) -> (Vec<Option<Ring>>, usize) {
     let index = options.offset.then(|| MortonIndex::new(&mesh.vertices));
-    borders
+    let smoothed: Vec<Option<(Ring, usize)>> = borders
         .par_iter()
         .map(|border| {
             (border.len() >= MIN_LOOP_POINTS).then(|| {
@@ -446,10 +468,22 @@ fn smoothed_loops(
                 let loop_beta = border.par_iter().map(|&v| beta.beta(v as usize)).collect();
                 let index = index.as_ref().map(|i| i as &dyn KNearest);
                 let lp = loop_with_beta(&mesh.vertices, loop_beta, border.clone(), index);
-                even_out(Ring::from_loop(&lp, beta))
+                let mut ring = Ring::from_loop(&lp, beta);
+                let held = options.max_deviation.map_or(0, |max| {
+                    tolerance::keep_within(&mut ring.p3, &ring.reference, &mesh.vertices, max)
+                });
+                (even_out(ring), held)
             })
         })
-        .collect()
+        .collect();
+    let held = smoothed.iter().flatten().map(|(_, held)| held).sum();
+    (
+        smoothed
+            .into_iter()
+            .map(|s| s.map(|(ring, _)| ring))
+            .collect(),
+        held,
+    )
 }
 
 /// Steps 3 to 5 for every smoothed loop: its band, what goes and the new
@@ -460,7 +494,7 @@ fn replace_bands(
     beta: &dyn PointResolution,
     borders: &[Vec<u32>],
     rings: &[Option<Ring>],
-    view: Option<Point3>,
+    shaping: Shaping,
     beta_median: f64,
 ) -> (Vec<Outcome>, Mesh) {
     let topology = Topology::new(mesh);
@@ -471,7 +505,8 @@ fn replace_bands(
         rings,
         topology: &topology,
         beta_median,
-        view,
+        view: shaping.view,
+        max_deviation: shaping.max_deviation,
     };
     let mut outcomes = replace_all(&context);
     replace_left_by_strips(&context, &mut outcomes);
@@ -779,6 +814,18 @@ struct Context<'a> {
     /// The direction a scan seen from one side was seen along; `None` for
     /// a surface that wraps round an object.
     view: Option<Point3>,
+    /// [`CleanOptions::max_deviation`].
+    max_deviation: Option<f64>,
+}
+
+/// What the strips need to know of the scan and the options, beyond the
+/// loops: the direction a scan seen from one side was seen along (`None`
+/// for a surface that wraps round an object), and
+/// [`CleanOptions::max_deviation`].
+#[derive(Debug, Clone, Copy)]
+struct Shaping {
+    view: Option<Point3>,
+    max_deviation: Option<f64>,
 }
 
 /// The new faces of one band.

@@ -47,10 +47,10 @@ pub(super) fn replace_in_rounds(
     beta: &dyn PointResolution,
     borders: &[Vec<u32>],
     rings: &[Option<Ring>],
-    view: Option<Point3>,
+    shaping: Shaping,
 ) -> Replaced {
     let beta_median = beta.median();
-    let (outcomes, out) = replace_bands(mesh, beta, borders, rings, view, beta_median);
+    let (outcomes, out) = replace_bands(mesh, beta, borders, rings, shaping, beta_median);
     let mut done = Replaced {
         kept_input_faces: kept_below(mesh.faces.len(), &outcomes),
         replaced: replaced_loops(borders.len(), &outcomes),
@@ -58,7 +58,7 @@ pub(super) fn replace_in_rounds(
         mesh: out,
     };
     for _ in 1..MAX_ROUNDS {
-        if !done.round(mesh, beta, borders, rings, view, beta_median) {
+        if !done.round(mesh, beta, borders, rings, shaping, beta_median) {
             break;
         }
     }
@@ -73,7 +73,7 @@ impl Replaced {
         beta: &dyn PointResolution,
         borders: &[Vec<u32>],
         rings: &[Option<Ring>],
-        view: Option<Point3>,
+        shaping: Shaping,
         beta_median: f64,
     ) -> bool {
         let again: BTreeSet<usize> = self
@@ -97,7 +97,7 @@ impl Replaced {
             .collect();
         let here_beta = beta_of_new_vertices(input, beta, mesh);
         let (outcomes, out) =
-            replace_bands(mesh, &here_beta, &here, &here_rings, view, beta_median);
+            replace_bands(mesh, &here_beta, &here, &here_rings, shaping, beta_median);
         let now_replaced: Vec<usize> = replaced_loops(here.len(), &outcomes)
             .iter()
             .enumerate()

@@ -129,8 +129,10 @@ impl Guide {
     pub(super) fn new(cx: &Context, l: usize, ring: &Ring) -> Option<Guide> {
         let border = &cx.borders[l];
         let mut points = ring.p3.clone();
+        let mut references = ring.reference.clone();
         if !runs_as_border(border, &ring.reference) {
             points.reverse();
+            references.reverse();
         }
         let m = points.len();
         if m < 3 {
@@ -138,6 +140,9 @@ impl Guide {
         }
         if let Some(view) = cx.view {
             smooth_depth(&mut points, view, DEPTH_SIGMA * cx.beta_median);
+            if let Some(max) = cx.max_deviation {
+                tolerance::keep_within(&mut points, &references, &cx.mesh.vertices, max);
+            }
         }
         // The direction into the surface at each smoothed vertex, from the
         // border vertex nearest it.
