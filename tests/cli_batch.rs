@@ -633,6 +633,26 @@ fn deviation_reports_how_far_each_cleaned_scan_moved() {
     let files = &report["files"];
     assert_eq!(files[0]["new_max"], cleaned["output_to_input"]["max"]);
     assert!(files[1].get("new_max").is_none(), "{}", files[1]);
+    // --max-deviation: the bytes `clean --max-deviation` writes.
+    let held = ["scans/j.stl", "--out-dir", "held", "--max-deviation", "1.5"];
+    assert_ok(&batch(d, &held));
+    let single = d.join("held.stl");
+    let run = Command::new(env!("CARGO_BIN_EXE_meshtrim"))
+        .args([
+            "clean",
+            JAGGED,
+            single.to_str().unwrap(),
+            "--max-deviation",
+            "1.5",
+        ])
+        .output()
+        .unwrap();
+    assert_ok(&run);
+    let (from_batch, from_clean) = (d.join("held/j.stl"), single);
+    assert!(std::fs::read(from_batch).unwrap() == std::fs::read(from_clean).unwrap());
+    assert!(
+        std::fs::read(d.join("held/j.stl")).unwrap() != std::fs::read(d.join("out/j.stl")).unwrap()
+    );
 }
 
 #[test]
