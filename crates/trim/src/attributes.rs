@@ -690,7 +690,7 @@ fn face_normal(from: &Mesh, face: u32, normals: &[Point3]) -> Point3 {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use rand::{RngExt, SeedableRng};
 
@@ -703,7 +703,7 @@ mod tests {
     }
 
     /// A jittered grid sheet, its height a wave.
-    fn sheet(n: usize, seed: u64) -> Mesh {
+    pub(crate) fn sheet(n: usize, seed: u64) -> Mesh {
         let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
         let mut vertices = Vec::new();
         for j in 0..n {

@@ -223,28 +223,12 @@ mod tests {
     use super::*;
     use rand::{RngExt, SeedableRng};
 
-    /// A jittered grid sheet of `n` × `n` vertices, its height a wave
-    /// scaled by `height`.
+    /// The carrying tests' jittered grid sheet of `n` × `n` vertices,
+    /// its height scaled by `height`.
     fn sheet(n: usize, height: f64, seed: u64) -> Mesh {
-        let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
-        let mut vertices = Vec::new();
-        for j in 0..n {
-            for i in 0..n {
-                let x = i as f64 + rng.random_range(-0.3..0.3);
-                let y = j as f64 + rng.random_range(-0.3..0.3);
-                vertices.push([x, y, height * ((0.4 * x).sin() + 0.2 * y)]);
-            }
-        }
-        let mut faces = Vec::new();
-        for j in 0..n - 1 {
-            for i in 0..n - 1 {
-                let v = (j * n + i) as u32;
-                let n = n as u32;
-                faces.push([v, v + 1, v + n + 1]);
-                faces.push([v, v + n + 1, v + n]);
-            }
-        }
-        Mesh { vertices, faces }
+        let mut mesh = crate::attributes::tests::sheet(n, seed);
+        mesh.vertices.iter_mut().for_each(|p| p[2] *= height);
+        mesh
     }
 
     #[test]
