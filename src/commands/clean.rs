@@ -151,12 +151,12 @@ pub struct Report {
     pub area_facing_one_way: f64,
     /// How far the input's vertices not in the output (the jagged border,
     /// and what the new border cut away) lie from the output's surface
-    /// (not measured by `batch`).
+    /// (by `batch` only with `--deviation`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub input_to_output: Option<Deviation>,
     /// How far the output's new vertices lie from the input's surface:
     /// where the new border runs out past the old border vertices, or
-    /// bridges a notch (not measured by `batch`).
+    /// bridges a notch (by `batch` only with `--deviation`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub output_to_input: Option<Deviation>,
     /// `--max-deviation`, when given.
