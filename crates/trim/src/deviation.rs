@@ -182,40 +182,28 @@ fn same_bits(a: Point3, b: Point3) -> bool {
 /// vertex of `mesh`'s faces not at a vertex of `surface` against every
 /// face of `surface` (or, without faces, every vertex).
 pub fn surface_deviation_reference(surface: &Mesh, mesh: &Mesh) -> Deviation {
-    let mut deviation = Deviation::default();
-    let mut sum = 0.0;
     let on_faces = used_vertices(mesh);
-    for (p, _) in mesh
-        .vertices
-        .iter()
-        .zip(&on_faces)
-        .filter(|(_, &used)| used)
-    {
-        if surface.vertices.iter().any(|q| same_bits(*q, *p)) {
+    let mut measured = Vec::new();
+    let mut distances = Vec::new();
+    for (v, p) in mesh.vertices.iter().enumerate() {
+        if !on_faces[v] || surface.vertices.iter().any(|q| same_bits(*q, *p)) {
             continue;
         }
-        let distance = if surface.faces.is_empty() {
-            let nearest = surface.vertices.iter().map(|q| norm2(sub(*q, *p)));
-            nearest.fold(f64::INFINITY, f64::min).sqrt()
+        let nearest2 = if surface.faces.is_empty() {
+            let to_points = surface.vertices.iter().map(|q| norm2(sub(*q, *p)));
+            to_points.fold(f64::INFINITY, f64::min)
         } else {
-            let nearest =
+            let to_faces =
                 (0..surface.faces.len() as u32).map(|f| closest_on_face(surface, f, *p).0);
-            nearest.fold(f64::INFINITY, f64::min).sqrt()
+            to_faces.fold(f64::INFINITY, f64::min)
         };
-        if !distance.is_finite() {
-            continue;
-        }
-        deviation.vertices += 1;
-        sum += distance;
-        if deviation.at.is_none() || distance > deviation.max {
-            deviation.max = distance;
-            deviation.at = Some(*p);
+        // Infinite only against a surface without vertices: none measured.
+        if nearest2.is_finite() {
+            measured.push(v as u32);
+            distances.push(nearest2.sqrt());
         }
     }
-    if deviation.vertices > 0 {
-        deviation.mean = sum / deviation.vertices as f64;
-    }
-    deviation
+    summary(&mesh.vertices, &measured, &distances)
 }
 
 #[cfg(test)]
