@@ -3,7 +3,8 @@
 use std::path::{Path, PathBuf};
 
 mod common;
-use common::{assert_clean_failure, grid_obj, meshtrim, stderr};
+use common::{assert_clean_failure, grid_obj, meshtrim, path_str, stderr};
+use meshtrim::io::Point3;
 
 const MESH: &str = concat!(
     env!("CARGO_MANIFEST_DIR"),
@@ -575,5 +576,57 @@ fn a_cloud_scale_must_be_above_zero() {
             stderr(&run)
         );
     }
+    assert!(!out.exists());
+}
+
+/// The fixture's mesh and cloud moved to UTM-like coordinates (half a
+/// million east, four million north, as a georeferenced scan's), where
+/// `f32` steps by 0.25: PLY and OBJ keep the trim to `f64`; glTF stores it
+/// about its centre and keeps it to 10⁻⁴ (the mesh is 930 across); STL
+/// would merge vertices and flatten faces, so it is refused, the file
+/// named and nothing written.
+#[test]
+fn a_mesh_far_from_the_origin_keeps_its_shape_or_is_refused() {
+    const UTM: Point3 = [512_345.0, 4_123_456.0, 250.0];
+    let dir = temp_dir();
+    let mut mesh = meshtrim::io::read_mesh(Path::new(MESH)).unwrap();
+    let faces = mesh.faces.take().unwrap();
+    let away = |p: &Point3| -> Point3 { std::array::from_fn(|k| p[k] + UTM[k]) };
+    let vertices: Vec<Point3> = mesh.vertices.iter().map(away).collect();
+    let mesh = path(dir.path(), "mesh.ply");
+    meshtrim::io::write_mesh(&mesh, &vertices, &faces).unwrap();
+    let cloud = meshtrim::io::read_cloud(Path::new(CLOUD)).unwrap();
+    let text: String = (cloud.points.iter().map(away))
+        .map(|p| format!("{:e} {:e} {:e}\n", p[0], p[1], p[2]))
+        .collect();
+    let cloud = path(dir.path(), "cloud.xyz");
+    std::fs::write(&cloud, text).unwrap();
+    let trim_to = |name: &str| {
+        let out = path(dir.path(), name);
+        let run = meshtrim(&[path_str(&mesh), path_str(&cloud), path_str(&out)], None);
+        (out, run)
+    };
+    let here = path(dir.path(), "here.ply");
+    let run = meshtrim(&[MESH, CLOUD, path_str(&here)], None);
+    assert!(run.status.success(), "{}", stderr(&run));
+    let here = meshtrim::io::read_mesh(&here).unwrap();
+    for (name, tolerance) in [("far.ply", 1e-8), ("far.obj", 1e-8), ("far.glb", 1e-4)] {
+        let (out, run) = trim_to(name);
+        assert!(run.status.success(), "{name}: {}", stderr(&run));
+        let far = meshtrim::io::read_mesh(&out).unwrap();
+        assert_eq!(far.faces, here.faces, "{name}");
+        for (a, b) in here.vertices.iter().zip(&far.vertices) {
+            let off = (0..3).fold(0.0f64, |m, k| m.max((a[k] + UTM[k] - b[k]).abs()));
+            assert!(off < tolerance, "{name}: {a:?} {b:?}");
+        }
+    }
+    let (out, run) = trim_to("far.stl");
+    assert_clean_failure(&run, "far.stl: STL stores coordinates as f32");
+    let message = stderr(&run);
+    assert!(message.contains("rounding merges vertex"), "{message}");
+    assert!(
+        message.contains("or .glb (f32 about the mesh's centre)"),
+        "{message}"
+    );
     assert!(!out.exists());
 }

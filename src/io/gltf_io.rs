@@ -32,7 +32,9 @@
 //! ([`super::gltf_materials`]).
 //!
 //! Writing: one mesh with one primitive, `f32` positions with the `min` and
-//! `max` bounds the spec requires, `u32` indices, and with the vertex
+//! `max` bounds the spec requires (about the mesh's centre, the node's
+//! translation, when the mesh lies far from the origin:
+//! [`f32_rounding::storage_origin`]), `u32` indices, and with the vertex
 //! attributes given, unit `f32` `NORMAL`s, `COLOR_0` as normalised
 //! unsigned bytes RGBA, `f32` `TEXCOORD_0` and the file's own values as
 //! `_NAME` ([`holds_field`]); with a glTF input's materials, one primitive
@@ -53,8 +55,8 @@ use super::gltf_materials::{self, NO_MATERIAL};
 use super::hash::HashMap;
 use super::ply::Scalar;
 use super::{
-    is_written_name, show, unit_channel, Colours, Materials, Mesh, Point3, ScalarField,
-    VertexAttributes,
+    f32_rounding, is_written_name, show, unit_channel, Colours, Materials, Mesh, Point3,
+    ScalarField, VertexAttributes,
 };
 
 /// Whether the bytes are a GLB container (the `glTF` magic).
@@ -1031,9 +1033,9 @@ fn document(
     let mut bin = Vec::with_capacity(12 * (vertices.len() + faces.len()));
     let mut min = [f32::INFINITY; 3];
     let mut max = [f32::NEG_INFINITY; 3];
+    let origin = f32_rounding::storage_origin(vertices);
     for p in vertices {
-        for k in 0..3 {
-            let c = p[k] as f32;
+        for (k, c) in f32_rounding::stored(p, origin).into_iter().enumerate() {
             min[k] = min[k].min(c);
             max[k] = max[k].max(c);
             bin.extend_from_slice(&c.to_le_bytes());
@@ -1146,11 +1148,15 @@ fn document(
             "type": "SCALAR"
         }));
     }
+    let mut node = serde_json::json!({ "mesh": 0 });
+    if let Some(origin) = origin {
+        node["translation"] = origin.into();
+    }
     let mut json = serde_json::json!({
         "asset": { "version": "2.0", "generator": "meshtrim" },
         "scene": 0,
         "scenes": [{ "nodes": [0] }],
-        "nodes": [{ "mesh": 0 }],
+        "nodes": [node],
         "meshes": [{ "primitives": primitives }],
         "accessors": accessors,
     });
@@ -1256,6 +1262,34 @@ mod tests {
             }
             read_gltf(&bytes, Path::new(".")).unwrap()
         })
+    }
+
+    /// A mesh 4·10⁶ from the origin, where f32 steps by 0.25, is stored
+    /// about its centre (the node's translation) and reads back to f32's
+    /// precision over its own size; one near the origin has no
+    /// translation.
+    #[test]
+    fn a_mesh_far_from_the_origin_keeps_its_precision() {
+        let (v, f) = square();
+        let far: Vec<Point3> = v
+            .iter()
+            .map(|p| [p[0] * 0.01 + 512_345.678, p[1] * 0.01 + 4_123_456.789, p[2]])
+            .collect();
+        for mesh in written_and_read(&far, &f, &VertexAttributes::default()) {
+            assert_eq!(mesh.faces.as_deref(), Some(f.as_slice()));
+            for (p, q) in far.iter().zip(&mesh.vertices) {
+                assert!((0..3).all(|k| (p[k] - q[k]).abs() < 1e-8), "{p:?} {q:?}");
+            }
+        }
+        let mut bytes = Vec::new();
+        write_gltf(&mut bytes, &far, &f, &VertexAttributes::default()).unwrap();
+        let json: serde_json::Value = serde_json::from_slice(&bytes).unwrap();
+        let origin = &json["nodes"][0]["translation"];
+        assert_eq!(origin[1].as_f64(), Some(4_123_456.75), "{origin}");
+        bytes.clear();
+        write_gltf(&mut bytes, &v, &f, &VertexAttributes::default()).unwrap();
+        let json: serde_json::Value = serde_json::from_slice(&bytes).unwrap();
+        assert_eq!(json["nodes"][0], serde_json::json!({ "mesh": 0 }));
     }
 
     /// Materials, textures, samplers and an image (its bytes embedded)

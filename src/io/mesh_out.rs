@@ -9,7 +9,10 @@
 //! | `.gltf` | glTF 2.0 JSON with the same data in an embedded base64 data URI |
 //!
 //! STL and glTF store coordinates as `f32`, so they lose precision beyond
-//! about 7 significant digits; OBJ and PLY keep `f64` exactly. Output is
+//! about 7 significant digits; OBJ and PLY keep `f64` exactly. glTF
+//! stores a mesh far from the origin about its centre, and a mesh that
+//! rounding would change (vertices merged, faces flattened or turned) is
+//! refused ([`super::f32_rounding`]). Output is
 //! written atomically ([`super::atomic::write_atomic`]), and the bytes
 //! depend only on the mesh (no dates, no hash-map order). Materials of
 //! another format's kind are made the output's
@@ -24,7 +27,8 @@ use super::atomic::write_atomic;
 use super::float_text::push_f64_debug;
 use super::simple_material::SimpleMaterials;
 use super::{
-    gltf_io, show, stl, write_formatted, Materials, Point3, ScalarField, VertexAttributes,
+    f32_rounding, gltf_io, show, stl, write_formatted, Materials, Point3, ScalarField,
+    VertexAttributes,
 };
 
 /// The mesh formats meshtrim writes.
@@ -298,6 +302,14 @@ pub fn check_mesh(format: MeshFormat, vertices: &[Point3], faces: &[[u32; 3]]) -
                 vertices.len()
             );
         }
+    }
+    match format {
+        MeshFormat::Stl => f32_rounding::check_rounding("STL", vertices, faces, None, true)?,
+        MeshFormat::Glb | MeshFormat::Gltf => {
+            let origin = f32_rounding::storage_origin(vertices);
+            f32_rounding::check_rounding("glTF", vertices, faces, origin, false)?
+        }
+        MeshFormat::Obj | MeshFormat::Ply => {}
     }
     match format {
         MeshFormat::Ply if vertices.len() > i32::MAX as usize + 1 => {
@@ -772,6 +784,13 @@ mod tests {
         // A tiny coordinate in a mesh of ordinary size is only rounded.
         let small = [[1e-50, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
         assert!(check_mesh(MeshFormat::Stl, &small, &[[0, 1, 2]]).is_ok());
+        // 0.1 apart 4·10⁶ from the origin, where f32 steps by 0.25: STL
+        // would merge the vertices; glTF stores them about their centre.
+        let far = [[0.0, 4e6, 0.0], [1.0, 4e6, 0.0], [0.0, 4e6 + 0.1, 0.0]];
+        let stl = e(MeshFormat::Stl, &far, &[[0, 1, 2]]);
+        assert!(stl.contains("flattens 1 face to zero area"), "{stl}");
+        assert!(check_mesh(MeshFormat::Glb, &far, &[[0, 1, 2]]).is_ok());
+        assert!(check_mesh(MeshFormat::Ply, &far, &[[0, 1, 2]]).is_ok());
         let nan = [[0.0, f64::NAN, 0.0]];
         assert_eq!(
             e(MeshFormat::Ply, &nan, &[]),

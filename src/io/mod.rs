@@ -18,6 +18,7 @@ pub mod atomic;
 mod corners;
 pub mod e57;
 pub mod edges_out;
+pub mod f32_rounding;
 pub(crate) mod float_text;
 pub mod gltf_io;
 pub mod gltf_materials;

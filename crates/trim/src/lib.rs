@@ -98,7 +98,7 @@ pub use error::{CleanError, CloudError, DelaunayError, MeshError, Placement, Tri
 pub use frame::{fit_plane, Frame};
 pub use geom::rotation_from_quaternion;
 pub use mesh::manifold::ManifoldRepair;
-pub use mesh::repair::FaceRepair;
+pub use mesh::repair::{FaceRepair, MIN_RELATIVE_AREA};
 pub use mesh::seams::{stitch_seams, Stitched};
 pub use mesh::{check_vertex_range, Mesh};
 pub use resolution::PointResolution;

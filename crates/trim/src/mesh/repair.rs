@@ -31,9 +31,9 @@ use super::Mesh;
 use crate::geom::{cross, dist2, norm2, sub, Point3};
 use rayon::prelude::*;
 
-/// Area below which a face is degenerate, relative to the squared
-/// bounding-box diagonal.
-const MIN_RELATIVE_AREA: f64 = 1e-12;
+/// Area below which a face is zero-area (degenerate), relative to the
+/// squared diagonal of the bounding box of the faces' vertices.
+pub const MIN_RELATIVE_AREA: f64 = 1e-12;
 /// A face whose shortest edge is below this share of the median edge is
 /// collapsed along it.
 const SHORT_EDGE: f64 = 0.01;
