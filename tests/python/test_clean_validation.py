@@ -609,16 +609,16 @@ HELD_TO = {"face000": 1.0, "lato000": 1.0, "Laurana50k": 1.0, "bun000": 0.001, "
 
 @pytest.mark.parametrize("name", sorted(REAL))
 def test_scan_max_deviation_holds_the_new_border(name, tmp_path, tmp_path_factory):
-    """With --max-deviation D, every vertex of the new border lies within
-    D of the scan's surface (Open3D's closest points), the output is as
-    valid as without it, and at most one more loop is left (chin: a
-    4-vertex hole). Measured at D = 1 mm (face000's new border up to
-    13.08 mm off the scan without it): the new borders at 1 mm exactly;
-    removed vertices up to 2.30 (face000: a one-face spike the edge
-    reconstruction steps over), 1.00, 1.15 mm on the MeshLab scans. On the
-    bunny's silhouettes the strip adds points between its wall and the
-    loop, over the range grid's skirts, up to 4.8 mm off the scan
-    (bun045): the bound is the border's, which the test checks."""
+    """With --max-deviation D, every new vertex lies within D of the
+    scan's surface (Open3D's closest points), the new border's and the
+    points the silhouettes' strips add when they refine thin faces alike,
+    the output is as valid as without it, and at most one more loop is
+    left (chin: a 4-vertex hole). Measured at D = 1 mm (face000's new
+    border up to 13.08 mm off the scan without it): the new vertices at
+    1 mm at most (the strips' points up to 4.8 mm off before they were
+    held too); removed vertices up to 2.30 (face000: a one-face spike the
+    edge reconstruction steps over), 1.00, 1.15 mm on the MeshLab
+    scans."""
     import meshtrim
 
     free = clean_scan(name, tmp_path_factory)
@@ -633,17 +633,52 @@ def test_scan_max_deviation_holds_the_new_border(name, tmp_path, tmp_path_factor
     unique, count = np.unique(edges, axis=0, return_counts=True)
     border = np.unique(unique[count == 1])
     in_input = set(map(tuple, iv))
-    new_border = np.array([v for v in border if tuple(ov[v]) not in in_input])
-    assert len(new_border) > 0
-    # The new border's vertices against the scan: the vertices of a
-    # one-vertex "mesh" each, so that all are measured.
-    distances, _ = open3d_vertex_deviation(ov[new_border], np.arange(len(new_border))[:, None].repeat(3, 1), iv, if_)
+    new = np.array([v for v in range(len(ov)) if tuple(ov[v]) not in in_input])
+    new_border = np.intersect1d(new, border)
+    assert len(new_border) > 0 and len(new) > len(new_border)
+    # The new vertices against the scan: the vertices of a one-vertex
+    # "mesh" each, so that all are measured.
+    distances, _ = open3d_vertex_deviation(ov[new], np.arange(len(new))[:, None].repeat(3, 1), iv, if_)
     diagonal = np.linalg.norm(np.ptp(iv, axis=0))
     assert distances.max() <= bound + 1e-6 * diagonal, (name, distances.max(), bound)
+    assert rep["output_to_input"]["max"] <= bound + 1e-6 * diagonal, rep
     pm = poisson.pymeshlab_validity(ov, of)
     assert pm["non_manifold_edges"] == 0 and pm["reoriented"] == 0, pm
     assert pm["null_faces"] == 0 and pm["duplicate_faces"] == 0, pm
-    print(f"\n{name} held to {bound}: new border max {distances.max():.5g}, report {rep['input_to_output']['max']:.5g} / {rep['output_to_input']['max']:.5g}")
+    print(f"\n{name} held to {bound}: new vertices max {distances.max():.5g}, report {rep['input_to_output']['max']:.5g} / {rep['output_to_input']['max']:.5g}")
+
+
+SELF_CROSSINGS_ADDED = {
+    # name: faces PyMeshLab finds self-intersecting in the output beyond
+    # those of the input, measured: mostly two new faces of a silhouette's
+    # strip crossing each other (of the crossing pairs, 2 of 3 on bun000,
+    # 11 of 12 on bun045, 8 of 10 on chin), the others a new face and a
+    # kept one still crossed after the strip's last remaking. Before the
+    # strips took in the kept faces they pass through: 36, 167, 5 and 99
+    # on bun000, bun045, bun090, chin.
+    "bun000": 4,
+    "bun045": 18,
+    "chin": 11,
+}
+
+
+def test_scan_cleanup_adds_few_self_crossings(scan):
+    """The cleaned scan intersects itself (PyMeshLab's "Select
+    Self-Intersecting Faces") in no more faces than the scan did, beyond
+    the measured remainder on the bunny's silhouettes above: a strip from
+    the smoothed loop to a wall several spacings behind it, across the
+    range grid's skirts, passed through the kept surface, and the kept
+    faces it passes through now go with the cut, the strip made again."""
+    import pymeshlab
+
+    counts = []
+    for path in [scan["src"], scan["out_path"]]:
+        ms = pymeshlab.MeshSet()
+        ms.load_new_mesh(str(path))
+        ms.compute_selection_by_self_intersections_per_face()
+        counts.append(ms.current_mesh().selected_face_number())
+    added = counts[1] - counts[0]
+    assert added <= SELF_CROSSINGS_ADDED.get(scan["name"], 0), (scan["name"], counts)
 
 
 def test_zippered_bunny_is_warned_about(tmp_path):
@@ -666,8 +701,8 @@ def test_scan_new_faces_are_rarely_thin(scan):
     more along the silhouette), where the kept mesh's new border lies
     several spacings behind the smoothed loop; the strip is refined in its
     unfolded plane, and about a third of what stays thin lies where the
-    strip folds and cannot be refined: bun000 15 / 48 of 2547, bun045
-    59 / 83 of 2479, bun090 35 / 87 of 2329, chin 70 / 130 of 2451 (96 /
+    strip folds and cannot be refined: bun000 13 / 49 of 2558, bun045
+    20 / 47 of 2484, bun090 39 / 84 of 2353, chin 29 / 80 of 2531 (96 /
     289, 168 / 332, 116 / 291, 180 / 351 unrefined). Bounds: 4 % below 5,
     8 % below 10."""
     angles = new_face_angles(scan)
@@ -693,7 +728,7 @@ SHORT_OF_THE_FLOOR = {
     # between them, have input edges 50-115 spacings long, which the new
     # faces beside them share or span: no triangulation keeping the input's
     # vertices avoids the needles there.
-    "bun045": 0.23,
+    "bun045": 0.46,
     "bun090": 0.44,
     "chin": 0.95,
 }

@@ -62,6 +62,7 @@
 mod align;
 mod assemble;
 mod band;
+mod crossing;
 mod gap;
 mod rounds;
 mod strip;
@@ -162,7 +163,10 @@ pub struct CleanOptions {
     /// The farthest each smoothed loop vertex may lie from the border
     /// vertex it was smoothed from (in the mesh's units): where it would
     /// lie farther (a notch bridged, a corner cut off), the loop follows
-    /// the border at that distance. None: as smooth as β makes it.
+    /// the border at that distance; the points a strip adds when it
+    /// refines its faces are held within it of the scan's faces it
+    /// replaces, so every new vertex lies within it of the scan. None: as
+    /// smooth as β makes it.
     pub max_deviation: Option<f64>,
 }
 

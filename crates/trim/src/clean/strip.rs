@@ -44,6 +44,11 @@
 //! 5. **The slivers.** Where the wall lies several spacings behind the
 //!    smoothed loop, runs of the strip that hold slivers are unfolded
 //!    into the plane and refined there ([`refine_strip`]).
+//! 6. **Kept faces passed through.** Where the wall lies behind the loop
+//!    across a range grid's skirts, a strip face can pierce the kept
+//!    surface between them. The kept faces a strip face passes through
+//!    ([`crossing`]) go with the cut, their vertices with the border's,
+//!    and the strip is made again, up to [`CROSSING_ROUNDS`] times.
 
 use super::*;
 use crate::edges::smooth::arc_lengths;
@@ -68,6 +73,11 @@ const DEPTH_WINDOW: f64 = 2.0;
 /// Borders one strip may absorb because they lie one face from others it
 /// absorbs.
 const MAX_ABSORBED: usize = 64;
+/// Times a strip is made again after passing through kept faces, which
+/// then go with the cut ([`crossing`]).
+const CROSSING_ROUNDS: usize = 3;
+/// The cells of the grid that finds those kept faces, in β.
+const CROSSING_CELL: f64 = 2.0;
 /// Times the faces round a pinched wall vertex are removed before the loop
 /// is left.
 const PINCH_REPAIRS: usize = 16;
@@ -330,14 +340,71 @@ pub(super) fn replace_by_strip(
     let ring = cx.rings[l].as_ref().ok_or(StripFailure::Wall)?;
     let guide = Guide::new(cx, l, ring).ok_or(StripFailure::Wall)?;
     let owner = border_owner(cx);
-    // A border kept out of the cut that lies one face from an absorbed one
-    // cannot keep the faces between them: it is absorbed too, and the cut
-    // made again.
+    // Vertices of kept faces an earlier strip passed through: they go, and
+    // the strip is made again.
+    let n = cx.mesh.vertices.len() as u32;
+    let mut pushed = BTreeSet::new();
+    let mut rounds = 0;
+    loop {
+        let (cut, removed) = cut_and_removed(cx, l, &guide, &owner, replaced, &pushed)?;
+        let (removed, wall) = closed_wall(cx, removed)?;
+        let faces = zip(cx, &guide, &wall)?;
+        let m = guide.len() as u32;
+        let position = |id: u32| guide.position(cx, id);
+        let joined = |a: u32, b: u32| {
+            a < n && b < n && (face_running(cx, a, b).is_some() || face_running(cx, b, a).is_some())
+        };
+        let (faces, mut added) = refine_strip(&faces, &position, &joined, n + m, cx.beta_median);
+        if let Some(max) = cx.max_deviation {
+            tolerance::pull_within(&mut added, cx.mesh, &removed, max);
+        }
+        let mut vertices = guide.points.clone();
+        vertices.extend(added);
+        if rounds < CROSSING_ROUNDS {
+            rounds += 1;
+            let at = |id: u32| match id.checked_sub(n) {
+                None => cx.mesh.vertices[id as usize],
+                Some(k) => vertices[k as usize],
+            };
+            let cell = CROSSING_CELL * cx.beta_median;
+            let crossed = crossing::kept_faces_crossed(cx.mesh, &removed, &faces, &at, cell);
+            if !crossed.is_empty() {
+                pushed.extend(crossed.iter().flat_map(|&f| cx.mesh.faces[f as usize]));
+                continue;
+            }
+        }
+        let footprint = footprint(cx, &removed);
+        let mut loops = vec![l];
+        loops.extend(cut.absorbed.iter().copied());
+        return Ok(Strip {
+            patch: Patch {
+                loops,
+                removed,
+                vertices,
+                faces,
+                reaches_far: false,
+            },
+            footprint,
+        });
+    }
+}
+
+/// The cut (step 2) and the faces it removes. A border kept out of the
+/// cut that lies one face from an absorbed one cannot keep the faces
+/// between them: it is absorbed too, and the cut made again.
+fn cut_and_removed(
+    cx: &Context,
+    l: usize,
+    guide: &Guide,
+    owner: &HashMap<u32, usize>,
+    replaced: &[bool],
+    pushed: &BTreeSet<u32>,
+) -> Result<(Cut, Vec<u32>), StripFailure> {
     let mut forced = BTreeSet::new();
-    let (cut, removed) = loop {
-        let cut = Cut::new(cx, l, &guide, &owner, replaced, &forced)?;
+    loop {
+        let cut = Cut::new(cx, l, guide, owner, replaced, &forced, pushed)?;
         let removed = cut.removed_faces(cx);
-        let (kept, touched) = clear_of_other_borders(cx, l, &cut, &owner, removed);
+        let (kept, touched) = clear_of_other_borders(cx, l, &cut, owner, removed);
         // A smaller border another patch replaces would be absorbed if that
         // patch gave way: say so, rather than leave a wall that runs into
         // it.
@@ -351,35 +418,11 @@ pub(super) fn replace_by_strip(
             .iter()
             .all(|&k| !replaced[k] && cx.borders[k].len() < cx.borders[l].len());
         if touched.is_empty() || !absorbable || forced.len() >= MAX_ABSORBED {
-            break (cut, kept);
+            return Ok((cut, kept));
         }
         forced.extend(cut.absorbed.iter().copied());
         forced.extend(touched);
-    };
-    let (removed, wall) = closed_wall(cx, removed)?;
-    let faces = zip(cx, &guide, &wall)?;
-    let n = cx.mesh.vertices.len() as u32;
-    let m = guide.len() as u32;
-    let position = |id: u32| guide.position(cx, id);
-    let joined = |a: u32, b: u32| {
-        a < n && b < n && (face_running(cx, a, b).is_some() || face_running(cx, b, a).is_some())
-    };
-    let (faces, added) = refine_strip(&faces, &position, &joined, n + m, cx.beta_median);
-    let mut vertices = guide.points.clone();
-    vertices.extend(added);
-    let footprint = footprint(cx, &removed);
-    let mut loops = vec![l];
-    loops.extend(cut.absorbed.iter().copied());
-    Ok(Strip {
-        patch: Patch {
-            loops,
-            removed,
-            vertices,
-            faces,
-            reaches_far: false,
-        },
-        footprint,
-    })
+    }
 }
 
 /// The border loop each border vertex is on.
@@ -405,6 +448,7 @@ impl Cut {
         owner: &HashMap<u32, usize>,
         replaced: &[bool],
         forced: &BTreeSet<usize>,
+        pushed: &BTreeSet<u32>,
     ) -> Result<Cut, StripFailure> {
         let mut cut = Cut {
             going: HashSet::default(),
@@ -413,6 +457,8 @@ impl Cut {
         let mut protected: HashSet<u32> = HashSet::default();
         let mut seen: HashSet<u32> = HashSet::default();
         let mut frontier: Vec<u32> = cx.borders[l].clone();
+        let own: HashSet<u32> = frontier.iter().copied().collect();
+        frontier.extend(pushed.iter().filter(|v| !own.contains(v)));
         for &v in &frontier {
             cut.going.insert(v);
             seen.insert(v);

@@ -1,0 +1,231 @@
+//! Kept faces a strip's new faces pass through (meshtrim's own, not the
+//! paper's). On a range grid's silhouette the wall can lie several
+//! spacings behind the smoothed loop, across the grid's skirts, and a
+//! strip face from the loop to the wall can pierce the kept surface
+//! between them. The strip takes those kept faces into its cut and is
+//! made again ([`super::strip::replace_by_strip`]).
+
+use super::*;
+
+/// A triangle's corners.
+type Corners = [Point3; 3];
+
+/// The kept faces of `mesh` (those not in `removed`, ascending) that a
+/// triangle of `strip` passes through, where the two share no vertex
+/// (`strip`'s ids below the mesh's vertex count are mesh vertices),
+/// ascending. The strip's triangles are filed in a grid of cells `cell`
+/// wide (a few spacings), and each kept face compared with those in the
+/// cells its bounding box meets.
+pub(super) fn kept_faces_crossed(
+    mesh: &Mesh,
+    removed: &[u32],
+    strip: &[[u32; 3]],
+    position: &dyn Fn(u32) -> Point3,
+    cell: f64,
+) -> Vec<u32> {
+    let corners: Vec<Corners> = strip.iter().map(|f| f.map(position)).collect();
+    let Some(grid) = Grid::new(&corners, cell) else {
+        return Vec::new();
+    };
+    let mut crossed = Vec::new();
+    let mut candidates = Vec::new();
+    for (f, face) in mesh.faces.iter().enumerate() {
+        let f = f as u32;
+        if removed.binary_search(&f).is_ok() {
+            continue;
+        }
+        let kept = face.map(|v| mesh.vertices[v as usize]);
+        grid.candidates(&kept, &mut candidates);
+        let crosses = candidates.iter().any(|&s| {
+            let shares = strip[s as usize].iter().any(|v| face.contains(v));
+            !shares && triangles_cross(&kept, &corners[s as usize])
+        });
+        if crosses {
+            crossed.push(f);
+        }
+    }
+    crossed
+}
+
+/// A uniform grid of cells holding the triangles whose bounding boxes
+/// meet them.
+struct Grid {
+    cell: f64,
+    cells: HashMap<[i64; 3], Vec<u32>>,
+}
+
+impl Grid {
+    fn new(triangles: &[Corners], cell: f64) -> Option<Grid> {
+        if triangles.is_empty() || !(cell > 0.0 && cell.is_finite()) {
+            return None;
+        }
+        let mut grid = Grid {
+            cell,
+            cells: HashMap::default(),
+        };
+        for (t, corners) in triangles.iter().enumerate() {
+            let (lo, hi) = grid.cell_range(corners);
+            for key in cells_between(lo, hi) {
+                grid.cells.entry(key).or_default().push(t as u32);
+            }
+        }
+        Some(grid)
+    }
+
+    fn cell_range(&self, corners: &Corners) -> ([i64; 3], [i64; 3]) {
+        let at = |k: usize, pick: fn(f64, f64) -> f64| {
+            let c = corners.iter().map(|p| p[k]).fold(corners[0][k], pick);
+            (c / self.cell).floor() as i64
+        };
+        (
+            std::array::from_fn(|k| at(k, f64::min)),
+            std::array::from_fn(|k| at(k, f64::max)),
+        )
+    }
+
+    /// The triangles in the cells `corners`' bounding box meets, ascending,
+    /// once each.
+    fn candidates(&self, corners: &Corners, out: &mut Vec<u32>) {
+        out.clear();
+        let (lo, hi) = self.cell_range(corners);
+        for key in cells_between(lo, hi) {
+            if let Some(ts) = self.cells.get(&key) {
+                out.extend_from_slice(ts);
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+    }
+}
+
+/// The cells from `lo` to `hi`, both included; none past a million (a
+/// box that large holds the whole mesh's worth and is not refined).
+fn cells_between(lo: [i64; 3], hi: [i64; 3]) -> impl Iterator<Item = [i64; 3]> {
+    let span = |k: usize| (hi[k] - lo[k] + 1).max(0);
+    let count = span(0).saturating_mul(span(1)).saturating_mul(span(2));
+    let (lo, hi) = if count > 1_000_000 {
+        (lo, lo)
+    } else {
+        (lo, hi)
+    };
+    (lo[0]..=hi[0]).flat_map(move |x| {
+        (lo[1]..=hi[1]).flat_map(move |y| (lo[2]..=hi[2]).map(move |z| [x, y, z]))
+    })
+}
+
+/// Whether an edge of either triangle passes through the other's interior
+/// (not through its edges or corners, so triangles that only touch do not
+/// cross; coplanar ones are not compared).
+pub(super) fn triangles_cross(a: &Corners, b: &Corners) -> bool {
+    let edge_through = |t: &Corners, s: &Corners| {
+        (0..3).any(|k| segment_through_triangle(s[k], s[(k + 1) % 3], t))
+    };
+    edge_through(a, b) || edge_through(b, a)
+}
+
+/// Möller and Trumbore's segment–triangle test, strictly inside both.
+fn segment_through_triangle(p: Point3, q: Point3, [a, b, c]: &Corners) -> bool {
+    const INSIDE: f64 = 1e-9;
+    let (e1, e2, d) = (sub(*b, *a), sub(*c, *a), sub(q, p));
+    let h = cross(d, e2);
+    let det = dot(e1, h);
+    if det.abs() <= 1e-12 * norm2(e1).sqrt() * norm2(e2).sqrt() * norm2(d).sqrt() {
+        return false;
+    }
+    let s = sub(p, *a);
+    let u = dot(s, h) / det;
+    let qv = cross(s, e1);
+    let v = dot(d, qv) / det;
+    let t = dot(e2, qv) / det;
+    u > INSIDE && v > INSIDE && u + v < 1.0 - INSIDE && t > INSIDE && t < 1.0 - INSIDE
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{RngExt, SeedableRng};
+
+    /// Every kept face compared with every strip triangle.
+    fn kept_faces_crossed_reference(
+        mesh: &Mesh,
+        removed: &[u32],
+        strip: &[[u32; 3]],
+        position: &dyn Fn(u32) -> Point3,
+    ) -> Vec<u32> {
+        (0..mesh.faces.len() as u32)
+            .filter(|f| !removed.contains(f))
+            .filter(|&f| {
+                let face = mesh.faces[f as usize];
+                let kept = face.map(|v| mesh.vertices[v as usize]);
+                strip.iter().any(|s| {
+                    !s.iter().any(|v| face.contains(v)) && triangles_cross(&kept, &s.map(position))
+                })
+            })
+            .collect()
+    }
+
+    /// The grid finds what comparing every pair finds: a bumpy grid mesh
+    /// with some faces removed, pierced by random triangles of new points
+    /// and mesh vertices, long ones among them, at cells from a tenth of
+    /// the mesh's spacing to beyond its size.
+    #[test]
+    fn the_grid_finds_every_crossing_pair() {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(17);
+        let mut mesh = crate::mesh::tests::grid(12);
+        for p in &mut mesh.vertices {
+            p[2] = 0.3 * (p[0] * 0.7).sin() * (p[1] * 0.5).cos();
+        }
+        let n = mesh.vertices.len() as u32;
+        let mut total = 0;
+        for case in 0..60 {
+            let removed: Vec<u32> = (0..mesh.faces.len() as u32)
+                .filter(|_| rng.random::<f64>() < 0.2)
+                .collect();
+            let new_points: Vec<Point3> = (0..30)
+                .map(|_| {
+                    [
+                        rng.random_range(0.0..11.0),
+                        rng.random_range(0.0..11.0),
+                        rng.random_range(-1.0..1.0),
+                    ]
+                })
+                .collect();
+            let id = |rng: &mut rand::rngs::StdRng| {
+                if rng.random::<f64>() < 0.3 {
+                    rng.random_range(0..n)
+                } else {
+                    n + rng.random_range(0..new_points.len() as u32)
+                }
+            };
+            let strip: Vec<[u32; 3]> = (0..20)
+                .map(|_| [id(&mut rng), id(&mut rng), id(&mut rng)])
+                .collect();
+            let position = |v: u32| match v.checked_sub(n) {
+                None => mesh.vertices[v as usize],
+                Some(k) => new_points[k as usize],
+            };
+            let cell = [0.1, 0.7, 2.0, 50.0][case % 4];
+            let fast = kept_faces_crossed(&mesh, &removed, &strip, &position, cell);
+            let plain = kept_faces_crossed_reference(&mesh, &removed, &strip, &position);
+            assert_eq!(fast, plain, "case {case}");
+            total += fast.len();
+        }
+        assert!(total > 100, "{total}");
+    }
+
+    #[test]
+    fn triangles_cross_only_through_their_interiors() {
+        let flat = [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [0.0, 4.0, 0.0]];
+        let through = [[1.0, 1.0, -1.0], [1.0, 1.0, 1.0], [3.0, 3.0, 1.0]];
+        assert!(triangles_cross(&flat, &through));
+        assert!(triangles_cross(&through, &flat));
+        let above = through.map(|p| [p[0], p[1], p[2] + 2.0]);
+        assert!(!triangles_cross(&flat, &above));
+        // Sharing an edge, folded: touching is not crossing.
+        let hinge = [[0.0, 0.0, 0.0], [4.0, 0.0, 0.0], [2.0, 0.0, 3.0]];
+        assert!(!triangles_cross(&flat, &hinge));
+        // One edge of each through the other (a chain link).
+        let link = [[1.0, -1.0, -1.0], [1.0, 2.0, -1.0], [1.0, 0.5, 2.0]];
+        assert!(triangles_cross(&flat, &link));
+    }
+}
