@@ -107,9 +107,14 @@ pub fn check_rounding(
     }
     let (far, step) = reach_and_step(vertices, origin);
     let about = if origin.is_some() {
-        " (stored about the mesh's centre)"
+        " (here about the mesh's centre)"
     } else {
         ""
+    };
+    let from = if origin.is_some() {
+        "its centre"
+    } else {
+        "the origin"
     };
     // Storing about the centre helps only a mesh far from the origin.
     let far_from_the_origin = origin.is_none() && storage_origin(vertices).is_some();
@@ -120,7 +125,7 @@ pub fn check_rounding(
         "write .ply or .obj (f64 coordinates)"
     };
     bail!(
-        "{format} stores coordinates as f32{about}, which at up to {far:e} from the origin \
+        "{format} stores coordinates as f32{about}, which at up to {far:e} from {from} \
          step by up to {step:e}: rounding {}; {instead}",
         what.join(", ")
     )

@@ -35,7 +35,7 @@ pub(super) fn kept_faces_crossed(
             continue;
         }
         let kept = face.map(|v| mesh.vertices[v as usize]);
-        grid.candidates(&kept, &mut candidates);
+        grid.candidates(&kept, strip.len(), &mut candidates);
         let crosses = candidates.iter().any(|&s| {
             let shares = strip[s as usize].iter().any(|v| face.contains(v));
             !shares && triangles_cross(&kept, &corners[s as usize])
@@ -47,11 +47,17 @@ pub(super) fn kept_faces_crossed(
     crossed
 }
 
+/// Cells a triangle's bounding box may meet and still be filed in them;
+/// a larger one is a candidate everywhere (on a scan's strip, faces span
+/// tens of cells at most).
+const MAX_CELLS: i64 = 4096;
+
 /// A uniform grid of cells holding the triangles whose bounding boxes
-/// meet them.
+/// meet them, and the triangles too large for it.
 struct Grid {
     cell: f64,
     cells: HashMap<[i64; 3], Vec<u32>>,
+    everywhere: Vec<u32>,
 }
 
 impl Grid {
@@ -62,55 +68,59 @@ impl Grid {
         let mut grid = Grid {
             cell,
             cells: HashMap::default(),
+            everywhere: Vec::new(),
         };
         for (t, corners) in triangles.iter().enumerate() {
-            let (lo, hi) = grid.cell_range(corners);
-            for key in cells_between(lo, hi) {
-                grid.cells.entry(key).or_default().push(t as u32);
+            match grid.cells_met(corners) {
+                Some(cells) => {
+                    for key in cells {
+                        grid.cells.entry(key).or_default().push(t as u32);
+                    }
+                }
+                None => grid.everywhere.push(t as u32),
             }
         }
         Some(grid)
     }
 
-    fn cell_range(&self, corners: &Corners) -> ([i64; 3], [i64; 3]) {
+    /// The cells `corners`' bounding box meets, or `None` past
+    /// [`MAX_CELLS`] (or for a box beyond the grid's coordinates).
+    fn cells_met(&self, corners: &Corners) -> Option<impl Iterator<Item = [i64; 3]>> {
         let at = |k: usize, pick: fn(f64, f64) -> f64| {
             let c = corners.iter().map(|p| p[k]).fold(corners[0][k], pick);
-            (c / self.cell).floor() as i64
+            (c / self.cell).floor()
         };
-        (
-            std::array::from_fn(|k| at(k, f64::min)),
-            std::array::from_fn(|k| at(k, f64::max)),
-        )
+        let lo: [f64; 3] = std::array::from_fn(|k| at(k, f64::min));
+        let hi: [f64; 3] = std::array::from_fn(|k| at(k, f64::max));
+        let count = (0..3).fold(1.0, |n, k| n * (hi[k] - lo[k] + 1.0));
+        // A NaN count (a non-finite corner) is past the limit too.
+        if count.is_nan() || count > MAX_CELLS as f64 {
+            return None;
+        }
+        let [lo, hi] = [lo, hi].map(|c| c.map(|x| x as i64));
+        Some((lo[0]..=hi[0]).flat_map(move |x| {
+            (lo[1]..=hi[1]).flat_map(move |y| (lo[2]..=hi[2]).map(move |z| [x, y, z]))
+        }))
     }
 
-    /// The triangles in the cells `corners`' bounding box meets, ascending,
-    /// once each.
-    fn candidates(&self, corners: &Corners, out: &mut Vec<u32>) {
+    /// The triangles that may meet `corners`' bounding box (every one for
+    /// a box past [`MAX_CELLS`]), ascending, once each.
+    fn candidates(&self, corners: &Corners, count: usize, out: &mut Vec<u32>) {
         out.clear();
-        let (lo, hi) = self.cell_range(corners);
-        for key in cells_between(lo, hi) {
-            if let Some(ts) = self.cells.get(&key) {
-                out.extend_from_slice(ts);
+        match self.cells_met(corners) {
+            Some(cells) => {
+                for key in cells {
+                    if let Some(ts) = self.cells.get(&key) {
+                        out.extend_from_slice(ts);
+                    }
+                }
+                out.extend_from_slice(&self.everywhere);
             }
+            None => out.extend(0..count as u32),
         }
         out.sort_unstable();
         out.dedup();
     }
-}
-
-/// The cells from `lo` to `hi`, both included; none past a million (a
-/// box that large holds the whole mesh's worth and is not refined).
-fn cells_between(lo: [i64; 3], hi: [i64; 3]) -> impl Iterator<Item = [i64; 3]> {
-    let span = |k: usize| (hi[k] - lo[k] + 1).max(0);
-    let count = span(0).saturating_mul(span(1)).saturating_mul(span(2));
-    let (lo, hi) = if count > 1_000_000 {
-        (lo, lo)
-    } else {
-        (lo, hi)
-    };
-    (lo[0]..=hi[0]).flat_map(move |x| {
-        (lo[1]..=hi[1]).flat_map(move |y| (lo[2]..=hi[2]).map(move |z| [x, y, z]))
-    })
 }
 
 /// Whether an edge of either triangle passes through the other's interior
@@ -166,8 +176,9 @@ mod tests {
 
     /// The grid finds what comparing every pair finds: a bumpy grid mesh
     /// with some faces removed, pierced by random triangles of new points
-    /// and mesh vertices, long ones among them, at cells from a tenth of
-    /// the mesh's spacing to beyond its size.
+    /// and mesh vertices, long ones among them, at cells from a hundredth
+    /// of the mesh's spacing (every box too large to file) to beyond its
+    /// size.
     #[test]
     fn the_grid_finds_every_crossing_pair() {
         let mut rng = rand::rngs::StdRng::seed_from_u64(17);
@@ -204,7 +215,8 @@ mod tests {
                 None => mesh.vertices[v as usize],
                 Some(k) => new_points[k as usize],
             };
-            let cell = [0.1, 0.7, 2.0, 50.0][case % 4];
+            // At 0.01 every box is past MAX_CELLS, at 0.1 the strip's.
+            let cell = [0.01, 0.1, 0.7, 2.0, 50.0][case % 5];
             let fast = kept_faces_crossed(&mesh, &removed, &strip, &position, cell);
             let plain = kept_faces_crossed_reference(&mesh, &removed, &strip, &position);
             assert_eq!(fast, plain, "case {case}");

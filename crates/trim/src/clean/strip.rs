@@ -48,7 +48,8 @@
 //!    across a range grid's skirts, a strip face can pierce the kept
 //!    surface between them. The kept faces a strip face passes through
 //!    ([`crossing`]) go with the cut, their vertices with the border's,
-//!    and the strip is made again, up to [`CROSSING_ROUNDS`] times.
+//!    and the strip is made again, up to [`CROSSING_ROUNDS`] times; where
+//!    it can no longer be made, the strip before stays.
 
 use super::*;
 use crate::edges::smooth::arc_lengths;
@@ -340,53 +341,69 @@ pub(super) fn replace_by_strip(
     let ring = cx.rings[l].as_ref().ok_or(StripFailure::Wall)?;
     let guide = Guide::new(cx, l, ring).ok_or(StripFailure::Wall)?;
     let owner = border_owner(cx);
-    // Vertices of kept faces an earlier strip passed through: they go, and
-    // the strip is made again.
-    let n = cx.mesh.vertices.len() as u32;
+    // Vertices of kept faces an earlier strip passed through go, and the
+    // strip is made again; a strip that then cannot be made leaves the one
+    // before.
     let mut pushed = BTreeSet::new();
-    let mut rounds = 0;
-    loop {
-        let (cut, removed) = cut_and_removed(cx, l, &guide, &owner, replaced, &pushed)?;
-        let (removed, wall) = closed_wall(cx, removed)?;
-        let faces = zip(cx, &guide, &wall)?;
-        let m = guide.len() as u32;
-        let position = |id: u32| guide.position(cx, id);
-        let joined = |a: u32, b: u32| {
-            a < n && b < n && (face_running(cx, a, b).is_some() || face_running(cx, b, a).is_some())
-        };
-        let (faces, mut added) = refine_strip(&faces, &position, &joined, n + m, cx.beta_median);
-        if let Some(max) = cx.max_deviation {
-            tolerance::pull_within(&mut added, cx.mesh, &removed, max);
+    let (mut strip, mut crossed) = strip_once(cx, l, &guide, &owner, replaced, &pushed)?;
+    for _ in 0..CROSSING_ROUNDS {
+        if crossed.is_empty() {
+            break;
         }
-        let mut vertices = guide.points.clone();
-        vertices.extend(added);
-        if rounds < CROSSING_ROUNDS {
-            rounds += 1;
-            let at = |id: u32| match id.checked_sub(n) {
-                None => cx.mesh.vertices[id as usize],
-                Some(k) => vertices[k as usize],
-            };
-            let cell = CROSSING_CELL * cx.beta_median;
-            let crossed = crossing::kept_faces_crossed(cx.mesh, &removed, &faces, &at, cell);
-            if !crossed.is_empty() {
-                pushed.extend(crossed.iter().flat_map(|&f| cx.mesh.faces[f as usize]));
-                continue;
-            }
+        pushed.extend(crossed.iter().flat_map(|&f| cx.mesh.faces[f as usize]));
+        match strip_once(cx, l, &guide, &owner, replaced, &pushed) {
+            Ok(again) => (strip, crossed) = again,
+            Err(_) => break,
         }
-        let footprint = footprint(cx, &removed);
-        let mut loops = vec![l];
-        loops.extend(cut.absorbed.iter().copied());
-        return Ok(Strip {
-            patch: Patch {
-                loops,
-                removed,
-                vertices,
-                faces,
-                reaches_far: false,
-            },
-            footprint,
-        });
     }
+    Ok(strip)
+}
+
+/// The strip of border `l` (steps 2–5) with the vertices of `pushed`
+/// going too, and the kept faces it passes through.
+fn strip_once(
+    cx: &Context,
+    l: usize,
+    guide: &Guide,
+    owner: &HashMap<u32, usize>,
+    replaced: &[bool],
+    pushed: &BTreeSet<u32>,
+) -> Result<(Strip, Vec<u32>), StripFailure> {
+    let (cut, removed) = cut_and_removed(cx, l, guide, owner, replaced, pushed)?;
+    let (removed, wall) = closed_wall(cx, removed)?;
+    let faces = zip(cx, guide, &wall)?;
+    let n = cx.mesh.vertices.len() as u32;
+    let m = guide.len() as u32;
+    let position = |id: u32| guide.position(cx, id);
+    let joined = |a: u32, b: u32| {
+        a < n && b < n && (face_running(cx, a, b).is_some() || face_running(cx, b, a).is_some())
+    };
+    let (faces, mut added) = refine_strip(&faces, &position, &joined, n + m, cx.beta_median);
+    if let Some(max) = cx.max_deviation {
+        tolerance::pull_within(&mut added, cx.mesh, &removed, max);
+    }
+    let mut vertices = guide.points.clone();
+    vertices.extend(added);
+    let at = |id: u32| match id.checked_sub(n) {
+        None => cx.mesh.vertices[id as usize],
+        Some(k) => vertices[k as usize],
+    };
+    let cell = CROSSING_CELL * cx.beta_median;
+    let crossed = crossing::kept_faces_crossed(cx.mesh, &removed, &faces, &at, cell);
+    let footprint = footprint(cx, &removed);
+    let mut loops = vec![l];
+    loops.extend(cut.absorbed.iter().copied());
+    let strip = Strip {
+        patch: Patch {
+            loops,
+            removed,
+            vertices,
+            faces,
+            reaches_far: false,
+        },
+        footprint,
+    };
+    Ok((strip, crossed))
 }
 
 /// The cut (step 2) and the faces it removes. A border kept out of the
