@@ -24,7 +24,7 @@
 use anyhow::{bail, Result};
 
 use super::hash::HashMap;
-use super::Point3;
+use super::{doubled_area, Point3};
 
 /// Plain `f32` rounding beyond this share of the mesh's diagonal has glTF
 /// store the positions about the mesh's centre.
@@ -238,15 +238,6 @@ fn bounds(points: impl Iterator<Item = Point3>) -> Option<(Point3, Point3)> {
         }
         Some((lo, hi))
     })
-}
-
-fn doubled_area([a, b, c]: [Point3; 3]) -> Point3 {
-    let (u, v) = (sub(b, a), sub(c, a));
-    [
-        u[1] * v[2] - u[2] * v[1],
-        u[2] * v[0] - u[0] * v[2],
-        u[0] * v[1] - u[1] * v[0],
-    ]
 }
 
 fn sub(a: Point3, b: Point3) -> Point3 {

@@ -1019,8 +1019,9 @@ fn accessor_data<'b>(
     }
 }
 
-/// The glTF JSON document and binary buffer of one mesh; `uri` is the
-/// buffer's URI (`None` for the GLB binary chunk). Normals, when given,
+/// The glTF JSON document and binary buffer of one mesh (the buffer
+/// without a URI: the GLB binary chunk, or `.gltf`'s data URI set by
+/// [`write_gltf`]). Normals, when given,
 /// are written as unit `f32` vectors (as the spec requires: a zero one as
 /// +z); colours as `COLOR_0`, normalised unsigned bytes RGBA; texture
 /// coordinates as `f32` `TEXCOORD_0`, v turned down the image.
@@ -1028,7 +1029,6 @@ fn document(
     vertices: &[Point3],
     faces: &[[u32; 3]],
     attributes: &VertexAttributes,
-    uri: Option<String>,
 ) -> (serde_json::Value, Vec<u8>) {
     let mut bin = Vec::with_capacity(12 * (vertices.len() + faces.len()));
     let mut min = [f32::INFINITY; 3];
@@ -1163,12 +1163,8 @@ fn document(
     if let Some(materials) = gltf_materials {
         gltf_materials::write(materials, &mut json, &mut views, &mut bin);
     }
-    let mut buffer = serde_json::json!({ "byteLength": bin.len() });
-    if let Some(uri) = uri {
-        buffer["uri"] = uri.into();
-    }
     json["bufferViews"] = views.into();
-    json["buffers"] = serde_json::json!([buffer]);
+    json["buffers"] = serde_json::json!([{ "byteLength": bin.len() }]);
     (json, bin)
 }
 
@@ -1201,7 +1197,7 @@ pub fn write_glb(
     attributes: &VertexAttributes,
 ) -> std::io::Result<()> {
     empty_error(vertices, faces)?;
-    let (json, bin) = document(vertices, faces, attributes, None);
+    let (json, bin) = document(vertices, faces, attributes);
     let mut json = serde_json::to_vec(&json).map_err(std::io::Error::other)?;
     json.resize(json.len().next_multiple_of(4), b' ');
     // The binary data is a multiple of 4 bytes already (f32, u32 and
@@ -1229,12 +1225,12 @@ pub fn write_gltf(
     attributes: &VertexAttributes,
 ) -> std::io::Result<()> {
     empty_error(vertices, faces)?;
-    let (_, bin) = document(vertices, faces, attributes, None);
+    let (mut json, bin) = document(vertices, faces, attributes);
     let uri = format!(
         "data:application/octet-stream;base64,{}",
         base64::engine::general_purpose::STANDARD.encode(&bin)
     );
-    let (json, _) = document(vertices, faces, attributes, Some(uri));
+    json["buffers"][0]["uri"] = uri.into();
     serde_json::to_writer_pretty(&mut *w, &json).map_err(std::io::Error::other)?;
     w.write_all(b"\n")
 }

@@ -49,6 +49,18 @@ use anyhow::{bail, Context, Result};
 /// A point in 3D, in the file's own units.
 pub type Point3 = [f64; 3];
 
+/// A triangle's normal times twice its area: the cross product of its
+/// sides from the first corner.
+pub(crate) fn doubled_area([a, b, c]: [Point3; 3]) -> Point3 {
+    let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+    [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ]
+}
+
 /// The file formats meshtrim reads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Format {

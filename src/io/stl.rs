@@ -507,13 +507,7 @@ pub fn write_stl(
 }
 
 fn unit_normal(a: Point3, b: Point3, c: Point3) -> Point3 {
-    let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-    let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-    let n = [
-        u[1] * v[2] - u[2] * v[1],
-        u[2] * v[0] - u[0] * v[2],
-        u[0] * v[1] - u[1] * v[0],
-    ];
+    let n = super::doubled_area([a, b, c]);
     let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
     if len > 0.0 && len.is_finite() {
         n.map(|x| x / len)
