@@ -1,9 +1,11 @@
-//! Kept faces a strip's new faces pass through (meshtrim's own, not the
-//! paper's). On a range grid's silhouette the wall can lie several
+//! Where a strip crosses the kept surface or itself (meshtrim's own, not
+//! the paper's). On a range grid's silhouette the wall can lie several
 //! spacings behind the smoothed loop, across the grid's skirts, and a
 //! strip face from the loop to the wall can pierce the kept surface
-//! between them. The strip takes those kept faces into its cut and is
-//! made again ([`super::strip::replace_by_strip`]).
+//! between them, or the strip fold over itself where the wall zig-zags.
+//! The strip takes those kept faces, and the wall's vertices at its
+//! folds, into its cut and is made again
+//! ([`super::strip::replace_by_strip`]).
 
 use super::*;
 
@@ -11,7 +13,7 @@ use super::*;
 type Corners = [Point3; 3];
 
 /// The kept faces of `mesh` (those not in `removed`, ascending) that a
-/// triangle of `strip` passes through, where the two share no vertex
+/// triangle of `strip` passes through, where the two share no edge
 /// (`strip`'s ids below the mesh's vertex count are mesh vertices),
 /// ascending. The strip's triangles are filed in a grid of cells `cell`
 /// wide (a few spacings), and each kept face compared with those in the
@@ -37,14 +39,83 @@ pub(super) fn kept_faces_crossed(
         let kept = face.map(|v| mesh.vertices[v as usize]);
         grid.candidates(&kept, strip.len(), &mut candidates);
         let crosses = candidates.iter().any(|&s| {
-            let shares = strip[s as usize].iter().any(|v| face.contains(v));
-            !shares && triangles_cross(&kept, &corners[s as usize])
+            !share_an_edge(&strip[s as usize], face) && triangles_cross(&kept, &corners[s as usize])
         });
         if crosses {
             crossed.push(f);
         }
     }
     crossed
+}
+
+/// The pairs of `faces` (indices, the smaller first, ascending) that
+/// share no edge and cross (see [`triangles_cross`]): a strip folding
+/// over itself. The faces are filed in a grid of cells `cell` wide, and
+/// each compared with those in the cells its bounding box meets.
+pub(super) fn crossing_pairs_filed(
+    faces: &[[u32; 3]],
+    position: &dyn Fn(u32) -> Point3,
+    cell: f64,
+) -> Vec<(u32, u32)> {
+    let corners: Vec<Corners> = faces.iter().map(|f| f.map(position)).collect();
+    let Some(grid) = Grid::new(&corners, cell) else {
+        return Vec::new();
+    };
+    let mut pairs = Vec::new();
+    let mut candidates = Vec::new();
+    for (i, face) in faces.iter().enumerate() {
+        grid.candidates(&corners[i], faces.len(), &mut candidates);
+        for &j in candidates.iter().filter(|&&j| j as usize > i) {
+            let other = &faces[j as usize];
+            if !share_an_edge(face, other) && triangles_cross(&corners[i], &corners[j as usize]) {
+                pairs.push((i as u32, j));
+            }
+        }
+    }
+    pairs
+}
+
+/// [`crossing_pairs_filed`] without a grid, for a few hundred faces (one
+/// refined run of a strip): a sweep along x compares the faces whose
+/// bounding boxes meet.
+pub(super) fn crossing_pairs(
+    faces: &[[u32; 3]],
+    position: &dyn Fn(u32) -> Point3,
+) -> Vec<(u32, u32)> {
+    let corners: Vec<Corners> = faces.iter().map(|f| f.map(position)).collect();
+    let boxes: Vec<[Point3; 2]> = corners.iter().map(bounding_box).collect();
+    let mut order: Vec<usize> = (0..faces.len()).collect();
+    order.sort_by(|&a, &b| boxes[a][0][0].total_cmp(&boxes[b][0][0]).then(a.cmp(&b)));
+    let mut pairs = Vec::new();
+    for (k, &i) in order.iter().enumerate() {
+        for &j in &order[k + 1..] {
+            if boxes[j][0][0] > boxes[i][1][0] {
+                break;
+            }
+            if boxes_meet(&boxes[i], &boxes[j])
+                && !share_an_edge(&faces[i], &faces[j])
+                && triangles_cross(&corners[i], &corners[j])
+            {
+                pairs.push((i.min(j) as u32, i.max(j) as u32));
+            }
+        }
+    }
+    pairs.sort_unstable();
+    pairs
+}
+
+fn bounding_box(corners: &Corners) -> [Point3; 2] {
+    let pick =
+        |k: usize, f: fn(f64, f64) -> f64| corners.iter().map(|p| p[k]).fold(corners[0][k], f);
+    [
+        std::array::from_fn(|k| pick(k, f64::min)),
+        std::array::from_fn(|k| pick(k, f64::max)),
+    ]
+}
+
+/// Whether two bounding boxes meet (a NaN corner meets nothing).
+fn boxes_meet(a: &[Point3; 2], b: &[Point3; 2]) -> bool {
+    (0..3).all(|k| a[0][k] <= b[1][k] && b[0][k] <= a[1][k])
 }
 
 /// Cells a triangle's bounding box may meet and still be filed in them;
@@ -123,6 +194,14 @@ impl Grid {
     }
 }
 
+/// Whether two faces share two or more vertices: triangles along a
+/// common edge meet there and cross nowhere else unless they lie in one
+/// plane, which [`triangles_cross`] does not compare. Faces sharing one
+/// vertex are compared: an edge away from it can pass through the other.
+fn share_an_edge(a: &[u32; 3], b: &[u32; 3]) -> bool {
+    a.iter().filter(|v| b.contains(v)).count() >= 2
+}
+
 /// Whether an edge of either triangle passes through the other's interior
 /// (not through its edges or corners, so triangles that only touch do not
 /// cross; coplanar ones are not compared).
@@ -167,9 +246,9 @@ mod tests {
             .filter(|&f| {
                 let face = mesh.faces[f as usize];
                 let kept = face.map(|v| mesh.vertices[v as usize]);
-                strip.iter().any(|s| {
-                    !s.iter().any(|v| face.contains(v)) && triangles_cross(&kept, &s.map(position))
-                })
+                strip
+                    .iter()
+                    .any(|s| !share_an_edge(s, &face) && triangles_cross(&kept, &s.map(position)))
             })
             .collect()
     }
@@ -221,6 +300,43 @@ mod tests {
             let plain = kept_faces_crossed_reference(&mesh, &removed, &strip, &position);
             assert_eq!(fast, plain, "case {case}");
             total += fast.len();
+        }
+        assert!(total > 100, "{total}");
+    }
+
+    /// The sweep and the grid find what comparing every pair finds:
+    /// random triangles on a few shared points (many share a vertex or an
+    /// edge) or on many, in cells from a thousandth of their extent (every
+    /// box too large to file) to beyond it.
+    #[test]
+    fn the_sweep_and_the_grid_find_every_crossing_pair_of_one_set() {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(23);
+        let mut total = 0;
+        for case in 0..40 {
+            let count = [12, 40, 240][case % 3];
+            let points: Vec<Point3> = (0..count)
+                .map(|_| std::array::from_fn(|_| rng.random_range(0.0..10.0)))
+                .collect();
+            let faces: Vec<[u32; 3]> = (0..80)
+                .map(|_| std::array::from_fn(|_| rng.random_range(0..points.len() as u32)))
+                .filter(|f: &[u32; 3]| f[0] != f[1] && f[1] != f[2] && f[0] != f[2])
+                .collect();
+            let position = |v: u32| points[v as usize];
+            let mut plain = Vec::new();
+            for i in 0..faces.len() {
+                for j in i + 1..faces.len() {
+                    if !share_an_edge(&faces[i], &faces[j])
+                        && triangles_cross(&faces[i].map(position), &faces[j].map(position))
+                    {
+                        plain.push((i as u32, j as u32));
+                    }
+                }
+            }
+            assert_eq!(crossing_pairs(&faces, &position), plain, "case {case}");
+            let cell = [0.01, 0.5, 2.0, 50.0][case % 4];
+            let filed = crossing_pairs_filed(&faces, &position, cell);
+            assert_eq!(filed, plain, "case {case}, cell {cell}");
+            total += plain.len();
         }
         assert!(total > 100, "{total}");
     }

@@ -74,10 +74,14 @@ const DEPTH_WINDOW: f64 = 2.0;
 /// Borders one strip may absorb because they lie one face from others it
 /// absorbs.
 const MAX_ABSORBED: usize = 64;
-/// Times a strip is made again after passing through kept faces, which
-/// then go with the cut ([`crossing`]).
-const CROSSING_ROUNDS: usize = 3;
-/// The cells of the grid that finds those kept faces, in β.
+/// Times a strip is made again after passing through kept faces or
+/// folding over itself, the kept faces and the wall's vertices at the
+/// folds then going with the cut ([`crossing`]) …
+const CROSSING_ROUNDS: usize = 8;
+/// … ending early after this many remakes in a row cross no less than
+/// the best so far.
+const PATIENCE: usize = 2;
+/// The cells of the grids that find those kept faces and folds, in β.
 const CROSSING_CELL: f64 = 2.0;
 /// Times the faces round a pinched wall vertex are removed before the loop
 /// is left.
@@ -341,26 +345,44 @@ pub(super) fn replace_by_strip(
     let ring = cx.rings[l].as_ref().ok_or(StripFailure::Wall)?;
     let guide = Guide::new(cx, l, ring).ok_or(StripFailure::Wall)?;
     let owner = border_owner(cx);
-    // Vertices of kept faces an earlier strip passed through go, and the
-    // strip is made again; a strip that then cannot be made leaves the one
-    // before.
+    // Vertices of kept faces a strip passed through go, and so do the
+    // wall's vertices where it folded over itself, and the strip is made
+    // again; the one that crosses least stays (the first on a tie).
     let mut pushed = BTreeSet::new();
-    let (mut strip, mut crossed) = strip_once(cx, l, &guide, &owner, replaced, &pushed)?;
+    let mut best = strip_once(cx, l, &guide, &owner, replaced, &pushed)?;
+    let mut to_push = best.to_push.clone();
+    let mut since_best = 0;
     for _ in 0..CROSSING_ROUNDS {
-        if crossed.is_empty() {
+        if to_push.is_empty() || since_best == PATIENCE {
             break;
         }
-        pushed.extend(crossed.iter().flat_map(|&f| cx.mesh.faces[f as usize]));
-        match strip_once(cx, l, &guide, &owner, replaced, &pushed) {
-            Ok(again) => (strip, crossed) = again,
-            Err(_) => break,
+        pushed.extend(to_push);
+        let Ok(again) = strip_once(cx, l, &guide, &owner, replaced, &pushed) else {
+            break;
+        };
+        to_push = again.to_push.clone();
+        if again.crossings < best.crossings {
+            best = again;
+            since_best = 0;
+        } else {
+            since_best += 1;
         }
     }
-    Ok(strip)
+    Ok(best.strip)
+}
+
+/// A strip made once, and how it crosses the kept faces and itself.
+struct Made {
+    strip: Strip,
+    /// The vertices that should go for it not to cross: those of the kept
+    /// faces it passes through, and the wall's at its folds.
+    to_push: Vec<u32>,
+    /// Kept faces it passes through, and pairs of its faces that cross.
+    crossings: usize,
 }
 
 /// The strip of border `l` (steps 2–5) with the vertices of `pushed`
-/// going too, and the kept faces it passes through.
+/// going too.
 fn strip_once(
     cx: &Context,
     l: usize,
@@ -368,7 +390,7 @@ fn strip_once(
     owner: &HashMap<u32, usize>,
     replaced: &[bool],
     pushed: &BTreeSet<u32>,
-) -> Result<(Strip, Vec<u32>), StripFailure> {
+) -> Result<Made, StripFailure> {
     let (cut, removed) = cut_and_removed(cx, l, guide, owner, replaced, pushed)?;
     let (removed, wall) = closed_wall(cx, removed)?;
     let faces = zip(cx, guide, &wall)?;
@@ -390,6 +412,14 @@ fn strip_once(
     };
     let cell = CROSSING_CELL * cx.beta_median;
     let crossed = crossing::kept_faces_crossed(cx.mesh, &removed, &faces, &at, cell);
+    let folds = crossing::crossing_pairs_filed(&faces, &at, cell);
+    let mut to_push: Vec<u32> = crossed
+        .iter()
+        .flat_map(|&f| cx.mesh.faces[f as usize])
+        .chain(wall_at_folds(&faces, &folds, n))
+        .collect();
+    to_push.sort_unstable();
+    to_push.dedup();
     let footprint = footprint(cx, &removed);
     let mut loops = vec![l];
     loops.extend(cut.absorbed.iter().copied());
@@ -403,7 +433,30 @@ fn strip_once(
         },
         footprint,
     };
-    Ok((strip, crossed))
+    Ok(Made {
+        strip,
+        to_push,
+        crossings: crossed.len() + folds.len(),
+    })
+}
+
+/// The wall's vertices (ids below `n`) of the strip faces in `folds`, or
+/// where a face has none, of the strip faces sharing a vertex with it.
+fn wall_at_folds(faces: &[[u32; 3]], folds: &[(u32, u32)], n: u32) -> Vec<u32> {
+    let on_wall = |f: &[u32; 3]| f.iter().copied().filter(|&v| v < n).collect::<Vec<u32>>();
+    let mut wall = Vec::new();
+    for f in folds.iter().flat_map(|&(a, b)| [a, b]) {
+        let face = &faces[f as usize];
+        let own = on_wall(face);
+        if own.is_empty() {
+            for other in faces.iter().filter(|g| g.iter().any(|v| face.contains(v))) {
+                wall.extend(on_wall(other));
+            }
+        } else {
+            wall.extend(own);
+        }
+    }
+    wall
 }
 
 /// The cut (step 2) and the faces it removes. A border kept out of the

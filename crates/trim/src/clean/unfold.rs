@@ -127,6 +127,7 @@ impl<P: Fn(u32) -> Point3, J: Fn(u32, u32) -> bool> Strip<'_, P, J> {
         refine_run(original, &at, splits, self.scale)
             .filter(|(f, _)| !joins_anew(original, f, self.joined))
             .filter(|(f, v)| smallest_angle_of(f, &at, v) > smallest)
+            .filter(|(f, v)| crossing::crossing_pairs(f, &with_added(&at, v)).is_empty())
     }
 
     /// The rungs that stay split, and each thin run refined with them. A
@@ -394,17 +395,26 @@ fn smallest_angle_of(
     position: &impl Fn(u32) -> Point3,
     added: &[Point3],
 ) -> f64 {
-    let at = |id: u32| match id {
-        STEINER_BASE.. => added[(id - STEINER_BASE) as usize],
-        _ => position(id),
-    };
+    let at = with_added(position, added);
     faces
         .iter()
         .map(|f| {
-            let corners = f.map(at);
+            let corners = f.map(&at);
             smallest_angle(&corners, [0, 1, 2])
         })
         .fold(f64::INFINITY, f64::min)
+}
+
+/// Positions of a refined run's vertices: ids from [`STEINER_BASE`] on
+/// index `added`.
+fn with_added<'a>(
+    position: &'a impl Fn(u32) -> Point3,
+    added: &'a [Point3],
+) -> impl Fn(u32) -> Point3 + 'a {
+    move |id: u32| match id {
+        STEINER_BASE.. => added[(id - STEINER_BASE) as usize],
+        _ => position(id),
+    }
 }
 
 /// A run's faces laid into the plane: each face keeps its edge lengths
