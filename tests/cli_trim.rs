@@ -73,11 +73,19 @@ fn trims_the_fixture_and_reports() {
         json["area_out"].as_f64().unwrap() < json["area_in"].as_f64().unwrap() / 2.0,
         "the envelope's far side must go"
     );
+    // Every cloud point is measured against the output (none lies at one
+    // of the envelope's vertices): the scan's fit to the reconstruction.
+    let fit = &json["cloud_to_output"];
+    assert_eq!(fit["vertices"], json["points"], "{fit}");
+    let (mean, max) = (fit["mean"].as_f64().unwrap(), fit["max"].as_f64().unwrap());
+    assert!(0.0 < mean && mean < max, "{fit}");
+    assert!(text.contains("cloud points"), "{text}");
     for key in [
         "read_ms",
         "detect_ms",
         "edges_ms",
         "trim_ms",
+        "deviation_ms",
         "write_ms",
         "faces_split",
         "pieces_dropped",

@@ -287,6 +287,7 @@ fn trim_py<'py>(
         progress: false,
         cloud: Default::default(),
         cloud_scale: None,
+        measure: true,
     };
     let mesh = mesh_of(&vertices, &faces)?;
     let points = rows(&points, "points")?;

@@ -214,7 +214,7 @@ impl From<trim::Deviation> for Deviation {
 
 impl Deviation {
     /// "up to MAX (mean MEAN over N)", or "none" when nothing was measured.
-    fn shown(&self, what: &str) -> String {
+    pub(crate) fn shown(&self, what: &str) -> String {
         if self.vertices == 0 {
             return "none".to_string();
         }

@@ -16,6 +16,7 @@ use crate::commands::args::{
     DXF_SPLINES_HELP, UNITS_HELP, VIEW_ALONG_HELP, VIEW_ALONG_LONG_HELP, VIEW_FROM_HELP,
     VIEW_FROM_LONG_HELP,
 };
+use crate::commands::clean::Deviation;
 use crate::io::edges_out::step::LengthUnit;
 use crate::io::edges_out::EdgeFileOptions;
 use crate::io::mesh_out::write_mesh_carrying;
@@ -163,6 +164,12 @@ pub struct Report {
     /// Per smoothed loop: mean and largest distance from the output border
     /// to it, in the cloud's units (once scaled by `cloud_scale`).
     pub border_to_edge: Vec<BorderFit>,
+    /// How far the cloud's points lie from the output's surface: the fit
+    /// of the reconstruction to the scan where it is kept, and the scan
+    /// the trimming cut away. Points at exactly an output vertex lie on
+    /// it and are not counted (by `batch` only with `--deviation`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cloud_to_output: Option<Deviation>,
     /// The mesh's vertex attributes written to the output ("normals",
     /// "colours"), carried to the new vertices from the mesh's surface.
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -178,6 +185,9 @@ pub struct Report {
     pub edges_ms: f64,
     /// Cutting and classification time.
     pub trim_ms: f64,
+    /// Time to measure `cloud_to_output`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub deviation_ms: Option<f64>,
     /// Writing time.
     pub write_ms: f64,
 }
@@ -206,6 +216,8 @@ pub struct TrimSettings {
     /// The factor the cloud's coordinates are multiplied by once read, to
     /// the mesh's units.
     pub cloud_scale: Option<f64>,
+    /// Whether the cloud's distance from the output is measured.
+    pub measure: bool,
 }
 
 /// Runs the trimming.
@@ -216,6 +228,7 @@ pub fn run(args: &Args) -> Result<()> {
         progress: true,
         cloud: CloudOptions { scan: args.scan },
         cloud_scale: args.cloud_scale,
+        measure: true,
     };
     let report = trim_file(
         &args.mesh,
@@ -313,13 +326,16 @@ pub fn trim_in_memory(
     let (out, trimmed) = trim_mesh(mesh, points, &detection, &edges, &TrimOptions::default())
         .with_context(|| format!("{mesh_name} with {cloud_name}"))?;
     let trim_time = started.elapsed();
-    let report = Report::new(
+    let mut report = Report::new(
         points.len(),
         detection.boundary_count(),
         &trimmed,
         LoopsFrom(edges.loops_from),
         [detect_time, edges_time, trim_time],
     );
+    if settings.measure {
+        report.measure(points, &out);
+    }
     Ok(Trimmed {
         mesh: out,
         report,
@@ -375,14 +391,27 @@ impl Report {
             area_in: r.area_in,
             area_out: r.area_out,
             border_to_edge: r.loops.iter().map(fit).collect(),
+            cloud_to_output: None,
             vertex_attributes: Vec::new(),
             vertex_attributes_not_written: Vec::new(),
             read_ms: 0.0,
             detect_ms: millis(detect),
             edges_ms: millis(edges),
             trim_ms: millis(trim),
+            deviation_ms: None,
             write_ms: 0.0,
         }
+    }
+
+    /// Measures how far the cloud's `points` lie from the `output` mesh.
+    fn measure(&mut self, points: &[Point3], output: &trim::Mesh) {
+        let started = Instant::now();
+        let cloud = trim::Mesh {
+            vertices: points.to_vec(),
+            faces: Vec::new(),
+        };
+        self.cloud_to_output = Some(trim::surface_deviation(output, &cloud).into());
+        self.deviation_ms = Some(millis(started.elapsed()));
     }
 }
 
@@ -478,6 +507,20 @@ impl crate::report::Table for Report {
             ("write time", format!("{:.1} ms", self.write_ms)),
             ("output", shown(&self.output)),
         ];
+        if let Some(d) = self.cloud_to_output {
+            let after_border = 1 + rows
+                .iter()
+                .position(|r| r.0 == "border to edge, max")
+                .unwrap_or(0);
+            rows.insert(
+                after_border,
+                ("cloud points", d.shown("from the output's surface")),
+            );
+        }
+        if let Some(ms) = self.deviation_ms {
+            let after_trim = 1 + rows.iter().position(|r| r.0 == "trim time").unwrap_or(0);
+            rows.insert(after_trim, ("deviation time", format!("{ms:.1} ms")));
+        }
         let attributes = [&self.vertex_attributes, &self.vertex_attributes_not_written];
         crate::report::add_attributes_row(
             &mut rows,

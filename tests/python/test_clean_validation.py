@@ -654,9 +654,9 @@ SELF_CROSSINGS_ADDED = {
     # segments of the smoothed loop, which itself folds in depth there (no
     # wall vertex is in them), and four where the strip still folds after
     # its last remaking.
-    # Before the strips were made again where they fold over themselves:
-    # 4, 18 and 11 on bun000, bun045 and chin; before they took in the kept
-    # faces they pass through: 36, 167, 5 and 99 on bun000, bun045,
+    # With the strips not made again where they fold over themselves: 4,
+    # 18 and 11 on bun000, bun045 and chin; with the kept faces they pass
+    # through not taken in either: 36, 167, 5 and 99 on bun000, bun045,
     # bun090, chin.
     "bun045": 6,
 }

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import meshtrim
-from meshtrim_cli import ROOT
+from meshtrim_cli import ROOT, run_meshtrim
 from test_clean_validation import open3d_vertex_deviation
 
 JAGGED = ROOT / "fixtures" / "meshes" / "blade_jagged.stl"
@@ -118,3 +118,31 @@ def test_clean_holds_the_border_to_max_deviation(tmp_path):
     for bad in (0, -1.0, float("nan"), "wide"):
         with pytest.raises(meshtrim.MeshtrimError, match="max_deviation"):
             meshtrim.clean(v, f, max_deviation=bad)
+
+
+def test_trims_report_is_the_clouds_distance_from_the_output(tmp_path):
+    """`meshtrim MESH CLOUD OUT` reports how far the cloud's points lie
+    from the trimmed surface: Open3D's closest-point distances of the
+    same points give the same count, largest distance, its point and
+    mean (float32: 1e-6 of the diagonal); `meshtrim.trim` reports the
+    same, and it is `meshtrim.deviation` of the cloud against the
+    output."""
+    mesh = ROOT / "fixtures" / "meshes" / "blade_small_poisson.ply"
+    cloud = ROOT / "fixtures" / "meshes" / "blade_small.ply"
+    out, report_path = tmp_path / "trimmed.ply", tmp_path / "report.json"
+    run_meshtrim(mesh, cloud, out, "--report", report_path)
+    reported = json.loads(report_path.read_text())["cloud_to_output"]
+    points = meshtrim.read_cloud(cloud)
+    out_v, out_f = meshtrim.read_mesh(out)
+    distances, measured = open3d_vertex_deviation(points, np.arange(len(points)), out_v, out_f)
+    tolerance = 1e-6 * np.linalg.norm(points.max(0) - points.min(0))
+    assert reported["vertices"] == len(measured) == len(points), (reported, len(points))
+    assert abs(reported["max"] - distances.max()) < tolerance, (reported, distances.max())
+    assert abs(reported["mean"] - distances.mean()) < tolerance, (reported, distances.mean())
+    assert np.allclose(reported["at"], points[measured[np.argmax(distances)]])
+    # The fit of a screened-Poisson envelope to its scan: small, not zero.
+    assert 0.0 < reported["mean"] < reported["max"]
+    _, _, in_python = meshtrim.trim(*meshtrim.read_mesh(mesh), points)
+    in_python = json.loads(in_python) if isinstance(in_python, str) else in_python
+    assert in_python["cloud_to_output"] == reported
+    assert dict(reported, at=tuple(reported["at"])) == meshtrim.deviation(points, np.empty((0, 3), np.uint32), out_v, out_f)

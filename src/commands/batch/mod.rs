@@ -309,6 +309,8 @@ fn work(job: &Job, settings: &FileSettings) -> Result<Outcome> {
                 progress: false,
                 cloud: CloudOptions::default(),
                 cloud_scale,
+                // Trimmed files are not measured (see `--deviation`).
+                measure: false,
             };
             let r = trim_file(&job.input, cloud, &job.output, None, &settings)?;
             Ok(Outcome {
