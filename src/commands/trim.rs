@@ -166,8 +166,9 @@ pub struct Report {
     pub border_to_edge: Vec<BorderFit>,
     /// How far the cloud's points lie from the output's surface: the fit
     /// of the reconstruction to the scan where it is kept, and the scan
-    /// the trimming cut away. Points at exactly an output vertex lie on
-    /// it and are not counted (by `batch` only with `--deviation`).
+    /// the trimming cut away. Its `vertices` are the points measured:
+    /// those at exactly an output vertex lie on it and are not counted.
+    /// Not measured for a batch's trimmed files.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cloud_to_output: Option<Deviation>,
     /// The mesh's vertex attributes written to the output ("normals",
