@@ -348,19 +348,26 @@ pub(super) fn replace_by_strip(
     // Vertices of kept faces a strip passed through go, and so do the
     // wall's vertices where it folded over itself, and the strip is made
     // again; the one that crosses least stays (the first on a tie).
+    let site = Site {
+        cx,
+        l,
+        guide: &guide,
+        owner: &owner,
+        replaced,
+    };
     let mut pushed = BTreeSet::new();
-    let mut best = strip_once(cx, l, &guide, &owner, replaced, &pushed)?;
-    let mut to_push = best.to_push.clone();
+    let mut best = strip_once(site, &pushed)?;
+    let mut to_push = std::mem::take(&mut best.to_push);
     let mut since_best = 0;
     for _ in 0..CROSSING_ROUNDS {
         if to_push.is_empty() || since_best == PATIENCE {
             break;
         }
         pushed.extend(to_push);
-        let Ok(again) = strip_once(cx, l, &guide, &owner, replaced, &pushed) else {
+        let Ok(mut again) = strip_once(site, &pushed) else {
             break;
         };
-        to_push = again.to_push.clone();
+        to_push = std::mem::take(&mut again.to_push);
         if again.crossings < best.crossings {
             best = again;
             since_best = 0;
@@ -369,6 +376,18 @@ pub(super) fn replace_by_strip(
         }
     }
     Ok(best.strip)
+}
+
+/// What every attempt at one border's strip reads: border `l`, its guide,
+/// the border each border vertex is on, and the loops other patches
+/// replace.
+#[derive(Clone, Copy)]
+struct Site<'a> {
+    cx: &'a Context<'a>,
+    l: usize,
+    guide: &'a Guide,
+    owner: &'a HashMap<u32, usize>,
+    replaced: &'a [bool],
 }
 
 /// A strip made once, and how it crosses the kept faces and itself.
@@ -381,17 +400,11 @@ struct Made {
     crossings: usize,
 }
 
-/// The strip of border `l` (steps 2–5) with the vertices of `pushed`
-/// going too.
-fn strip_once(
-    cx: &Context,
-    l: usize,
-    guide: &Guide,
-    owner: &HashMap<u32, usize>,
-    replaced: &[bool],
-    pushed: &BTreeSet<u32>,
-) -> Result<Made, StripFailure> {
-    let (cut, removed) = cut_and_removed(cx, l, guide, owner, replaced, pushed)?;
+/// The strip of the site's border (steps 2–5) with the vertices of
+/// `pushed` going too.
+fn strip_once(site: Site, pushed: &BTreeSet<u32>) -> Result<Made, StripFailure> {
+    let Site { cx, l, guide, .. } = site;
+    let (cut, removed) = cut_and_removed(site, pushed)?;
     let (removed, wall) = closed_wall(cx, removed)?;
     let faces = zip(cx, guide, &wall)?;
     let n = cx.mesh.vertices.len() as u32;
@@ -462,17 +475,17 @@ fn wall_at_folds(faces: &[[u32; 3]], folds: &[(u32, u32)], n: u32) -> Vec<u32> {
 /// The cut (step 2) and the faces it removes. A border kept out of the
 /// cut that lies one face from an absorbed one cannot keep the faces
 /// between them: it is absorbed too, and the cut made again.
-fn cut_and_removed(
-    cx: &Context,
-    l: usize,
-    guide: &Guide,
-    owner: &HashMap<u32, usize>,
-    replaced: &[bool],
-    pushed: &BTreeSet<u32>,
-) -> Result<(Cut, Vec<u32>), StripFailure> {
+fn cut_and_removed(site: Site, pushed: &BTreeSet<u32>) -> Result<(Cut, Vec<u32>), StripFailure> {
+    let Site {
+        cx,
+        l,
+        owner,
+        replaced,
+        ..
+    } = site;
     let mut forced = BTreeSet::new();
     loop {
-        let cut = Cut::new(cx, l, guide, owner, replaced, &forced, pushed)?;
+        let cut = Cut::new(site, &forced, pushed)?;
         let removed = cut.removed_faces(cx);
         let (kept, touched) = clear_of_other_borders(cx, l, &cut, owner, removed);
         // A smaller border another patch replaces would be absorbed if that
@@ -512,14 +525,17 @@ struct Cut {
 
 impl Cut {
     fn new(
-        cx: &Context,
-        l: usize,
-        guide: &Guide,
-        owner: &HashMap<u32, usize>,
-        replaced: &[bool],
+        site: Site,
         forced: &BTreeSet<usize>,
         pushed: &BTreeSet<u32>,
     ) -> Result<Cut, StripFailure> {
+        let Site {
+            cx,
+            l,
+            guide,
+            owner,
+            replaced,
+        } = site;
         let mut cut = Cut {
             going: HashSet::default(),
             absorbed: forced.clone(),
