@@ -383,14 +383,16 @@ fn bad_files_fail_alone_and_the_reports_say_why() {
             "repaired",
             "cloud",
             "removed_max",
-            "new_max"
+            "new_max",
+            "cloud_max",
+            "cloud_mean"
         ]
     );
     assert_eq!(rows.len(), 5, "{rows:?}");
     // Not measured without --deviation.
     assert!(rows[1..]
         .iter()
-        .all(|r| r[14].is_empty() && r[15].is_empty()));
+        .all(|r| r[14..18].iter().all(String::is_empty)));
     // The cloud each trimmed file was paired with; none for a clean.
     let clouds: Vec<&str> = rows[1..].iter().map(|r| r[13].as_str()).collect();
     assert_eq!(
@@ -595,7 +597,7 @@ fn to_writes_every_output_in_one_format() {
 }
 
 #[test]
-fn deviation_reports_how_far_each_cleaned_scan_moved() {
+fn deviation_reports_how_far_each_output_lies_from_its_scan() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     std::fs::create_dir_all(d.join("scans")).unwrap();
@@ -610,29 +612,64 @@ fn deviation_reports_how_far_each_cleaned_scan_moved() {
         .unwrap();
     assert_ok(&clean);
     let cleaned: serde_json::Value = serde_json::from_slice(&clean.stdout).unwrap();
+    let trim = Command::new(env!("CARGO_BIN_EXE_meshtrim"))
+        .args([
+            "trim",
+            MESH,
+            CLOUD,
+            d.join("t.ply").to_str().unwrap(),
+            "--json",
+        ])
+        .output()
+        .unwrap();
+    assert_ok(&trim);
+    let trimmed: serde_json::Value = serde_json::from_slice(&trim.stdout).unwrap();
     let rows = parse_csv(&std::fs::read_to_string(d.join("r.csv")).unwrap());
     let (j, t) = (&rows[1], &rows[2]);
     assert_eq!(
         (j[0].as_str(), t[0].as_str()),
         ("scans/j.stl", "scans/t.ply")
     );
-    // The cleaned file's are `clean`'s maxima; a trimmed file has none.
+    // The cleaned file's are `clean`'s maxima, the trimmed file's are
+    // `trim`'s cloud_to_output; each has none of the other's.
     for (column, key) in [(14, "input_to_output"), (15, "output_to_input")] {
         let reported: f64 = j[column].parse().unwrap();
         assert_eq!(reported, cleaned[key]["max"].as_f64().unwrap(), "{key}");
         assert!(t[column].is_empty(), "{t:?}");
+    }
+    for (column, key) in [(16, "max"), (17, "mean")] {
+        let reported: f64 = t[column].parse().unwrap();
+        let single = trimmed["cloud_to_output"][key].as_f64().unwrap();
+        assert_eq!(reported, single, "{key}");
+        assert!(reported > 0.0 && j[column].is_empty(), "{j:?}");
     }
     let stdout = text(&run.stdout);
     assert!(
         stdout.contains("faces 5768→5759  moved: removed≤0.6877 new≤4.026  "),
         "{stdout}"
     );
+    // The trimmed file's line shows both to four significant digits.
+    let line = stdout.lines().find(|l| l.contains("scans/t.ply")).unwrap();
+    let shown = line
+        .split("  cloud: off≤")
+        .nth(1)
+        .unwrap_or_else(|| panic!("{line}"));
+    let mut numbers = shown.split_whitespace();
+    let max: f64 = numbers.next().unwrap().parse().unwrap();
+    assert_eq!(numbers.next(), Some("mean"), "{line}");
+    let mean: f64 = numbers.next().unwrap().parse().unwrap();
+    for (shown, column) in [(max, 16), (mean, 17)] {
+        let reported: f64 = t[column].parse().unwrap();
+        assert!((shown - reported).abs() <= 5e-4 * reported, "{line}");
+    }
     let run = batch(d, &[&args[..], &["r.json"]].concat());
     assert_ok(&run);
     let report = json_report(&d.join("r.json"));
     let files = &report["files"];
     assert_eq!(files[0]["new_max"], cleaned["output_to_input"]["max"]);
     assert!(files[1].get("new_max").is_none(), "{}", files[1]);
+    assert_eq!(files[1]["cloud_max"], trimmed["cloud_to_output"]["max"]);
+    assert!(files[0].get("cloud_max").is_none(), "{}", files[0]);
     // --max-deviation: the bytes `clean --max-deviation` writes.
     let held = ["scans/j.stl", "--out-dir", "held", "--max-deviation", "1.5"];
     assert_ok(&batch(d, &held));

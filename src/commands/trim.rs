@@ -168,7 +168,7 @@ pub struct Report {
     /// of the reconstruction to the scan where it is kept, and the scan
     /// the trimming cut away. Its `vertices` are the points measured:
     /// those at exactly an output vertex lie on it and are not counted.
-    /// Not measured for a batch's trimmed files.
+    /// A batch's trimmed files are measured with `--deviation`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cloud_to_output: Option<Deviation>,
     /// The mesh's vertex attributes written to the output ("normals",

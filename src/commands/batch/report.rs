@@ -73,6 +73,9 @@ pub struct Outcome {
     /// the removed vertices from the output and of the new ones from the
     /// input.
     pub deviation: Option<[f64; 2]>,
+    /// With `--deviation`, for a trimmed file: the largest and the mean
+    /// distance of its cloud's points from the output.
+    pub cloud_deviation: Option<[f64; 2]>,
     /// What the user should know about the file (a closed mesh cleaned).
     pub note: Option<&'static str>,
 }
@@ -116,6 +119,14 @@ pub struct Row {
     /// new vertices from the input.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub new_max: Option<f64>,
+    /// With `--deviation`, for a trimmed file: the largest distance of its
+    /// cloud's points from the output.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cloud_max: Option<f64>,
+    /// With `--deviation`, for a trimmed file: the mean distance of its
+    /// cloud's points from the output.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cloud_mean: Option<f64>,
     /// The cloud a trimmed file was paired with (none for a clean, or
     /// when several clouds matched: the error names them).
     pub cloud: Option<String>,
@@ -134,11 +145,21 @@ impl Row {
             Some(n) if n > 0 => format!("  repaired={n}"),
             _ => String::new(),
         };
-        let moved = match (self.removed_max, self.new_max) {
-            (Some(removed), Some(new)) => format!(
+        let moved = match (
+            self.removed_max,
+            self.new_max,
+            self.cloud_max,
+            self.cloud_mean,
+        ) {
+            (Some(removed), Some(new), _, _) => format!(
                 "  moved: removed≤{} new≤{}",
                 significant(removed, 4),
                 significant(new, 4)
+            ),
+            (_, _, Some(max), Some(mean)) => format!(
+                "  cloud: off≤{} mean {}",
+                significant(max, 4),
+                significant(mean, 4)
             ),
             _ => String::new(),
         };
@@ -160,7 +181,7 @@ impl Row {
     }
 
     /// The row's CSV fields, in [`CSV_HEADER`] order.
-    fn csv_fields(&self) -> [String; 16] {
+    fn csv_fields(&self) -> [String; 18] {
         let opt = |v: Option<String>| v.unwrap_or_default();
         [
             self.input.clone(),
@@ -179,13 +200,15 @@ impl Row {
             opt(self.cloud.clone()),
             opt(self.removed_max.map(|v| v.to_string())),
             opt(self.new_max.map(|v| v.to_string())),
+            opt(self.cloud_max.map(|v| v.to_string())),
+            opt(self.cloud_mean.map(|v| v.to_string())),
         ]
     }
 }
 
 /// The CSV columns (new ones go last, so that columns read by position
 /// keep theirs).
-pub const CSV_HEADER: [&str; 16] = [
+pub const CSV_HEADER: [&str; 18] = [
     "input",
     "output",
     "mode",
@@ -202,6 +225,8 @@ pub const CSV_HEADER: [&str; 16] = [
     "cloud",
     "removed_max",
     "new_max",
+    "cloud_max",
+    "cloud_mean",
 ];
 
 /// The report formats, by the file's extension.
