@@ -153,15 +153,23 @@ class Edges(list):
         self.summary = summary
 
 
-def _float_rows(array: Any, name: str) -> np.ndarray:
-    """``array`` as a C-order float64 ``(n, 3)`` array (no copy when it
-    already is one)."""
+def _real_array(array: Any, name: str, kinds: str = "fiu") -> np.ndarray:
+    """``array`` as a numpy array of one of the dtype ``kinds`` (real
+    numbers: not complex, text or objects, which would not convert or
+    would lose their imaginary part)."""
     try:
         a = np.asarray(array)
     except Exception as e:  # e.g. ragged nested lists
         raise MeshtrimError(f"{name}: not an array of numbers: {e}") from None
-    if a.dtype.kind not in "fiu":
+    if a.dtype.kind not in kinds:
         raise MeshtrimError(f"{name}: expected real numbers, got dtype {a.dtype}")
+    return a
+
+
+def _float_rows(array: Any, name: str) -> np.ndarray:
+    """``array`` as a C-order float64 ``(n, 3)`` array (no copy when it
+    already is one)."""
+    a = _real_array(array, name)
     if a.ndim != 2 or a.shape[1] != 3:
         raise MeshtrimError(f"{name}: expected an array of shape (n, 3), got {a.shape}")
     return np.ascontiguousarray(a, dtype=np.float64)
@@ -616,7 +624,7 @@ def _field(name: Any, values: Any, vertices: int) -> tuple:
 
 def _per_vertex(array: Any, name: str, vertices: int, widths: tuple) -> np.ndarray:
     """A C-order float64 ``(vertices, w)`` array, ``w`` one of ``widths``."""
-    a = np.ascontiguousarray(array, dtype=np.float64)
+    a = np.ascontiguousarray(_real_array(array, name), dtype=np.float64)
     if a.ndim != 2 or a.shape[0] != vertices or a.shape[1] not in widths:
         shape = " or ".join(f"({vertices}, {w})" for w in widths)
         raise MeshtrimError(f"{name}: expected an array of shape {shape}, got {a.shape}")
@@ -671,7 +679,7 @@ class _Table:
     give the carried rows back in the values' shape and type."""
 
     def __init__(self, values: Any, vertices: int, nearest: Optional[bool] = None, name: str = "values"):
-        self.given = np.asarray(values)
+        self.given = _real_array(values, name, kinds="biuf")
         self.labels = self.given.dtype.kind in "biu"
         self.nearest = self.labels if nearest is None else bool(nearest)
         as_float = self.given.astype(np.float64)

@@ -279,6 +279,21 @@ def test_bad_meshes_raise(tmp_path):
     assert not (tmp_path / "x.ply").exists() and not (tmp_path / "x.txt").exists()
 
 
+def test_values_that_are_not_real_numbers_raise(tmp_path):
+    """Complex values would lose their imaginary part in the conversion
+    to float64, text would not convert: both are refused by name, as
+    coordinates are."""
+    vertices, faces = meshtrim.read_mesh(POISSON)
+    for bad in (vertices[:, 0] * 1j, vertices[:, 0].astype(str)):
+        message = raises(meshtrim.carry, vertices, faces, bad, vertices, faces)
+        assert message == f"values: expected real numbers, got dtype {bad.dtype}", message
+        message = raises(meshtrim.write_mesh, tmp_path / "x.ply", vertices, faces, colours=np.c_[bad, bad, bad])
+        assert message == f"colours: expected real numbers, got dtype {bad.dtype}", message
+    message = raises(meshtrim.carry, vertices, faces, [[1.0, 2.0], [3.0]], vertices, faces)
+    assert message.startswith("values: not an array of numbers"), message
+    assert not (tmp_path / "x.ply").exists()
+
+
 def test_file_errors_carry_the_cli_message(tmp_path):
     broken = tmp_path / "broken.ply"
     broken.write_bytes(POISSON.read_bytes()[:2000])
