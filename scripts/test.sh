@@ -42,6 +42,8 @@ else
     "${rust_tests[@]}" -q -- --list --format terse 2>/dev/null | grep 'shared_data::' \
         | sed 's/: test$//; s/^/  not run: /' || true
 fi
+# The library's documented example (crates/trim/src/lib.rs), run as a test.
+cargo test --workspace --exclude meshtrim-python --release --doc
 bash scripts/python_env.sh
 cargo build --release --bin meshtrim
 # The Python package (python/), built by maturin in release into the shared

@@ -41,6 +41,86 @@
 //! say what is wrong with the input in the library's terms (parameters,
 //! not command-line flags).
 //!
+//! ## Example
+//!
+//! The scan of a plate with a square hole, as a range scanner gives it: a
+//! jittered grid of points, triangulated cell by cell. Its border is
+//! detected and smoothed, the cloud meshed inside the smoothed edges, a
+//! larger mesh (standing in for a screened-Poisson envelope) trimmed
+//! along them, and the scan's own jagged border cleaned.
+//!
+//! ```
+//! use trim::{
+//!     clean_mesh, delaunay_mesh, detect_boundary, reconstruct_edges, trim_mesh, BpdOptions,
+//!     CleanOptions, DelaunayOptions, EdgeOptions, LocalResolution, Mesh, Point3, TrimOptions,
+//! };
+//!
+//! /// A grid of `columns` × `rows` points `step` apart from `origin`, each
+//! /// moved by up to `jitter` in x and y, triangulated cell by cell; nodes
+//! /// for which `keep` is false are left out with their cells.
+//! fn grid(
+//!     (columns, rows): (u32, u32),
+//!     origin: Point3,
+//!     step: f64,
+//!     jitter: f64,
+//!     keep: impl Fn(f64, f64) -> bool,
+//! ) -> Mesh {
+//!     let wobble = |a: u32, b: u32| ((a * 7919 + b * 104_729) % 1000) as f64 / 1000.0 - 0.5;
+//!     let mut mesh = Mesh { vertices: Vec::new(), faces: Vec::new() };
+//!     let mut index = vec![None; (columns * rows) as usize];
+//!     for i in 0..columns {
+//!         for j in 0..rows {
+//!             let x = origin[0] + step * i as f64 + jitter * wobble(i, j);
+//!             let y = origin[1] + step * j as f64 + jitter * wobble(j, i);
+//!             if keep(x, y) {
+//!                 index[(i * rows + j) as usize] = Some(mesh.vertices.len() as u32);
+//!                 mesh.vertices.push([x, y, origin[2]]);
+//!             }
+//!         }
+//!     }
+//!     for i in 0..columns - 1 {
+//!         for j in 0..rows - 1 {
+//!             let at = |a: u32, b: u32| index[(a * rows + b) as usize];
+//!             let corners = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
+//!             if let [Some(a), Some(b), Some(c), Some(d)] = corners {
+//!                 mesh.faces.extend([[a, b, c], [a, c, d]]);
+//!             }
+//!         }
+//!     }
+//!     mesh
+//! }
+//!
+//! // The scan: 60 × 40 mm, 1 mm apart, a 10 mm hole in the middle.
+//! let outside_hole = |x: f64, y: f64| !((25.0..35.0).contains(&x) && (15.0..25.0).contains(&y));
+//! let scan = grid((60, 40), [0.0; 3], 1.0, 0.3, outside_hole);
+//! let cloud = &scan.vertices;
+//!
+//! // Boundary point detection (BPD), then the smoothed edges (RBS): the
+//! // outer border and the hole's.
+//! let detection = detect_boundary(cloud, &BpdOptions::default())?;
+//! let edges = reconstruct_edges(cloud, &detection, &EdgeOptions::default());
+//! assert_eq!(edges.loops.len(), 2);
+//!
+//! // The Delaunay path: the cloud meshed inside its smoothed edges.
+//! let meshed = delaunay_mesh(cloud, &detection, &edges, &DelaunayOptions::default())?;
+//! assert!(!meshed.faces.is_empty());
+//!
+//! // Trimming: a mesh that overhangs the scan and covers its hole, as a
+//! // Poisson envelope does, cut along the smoothed edges.
+//! let envelope = grid((36, 26), [-5.0, -5.0, 0.0], 2.0, 0.0, |_, _| true);
+//! let options = TrimOptions::default();
+//! let (trimmed, report) = trim_mesh(&envelope, cloud, &detection, &edges, &options)?;
+//! assert!(report.faces_split > 0 && trimmed.faces.len() < envelope.faces.len());
+//!
+//! // Cleanup: the scan's jagged border and hole replaced by their smoothed
+//! // edges; β is the local resolution of the scan's own vertices.
+//! let beta = LocalResolution::new(&scan.vertices, &BpdOptions::default())?;
+//! let (cleaned, report) = clean_mesh(&scan, &beta, &CleanOptions::default())?;
+//! assert_eq!(report.loops_smoothed, 2);
+//! assert!(!cleaned.faces.is_empty());
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
 //! ## Vector kernels
 //!
 //! The per-neighbourhood kernels of detection (k-NN selection, plane fit
