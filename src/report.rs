@@ -31,6 +31,7 @@ impl LoopsFrom {
             LoopSource::OwnPlane { normal: [x, y, z] } => {
                 format!("the cloud's own plane, seen along {x:.3},{y:.3},{z:.3}")
             }
+            LoopSource::MeshBorder => "the mesh's border".to_string(),
         }
     }
 }

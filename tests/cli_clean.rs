@@ -90,6 +90,89 @@ fn cleans_the_fixture_and_reports() {
     );
 }
 
+/// `--edges FILE` writes the cleaned mesh's border: one loop per border
+/// loop of the output as written, through its vertices, each corner
+/// shared by the two edges it joins; the fixture's outer border has its
+/// four corners, its holes none. A bad edges output is refused before any
+/// work.
+#[test]
+fn edges_are_the_cleaned_border() {
+    let dir = tempfile::tempdir().unwrap();
+    let (out, edges) = (dir.path().join("clean.ply"), dir.path().join("e.json"));
+    let run = meshtrim(&["clean", JAGGED, s(&out), "--edges", s(&edges)], None);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let written = meshtrim::io::read_mesh(&out).unwrap();
+    let mesh = trim::Mesh {
+        vertices: written.vertices,
+        faces: written.faces.unwrap(),
+    };
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&edges).unwrap()).unwrap();
+    let loops = json["loops"].as_array().unwrap();
+    let borders = mesh.boundary_loops();
+    assert_eq!(loops.len(), borders.len());
+    for (lp, border) in loops.iter().zip(&borders) {
+        let points: Vec<u32> = serde_json::from_value(lp["boundary_points"].clone()).unwrap();
+        assert_eq!(&points, border);
+        // The edges joined, each corner once, are the border's vertices
+        // from the first corner on.
+        let mut through: Vec<[f64; 3]> = Vec::new();
+        for edge in lp["edges"].as_array().unwrap() {
+            let p: Vec<[f64; 3]> = serde_json::from_value(edge["points"].clone()).unwrap();
+            let closed = edge["closed"].as_bool().unwrap();
+            through.extend_from_slice(if closed { &p } else { &p[..p.len() - 1] });
+        }
+        let corners = lp["corners"].as_array().unwrap();
+        let start = corners.first().map_or(0, |c| {
+            let c: [f64; 3] = serde_json::from_value(c.clone()).unwrap();
+            border
+                .iter()
+                .position(|&v| mesh.vertices[v as usize] == c)
+                .unwrap()
+        });
+        let n = border.len();
+        let expected: Vec<[f64; 3]> = (0..n)
+            .map(|j| mesh.vertices[border[(start + j) % n] as usize])
+            .collect();
+        assert_eq!(through, expected);
+    }
+    let mut corners: Vec<usize> = loops
+        .iter()
+        .map(|l| l["corners"].as_array().unwrap().len())
+        .collect();
+    corners.sort_unstable();
+    assert_eq!(corners, [0, 0, 0, 4]);
+    for bad in ["e.txt", "e.ply"] {
+        let out = dir.path().join("never.ply");
+        let run = meshtrim(
+            &[
+                "clean",
+                JAGGED,
+                s(&out),
+                "--edges",
+                s(&dir.path().join(bad)),
+            ],
+            None,
+        );
+        assert_clean_failure(
+            &run,
+            "unsupported output format: use .json, .obj, .svg, .dxf, .step or .igs",
+        );
+        assert!(!out.exists());
+    }
+    // An OBJ is a mesh and an edges format: the input is never written.
+    let grid = dir.path().join("grid.obj");
+    std::fs::write(&grid, grid_obj(30, 1.0, true)).unwrap();
+    let before = std::fs::read(&grid).unwrap();
+    let run = meshtrim(&["clean", s(&grid), s(&out), "--edges", s(&grid)], None);
+    assert_clean_failure(&run, "an output would overwrite this input");
+    assert_eq!(std::fs::read(&grid).unwrap(), before);
+}
+
 #[test]
 fn max_deviation_holds_the_new_border_to_the_old() {
     let dir = tempfile::tempdir().unwrap();

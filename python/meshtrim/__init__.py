@@ -9,7 +9,8 @@ same Rust library, with the same results bit for bit:
   along the cloud's smoothed boundary;
 - :func:`mesh`: a Delaunay mesh of the cloud bounded by that boundary;
 - :func:`clean`: a triangulated scan's jagged border replaced by its
-  smoothed edge;
+  smoothed edge; :func:`border_edges` a mesh's border as loops and edges,
+  for :func:`write_edges` (``clean --edges``);
 - :func:`read_cloud`, :func:`read_mesh`, :func:`write_mesh`: the CLI's
   readers and writers, vertex normals and colours included;
 - :func:`carry`: per-vertex values (normals, colours, anything) carried
@@ -59,6 +60,7 @@ __all__ = [
     "trim",
     "mesh",
     "clean",
+    "border_edges",
     "read_cloud",
     "read_mesh",
     "write_mesh",
@@ -145,9 +147,11 @@ class Loop:
 
 class Edges(list):
     """The loops of :func:`edges` (a list of :class:`Loop`), with the
-    detection they came from and the summary of ``meshtrim edges --json``."""
+    detection they came from and the summary of ``meshtrim edges --json``
+    (for :func:`border_edges`: no detection, and the summary's ``loops``
+    and ``loops_from``)."""
 
-    def __init__(self, loops: list, detection: Detection, summary: dict):
+    def __init__(self, loops: list, detection: Optional[Detection], summary: dict):
         super().__init__(loops)
         self.detection = detection
         self.summary = summary
@@ -283,12 +287,17 @@ def edges(
     (boundary, beta), raw, summary = _meshtrim.edges(
         pts, k, anisotropy, bool(offset), along, from_
     )
-    loops = [
+    loops = _loops(raw)
+    summary = json.loads(summary)
+    return Edges(loops, Detection(boundary, beta, summary), summary)
+
+
+def _loops(raw: list) -> list:
+    """The native module's loop tuples as a list of :class:`Loop`."""
+    return [
         Loop(closed, indices, corners, [Edge(c, p) for c, p in pieces])
         for closed, indices, corners, pieces in raw
     ]
-    summary = json.loads(summary)
-    return Edges(loops, Detection(boundary, beta, summary), summary)
 
 
 def trim(
@@ -371,6 +380,24 @@ def clean(
     bound = None if max_deviation is None else _distance(max_deviation, "max_deviation")
     out_v, out_f, report = _meshtrim.clean(v, f, k, anisotropy, bool(offset), along, from_, bool(repair), bound)
     return out_v, out_f, json.loads(report)
+
+
+def border_edges(vertices: Any, faces: Any, *, k: int = 30, anisotropy: bool = True) -> Edges:
+    """The border of the mesh ``vertices``, ``faces`` as a list of
+    :class:`Loop`, one per border loop (its ``boundary_points`` index
+    ``vertices``), split at its corners, found by the paper's corner test
+    at the vertices' local resolution (``k`` and ``anisotropy`` as
+    :func:`detect`'s), into edges through the border vertices themselves:
+    nothing is smoothed. What ``meshtrim clean --edges`` writes of its output:
+
+    >>> out_v, out_f, _ = meshtrim.clean(v, f)
+    >>> meshtrim.write_edges("outline.step", meshtrim.border_edges(out_v, out_f), out_v)
+    """
+    k, anisotropy, _, _ = _options(k, anisotropy, None, None)
+    v = _float_rows(vertices, "vertices")
+    f = _face_rows(faces, len(v))
+    loops = _loops(_meshtrim.border_edges(v, f, k, anisotropy))
+    return Edges(loops, None, {"loops": len(loops), "loops_from": "mesh_border"})
 
 
 def write_edges(

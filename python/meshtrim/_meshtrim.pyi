@@ -35,6 +35,9 @@ def detect(
 def edges(
     points: Points, k: int, anisotropy: bool, offset: bool, view_along: Vector, view_from: Vector
 ) -> Tuple[Labels, list[LoopTuple], str]: ...
+def border_edges(
+    vertices: Points, faces: npt.NDArray[np.uint32], k: int, anisotropy: bool
+) -> list[LoopTuple]: ...
 def trim(
     vertices: Points,
     faces: npt.NDArray[np.uint32],

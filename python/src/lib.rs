@@ -238,8 +238,22 @@ fn edges_py<'py>(
     let (detection, found, summary) = without_gil(py, || {
         commands::edges::edges_in_memory(&points, &stages, false, "points")
     })?;
-    let mut loops = Vec::with_capacity(found.loops.len());
-    for l in &found.loops {
+    Ok((
+        labels(py, &detection),
+        loops_list(py, &points, &found)?,
+        to_json(&summary)?,
+    ))
+}
+
+/// The loops of `edges` over `points` as the Python package's tuples:
+/// (closed, boundary point indices, corner positions, [(closed, points)]).
+fn loops_list<'py>(
+    py: Python<'py>,
+    points: &[Point3],
+    edges: &Edges,
+) -> PyResult<Bound<'py, PyList>> {
+    let mut loops = Vec::with_capacity(edges.loops.len());
+    for l in &edges.loops {
         let indices: Vec<i64> = l.boundary_points.iter().map(|&i| i64::from(i)).collect();
         let mut pieces = Vec::with_capacity(l.edges.len());
         for e in &l.edges {
@@ -248,16 +262,38 @@ fn edges_py<'py>(
         let looped: LoopTuple = (
             true,
             PyArray1::from_vec(py, indices),
-            points_array(py, &l.corner_points(&points))?,
+            points_array(py, &l.corner_points(points))?,
             pieces,
         );
         loops.push(looped);
     }
-    Ok((
-        labels(py, &detection),
-        PyList::new(py, loops)?,
-        to_json(&summary)?,
-    ))
+    PyList::new(py, loops)
+}
+
+/// The border of a mesh as the loops of `edges`: what `clean --edges`
+/// writes of its output.
+#[pyfunction]
+#[pyo3(signature = (vertices, faces, k, anisotropy))]
+fn border_edges<'py>(
+    py: Python<'py>,
+    vertices: PyReadonlyArray2<'py, f64>,
+    faces: PyReadonlyArray2<'py, u32>,
+    k: usize,
+    anisotropy: bool,
+) -> PyResult<Bound<'py, PyList>> {
+    let stages = Options {
+        k,
+        anisotropy,
+        offset: true,
+        view_along: None,
+        view_from: None,
+    }
+    .stages()?;
+    let mesh = mesh_of(&vertices, &faces)?;
+    let found = without_gil(py, || {
+        commands::clean::border_curves(&mesh, &stages, "vertices")
+    })?;
+    loops_list(py, &mesh.vertices, &found)
 }
 
 /// The trimmed mesh and the report as JSON.
@@ -1098,6 +1134,7 @@ fn _meshtrim(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MeshtrimError", m.py().get_type::<MeshtrimError>())?;
     m.add_function(wrap_pyfunction!(detect_py, m)?)?;
     m.add_function(wrap_pyfunction!(edges_py, m)?)?;
+    m.add_function(wrap_pyfunction!(border_edges, m)?)?;
     m.add_function(wrap_pyfunction!(trim_py, m)?)?;
     m.add_function(wrap_pyfunction!(mesh_py, m)?)?;
     m.add_function(wrap_pyfunction!(clean_py, m)?)?;

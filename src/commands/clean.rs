@@ -12,7 +12,8 @@ use anyhow::{Context, Result};
 use serde::Serialize;
 use trim::{clean_mesh, CleanOptions, CleanReport};
 
-use crate::commands::args::StageArgs;
+use crate::commands::args::{EdgeFileArgs, StageArgs};
+use crate::io::edges_out::{EdgeData, EdgeFileOptions};
 use crate::io::mesh_out::write_mesh_carrying;
 use crate::io::read_mesh_with_attributes;
 use crate::report::{shown, significant};
@@ -42,9 +43,19 @@ pub struct Args {
     /// at this distance instead.
     #[arg(long, value_name = "D", value_parser = crate::commands::args::parse_distance, allow_hyphen_values = true)]
     pub max_deviation: Option<f64>,
+    /// Also write the cleaned mesh's border as curves: FILE.json, .obj,
+    /// .svg, .dxf, .step or .igs, as `meshtrim edges` writes edges. Each
+    /// border loop is split at its corners into edges through the border
+    /// vertices themselves: the smoothed border where a loop was replaced,
+    /// the scan's own where one was left.
+    #[arg(long, value_name = "FILE")]
+    pub edges: Option<PathBuf>,
     /// Detection and edge options.
     #[command(flatten)]
     pub stages: StageArgs,
+    /// The unit declared, DXF splines.
+    #[command(flatten)]
+    pub file: EdgeFileArgs,
     /// Print the report as one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -241,6 +252,10 @@ pub struct LeftLoops {
 /// Runs `meshtrim clean`.
 pub fn run(args: &Args) -> Result<()> {
     crate::report::check_outputs(&args.output, args.report.as_deref(), &[&args.input])?;
+    if let Some(edges) = &args.edges {
+        crate::report::check_edges_output(edges, &[&args.input])?;
+    }
+    args.file.check(args.edges.as_deref())?;
     let job = Job {
         stages: &args.stages.stages(),
         choices: Choices {
@@ -248,6 +263,10 @@ pub fn run(args: &Args) -> Result<()> {
             max_deviation: args.max_deviation,
         },
         measured: true,
+        edges: args
+            .edges
+            .as_deref()
+            .map(|path| (path, args.file.options())),
     };
     let report = clean(
         &args.input,
@@ -274,6 +293,7 @@ pub fn clean_file(
         stages,
         choices,
         measured,
+        edges: None,
     };
     let r = clean(input, output, &job, no_faces)?;
     Ok(CleanOutcome {
@@ -308,6 +328,8 @@ struct Job<'a> {
     choices: Choices,
     /// Whether the deviations between input and output are measured.
     measured: bool,
+    /// Where to write the output's border as curves, and how.
+    edges: Option<(&'a Path, EdgeFileOptions)>,
 }
 
 /// Reads, finds the local resolution, cleans, writes.
@@ -320,15 +342,52 @@ fn clean(input: &Path, output: &Path, job: &Job, no_faces: &str) -> Result<Repor
     if job.measured {
         report.measure(&mesh, &out);
     }
+    let border = job
+        .edges
+        .map(|(path, options)| border_curves(&out, job.stages, &name).map(|e| (e, path, options)))
+        .transpose()?;
     let started = Instant::now();
     let carried = write_mesh_carrying(output, &out, &mesh, attributes)?;
     report.vertex_attributes = carried.written;
     report.vertex_attributes_not_written = carried.not_written;
+    if let Some((border, path, options)) = border {
+        write_border(path, &out, &border, options)?;
+    }
     report.read_ms = millis(read_time);
     report.write_ms = millis(started.elapsed());
     report.input = Some(name);
     report.output = Some(output.display().to_string());
     Ok(report)
+}
+
+/// The border of the cleaned mesh `out` as edges: its loops split at their
+/// corners, found at the output vertices' own local resolution (`stages`'
+/// detection options). Errors begin with `name`.
+pub fn border_curves(out: &trim::Mesh, stages: &Stages, name: &str) -> Result<trim::Edges> {
+    let beta = trim::LocalResolution::new(&out.vertices, &stages.detection)
+        .with_context(|| format!("{name}: the border's local resolution"))?;
+    Ok(trim::mesh_border_edges(out, &beta))
+}
+
+/// Writes the border `edges` of the cleaned mesh `out` to `path`, as
+/// `meshtrim edges -o` writes edges (the SVG marks the border vertices).
+fn write_border(
+    path: &Path,
+    out: &trim::Mesh,
+    edges: &trim::Edges,
+    options: EdgeFileOptions,
+) -> Result<()> {
+    let mut on_border = vec![false; out.vertices.len()];
+    for v in edges.loops.iter().flat_map(|l| &l.boundary_points) {
+        on_border[*v as usize] = true;
+    }
+    let data = EdgeData {
+        points: &out.vertices,
+        boundary: &on_border,
+        edges,
+        options,
+    };
+    crate::io::edges_out::write_file(path, data)
 }
 
 /// Cleans `mesh` in memory: everything `meshtrim clean` does between

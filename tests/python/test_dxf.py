@@ -16,7 +16,7 @@ import pytest
 
 import synthetic
 from curves import cases, median_spacing, segment_distance
-from meshtrim_cli import ROOT, run_meshtrim
+from meshtrim_cli import ROOT, run_meshtrim, shared_data
 
 
 def closed_polyline(loop):
@@ -169,3 +169,57 @@ def test_a_bad_edges_output_is_refused_before_any_work(tmp_path):
     )
     assert r.returncode == 1 and "e.txt: unsupported output format: use .json, .obj, .svg, .dxf, .step or .igs" in r.stderr
     assert not out.exists()
+
+
+def border_of(path):
+    """The border of the mesh in `path` as trimesh reads it: the edges of
+    one face (as vertex position pairs, either way round) and how many
+    loops they form."""
+    import trimesh
+
+    mesh = trimesh.load(path, process=False)
+    edges = np.sort(mesh.edges, axis=1)
+    unique, count = np.unique(edges, axis=0, return_counts=True)
+    border = unique[count == 1]
+    positions = {tuple(map(float, p)) for p in mesh.vertices[np.unique(border)]}
+    pairs = {frozenset((tuple(map(float, mesh.vertices[a])), tuple(map(float, mesh.vertices[b])))) for a, b in border}
+    parent = {v: v for v in np.unique(border)}
+
+    def root(v):
+        while parent[v] != v:
+            parent[v] = parent[parent[v]]
+            v = parent[v]
+        return v
+
+    for a, b in border:
+        parent[root(a)] = root(b)
+    return pairs, positions, len({root(v) for v in parent})
+
+
+@pytest.mark.parametrize("scan", ["fixture", "bun000"])
+def test_clean_writes_the_cleaned_border(tmp_path, scan):
+    """`clean --edges OUT.dxf`: one closed 3-D polyline per border loop of
+    the cleaned mesh as trimesh reads it, running along its border edges
+    through every border vertex, to the last bit; the corners are POINTs
+    at polyline vertices (the fixture's outer border has its four)."""
+    src = ROOT / "fixtures" / "meshes" / "blade_jagged.stl" if scan == "fixture" else shared_data("stanford_bunny/bun000.ply")
+    out = tmp_path / "clean.ply"
+    run_meshtrim("clean", src, out, "--edges", tmp_path / "e.dxf")
+    doc = ezdxf.readfile(tmp_path / "e.dxf")
+    auditor = doc.audit()
+    assert not auditor.has_errors, [str(e.message) for e in auditor.errors]
+    pairs, positions, loops = border_of(out)
+    polylines = doc.modelspace().query("POLYLINE")
+    assert len(polylines) == loops > 0
+    seen = set()
+    for polyline in polylines:
+        assert polyline.is_3d_polyline and polyline.is_closed
+        vertices = [tuple(map(float, v.dxf.location)) for v in polyline.vertices]
+        steps = {frozenset(pair) for pair in zip(vertices, vertices[1:] + vertices[:1])}
+        assert steps <= pairs, "every step of the polyline is a border edge"
+        seen.update(vertices)
+    assert seen == positions, "every border vertex, on one polyline or another"
+    corners = [tuple(map(float, c.dxf.location)) for c in doc.modelspace().query("POINT")]
+    assert set(corners) <= positions
+    if scan == "fixture":
+        assert len(corners) == 4

@@ -466,3 +466,18 @@ def test_dask_example_matches_meshtrim_batch(tmp_path):
     assert batch.returncode == 1, batch.stderr
     for name in ("blade.ply", "jagged.stl", "sub/part.ply"):
         assert (dask_out / name).read_bytes() == (batch_out / name).read_bytes(), name
+
+
+@pytest.mark.parametrize("ext", ["json", "dxf", "step", "svg"])
+def test_border_edges_write_what_clean_edges_writes(tmp_path, ext):
+    """`border_edges` of `clean`'s output, written by `write_edges`, is
+    the file `meshtrim clean --edges` writes."""
+    cli = tmp_path / f"cli.{ext}"
+    run_meshtrim("clean", JAGGED, tmp_path / "out.ply", "--edges", cli)
+    v, f = meshtrim.read_mesh(JAGGED)
+    out_v, out_f, _ = meshtrim.clean(v, f)
+    loops = meshtrim.border_edges(out_v, out_f)
+    assert len(loops) == 4 and loops.summary["loops_from"] == "mesh_border"
+    ours = tmp_path / f"ours.{ext}"
+    meshtrim.write_edges(ours, loops, out_v)
+    assert ours.read_bytes() == cli.read_bytes()

@@ -126,3 +126,27 @@ def test_iges_records_and_corners(tmp_path):
     loops = json.loads((tmp_path / "e.json").read_text())["loops"]
     assert kinds.count(116) == sum(len(l["corners"]) for l in loops) == 4
     assert kinds.count(126) == sum(len(l["edges"]) for l in loops)
+
+
+@pytest.mark.parametrize("suffix", [".step", ".igs"])
+def test_clean_writes_the_cleaned_border_as_curves(tmp_path, suffix):
+    """`clean --edges OUT.step|OUT.igs`: one B-spline curve per edge of the
+    JSON it writes, through every one of its border vertices (within 1e-6
+    of the part's size), ending at its corners."""
+    src = ROOT / "fixtures" / "meshes" / "blade_jagged.stl"
+    run_meshtrim("clean", src, tmp_path / "a.ply", "--edges", tmp_path / "e.json")
+    run_meshtrim("clean", src, tmp_path / "b.ply", "--edges", (tmp_path / "e").with_suffix(suffix))
+    loops = json.loads((tmp_path / "e.json").read_text())["loops"]
+    edges = [e for l in loops for e in l["edges"]]
+    curves, closest = read_step((tmp_path / "e").with_suffix(suffix))
+    try:
+        assert len(curves) == len(edges) == 7
+        size = max(np.abs(np.array(e["points"])).max() for e in edges)
+        for curve, edge in zip(curves, edges):
+            points = np.array(edge["points"])
+            off = np.linalg.norm(closest(curve["tag"], points) - points, axis=1)
+            assert off.max() <= 1e-6 * size, off.max()
+            if not edge["closed"]:
+                assert np.allclose(curve["samples"][[0, -1]], points[[0, -1]], rtol=0, atol=1e-9 * size)
+    finally:
+        gmsh.finalize()

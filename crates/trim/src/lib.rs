@@ -173,7 +173,7 @@ pub use delaunay::{delaunay_mesh, delaunay_mesh_with_report, DelaunayOptions, De
 #[doc(hidden)]
 pub use deviation::surface_deviation_reference;
 pub use deviation::{surface_deviation, Deviation};
-pub use edges::{reconstruct_edges, Edge, EdgeOptions, Edges, Loop, LoopSource};
+pub use edges::{mesh_border_edges, reconstruct_edges, Edge, EdgeOptions, Edges, Loop, LoopSource};
 pub use error::{CleanError, CloudError, DelaunayError, MeshError, Placement, TrimError};
 pub use frame::{fit_plane, Frame};
 pub use geom::rotation_from_quaternion;

@@ -23,6 +23,9 @@ pub mod smooth;
 pub mod split;
 pub mod trace;
 
+mod border;
+pub use border::mesh_border_edges;
+
 use rayon::prelude::*;
 
 use crate::bpd::Detection;
@@ -131,15 +134,19 @@ pub enum LoopSource {
         /// The plane's normal, the direction the image was seen along.
         normal: Point3,
     },
+    /// A mesh's own border, not detected ([`mesh_border_edges`]).
+    MeshBorder,
 }
 
 impl LoopSource {
-    /// A short name: `links`, `scanner_image` or `own_plane`.
+    /// A short name: `links`, `scanner_image`, `own_plane` or
+    /// `mesh_border`.
     pub fn name(self) -> &'static str {
         match self {
             LoopSource::Links => "links",
             LoopSource::ScannerImage => "scanner_image",
             LoopSource::OwnPlane { .. } => "own_plane",
+            LoopSource::MeshBorder => "mesh_border",
         }
     }
 }
@@ -516,14 +523,8 @@ fn smoothed_edges(loop_points: &[Point3], beta: &[f64], corners: &[usize]) -> Ve
             points: smooth::smooth_closed_edge(loop_points, beta),
         }];
     }
-    let n = loop_points.len();
-    (0..corners.len())
-        .map(|k| {
-            let (from, to) = (corners[k], corners[(k + 1) % corners.len()]);
-            // From one corner to the next, both included, wrapping round.
-            let len = (to + n - from) % n;
-            let len = if len == 0 { n } else { len };
-            let range: Vec<usize> = (0..=len).map(|j| (from + j) % n).collect();
+    between_corners(loop_points.len(), corners)
+        .map(|range| {
             let piece: Vec<Point3> = range.iter().map(|&j| loop_points[j]).collect();
             let piece_beta: Vec<f64> = range.iter().map(|&j| beta[j]).collect();
             Edge {
@@ -532,6 +533,18 @@ fn smoothed_edges(loop_points: &[Point3], beta: &[f64], corners: &[usize]) -> Ve
             }
         })
         .collect()
+}
+
+/// The positions of a closed loop of `n` points from each of its
+/// `corners` (ascending, at least one) to the next, both included,
+/// wrapping round: one run per edge.
+fn between_corners(n: usize, corners: &[usize]) -> impl Iterator<Item = Vec<usize>> + '_ {
+    (0..corners.len()).map(move |k| {
+        let (from, to) = (corners[k], corners[(k + 1) % corners.len()]);
+        let len = (to + n - from) % n;
+        let len = if len == 0 { n } else { len };
+        (0..=len).map(|j| (from + j) % n).collect()
+    })
 }
 
 /// Moves every edge out to the estimated physical edge; corners move to
