@@ -548,6 +548,103 @@ fn meshes_without_a_cloud_are_cleaned_like_meshtrim_clean() {
     }
 }
 
+/// `--edges-to EXT` writes S.edges.EXT beside each output S.ext: the bytes
+/// `meshtrim clean --edges` writes for a cleaned file, `meshtrim trim
+/// --edges` for a trimmed one (with `--units` and `--dxf-splines` alike).
+/// Two outputs of one stem, whose edges files would be one, are refused
+/// before any work, as is `--dxf-splines` without DXF edges.
+#[test]
+fn edges_to_writes_each_outputs_edges_beside_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::create_dir_all(d.join("scans")).unwrap();
+    std::fs::copy(JAGGED, d.join("scans/j.stl")).unwrap();
+    pair(d, "scans/t");
+    let single = |args: &[&str]| {
+        let run = Command::new(env!("CARGO_BIN_EXE_meshtrim"))
+            .args(args)
+            .current_dir(d)
+            .output()
+            .unwrap();
+        assert_ok(&run);
+    };
+    for (ext, flags) in [
+        ("json", &[][..]),
+        ("dxf", &["--dxf-splines", "--units", "in"][..]),
+    ] {
+        let out = format!("out_{ext}");
+        let run = batch(
+            d,
+            &[&["scans", "--out-dir", &out, "--edges-to", ext][..], flags].concat(),
+        );
+        assert_ok(&run);
+        let clean_edges = format!("clean.{ext}");
+        single(
+            &[
+                &["clean", JAGGED, "c.stl", "--edges", &clean_edges][..],
+                flags,
+            ]
+            .concat(),
+        );
+        let trim_edges = format!("trim.{ext}");
+        single(
+            &[
+                &["trim", MESH, CLOUD, "t.ply", "--edges", &trim_edges][..],
+                flags,
+            ]
+            .concat(),
+        );
+        for (batched, alone) in [
+            (format!("{out}/j.edges.{ext}"), clean_edges),
+            (format!("{out}/t.edges.{ext}"), trim_edges),
+        ] {
+            let (batched, alone) = (
+                std::fs::read(d.join(&batched)).unwrap(),
+                std::fs::read(d.join(&alone)).unwrap(),
+            );
+            assert!(batched == alone, "{ext}");
+        }
+    }
+    // Two stems alike: their meshes differ, their edges files would not.
+    std::fs::copy(d.join("scans/t.ply"), d.join("scans/j.ply")).unwrap();
+    let run = batch(
+        d,
+        &[
+            "scans/j.stl",
+            "scans/j.ply",
+            "--out-dir",
+            "two",
+            "--edges-to",
+            "dxf",
+        ],
+    );
+    assert_eq!(run.status.code(), Some(1), "{}", text(&run.stdout));
+    let stderr = text(&run.stderr);
+    assert!(
+        stderr.contains("would both be written to two/j.edges.dxf"),
+        "{stderr}"
+    );
+    assert!(!d.join("two").exists());
+    let run = batch(
+        d,
+        &[
+            "scans/j.stl",
+            "--out-dir",
+            "three",
+            "--edges-to",
+            "step",
+            "--dxf-splines",
+        ],
+    );
+    assert_eq!(run.status.code(), Some(1));
+    assert!(
+        text(&run.stderr).contains("give --edges-to dxf"),
+        "{}",
+        text(&run.stderr)
+    );
+    assert!(!d.join("three").exists());
+}
+
 /// `--to` writes every output in one format: the bytes `meshtrim clean`
 /// and `meshtrim trim` write to that extension; two inputs of one stem
 /// that would share an output are refused before any work; an unknown

@@ -1010,6 +1010,7 @@ fn batch_plan(
             cloud_dir: cloud_dir.as_deref(),
             report: None,
             to: to.as_deref(),
+            edges_to: None,
         })
     })?;
     Ok(jobs

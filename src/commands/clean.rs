@@ -279,13 +279,14 @@ pub fn run(args: &Args) -> Result<()> {
 
 /// Cleans one file without printing (the unit of `batch`); `choices` as
 /// `clean`'s; `measured`: whether the deviations are measured (they cost
-/// about a tenth of a small file's time). `no_faces` is the advice for a
-/// file without faces.
+/// about a tenth of a small file's time); `edges`: where to write the
+/// output's border, and how. `no_faces` is the advice for a file without
+/// faces.
 pub fn clean_file(
     input: &Path,
     output: &Path,
     stages: &Stages,
-    (choices, measured): (Choices, bool),
+    (choices, measured, edges): (Choices, bool, Option<(&Path, EdgeFileOptions)>),
     no_faces: &str,
 ) -> Result<CleanOutcome> {
     crate::report::check_outputs(output, None, &[input])?;
@@ -293,7 +294,7 @@ pub fn clean_file(
         stages,
         choices,
         measured,
-        edges: None,
+        edges,
     };
     let r = clean(input, output, &job, no_faces)?;
     Ok(CleanOutcome {

@@ -25,8 +25,9 @@ use rayon::prelude::*;
 
 use super::clean::{clean_file, Choices, WRAPS_BELOW};
 use super::trim::{trim_file, TrimSettings};
-use crate::commands::args::StageArgs;
+use crate::commands::args::{EdgeFileArgs, StageArgs};
 use crate::console;
+use crate::io::edges_out::EdgeFileOptions;
 use crate::io::CloudOptions;
 use crate::stages::{in_cli_words, millis, Stages};
 
@@ -89,9 +90,18 @@ pub struct Args {
     /// one (as `clean --max-deviation`).
     #[arg(long, value_name = "D", value_parser = crate::commands::args::parse_distance, allow_hyphen_values = true)]
     pub max_deviation: Option<f64>,
+    /// Also write each output's edges, as S.edges.EXT beside the output
+    /// S.ext, in this format (json, obj, svg, dxf, step, igs): a cleaned
+    /// file's border, as `clean --edges` writes it; the smoothed edges a
+    /// trimmed file was cut along, as `trim --edges` writes them.
+    #[arg(long, value_name = "EXT", value_parser = ["json", "obj", "svg", "dxf", "step", "igs"])]
+    pub edges_to: Option<String>,
     /// Detection and edge options.
     #[command(flatten)]
     pub stages: StageArgs,
+    /// The unit declared, DXF splines.
+    #[command(flatten)]
+    pub file: EdgeFileArgs,
 }
 
 /// Runs `meshtrim batch`.
@@ -101,12 +111,16 @@ pub fn run(args: &Args) -> Result<()> {
         .as_deref()
         .map(ReportFormat::from_path)
         .transpose()?;
+    if args.file.dxf_splines && args.edges_to.as_deref() != Some("dxf") {
+        bail!("--dxf-splines writes splines into the edges files: give --edges-to dxf");
+    }
     let jobs = plan(&Inputs {
         args: &args.inputs,
         out_dir: &args.out_dir,
         cloud_dir: args.cloud_dir.as_deref(),
         report: args.report.as_deref(),
         to: args.to.as_deref(),
+        edges_to: args.edges_to.as_deref(),
     })?;
     let inputs = jobs.len();
     let jobs: Vec<Job> = match args.shard {
@@ -152,6 +166,7 @@ fn process_all(jobs: &[Job], args: &Args) -> Result<Vec<Row>> {
             max_deviation: args.max_deviation,
         },
         deviation: args.deviation,
+        edges: args.file.options(),
         stages: args.stages.stages(),
         cloud_scale: args.cloud_scale,
     };
@@ -192,6 +207,8 @@ struct FileSettings {
     choices: Choices,
     /// Measure how far each output lies from its scan (`--deviation`).
     deviation: bool,
+    /// How each job's edges file, if any, is written.
+    edges: EdgeFileOptions,
     /// Detection's and edge reconstruction's options.
     stages: Stages,
     /// The clouds' scale factor (`--cloud-scale`).
@@ -279,17 +296,19 @@ fn work(job: &Job, settings: &FileSettings) -> Result<Outcome> {
     let FileSettings {
         choices,
         deviation,
+        edges,
         ref stages,
         cloud_scale,
         ..
     } = *settings;
+    let edges = job.edges.as_deref().map(|path| (path, edges));
     match &job.cloud {
         CloudMatch::None => {
             let o = clean_file(
                 &job.input,
                 &job.output,
                 stages,
-                (choices, deviation),
+                (choices, deviation, edges),
                 NO_FACES,
             )?;
             Ok(Outcome {
@@ -317,7 +336,7 @@ fn work(job: &Job, settings: &FileSettings) -> Result<Outcome> {
                 cloud_scale,
                 measure: deviation,
             };
-            let r = trim_file(&job.input, cloud, &job.output, None, &settings)?;
+            let r = trim_file(&job.input, cloud, &job.output, edges, &settings)?;
             Ok(Outcome {
                 loops: r.loops,
                 faces_in: r.faces_in,

@@ -24,6 +24,9 @@ pub struct Job {
     pub input: PathBuf,
     /// Where its output goes.
     pub output: PathBuf,
+    /// Where its edges go, when asked for: `S.edges.EXT` beside the
+    /// output `S.ext`.
+    pub edges: Option<PathBuf>,
     /// The cloud it is trimmed with.
     pub cloud: CloudMatch,
 }
@@ -90,6 +93,8 @@ pub struct Inputs<'a> {
     pub report: Option<&'a Path>,
     /// The outputs' extension (a mesh format's) instead of the inputs'.
     pub to: Option<&'a str>,
+    /// The edges files' extension, when each output's edges are written.
+    pub edges_to: Option<&'a str>,
 }
 
 /// The whole batch (every shard), sorted by input path: expands the
@@ -118,6 +123,7 @@ pub fn plan(inputs: &Inputs) -> Result<Vec<Job>> {
             }
             Ok(Job {
                 input: f.path,
+                edges: inputs.edges_to.map(|ext| edges_beside(&output, ext)),
                 output,
                 cloud,
             })
@@ -126,6 +132,14 @@ pub fn plan(inputs: &Inputs) -> Result<Vec<Job>> {
     check_collisions(&jobs)?;
     check_overwrites(&jobs, inputs.report)?;
     Ok(jobs)
+}
+
+/// The edges file of the output `S.ext`: `S.edges.EXT`, beside it.
+fn edges_beside(output: &Path, extension: &str) -> PathBuf {
+    let stem = output.file_stem().unwrap_or(output.as_os_str());
+    let mut name = stem.to_os_string();
+    name.push(format!(".edges.{extension}"));
+    output.with_file_name(name)
 }
 
 /// A mesh input found from an argument, with its output path relative to
@@ -420,6 +434,18 @@ fn check_collisions(jobs: &[Job]) -> Result<()> {
             );
         }
     }
+    for job in jobs {
+        let Some(edges) = &job.edges else { continue };
+        if let Some(first) = outputs.insert(edges, &job.input) {
+            bail!(
+                "{} and {} would both be written to {} (an edges file is S.edges.EXT beside \
+                 the output S.ext): give them in separate batches",
+                first.display(),
+                job.input.display(),
+                edges.display()
+            );
+        }
+    }
     Ok(())
 }
 
@@ -441,9 +467,10 @@ fn check_overwrites(jobs: &[Job], report: Option<&Path>) -> Result<()> {
         }
     }
     // The advice names the option that chose the path at fault.
-    let outputs = jobs
-        .iter()
-        .map(|j| (j.output.as_path(), "output", "--out-dir"));
+    let outputs = jobs.iter().flat_map(|j| {
+        let edges = j.edges.as_deref().map(|e| (e, "edges file", "--out-dir"));
+        std::iter::once((j.output.as_path(), "output", "--out-dir")).chain(edges)
+    });
     let report = report.map(|r| (r, "report", "--report"));
     for (out, what, option) in outputs.chain(report) {
         if let Some(input) = canonical(out).and_then(|c| inputs.get(&c)) {
@@ -493,6 +520,20 @@ mod tests {
         assert!(is_mesh_input(Path::new("blade.cloud.stl")));
         assert!(!is_mesh_input(Path::new("blade.cloud.ply")));
         assert!(!is_mesh_input(Path::new("blade.xyz")));
+    }
+
+    #[test]
+    fn edges_files_sit_beside_their_outputs() {
+        let beside = |out: &str, ext: &str| edges_beside(Path::new(out), ext);
+        assert_eq!(
+            beside("out/a/part.stl", "dxf"),
+            Path::new("out/a/part.edges.dxf")
+        );
+        assert_eq!(
+            beside("out/part.v2.ply", "step"),
+            Path::new("out/part.v2.edges.step")
+        );
+        assert_eq!(beside("out/part", "json"), Path::new("out/part.edges.json"));
     }
 
     /// An OBJ beside a mesh of its stem is that mesh's cloud only if the
