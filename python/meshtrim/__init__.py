@@ -846,13 +846,15 @@ def _faces_or_none(faces: Any, vertices: int) -> np.ndarray:
 
 
 class BatchJob(NamedTuple):
-    """One mesh of a batch: the mesh, its output, and the clouds paired
+    """One mesh of a batch: the mesh, its output, the clouds paired
     with it (none: it is cleaned; one: trimmed with it; several: the
-    batch fails it, as the choice would be a guess)."""
+    batch fails it, as the choice would be a guess), and where its edges
+    go (``S.edges.EXT`` beside the output ``S.ext``, when asked for)."""
 
     input: Path
     output: Path
     clouds: tuple
+    edges: Optional[Path] = None
 
 
 def batch_plan(
@@ -861,15 +863,18 @@ def batch_plan(
     *,
     cloud_dir: Optional[PathLike] = None,
     to: Optional[str] = None,
+    edges_to: Optional[str] = None,
 ) -> list:
     """The work ``meshtrim batch INPUTS --out-dir OUT_DIR [--cloud-dir
-    CLOUD_DIR] [--to EXT]`` would do, decided as it decides it before processing
+    CLOUD_DIR] [--to EXT] [--edges-to EXT]`` would do, decided as it decides it before processing
     anything: ``inputs`` (files, directories walked recursively, glob
     patterns) expanded, sorted and de-duplicated, each mesh paired with
     its clouds by name (``S.cloud.EXT``, or ``S.EXT`` with a cloud-only
     extension such as ``.e57``, ``.laz`` or ``.xyz``), outputs mirrored
     below ``out_dir`` (with the extension ``to``, a mesh format's, when
-    given) and checked (two meshes with one output, or an
+    given), each output's edges file named when ``edges_to`` (an edges
+    format's extension) is given, and all checked (two meshes with one
+    output or edges file, or an
     output that is an input, raise :class:`MeshtrimError`). A list of
     :class:`BatchJob`, sorted by input path; nothing is read but
     directory listings and PLY/OBJ headers, nothing written."""
@@ -878,6 +883,6 @@ def batch_plan(
     args = [os.fspath(p) for p in inputs]
     cloud = None if cloud_dir is None else os.fspath(cloud_dir)
     return [
-        BatchJob(Path(i), Path(o), tuple(Path(c) for c in clouds))
-        for i, o, clouds in _meshtrim.batch_plan(args, os.fspath(out_dir), cloud, to)
+        BatchJob(Path(i), Path(o), tuple(Path(c) for c in clouds), None if e is None else Path(e))
+        for i, o, clouds, e in _meshtrim.batch_plan(args, os.fspath(out_dir), cloud, to, edges_to)
     ]

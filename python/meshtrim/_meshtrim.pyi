@@ -140,5 +140,9 @@ def write_edges(
     dxf_splines: bool,
 ) -> None: ...
 def batch_plan(
-    inputs: list[str], out_dir: str, cloud_dir: Optional[str] = None, to: Optional[str] = None
-) -> list[Tuple[PathLike[str], PathLike[str], list[PathLike[str]]]]: ...
+    inputs: list[str],
+    out_dir: str,
+    cloud_dir: Optional[str] = None,
+    to: Optional[str] = None,
+    edges_to: Optional[str] = None,
+) -> list[Tuple[PathLike[str], PathLike[str], list[PathLike[str]], Optional[PathLike[str]]]]: ...

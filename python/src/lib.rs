@@ -995,14 +995,15 @@ fn face_index_array(py: Python<'_>, faces: Vec<Option<u32>>) -> Bound<'_, PyArra
 /// (sorted by path), its output and the clouds paired with it (none:
 /// cleaned; one: trimmed with it; several: the batch fails that mesh).
 #[pyfunction]
-#[pyo3(signature = (inputs, out_dir, cloud_dir=None, to=None))]
+#[pyo3(signature = (inputs, out_dir, cloud_dir=None, to=None, edges_to=None))]
 fn batch_plan(
     py: Python<'_>,
     inputs: Vec<PathBuf>,
     out_dir: PathBuf,
     cloud_dir: Option<PathBuf>,
     to: Option<String>,
-) -> PyResult<Vec<(PathBuf, PathBuf, Vec<PathBuf>)>> {
+    edges_to: Option<String>,
+) -> PyResult<Vec<PlannedJob>> {
     let jobs = without_gil(py, || {
         commands::batch::plan(&commands::batch::Inputs {
             args: &inputs,
@@ -1010,7 +1011,7 @@ fn batch_plan(
             cloud_dir: cloud_dir.as_deref(),
             report: None,
             to: to.as_deref(),
-            edges_to: None,
+            edges_to: edges_to.as_deref(),
         })
     })?;
     Ok(jobs
@@ -1021,10 +1022,13 @@ fn batch_plan(
                 commands::batch::CloudMatch::One(cloud) => vec![cloud],
                 commands::batch::CloudMatch::Several(clouds) => clouds,
             };
-            (job.input, job.output, clouds)
+            (job.input, job.output, clouds, job.edges)
         })
         .collect())
 }
+
+/// One job of [`batch_plan`]: input, output, clouds, edges file.
+type PlannedJob = (PathBuf, PathBuf, Vec<PathBuf>, Option<PathBuf>);
 
 /// A loop as Python passes it back: boundary point indices, corner
 /// positions, edges (closed, points).

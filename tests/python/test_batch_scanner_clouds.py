@@ -84,6 +84,11 @@ def test_batch_plan_pairs_the_scanners_files(scans):
     assert [j.output for j in meshtrim.batch_plan(d, out, to="glb")] == [
         out / "a.glb", out / "b.glb", out / "d.glb", out / "e.glb", out / "m.glb", out / "sub" / "c.glb"
     ]
+    # Each output's edges file beside it (--edges-to).
+    assert [j.edges for j in meshtrim.batch_plan(d, out, edges_to="step")] == [
+        out / "a.edges.step", out / "b.edges.step", out / "d.edges.step", out / "e.edges.step", out / "m.edges.step", out / "sub" / "c.edges.step"
+    ]
+    assert all(j.edges is None for j in plan)
     # A glob pattern and a file argument, as the CLI takes them.
     assert [j.input for j in meshtrim.batch_plan([str(d / "*.ply"), d / "d.stl"], out)] == [
         d / "a.ply",
@@ -105,6 +110,8 @@ def test_batch_plan_refuses_what_the_batch_refuses(scans):
         meshtrim.batch_plan(d, d)
     with pytest.raises(meshtrim.MeshtrimError, match="cannot write meshes as '.xyz'"):
         meshtrim.batch_plan(d, scans / "out", to="xyz")
+    with pytest.raises(meshtrim.MeshtrimError, match="cannot write edges as '.stl'"):
+        meshtrim.batch_plan(d, scans / "out", edges_to="stl")
 
 
 def test_batch_trims_with_the_scanners_files(scans, tmp_path):

@@ -432,7 +432,7 @@ def test_dask_example_matches_meshtrim_batch(tmp_path):
     """The example runs `meshtrim batch`'s own list of work: a cloud beside
     its mesh or under a cloud-only extension (`sub/part.xyz`) trims it,
     sub-directories are mirrored, two clouds for one mesh fail it, and each
-    output is the batch's bytes."""
+    output, and with `--edges-to` each edges file, is the batch's bytes."""
     scans = tmp_path / "scans"
     (scans / "sub").mkdir(parents=True)
     shutil.copy(JAGGED, scans / "jagged.stl")
@@ -448,7 +448,10 @@ def test_dask_example_matches_meshtrim_batch(tmp_path):
     # As a user runs it: a LocalCluster of worker processes.
     example = ROOT / "examples" / "python" / "dask_clean.py"
     r = subprocess.run(
-        [sys.executable, str(example), str(scans), str(dask_out)], capture_output=True, text=True, timeout=300
+        [sys.executable, str(example), str(scans), str(dask_out), "--edges-to", "dxf"],
+        capture_output=True,
+        text=True,
+        timeout=300,
     )
     assert r.returncode == 1, r.stderr  # the empty file and two.ply fail, the others not
     lines = [line.split(maxsplit=3) for line in r.stdout.splitlines()]
@@ -461,10 +464,13 @@ def test_dask_example_matches_meshtrim_batch(tmp_path):
     ], r.stdout
     assert "several clouds match this mesh" in lines[-1][3], r.stdout
     batch = subprocess.run(
-        [str(MESHTRIM), "batch", str(scans), "--out-dir", str(batch_out)], capture_output=True, text=True, timeout=300
+        [str(MESHTRIM), "batch", str(scans), "--out-dir", str(batch_out), "--edges-to", "dxf"],
+        capture_output=True,
+        text=True,
+        timeout=300,
     )
     assert batch.returncode == 1, batch.stderr
-    for name in ("blade.ply", "jagged.stl", "sub/part.ply"):
+    for name in ("blade.ply", "jagged.stl", "sub/part.ply", "blade.edges.dxf", "jagged.edges.dxf", "sub/part.edges.dxf"):
         assert (dask_out / name).read_bytes() == (batch_out / name).read_bytes(), name
 
 

@@ -106,6 +106,12 @@ pub fn plan(inputs: &Inputs) -> Result<Vec<Job>> {
             bail!("cannot write meshes as '.{extension}': the extension must be one of obj, ply, stl, glb, gltf");
         }
     }
+    if let Some(extension) = inputs.edges_to {
+        let named = Path::new("edges").with_extension(extension);
+        if crate::io::edges_out::EdgesFormat::from_path(&named).is_none() {
+            bail!("cannot write edges as '.{extension}': the extension must be one of json, obj, svg, dxf, step, igs");
+        }
+    }
     if let Some(dir) = inputs.cloud_dir {
         if !dir.is_dir() {
             bail!("{}: --cloud-dir is not a directory", dir.display());
