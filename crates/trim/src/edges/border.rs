@@ -19,6 +19,9 @@ use crate::resolution::PointResolution;
 /// test at `beta` (one value per vertex of the mesh; only the border's
 /// are read), its edges through the vertices from corner to corner (one
 /// closed edge without corners). A mesh without a border has no loops.
+///
+/// The faces must index the vertices (as [`Mesh::validate`] checks), and
+/// `beta` must hold a value for every border vertex.
 pub fn mesh_border_edges(mesh: &Mesh, beta: &(impl PointResolution + ?Sized)) -> Edges {
     let loops = mesh
         .boundary_loops()
