@@ -312,6 +312,28 @@ fn skip_existing_resumes_without_rewriting() {
         ["scans/a.ply", "out/a.ply", "trim", "skipped"]
     );
     assert_eq!(rows[2][..4], ["scans/b.ply", "out/b.ply", "trim", "ok"]);
+    // With edges files: a job whose mesh was written but not its edges
+    // (interrupted between the two) is done again.
+    assert_ok(&batch(
+        d,
+        &["scans", "--out-dir", "edged", "--edges-to", "json"],
+    ));
+    std::fs::remove_file(d.join("edged/b.edges.json")).unwrap();
+    let args = [
+        "scans",
+        "--out-dir",
+        "edged",
+        "--edges-to",
+        "json",
+        "--skip-existing",
+    ];
+    let stdout = text(&batch(d, &args).stdout);
+    assert!(
+        stdout.contains("skipped trim   scans/a.ply (output exists)"),
+        "{stdout}"
+    );
+    assert!(stdout.contains("ok      trim   scans/b.ply"), "{stdout}");
+    assert!(d.join("edged/b.edges.json").exists());
 }
 
 #[test]

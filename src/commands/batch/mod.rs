@@ -16,7 +16,7 @@ pub use plan::{plan, CloudMatch, Inputs, Job, Shard};
 pub use report::{Mode, Outcome, ReportFormat, Row, Status};
 
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{anyhow, bail, Context, Result};
@@ -66,7 +66,8 @@ pub struct Args {
     /// Write a line per file to FILE.csv or FILE.json.
     #[arg(long, value_name = "FILE.csv|FILE.json")]
     pub report: Option<PathBuf>,
-    /// Skip inputs whose output exists (resumes an interrupted batch).
+    /// Skip inputs whose output exists, and with --edges-to whose edges
+    /// file exists too (resumes an interrupted batch).
     #[arg(long)]
     pub skip_existing: bool,
     /// Process only the K-th of N deterministic shards of the sorted input
@@ -247,7 +248,8 @@ fn process(job: &Job, settings: &FileSettings) -> Row {
         },
         note: None,
     };
-    if settings.skip_existing && job.output.exists() {
+    let done = job.output.exists() && job.edges.as_deref().is_none_or(Path::exists);
+    if settings.skip_existing && done {
         return row;
     }
     let result = catch_unwind(AssertUnwindSafe(|| work(job, settings)))
