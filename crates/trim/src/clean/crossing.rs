@@ -33,10 +33,11 @@ pub(super) fn kept_faces_crossed(
     let mut candidates = Vec::new();
     for (f, face) in mesh.faces.iter().enumerate() {
         let f = f as u32;
-        if removed.binary_search(&f).is_ok() {
+        let kept = face.map(|v| mesh.vertices[v as usize]);
+        // Most of the mesh lies away from the strip: its box decides.
+        if grid.beyond(&kept) || removed.binary_search(&f).is_ok() {
             continue;
         }
-        let kept = face.map(|v| mesh.vertices[v as usize]);
         grid.candidates(&kept, strip.len(), &mut candidates);
         let crosses = candidates.iter().any(|&s| {
             !share_an_edge(&strip[s as usize], face) && triangles_cross(&kept, &corners[s as usize])
@@ -129,6 +130,9 @@ struct Grid {
     cell: f64,
     cells: HashMap<[i64; 3], Vec<u32>>,
     everywhere: Vec<u32>,
+    /// The bounding box of every triangle filed, corner by corner.
+    lo: Point3,
+    hi: Point3,
 }
 
 impl Grid {
@@ -140,8 +144,23 @@ impl Grid {
             cell,
             cells: HashMap::default(),
             everywhere: Vec::new(),
+            lo: [f64::INFINITY; 3],
+            hi: [f64::NEG_INFINITY; 3],
         };
         for (t, corners) in triangles.iter().enumerate() {
+            for p in corners {
+                for k in 0..3 {
+                    // A NaN corner opens the box along its axis, so that
+                    // nothing is passed over that was compared before.
+                    let (lo, hi) = if p[k].is_nan() {
+                        (f64::NEG_INFINITY, f64::INFINITY)
+                    } else {
+                        (p[k], p[k])
+                    };
+                    grid.lo[k] = grid.lo[k].min(lo);
+                    grid.hi[k] = grid.hi[k].max(hi);
+                }
+            }
             match grid.cells_met(corners) {
                 Some(cells) => {
                     for key in cells {
@@ -172,6 +191,14 @@ impl Grid {
         Some((lo[0]..=hi[0]).flat_map(move |x| {
             (lo[1]..=hi[1]).flat_map(move |y| (lo[2]..=hi[2]).map(move |z| [x, y, z]))
         }))
+    }
+
+    /// Whether `corners`' bounding box lies clear of every triangle filed,
+    /// so that it can meet none. False where a coordinate is NaN.
+    fn beyond(&self, corners: &Corners) -> bool {
+        (0..3).any(|k| {
+            corners.iter().all(|p| p[k] < self.lo[k]) || corners.iter().all(|p| p[k] > self.hi[k])
+        })
     }
 
     /// The triangles that may meet `corners`' bounding box (every one for
