@@ -149,13 +149,13 @@ impl Grid {
         };
         for (t, corners) in triangles.iter().enumerate() {
             for p in corners {
-                for k in 0..3 {
+                for (k, &x) in p.iter().enumerate() {
                     // A NaN corner opens the box along its axis, so that
                     // nothing is passed over that was compared before.
-                    let (lo, hi) = if p[k].is_nan() {
+                    let (lo, hi) = if x.is_nan() {
                         (f64::NEG_INFINITY, f64::INFINITY)
                     } else {
-                        (p[k], p[k])
+                        (x, x)
                     };
                     grid.lo[k] = grid.lo[k].min(lo);
                     grid.hi[k] = grid.hi[k].max(hi);
