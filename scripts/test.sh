@@ -46,6 +46,9 @@ fi
 cargo test --workspace --exclude meshtrim-python --release --doc
 bash scripts/python_env.sh
 cargo build --release --bin meshtrim
+# The C API's library (crates/capi), which tests/python/test_c_api.py
+# compiles a C program against.
+cargo build --release -p meshtrim-capi
 # The Python package (python/), built by maturin in release into the shared
 # target/ (so the CLI's compiled dependencies are reused) and installed into
 # the venv, replacing any earlier build.

@@ -25,6 +25,19 @@ REAL_MESHES = {
     "chin": "stanford_bunny/chin.ply",
 }
 
+# What differs between a CLI report and one from the Python package or the
+# C API: file names and the times (none of which is a result).
+NOT_RESULTS = {"mesh", "cloud", "output", "input", "file"}
+# What the CLI did with the input's vertex attributes while writing; from
+# Python, write_mesh_carrying says it.
+NOT_RESULTS |= {"vertex_attributes", "vertex_attributes_not_written"}
+
+
+def results(report: dict) -> dict:
+    """A report's results: without NOT_RESULTS and the times."""
+    return {k: v for k, v in report.items() if k not in NOT_RESULTS and not k.endswith("_ms")}
+
+
 
 def shared_data(rel: str) -> Path:
     """A real scan by its path under the shared data directory: the PCL

@@ -19,25 +19,13 @@ import numpy as np
 import pytest
 
 import meshtrim
-from meshtrim_cli import MESHTRIM, ROOT, run_meshtrim, shared_data
+from meshtrim_cli import MESHTRIM, NOT_RESULTS, ROOT, results, run_meshtrim, shared_data
 
 FIXTURES = ROOT / "fixtures" / "meshes"
 CLOUD = FIXTURES / "blade_small.ply"
 POISSON = FIXTURES / "blade_small_poisson.ply"
 HOLES = FIXTURES / "blade_holes.ply"
 JAGGED = FIXTURES / "blade_jagged.stl"
-
-# What differs between a CLI report and the package's: file names and the
-# times (none of which is a result).
-NOT_RESULTS = {"mesh", "cloud", "output", "input", "file"}
-# What the CLI did with the input's vertex attributes while writing; from
-# Python, write_mesh_carrying says it.
-NOT_RESULTS |= {"vertex_attributes", "vertex_attributes_not_written"}
-
-
-def results(report: dict) -> dict:
-    return {k: v for k, v in report.items() if k not in NOT_RESULTS and not k.endswith("_ms")}
-
 
 def cli_json(*args) -> dict:
     return json.loads(run_meshtrim(*args, "--json").stdout)
