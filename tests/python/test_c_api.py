@@ -7,6 +7,7 @@ meshtrim-capi``); MESHTRIM_CAPI names another build."""
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import shutil
@@ -95,6 +96,53 @@ def test_clean_gives_the_cli_mesh(arrays_program, tmp_path):
         assert report["loops_smoothed"] > 0 and report.get("max_deviation") == bound
         if bound is not None:
             assert report["vertices_held"] > 0 and report["input_to_output"]["max"] <= bound * (1 + 1e-9)
+
+
+def test_results_do_not_depend_on_threads(arrays_program, tmp_path):
+    """One worker thread or all of them, and four callers at once on
+    their own threads (ctypes releases the GIL): the same arrays."""
+    vertices, faces = meshtrim.read_mesh(JAGGED)
+    v_file, f_file = tofile(tmp_path / "v", vertices, "<f8"), tofile(tmp_path / "f", faces, "<u4")
+    run_c(arrays_program, "clean", v_file, f_file, tmp_path / "all")
+    env = {**os.environ, "RAYON_NUM_THREADS": "1"}
+    subprocess.run([str(arrays_program), "clean", v_file, f_file, tmp_path / "one"], env=env, check=True, capture_output=True)
+    for suffix in [".vertices", ".faces"]:
+        assert Path(f"{tmp_path / 'all'}{suffix}").read_bytes() == Path(f"{tmp_path / 'one'}{suffix}").read_bytes()
+    script = tmp_path / "callers.py"
+    script.write_text(CALLERS)
+    r = subprocess.run([sys.executable, str(script), str(LIBRARY), str(v_file), str(f_file)], capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, (r.stdout, r.stderr[-4000:])
+    expected = hashlib.sha256(Path(f"{tmp_path / 'all'}.vertices").read_bytes()).hexdigest()
+    assert r.stdout.split() == [expected] * 4, r.stdout
+
+
+CALLERS = """
+import ctypes, hashlib, sys, threading
+import numpy as np
+
+lib = ctypes.CDLL(sys.argv[1])
+P, S = ctypes.c_void_p, ctypes.c_size_t
+class Mesh(ctypes.Structure):
+    _fields_ = [("vertices", P), ("vertex_count", S), ("faces", P), ("face_count", S), ("report_json", P)]
+lib.meshtrim_clean.argtypes = [P, S, P, S, P, P, P]
+lib.meshtrim_mesh_free.argtypes = [P]
+v = np.fromfile(sys.argv[2], dtype="<f8")
+f = np.fromfile(sys.argv[3], dtype="<u4")
+digests = [None] * 4
+
+def clean(i):
+    out = Mesh()
+    assert lib.meshtrim_clean(v.ctypes.data, len(v) // 3, f.ctypes.data, len(f) // 3, None, ctypes.byref(out), None) == 0
+    digests[i] = hashlib.sha256(ctypes.string_at(out.vertices, out.vertex_count * 24)).hexdigest()
+    lib.meshtrim_mesh_free(ctypes.byref(out))
+
+threads = [threading.Thread(target=clean, args=(i,)) for i in range(4)]
+for t in threads:
+    t.start()
+for t in threads:
+    t.join()
+print(*digests)
+"""
 
 
 def test_trim_and_mesh_give_the_cli_meshes(arrays_program, tmp_path):
