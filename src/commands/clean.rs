@@ -372,7 +372,7 @@ pub fn border_curves(out: &trim::Mesh, stages: &Stages, name: &str) -> Result<tr
 
 /// Writes the border `edges` of the cleaned mesh `out` to `path`, as
 /// `meshtrim edges -o` writes edges (the SVG marks the border vertices).
-fn write_border(
+pub fn write_border(
     path: &Path,
     out: &trim::Mesh,
     edges: &trim::Edges,

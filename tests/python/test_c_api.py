@@ -98,6 +98,20 @@ def test_clean_gives_the_cli_mesh(arrays_program, tmp_path):
             assert report["vertices_held"] > 0 and report["input_to_output"]["max"] <= bound * (1 + 1e-9)
 
 
+@pytest.mark.parametrize("name, units", [("border.step", "in"), ("border.dxf", None), ("border.json", None)])
+def test_border_edges_are_clean_edges_bytes(arrays_program, tmp_path, name, units):
+    """The C-cleaned mesh's border, written by meshtrim_border_edges: the
+    bytes ``meshtrim clean IN OUT --edges FILE`` writes."""
+    vertices, faces = meshtrim.read_mesh(JAGGED)
+    v_file, f_file = tofile(tmp_path / "v", vertices, "<f8"), tofile(tmp_path / "f", faces, "<u4")
+    run_c(arrays_program, "clean", v_file, f_file, tmp_path / "c")
+    units_args = [units] if units else []
+    run_c(arrays_program, "border", f"{tmp_path / 'c'}.vertices", f"{tmp_path / 'c'}.faces", tmp_path / name, *units_args)
+    cli_file = tmp_path / f"cli_{name}"
+    run_meshtrim("clean", JAGGED, tmp_path / "cli.ply", "--edges", cli_file, *(["--units", units] if units else []))
+    assert (tmp_path / name).read_bytes() == cli_file.read_bytes()
+
+
 def test_results_do_not_depend_on_threads(arrays_program, tmp_path):
     """One worker thread or all of them, and four callers at once on
     their own threads (ctypes releases the GIL): the same arrays."""
@@ -245,10 +259,12 @@ class Options(ctypes.Structure):
 lib.meshtrim_default_options.restype = Options
 lib.meshtrim_clean.argtypes = [P, S, P, S, P, P, P]
 lib.meshtrim_detect.argtypes = [P, S, P, P, P, P, P]
+lib.meshtrim_border_edges.argtypes = [P, S, P, S, P, ctypes.c_char_p, ctypes.c_char_p, I, P]
 lib.meshtrim_string_free.argtypes = [P]
 lib.meshtrim_mesh_free.argtypes = [P]
 rng = np.random.default_rng(int(sys.argv[2]))
-statuses = {("clean", 0): 0, ("clean", 1): 0, ("detect", 0): 0, ("detect", 1): 0}
+statuses = {(call, s): 0 for call in ["clean", "detect", "border"] for s in (0, 1)}
+border_file = (sys.argv[4] + "/border.json").encode()
 for case in range(int(sys.argv[3])):
     if rng.random() < 0.5:  # a random blob and random faces
         n = int(rng.integers(0, 60))
@@ -290,8 +306,13 @@ for case in range(int(sys.argv[3])):
     s2 = lib.meshtrim_detect(v.ctypes.data, n, ctypes.byref(o), boundary.ctypes.data, None, None, ctypes.byref(err))
     assert s2 in (0, 1), (case, s2, ctypes.string_at(err.value))
     lib.meshtrim_string_free(err)
+    err = ctypes.c_void_p()
+    s3 = lib.meshtrim_border_edges(v.ctypes.data, n, f.ctypes.data, m, ctypes.byref(o), border_file, None, 0, ctypes.byref(err))
+    assert s3 in (0, 1), (case, s3, ctypes.string_at(err.value))
+    lib.meshtrim_string_free(err)
     statuses["clean", s] += 1
     statuses["detect", s2] += 1
+    statuses["border", s3] += 1
 print(*statuses.values())
 """
 
@@ -303,7 +324,8 @@ def test_random_input_never_crashes_the_caller(tmp_path):
     link_flags()
     script = tmp_path / "fuzz.py"
     script.write_text(FUZZ)
-    r = subprocess.run([sys.executable, str(script), str(LIBRARY), "7", "300"], capture_output=True, text=True, timeout=600)
+    r = subprocess.run([sys.executable, str(script), str(LIBRARY), "7", "300", str(tmp_path)], capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, (r.returncode, r.stdout[-2000:], r.stderr[-4000:])
-    # Cleaned, refused; detected, refused: each way taken.
+    # Cleaned, refused; detected, refused; border written, refused: each
+    # way taken.
     assert all(int(count) > 0 for count in r.stdout.split()), r.stdout

@@ -6,6 +6,7 @@
  *   arrays mesh   POINTS OUT
  *   arrays detect POINTS OUT
  *   arrays edges  POINTS EDGES_FILE [UNITS]
+ *   arrays border VERTICES FACES EDGES_FILE [UNITS]
  *
  * VERTICES and POINTS are files of little-endian doubles (x, y, z per
  * row), FACES of little-endian uint32 (three per face), as numpy's
@@ -89,7 +90,7 @@ static int write_mesh(const char *out, MeshtrimMesh *mesh) {
 
 int main(int argc, char **argv) {
     if (argc < 4) {
-        fprintf(stderr, "usage: arrays clean|trim|mesh|detect|edges FILES... (see the source)\n");
+        fprintf(stderr, "usage: arrays clean|border|trim|mesh|detect|edges FILES... (see the source)\n");
         return 64;
     }
     const char *command = argv[1];
@@ -108,6 +109,16 @@ int main(int argc, char **argv) {
         free(vertices);
         free(faces);
         return status == MESHTRIM_OK ? write_mesh(argv[4], &mesh) : failed(status, error);
+    }
+    if (strcmp(command, "border") == 0 && argc >= 5) {
+        double *vertices = read_rows(argv[2], sizeof(double), &n);
+        uint32_t *faces = read_rows(argv[3], sizeof(uint32_t), &m);
+        if (!vertices || !faces) return 66;
+        const char *units = argc > 5 ? argv[5] : NULL;
+        status = meshtrim_border_edges(vertices, n, faces, m, &options, argv[4], units, 0, &error);
+        free(vertices);
+        free(faces);
+        return status == MESHTRIM_OK ? 0 : failed(status, error);
     }
     if (strcmp(command, "trim") == 0 && argc >= 6) {
         double *vertices = read_rows(argv[2], sizeof(double), &n);

@@ -133,6 +133,17 @@ int meshtrim_clean(const double *vertices, size_t vertex_count,
                    const MeshtrimOptions *options,
                    MeshtrimMesh *out, char **error);
 
+/* `meshtrim clean IN OUT --edges path`'s curves: the mesh's border (a
+ * cleaned mesh's, say), each loop split at its corners into edges through
+ * its own vertices, nothing smoothed or moved, written to `path` as
+ * meshtrim_edges writes (same formats, `units` and `dxf_splines`). Of
+ * `options`, k and anisotropy apply (the corners' local resolution). */
+int meshtrim_border_edges(const double *vertices, size_t vertex_count,
+                          const uint32_t *faces, size_t face_count,
+                          const MeshtrimOptions *options,
+                          const char *path, const char *units, int dxf_splines,
+                          char **error);
+
 /* Frees a mesh's arrays and report and empties it; NULL is allowed. */
 void meshtrim_mesh_free(MeshtrimMesh *mesh);
 

@@ -221,6 +221,40 @@ pub unsafe extern "C" fn meshtrim_edges(
     })
 }
 
+/// `meshtrim_border_edges`.
+///
+/// # Safety
+/// As the header states: each array holds its count of rows, `path` is a
+/// NUL-terminated string, `units` is NULL or one; `options` and `error`
+/// are NULL or valid.
+#[no_mangle]
+#[allow(clippy::too_many_arguments)] // the header's signature
+pub unsafe extern "C" fn meshtrim_border_edges(
+    vertices: *const f64,
+    vertex_count: usize,
+    faces: *const u32,
+    face_count: usize,
+    options: *const MeshtrimOptions,
+    path: *const c_char,
+    units: *const c_char,
+    dxf_splines: c_int,
+    error: *mut *mut c_char,
+) -> c_int {
+    // SAFETY (whole body): the caller's pointers, as documented above.
+    run(error, || unsafe {
+        let options = MeshtrimOptions::read(options);
+        let path = text(path, "path")?.ok_or_else(|| anyhow!("path: NULL"))?;
+        let path = Path::new(path);
+        let file_options = edge_file_options(path, text(units, "units")?, dxf_splines != 0)?;
+        let stages = options.stages()?;
+        let mesh = read_mesh(vertices, vertex_count, faces, face_count)?;
+        mesh.validate()
+            .map_err(|e| anyhow!("vertices and faces: {e}"))?;
+        let border = commands::clean::border_curves(&mesh, &stages, "vertices")?;
+        commands::clean::write_border(path, &mesh, &border, file_options)
+    })
+}
+
 /// How an edges file at `path` is written; its format and the options
 /// checked before any work.
 fn edge_file_options(

@@ -328,3 +328,48 @@ fn edges_files_are_checked_before_any_work() {
         .contains("INCH"));
     std::fs::remove_dir_all(&dir).expect("removed");
 }
+
+#[test]
+fn border_edges_are_the_commands_border() {
+    let scan = jagged_scan();
+    let stages = MeshtrimOptions::default().stages().expect("valid");
+    let (cleaned, _) = commands::clean::clean_in_memory(&scan, &stages, Default::default(), "mesh")
+        .expect("cleaned");
+    let dir = std::env::temp_dir().join(format!("meshtrim-capi-border-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("a temporary folder");
+    let write = |mesh: &Mesh, name: &str| {
+        let path = CString::new(dir.join(name).to_str().expect("UTF-8")).expect("no NUL");
+        let mut error = null_mut();
+        // SAFETY: the mesh's rows and a NUL-terminated path.
+        let status = unsafe {
+            meshtrim_border_edges(
+                mesh.vertices.as_flattened().as_ptr(),
+                mesh.vertices.len(),
+                mesh.faces.as_flattened().as_ptr(),
+                mesh.faces.len(),
+                null(),
+                path.as_ptr(),
+                null(),
+                0,
+                &mut error,
+            )
+        };
+        (status != MESHTRIM_OK).then(|| message(error))
+    };
+    assert_eq!(write(&cleaned, "ours.json"), None);
+    let border = commands::clean::border_curves(&cleaned, &stages, "vertices").expect("border");
+    let theirs = dir.join("theirs.json");
+    commands::clean::write_border(&theirs, &cleaned, &border, EdgeFileOptions::default())
+        .expect("written");
+    let ours = std::fs::read(dir.join("ours.json")).expect("written");
+    assert_eq!(ours, std::fs::read(&theirs).expect("written"));
+    assert!(!border.loops.is_empty());
+    let no_faces = Mesh {
+        vertices: cleaned.vertices.clone(),
+        faces: Vec::new(),
+    };
+    let e = write(&no_faces, "none.json").expect("refused");
+    assert!(e.starts_with("vertices and faces: "), "{e}");
+    assert!(!dir.join("none.json").exists());
+    std::fs::remove_dir_all(&dir).expect("removed");
+}
