@@ -79,14 +79,10 @@ fn without_gil<T: Send>(
     match py.detach(|| catch_unwind(AssertUnwindSafe(work))) {
         Ok(Ok(value)) => Ok(value),
         Ok(Err(error)) => Err(MeshtrimError::new_err(format!("{error:#}"))),
-        Err(panic) => {
-            let text = panic
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| panic.downcast_ref::<String>().cloned())
-                .unwrap_or_default();
-            Err(MeshtrimError::new_err(format!("internal error: {text}")))
-        }
+        Err(panic) => Err(MeshtrimError::new_err(format!(
+            "internal error: {}",
+            commands::panic_text(panic.as_ref())
+        ))),
     }
 }
 

@@ -420,11 +420,7 @@ fn run(error: *mut *mut c_char, work: impl FnOnce() -> Result<()>) -> c_int {
         Ok(Ok(())) => (MESHTRIM_OK, None),
         Ok(Err(e)) => (MESHTRIM_ERROR, Some(format!("{e:#}"))),
         Err(panic) => {
-            let text = panic
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| panic.downcast_ref::<String>().cloned())
-                .unwrap_or_default();
+            let text = commands::panic_text(panic.as_ref());
             (
                 MESHTRIM_INTERNAL_ERROR,
                 Some(format!("internal error: {text}")),

@@ -26,6 +26,7 @@ use rayon::prelude::*;
 use super::clean::{clean_file, Choices, WRAPS_BELOW};
 use super::trim::{trim_file, TrimSettings};
 use crate::commands::args::{EdgeFileArgs, StageArgs};
+use crate::commands::panic_text;
 use crate::console;
 use crate::io::edges_out::EdgeFileOptions;
 use crate::io::CloudOptions;
@@ -360,13 +361,4 @@ fn work(job: &Job, settings: &FileSettings) -> Result<Outcome> {
             )
         }
     }
-}
-
-/// A panic's message, when it has one.
-fn panic_text(panic: &(dyn std::any::Any + Send)) -> String {
-    panic
-        .downcast_ref::<&str>()
-        .map(|s| s.to_string())
-        .or_else(|| panic.downcast_ref::<String>().cloned())
-        .unwrap_or_else(|| "a panic without a message".to_string())
 }
