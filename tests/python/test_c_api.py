@@ -245,6 +245,32 @@ def test_the_header_compiles_as_cpp(tmp_path):
     assert printed.startswith("0.1.0 1 "), printed
 
 
+def test_installed_library_builds_through_pkg_config(tmp_path):
+    """scripts/install_capi.sh under a prefix: the header, the library
+    without its debug information, and a pkg-config file whose flags
+    build a program that runs against the installed copy."""
+    prefix = tmp_path / "prefix"
+    subprocess.run(["bash", str(ROOT / "scripts" / "install_capi.sh"), str(prefix)], check=True, capture_output=True, text=True)
+    installed = prefix / "lib" / "libmeshtrim.so"
+    assert (prefix / "include" / "meshtrim.h").read_bytes() == (CAPI / "include" / "meshtrim.h").read_bytes()
+    assert installed.stat().st_size < LIBRARY.stat().st_size
+    env = {**os.environ, "PKG_CONFIG_PATH": str(prefix / "lib" / "pkgconfig")}
+
+    def pkg_config(*args):
+        return subprocess.run(["pkg-config", *args, "meshtrim"], env=env, check=True, capture_output=True, text=True).stdout.split()
+
+    source = tmp_path / "version.c"
+    source.write_text('#include <stdio.h>\n#include "meshtrim.h"\nint main(void) { puts(meshtrim_version()); return 0; }\n')
+    libdir = pkg_config("--variable=libdir")[0]
+    program = tmp_path / "version"
+    cmd = [compiler("cc"), "-std=c99", *STRICT, str(source), *pkg_config("--cflags", "--libs"), f"-Wl,-rpath,{libdir}", "-o", str(program)]
+    subprocess.run(cmd, check=True, capture_output=True, text=True)
+    version = run_c(program).stdout.strip()
+    assert [version] == pkg_config("--modversion") and version == "0.1.0"
+    linked = subprocess.run(["ldd", str(program)], check=True, capture_output=True, text=True).stdout
+    assert str(installed) in linked, linked
+
+
 FUZZ = """
 import ctypes, sys
 import numpy as np
