@@ -225,7 +225,16 @@ def test_the_header_compiles_as_cpp(tmp_path):
     source = tmp_path / "use.cpp"
     source.write_text(textwrap.dedent("""\
         #include "meshtrim.h"
+        #include <cstddef>
         #include <cstdio>
+        // The layouts crates/capi/src/tests.rs::layouts_are_the_headers asserts.
+        static_assert(offsetof(MeshtrimOptions, k) == 0 && offsetof(MeshtrimOptions, anisotropy) == 4, "");
+        static_assert(offsetof(MeshtrimOptions, offset) == 8 && offsetof(MeshtrimOptions, view_kind) == 12, "");
+        static_assert(offsetof(MeshtrimOptions, view) == 16 && offsetof(MeshtrimOptions, repair) == 40, "");
+        static_assert(offsetof(MeshtrimOptions, max_deviation) == 48 && sizeof(MeshtrimOptions) == 56, "");
+        static_assert(offsetof(MeshtrimMesh, vertices) == 0 && offsetof(MeshtrimMesh, vertex_count) == 8, "");
+        static_assert(offsetof(MeshtrimMesh, faces) == 16 && offsetof(MeshtrimMesh, face_count) == 24, "");
+        static_assert(offsetof(MeshtrimMesh, report_json) == 32 && sizeof(MeshtrimMesh) == 40, "");
         int main() {
             MeshtrimOptions options = meshtrim_default_options();
             MeshtrimMesh mesh;

@@ -373,3 +373,30 @@ fn border_edges_are_the_commands_border() {
     assert!(!dir.join("none.json").exists());
     std::fs::remove_dir_all(&dir).expect("removed");
 }
+
+/// The structs' layouts as the header's C gives them
+/// (`test_c_api.py::test_the_header_compiles_as_cpp` asserts the C side's).
+#[test]
+fn layouts_are_the_headers() {
+    use std::mem::{offset_of, size_of};
+    let options = [
+        offset_of!(MeshtrimOptions, k),
+        offset_of!(MeshtrimOptions, anisotropy),
+        offset_of!(MeshtrimOptions, offset),
+        offset_of!(MeshtrimOptions, view_kind),
+        offset_of!(MeshtrimOptions, view),
+        offset_of!(MeshtrimOptions, repair),
+        offset_of!(MeshtrimOptions, max_deviation),
+        size_of::<MeshtrimOptions>(),
+    ];
+    assert_eq!(options, [0, 4, 8, 12, 16, 40, 48, 56]);
+    let mesh = [
+        offset_of!(OutMesh, vertices),
+        offset_of!(OutMesh, vertex_count),
+        offset_of!(OutMesh, faces),
+        offset_of!(OutMesh, face_count),
+        offset_of!(OutMesh, report_json),
+        size_of::<OutMesh>(),
+    ];
+    assert_eq!(mesh, [0, 8, 16, 24, 32, 40]);
+}
