@@ -193,7 +193,7 @@ def commands(path, is_mesh, work):
     out = lambda name: os.path.join(work, name)
     if is_mesh:
         return [["clean", path, out("clean.ply"), "--edges", out("border.step")],
-                ["clean", path, out("repaired.glb"), "--repair", "--max-deviation", "0.5"],
+                ["clean", path, out("repaired.glb"), "--repair", "--max-deviation", "0.5", "--fill-holes", "60"],
                 [path, CLOUD, out("trim.ply")],
                 ["detect", path, "-o", out("d.csv")], ["mesh", path, out("m.ply")]]
     # A LAS or LAZ input's labels go to LAS, which reads its records again.

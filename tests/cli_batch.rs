@@ -809,6 +809,28 @@ fn deviation_reports_how_far_each_output_lies_from_its_scan() {
     assert!(
         std::fs::read(d.join("held/j.stl")).unwrap() != std::fs::read(d.join("out/j.stl")).unwrap()
     );
+    // --fill-holes: the bytes `clean --fill-holes` writes.
+    let filled = ["scans/j.stl", "--out-dir", "filled", "--fill-holes", "100"];
+    assert_ok(&batch(d, &filled));
+    let single = d.join("filled.stl");
+    let args = [
+        "clean",
+        JAGGED,
+        single.to_str().unwrap(),
+        "--fill-holes",
+        "100",
+    ];
+    assert_ok(
+        &Command::new(env!("CARGO_BIN_EXE_meshtrim"))
+            .args(args)
+            .output()
+            .unwrap(),
+    );
+    assert!(std::fs::read(d.join("filled/j.stl")).unwrap() == std::fs::read(&single).unwrap());
+    assert!(
+        std::fs::read(d.join("filled/j.stl")).unwrap()
+            != std::fs::read(d.join("out/j.stl")).unwrap()
+    );
 }
 
 #[test]

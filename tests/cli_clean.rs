@@ -231,6 +231,66 @@ fn max_deviation_holds_the_new_border_to_the_old() {
 }
 
 #[test]
+fn fill_holes_closes_the_holes_no_wider_than_asked() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("filled.ply");
+    let report = |width: &str| {
+        let run = meshtrim(
+            &["clean", JAGGED, s(&out), "--fill-holes", width, "--json"],
+            None,
+        );
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        serde_json::from_slice::<serde_json::Value>(&run.stdout).unwrap()
+    };
+    // The fixture's three holes are 30-60, 60-100 and 100-200 mm wide.
+    for (width, holes, loops) in [("30", 0, 4), ("60", 1, 3), ("100", 2, 2), ("200", 3, 1)] {
+        let r = report(width);
+        assert_eq!(r["holes_filled"], holes, "{r}");
+        assert_eq!(r["holes_not_filled"], 0, "{r}");
+        assert_eq!(r["loops_in"], loops, "{r}");
+        let written = meshtrim::io::read_mesh(&out).unwrap();
+        let mesh = trim::Mesh {
+            vertices: written.vertices,
+            faces: written.faces.unwrap(),
+        };
+        mesh.check_manifold().unwrap();
+        // The outer border stays, however wide the size.
+        assert_eq!(mesh.boundary_loops().len(), loops, "{width}");
+    }
+    let run = meshtrim(&["clean", JAGGED, s(&out), "--fill-holes", "200"], None);
+    let text = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        text.contains(
+            "holes filled         3 up to 200.0 wide, with 67 faces (0 as narrow left open)"
+        ),
+        "{text}"
+    );
+    // Without the option the report has no such keys.
+    let run = meshtrim(&["clean", JAGGED, s(&out), "--json"], None);
+    let plain: serde_json::Value = serde_json::from_slice(&run.stdout).unwrap();
+    assert!(plain.get("holes_filled").is_none() && plain.get("fill_holes").is_none());
+    for bad in ["0", "-3", "inf"] {
+        let run = meshtrim(
+            &[
+                "clean",
+                JAGGED,
+                s(&dir.path().join("no.ply")),
+                "--fill-holes",
+                bad,
+            ],
+            None,
+        );
+        assert!(!run.status.success());
+        assert!(String::from_utf8_lossy(&run.stderr).contains("--fill-holes"));
+    }
+    assert!(!dir.path().join("no.ply").exists());
+}
+
+#[test]
 fn same_bytes_whatever_the_threads() {
     let dir = tempfile::tempdir().unwrap();
     // The fixture, and the fixture with a fin stood on one of its edges,

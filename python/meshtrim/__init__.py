@@ -356,6 +356,7 @@ def clean(
     view_from: Vector = None,
     repair: bool = False,
     max_deviation: Optional[float] = None,
+    fill_holes: Optional[float] = None,
 ) -> tuple:
     """Replaces a triangulated scan's jagged border by its smoothed edge
     (``meshtrim clean``): the mesh's own vertices are the cloud. Returns
@@ -371,14 +372,19 @@ def clean(
     :func:`write_mesh_carrying` splits it again where the input was split,
     as the CLI writes it. ``max_deviation`` (the CLI's
     ``--max-deviation``) keeps the new border within that distance of the
-    old one. The report's ``input_to_output`` and ``output_to_input``
+    old one. ``fill_holes`` (the CLI's ``--fill-holes``) first closes
+    the holes no wider than that (the largest distance between two of a
+    hole's vertices), with faces over their own vertices; the report's
+    ``holes_filled``, ``faces_filling`` and ``holes_not_filled`` say what
+    it did. The report's ``input_to_output`` and ``output_to_input``
     say how far the scan moved (see :func:`deviation`).
     """
     k, anisotropy, along, from_ = _options(k, anisotropy, view_along, view_from)
     v = _float_rows(vertices, "vertices")
     f = _face_rows(faces, len(v))
     bound = None if max_deviation is None else _distance(max_deviation, "max_deviation")
-    out_v, out_f, report = _meshtrim.clean(v, f, k, anisotropy, bool(offset), along, from_, bool(repair), bound)
+    width = None if fill_holes is None else _distance(fill_holes, "fill_holes")
+    out_v, out_f, report = _meshtrim.clean(v, f, k, anisotropy, bool(offset), along, from_, bool(repair), bound, width)
     return out_v, out_f, json.loads(report)
 
 

@@ -61,6 +61,7 @@ def clean(
     view_from: Vector,
     repair: bool,
     max_deviation: float | None,
+    fill_holes: float | None,
 ) -> Tuple[Points, Faces, str]: ...
 Fields = list[Tuple[str, str, npt.NDArray[np.float64]]]
 

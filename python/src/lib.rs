@@ -359,7 +359,7 @@ fn mesh_py<'py>(
 
 /// The cleaned mesh and the report as JSON.
 #[pyfunction]
-#[pyo3(name = "clean", signature = (vertices, faces, k, anisotropy, offset, view_along, view_from, repair, max_deviation))]
+#[pyo3(name = "clean", signature = (vertices, faces, k, anisotropy, offset, view_along, view_from, repair, max_deviation, fill_holes))]
 #[allow(clippy::too_many_arguments)] // the CLI's options, as keywords
 fn clean_py<'py>(
     py: Python<'py>,
@@ -372,15 +372,19 @@ fn clean_py<'py>(
     view_from: Option<[f64; 3]>,
     repair: bool,
     max_deviation: Option<f64>,
+    fill_holes: Option<f64>,
 ) -> PyResult<MeshResult<'py>> {
-    if let Some(d) = max_deviation.filter(|d| !(d.is_finite() && *d > 0.0)) {
-        return Err(MeshtrimError::new_err(format!(
-            "max_deviation: {d} is not a distance: give a number above zero, in the mesh's units"
-        )));
+    for (name, value) in [("max_deviation", max_deviation), ("fill_holes", fill_holes)] {
+        if let Some(d) = value.filter(|d| !(d.is_finite() && *d > 0.0)) {
+            return Err(MeshtrimError::new_err(format!(
+                "{name}: {d} is not a distance: give a number above zero, in the mesh's units"
+            )));
+        }
     }
     let choices = commands::clean::Choices {
         repair,
         max_deviation,
+        fill_holes,
     };
     let stages = Options {
         k,

@@ -43,6 +43,12 @@ pub struct Args {
     /// at this distance instead.
     #[arg(long, value_name = "D", value_parser = crate::commands::args::parse_distance, allow_hyphen_values = true)]
     pub max_deviation: Option<f64>,
+    /// Close the holes no wider than W (the largest distance between two
+    /// of a hole's border vertices, in the mesh's units) before smoothing
+    /// the borders, with faces over the hole's own vertices; a piece's
+    /// outer border is never closed.
+    #[arg(long, value_name = "W", value_parser = crate::commands::args::parse_distance, allow_hyphen_values = true)]
+    pub fill_holes: Option<f64>,
     /// Also write the cleaned mesh's border as curves: FILE.json, .obj,
     /// .svg, .dxf, .step or .igs, as `meshtrim edges` writes edges. Each
     /// border loop is split at its corners into edges through the border
@@ -173,6 +179,19 @@ pub struct Report {
     /// `--max-deviation`, when given.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub max_deviation: Option<f64>,
+    /// `--fill-holes`, when given.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fill_holes: Option<f64>,
+    /// With `--fill-holes`: holes closed, faces added to close them, and
+    /// holes narrow enough that stay open (touching themselves, or every
+    /// way of closing them would repeat an edge or make a face of no
+    /// area).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub holes_filled: Option<usize>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub faces_filling: Option<usize>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub holes_not_filled: Option<usize>,
     /// With `--max-deviation`: smoothed border vertices held back to that
     /// distance from the old border.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -261,6 +280,7 @@ pub fn run(args: &Args) -> Result<()> {
         choices: Choices {
             repair: args.repair,
             max_deviation: args.max_deviation,
+            fill_holes: args.fill_holes,
         },
         measured: true,
         edges: args
@@ -321,6 +341,8 @@ pub struct Choices {
     pub repair: bool,
     /// `--max-deviation`.
     pub max_deviation: Option<f64>,
+    /// `--fill-holes`.
+    pub fill_holes: Option<f64>,
 }
 
 /// How to clean one file.
@@ -427,6 +449,7 @@ fn unmeasured(
         offset: stages.edges.offset,
         repair,
         max_deviation: choices.max_deviation,
+        fill_holes: choices.fill_holes,
     };
     let (out, cleaned) = clean_mesh(mesh, &beta, &options)
         .map_err(|e| refused_unless_repaired(e, repair))
@@ -439,6 +462,12 @@ fn unmeasured(
     if choices.max_deviation.is_some() {
         report.max_deviation = choices.max_deviation;
         report.vertices_held = Some(cleaned.vertices_held);
+    }
+    if choices.fill_holes.is_some() {
+        report.fill_holes = choices.fill_holes;
+        report.holes_filled = Some(cleaned.holes_filled.holes);
+        report.faces_filling = Some(cleaned.holes_filled.faces);
+        report.holes_not_filled = Some(cleaned.holes_filled.left);
     }
     Ok((out, report))
 }
@@ -502,6 +531,10 @@ impl Report {
             output_to_input: None,
             max_deviation: None,
             vertices_held: None,
+            fill_holes: None,
+            holes_filled: None,
+            faces_filling: None,
+            holes_not_filled: None,
             deviation_ms: None,
             vertex_attributes: Vec::new(),
             vertex_attributes_not_written: Vec::new(),
@@ -626,6 +659,18 @@ impl crate::report::Table for Report {
                 significant(max, 4)
             );
             rows.insert(after_area, ("max deviation", held));
+        }
+        if let (Some(width), Some(holes), Some(faces), Some(open)) = (
+            self.fill_holes,
+            self.holes_filled,
+            self.faces_filling,
+            self.holes_not_filled,
+        ) {
+            let filled = format!(
+                "{holes} up to {} wide, with {faces} faces ({open} as narrow left open)",
+                significant(width, 4)
+            );
+            rows.insert(1, ("holes filled", filled));
         }
         let attributes = [&self.vertex_attributes, &self.vertex_attributes_not_written];
         crate::report::add_attributes_row(

@@ -231,7 +231,8 @@ def test_the_header_compiles_as_cpp(tmp_path):
         static_assert(offsetof(MeshtrimOptions, k) == 0 && offsetof(MeshtrimOptions, anisotropy) == 4, "");
         static_assert(offsetof(MeshtrimOptions, offset) == 8 && offsetof(MeshtrimOptions, view_kind) == 12, "");
         static_assert(offsetof(MeshtrimOptions, view) == 16 && offsetof(MeshtrimOptions, repair) == 40, "");
-        static_assert(offsetof(MeshtrimOptions, max_deviation) == 48 && sizeof(MeshtrimOptions) == 56, "");
+        static_assert(offsetof(MeshtrimOptions, max_deviation) == 48 && offsetof(MeshtrimOptions, fill_holes) == 56, "");
+        static_assert(sizeof(MeshtrimOptions) == 64, "");
         static_assert(offsetof(MeshtrimMesh, vertices) == 0 && offsetof(MeshtrimMesh, vertex_count) == 8, "");
         static_assert(offsetof(MeshtrimMesh, faces) == 16 && offsetof(MeshtrimMesh, face_count) == 24, "");
         static_assert(offsetof(MeshtrimMesh, report_json) == 32 && sizeof(MeshtrimMesh) == 40, "");
@@ -290,7 +291,8 @@ class Mesh(ctypes.Structure):
     _fields_ = [("vertices", P), ("vertex_count", S), ("faces", P), ("face_count", S), ("report_json", ctypes.c_char_p)]
 class Options(ctypes.Structure):
     _fields_ = [("k", ctypes.c_uint32), ("anisotropy", I), ("offset", I), ("view_kind", I),
-                ("view", ctypes.c_double * 3), ("repair", I), ("max_deviation", ctypes.c_double)]
+                ("view", ctypes.c_double * 3), ("repair", I), ("max_deviation", ctypes.c_double),
+                ("fill_holes", ctypes.c_double)]
 lib.meshtrim_default_options.restype = Options
 lib.meshtrim_clean.argtypes = [P, S, P, S, P, P, P]
 lib.meshtrim_detect.argtypes = [P, S, P, P, P, P, P]
@@ -327,6 +329,7 @@ for case in range(int(sys.argv[3])):
     o.view[:] = rng.normal(size=3) * rng.integers(0, 2)
     o.repair = int(rng.integers(0, 2))
     o.max_deviation = float(rng.choice([0.0, 0.5, -1.0, np.nan]))
+    o.fill_holes = float(rng.choice([0.0, 0.0, 3.0, 1e9, -2.0]))
     v = np.ascontiguousarray(v, dtype=np.float64)
     out, err = Mesh(), ctypes.c_void_p()
     s = lib.meshtrim_clean(v.ctypes.data, n, f.ctypes.data, m, ctypes.byref(o), ctypes.byref(out), ctypes.byref(err))

@@ -71,6 +71,9 @@ typedef struct MeshtrimOptions {
     /* clean only: the border moves at most this far (--max-deviation, in
      * the mesh's units); 0 for no bound (default). */
     double max_deviation;
+    /* clean only: first close the holes no wider than this (--fill-holes,
+     * in the mesh's units); 0 to close none (default). */
+    double fill_holes;
 } MeshtrimOptions;
 
 /* A mesh meshtrim made: free it with meshtrim_mesh_free. */
@@ -86,7 +89,7 @@ typedef struct MeshtrimMesh {
 const char *meshtrim_version(void);
 
 /* The CLI's defaults: k = 30, anisotropy and offset on, no view, no
- * repair, no bound on the deviation. */
+ * repair, no bound on the deviation, no hole closed. */
 MeshtrimOptions meshtrim_default_options(void);
 
 /* `meshtrim detect`: labels each of the point_count points boundary (1)

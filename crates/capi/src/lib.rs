@@ -53,6 +53,7 @@ pub struct MeshtrimOptions {
     pub view: [f64; 3],
     pub repair: c_int,
     pub max_deviation: f64,
+    pub fill_holes: f64,
 }
 
 impl Default for MeshtrimOptions {
@@ -66,6 +67,7 @@ impl Default for MeshtrimOptions {
             view: [0.0; 3],
             repair: 0,
             max_deviation: 0.0,
+            fill_holes: 0.0,
         }
     }
 }
@@ -104,21 +106,29 @@ impl MeshtrimOptions {
         })
     }
 
-    /// `clean`'s own choices: `max_deviation` 0 is no bound, any other
-    /// value must be a distance.
+    /// `clean`'s own choices: `max_deviation` 0 is no bound and
+    /// `fill_holes` 0 closes none; any other value must be a distance.
     fn clean_choices(&self) -> Result<commands::clean::Choices> {
-        let d = self.max_deviation;
-        if d != 0.0 && !(d.is_finite() && d > 0.0) {
-            bail!(
-                "max_deviation: {d} is not a distance: give a number above zero, \
-                 in the mesh's units, or 0 for no bound"
-            );
-        }
         Ok(commands::clean::Choices {
             repair: self.repair != 0,
-            max_deviation: (d != 0.0).then_some(d),
+            max_deviation: distance_or_none(self.max_deviation, "max_deviation", "no bound")?,
+            fill_holes: distance_or_none(self.fill_holes, "fill_holes", "no hole closed")?,
         })
     }
+}
+
+/// `value` as a distance, None for 0 (`zero` says what 0 means).
+fn distance_or_none(value: f64, name: &str, zero: &str) -> Result<Option<f64>> {
+    if value == 0.0 {
+        return Ok(None);
+    }
+    if !(value.is_finite() && value > 0.0) {
+        bail!(
+            "{name}: {value} is not a distance: give a number above zero, \
+             in the mesh's units, or 0 for {zero}"
+        );
+    }
+    Ok(Some(value))
 }
 
 /// `meshtrim_version`: the crate's version, NUL-terminated.

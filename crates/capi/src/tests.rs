@@ -85,7 +85,7 @@ fn defaults_are_the_clis() {
     assert_eq!(stages.detection, BpdOptions::default());
     assert!(stages.edges.offset);
     let choices = options.clean_choices().expect("valid");
-    assert!(!choices.repair && choices.max_deviation.is_none());
+    assert!(!choices.repair && choices.max_deviation.is_none() && choices.fill_holes.is_none());
     // SAFETY: a static NUL-terminated string.
     let version = unsafe { CStr::from_ptr(meshtrim_version()) };
     assert_eq!(version.to_str(), Ok(env!("CARGO_PKG_VERSION")));
@@ -96,6 +96,7 @@ fn clean_gives_the_commands_mesh_and_report() {
     let scan = jagged_scan();
     let options = MeshtrimOptions {
         max_deviation: 0.8,
+        fill_holes: 60.0,
         ..Default::default()
     };
     let (out, report) = clean_c(&scan, Some(&options)).expect("cleaned");
@@ -110,6 +111,7 @@ fn clean_gives_the_commands_mesh_and_report() {
     assert_eq!(report["loops_smoothed"], expected_report["loops_smoothed"]);
     assert_eq!(report["faces_out"], expected_report["faces_out"]);
     assert!(report["loops_smoothed"].as_u64() > Some(0), "{report}");
+    assert_eq!(report["holes_filled"], 1, "{report}");
 }
 
 #[test]
@@ -240,6 +242,11 @@ fn bad_meshes_and_options_are_errors_with_messages() {
             ..Default::default()
         });
         assert!(e.starts_with("max_deviation: "), "{e}");
+        let e = options(MeshtrimOptions {
+            fill_holes: d,
+            ..Default::default()
+        });
+        assert!(e.starts_with("fill_holes: "), "{e}");
     }
 }
 
@@ -387,9 +394,10 @@ fn layouts_are_the_headers() {
         offset_of!(MeshtrimOptions, view),
         offset_of!(MeshtrimOptions, repair),
         offset_of!(MeshtrimOptions, max_deviation),
+        offset_of!(MeshtrimOptions, fill_holes),
         size_of::<MeshtrimOptions>(),
     ];
-    assert_eq!(options, [0, 4, 8, 12, 16, 40, 48, 56]);
+    assert_eq!(options, [0, 4, 8, 12, 16, 40, 48, 56, 64]);
     let mesh = [
         offset_of!(OutMesh, vertices),
         offset_of!(OutMesh, vertex_count),

@@ -326,4 +326,7 @@ pub enum CleanError {
     /// The bound on how far the border may move is not a positive number.
     #[error("max_deviation must be a positive finite distance, got {0}")]
     MaxDeviation(f64),
+    /// The width of the holes to close is not a positive number.
+    #[error("fill_holes must be a positive finite width, got {0}")]
+    FillHoles(f64),
 }

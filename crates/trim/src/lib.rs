@@ -177,6 +177,7 @@ pub use edges::{mesh_border_edges, reconstruct_edges, Edge, EdgeOptions, Edges, 
 pub use error::{CleanError, CloudError, DelaunayError, MeshError, Placement, TrimError};
 pub use frame::{fit_plane, Frame};
 pub use geom::rotation_from_quaternion;
+pub use mesh::fill::{HolesFilled, MAX_HOLE_VERTICES};
 pub use mesh::manifold::ManifoldRepair;
 pub use mesh::repair::{FaceRepair, MIN_RELATIVE_AREA};
 pub use mesh::seams::{stitch_seams, Stitched};

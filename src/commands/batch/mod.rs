@@ -92,6 +92,10 @@ pub struct Args {
     /// one (as `clean --max-deviation`).
     #[arg(long, value_name = "D", value_parser = crate::commands::args::parse_distance, allow_hyphen_values = true)]
     pub max_deviation: Option<f64>,
+    /// Close each cleaned scan's holes no wider than W first (as `clean
+    /// --fill-holes`).
+    #[arg(long, value_name = "W", value_parser = crate::commands::args::parse_distance, allow_hyphen_values = true)]
+    pub fill_holes: Option<f64>,
     /// Also write each output's edges, as S.edges.EXT beside the output
     /// S.ext, in this format (json, obj, svg, dxf, step, igs): a cleaned
     /// file's border, as `clean --edges` writes it; the smoothed edges a
@@ -166,6 +170,7 @@ fn process_all(jobs: &[Job], args: &Args) -> Result<Vec<Row>> {
         choices: Choices {
             repair: args.repair,
             max_deviation: args.max_deviation,
+            fill_holes: args.fill_holes,
         },
         deviation: args.deviation,
         edges: args.file.options(),

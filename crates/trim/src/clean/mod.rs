@@ -95,6 +95,7 @@ use crate::frame::fit_plane;
 use crate::geom::{add, cross, dist2, dot, norm2, sub, Point3};
 use crate::geom::{orient, orientation};
 use crate::mesh::boundary_loops_of;
+use crate::mesh::fill::{fill_holes, HolesFilled};
 use crate::mesh::manifold::{make_manifold, ManifoldRepair};
 use crate::mesh::pinches::open_new_pinches;
 use crate::mesh::repair::{repair_degenerate_faces, FaceRepair};
@@ -168,6 +169,11 @@ pub struct CleanOptions {
     /// replaces, so every new vertex lies within it of the scan. None: as
     /// smooth as β makes it.
     pub max_deviation: Option<f64>,
+    /// Close the holes no wider than this (the largest distance between
+    /// two of a hole's vertices, in the mesh's units) before the cleanup,
+    /// with faces over their own vertices ([`crate::mesh::fill`]); never a
+    /// piece's outer border. None: every hole stays, its border smoothed.
+    pub fill_holes: Option<f64>,
 }
 
 impl Default for CleanOptions {
@@ -176,6 +182,7 @@ impl Default for CleanOptions {
             offset: true,
             repair: false,
             max_deviation: None,
+            fill_holes: None,
         }
     }
 }
@@ -332,6 +339,9 @@ pub struct CleanReport {
     /// Smoothed loop vertices moved back to
     /// [`CleanOptions::max_deviation`] from the border they replace.
     pub vertices_held: usize,
+    /// Holes closed before the cleanup ([`CleanOptions::fill_holes`]);
+    /// `loops_in` counts the loops left after.
+    pub holes_filled: HolesFilled,
 }
 
 /// Replaces the jagged border of `mesh` by its smoothed boundary (see the
@@ -358,6 +368,9 @@ fn clean_with(
         .filter(|m| !(m.is_finite() && *m > 0.0))
     {
         return Err(CleanError::MaxDeviation(max));
+    }
+    if let Some(width) = options.fill_holes.filter(|w| !(w.is_finite() && *w > 0.0)) {
+        return Err(CleanError::FillHoles(width));
     }
     let faces_in = mesh.faces.len();
     let (kept, dropped, edges) = without_empty_faces(mesh);
@@ -397,6 +410,16 @@ fn clean_with(
     check_cleanable(mesh, &edges)?;
     let borders = boundary_loops_of(&edges);
     drop(edges);
+    let (area_in, area_facing_one_way) = (mesh.area(), mesh.area_facing_one_way());
+    let filled;
+    let (mesh, borders, holes_filled) = match options.fill_holes {
+        Some(width) => {
+            let (with_holes_closed, borders, holes) = close_holes(mesh, borders, width);
+            filled = with_holes_closed;
+            (&filled, borders, holes)
+        }
+        None => (mesh, borders, HolesFilled::default()),
+    };
     let (rings, vertices_held) = smoothed_loops(mesh, beta, &borders, options);
     let mut report = CleanReport {
         loops_in: borders.len(),
@@ -406,8 +429,9 @@ fn clean_with(
         slivers_dropped: dropped.slivers,
         repeated_faces_dropped: dropped.repeats,
         manifold,
-        area_in: mesh.area(),
-        area_facing_one_way: mesh.area_facing_one_way(),
+        area_in,
+        area_facing_one_way,
+        holes_filled,
         ..Default::default()
     };
     // A scan seen from one side was seen along its faces' mean normal.
@@ -429,6 +453,23 @@ fn clean_with(
         left.vertices = left.loops.iter().map(|&l| borders[l].len()).collect();
     }
     Ok((out, report))
+}
+
+/// `mesh` with its holes no wider than `width` closed, its border loops
+/// after, and what was closed.
+fn close_holes(
+    mesh: &Mesh,
+    borders: Vec<Vec<u32>>,
+    width: f64,
+) -> (Mesh, Vec<Vec<u32>>, HolesFilled) {
+    let mut filled = mesh.clone();
+    let holes = fill_holes(&mut filled, &borders, width);
+    let borders = if holes.holes > 0 {
+        filled.boundary_loops()
+    } else {
+        borders
+    };
+    (filled, borders, holes)
 }
 
 /// What the cleanup needs of the mesh left once its empty faces are dropped:

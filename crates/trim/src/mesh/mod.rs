@@ -8,6 +8,7 @@ use crate::cloud::out_of_range;
 use crate::cloud::{MAX_COORDINATE, MIN_LARGEST_COORDINATE};
 use crate::error::MeshError;
 
+pub(crate) mod fill;
 pub(crate) mod manifold;
 pub(crate) mod pinches;
 pub(crate) mod repair;

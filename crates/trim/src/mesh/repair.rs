@@ -496,7 +496,7 @@ fn normal(p: [Point3; 3]) -> Point3 {
 }
 
 /// The squared diagonal of the bounding box of the faces' vertices.
-fn diagonal2(mesh: &Mesh) -> f64 {
+pub(crate) fn diagonal2(mesh: &Mesh) -> f64 {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     for f in &mesh.faces {
