@@ -183,9 +183,8 @@ pub struct Report {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fill_holes: Option<f64>,
     /// With `--fill-holes`: holes closed, faces added to close them, and
-    /// holes narrow enough that stay open (touching themselves, or every
-    /// way of closing them would repeat an edge or make a face of no
-    /// area).
+    /// holes narrow enough that stay open (every way of closing them
+    /// would repeat an edge or make a face of no area).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub holes_filled: Option<usize>,
     #[serde(skip_serializing_if = "Option::is_none")]

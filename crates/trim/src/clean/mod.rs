@@ -171,7 +171,7 @@ pub struct CleanOptions {
     pub max_deviation: Option<f64>,
     /// Close the holes no wider than this (the largest distance between
     /// two of a hole's vertices, in the mesh's units) before the cleanup,
-    /// with faces over their own vertices ([`crate::mesh::fill`]); never a
+    /// with faces over their own vertices (`mesh/fill.rs`); never a
     /// piece's outer border. None: every hole stays, its border smoothed.
     pub fill_holes: Option<f64>,
 }

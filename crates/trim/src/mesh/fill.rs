@@ -12,33 +12,32 @@
 //! add vertices): each sub-polygon takes the apex whose triangle, with its
 //! sides' own best triangulations, has the smallest largest dihedral
 //! angle (against those triangles, and the mesh's faces along the hole),
-//! then the least area. Diagonals
-//! that are edges of the mesh already, and faces of no area, are not
-//! allowed, so the mesh stays manifold and has no zero-area face; a hole
-//! that cannot be closed so, or that touches itself at a vertex, stays
-//! open and is counted.
+//! then the least area. Diagonals that are edges of the mesh already, and
+//! faces of no area, are not allowed, so the mesh stays manifold and has
+//! no zero-area face; a hole that cannot be closed so stays open and is
+//! counted. A loop through a vertex twice (holes touching at a pinched
+//! vertex) is split there into loops through each vertex once.
 
 use crate::geom::{cross, dot, norm2, sub, Point3};
 use crate::hash::{HashMap, HashSet};
 use crate::mesh::repair::{diagonal2, MIN_RELATIVE_AREA};
 use crate::mesh::Mesh;
 
-/// Holes with more vertices than this stay open: the triangulation costs
-/// the cube of the count (a hole this many spacings round is no gap to
-/// close without new vertices).
+/// Loops with more vertices than this are no holes to close, whatever
+/// their width: the triangulation costs the cube of the count (a hole this
+/// many spacings round is no gap to close without new vertices).
 pub const MAX_HOLE_VERTICES: usize = 400;
 
-/// What [`fill_holes`] did.
+/// What closing the small holes did ([`crate::CleanOptions::fill_holes`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct HolesFilled {
     /// Holes closed.
     pub holes: usize,
     /// Faces added to close them.
     pub faces: usize,
-    /// Holes no wider than the size asked for that stay open: they touch
-    /// themselves at a vertex, have more than [`MAX_HOLE_VERTICES`], or
-    /// every triangulation would repeat an edge of the mesh or make a face
-    /// of no area.
+    /// Holes no wider than the size asked for that stay open: every
+    /// triangulation would repeat an edge of the mesh or make a face of no
+    /// area.
     pub left: usize,
 }
 
@@ -68,9 +67,9 @@ pub fn fill_holes(mesh: &mut Mesh, borders: &[Vec<u32>], max_width: f64) -> Hole
     filled
 }
 
-/// The loops to close, in the order of `borders`: no wider than
-/// `max_width`, not the longest loop of their piece, not touching
-/// themselves, not too long.
+/// The loops to close, in the order of `borders` (each split into loops
+/// through each vertex once): no wider than `max_width`, not the longest
+/// loop of their piece, of at most [`MAX_HOLE_VERTICES`].
 fn holes_to_fill(mesh: &Mesh, borders: &[Vec<u32>], max_width: f64) -> Vec<Vec<u32>> {
     let borders: Vec<Vec<u32>> = borders.iter().flat_map(|b| simple_cycles(b)).collect();
     let borders = &borders[..];
@@ -253,7 +252,7 @@ impl Best {
 /// The faces closing `hole` (its vertices in the order the mesh's faces
 /// run along them), wound against that order so that they continue the
 /// mesh's orientation; None when no triangulation avoids the mesh's own
-/// edges and faces of no area, or the hole touches itself.
+/// edges and faces of no area, or the hole passes a vertex twice.
 fn triangulate(
     points: &[Point3],
     hole: &[u32],
