@@ -25,8 +25,6 @@
 //! bunny seen askew, a scene of several objects), two layers of points lie
 //! at one place of the image, and the loops are left to the links.
 
-use std::collections::HashMap;
-
 use rayon::prelude::*;
 use spade::handles::{FixedDirectedEdgeHandle, FixedFaceHandle, InnerTag};
 use spade::{DelaunayTriangulation, Point2, Triangulation};
@@ -34,6 +32,7 @@ use spade::{DelaunayTriangulation, Point2, Triangulation};
 use crate::bpd::{Detection, View};
 use crate::frame::Frame;
 use crate::geom::{dist2, dot, sub, unit, Point3};
+use crate::mesh::simple_cycles;
 use crate::planar::Node;
 
 /// The image's Delaunay triangulation; each vertex's id is the input point
@@ -191,7 +190,7 @@ impl Region {
     /// The region's border as simple cycles of input indices.
     fn border_loops(&self) -> Vec<Vec<u32>> {
         let cycles = trace_borders(&self.image, &self.covered);
-        cycles.into_iter().flat_map(simple_cycles).collect()
+        cycles.iter().flat_map(|walk| simple_cycles(walk)).collect()
     }
 
     /// The share of the image's points that [`Region::layered`] marks.
@@ -425,30 +424,6 @@ fn next_border_edge(
     next.fix()
 }
 
-/// A closed walk split into simple cycles where it passes a vertex twice
-/// (a region pinched at a vertex between two of its stretches).
-fn simple_cycles(walk: Vec<u32>) -> Vec<Vec<u32>> {
-    let mut cycles = Vec::new();
-    let mut path: Vec<u32> = Vec::with_capacity(walk.len());
-    let mut at: HashMap<u32, usize> = HashMap::new();
-    for v in walk {
-        if let Some(&first) = at.get(&v) {
-            let cycle = path.split_off(first + 1);
-            for w in &cycle {
-                at.remove(w);
-            }
-            let mut closed = vec![v];
-            closed.extend(cycle);
-            cycles.push(closed);
-        } else {
-            at.insert(v, path.len());
-            path.push(v);
-        }
-    }
-    cycles.push(path);
-    cycles
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -663,7 +638,7 @@ mod tests {
     /// A walk through a pinch vertex comes apart into simple cycles.
     #[test]
     fn a_pinched_walk_splits_into_simple_cycles() {
-        let cycles = simple_cycles(vec![1, 2, 3, 9, 4, 5, 9, 6]);
+        let cycles = simple_cycles(&[1, 2, 3, 9, 4, 5, 9, 6]);
         assert_eq!(cycles, vec![vec![9, 4, 5], vec![1, 2, 3, 9, 6]]);
     }
 

@@ -21,7 +21,7 @@
 use crate::geom::{cross, dot, norm2, sub, Point3};
 use crate::hash::{HashMap, HashSet};
 use crate::mesh::repair::{diagonal2, MIN_RELATIVE_AREA};
-use crate::mesh::Mesh;
+use crate::mesh::{simple_cycles, Mesh};
 
 /// Loops with more vertices than this are no holes to close, whatever
 /// their width: the triangulation costs the cube of the count (a hole this
@@ -71,7 +71,12 @@ pub fn fill_holes(mesh: &mut Mesh, borders: &[Vec<u32>], max_width: f64) -> Hole
 /// through each vertex once): no wider than `max_width`, not the longest
 /// loop of their piece, of at most [`MAX_HOLE_VERTICES`].
 fn holes_to_fill(mesh: &Mesh, borders: &[Vec<u32>], max_width: f64) -> Vec<Vec<u32>> {
-    let borders: Vec<Vec<u32>> = borders.iter().flat_map(|b| simple_cycles(b)).collect();
+    // Holes touching at a pinched vertex are one loop through it twice.
+    let borders: Vec<Vec<u32>> = borders
+        .iter()
+        .flat_map(|b| simple_cycles(b))
+        .filter(|c| c.len() >= 3)
+        .collect();
     let borders = &borders[..];
     let piece = loop_pieces(mesh, borders);
     let length: Vec<f64> = borders
@@ -92,32 +97,6 @@ fn holes_to_fill(mesh: &Mesh, borders: &[Vec<u32>], max_width: f64) -> Vec<Vec<u
         .filter(|(_, b)| width(&mesh.vertices, b) <= max_width)
         .map(|(_, b)| b.clone())
         .collect()
-}
-
-/// A loop through a vertex more than once (where holes, or a hole and
-/// the outer border, touch at a pinched vertex) split there into loops
-/// through each vertex once, in order.
-fn simple_cycles(border: &[u32]) -> Vec<Vec<u32>> {
-    let mut cycles = Vec::new();
-    let mut path: Vec<u32> = Vec::with_capacity(border.len());
-    let mut at: HashMap<u32, usize> = HashMap::default();
-    for &v in border {
-        if let Some(&start) = at.get(&v) {
-            let cycle = path.split_off(start + 1);
-            for u in &cycle {
-                at.remove(u);
-            }
-            let mut closed = vec![v];
-            closed.extend(cycle);
-            cycles.push(closed);
-        } else {
-            at.insert(v, path.len());
-            path.push(v);
-        }
-    }
-    cycles.push(path);
-    cycles.retain(|c| c.len() >= 3);
-    cycles
 }
 
 /// Each loop's piece of surface: faces joined across their edges (a piece
@@ -415,8 +394,10 @@ mod tests {
             vec![vec![2, 3, 4], vec![1, 2, 5, 6]]
         );
         assert_eq!(simple_cycles(&[1, 2, 3]), vec![vec![1, 2, 3]]);
-        // A cycle of two vertices (an edge there and back) is none.
-        assert_eq!(simple_cycles(&[1, 2, 3, 2, 4, 5]), vec![vec![1, 2, 4, 5]]);
+        assert_eq!(
+            simple_cycles(&[1, 2, 3, 2, 4, 5]),
+            vec![vec![2, 3], vec![1, 2, 4, 5]]
+        );
     }
 
     #[test]

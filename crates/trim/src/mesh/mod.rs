@@ -264,6 +264,31 @@ impl Mesh {
     }
 }
 
+/// A closed walk split into simple cycles where it passes a vertex twice
+/// (a region pinched at a vertex between two of its stretches; holes
+/// touching at a vertex), each cycle in the walk's order.
+pub(crate) fn simple_cycles(walk: &[u32]) -> Vec<Vec<u32>> {
+    let mut cycles = Vec::new();
+    let mut path: Vec<u32> = Vec::with_capacity(walk.len());
+    let mut at: HashMap<u32, usize> = HashMap::default();
+    for &v in walk {
+        if let Some(&first) = at.get(&v) {
+            let cycle = path.split_off(first + 1);
+            for w in &cycle {
+                at.remove(w);
+            }
+            let mut closed = vec![v];
+            closed.extend(cycle);
+            cycles.push(closed);
+        } else {
+            at.insert(v, path.len());
+            path.push(v);
+        }
+    }
+    cycles.push(path);
+    cycles
+}
+
 /// [`Mesh::boundary_loops`] of a mesh whose directed edges are built.
 pub(crate) fn boundary_loops_of(edges: &EdgeRows) -> Vec<Vec<u32>> {
     chain_loops(edges.border())
