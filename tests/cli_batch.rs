@@ -407,14 +407,15 @@ fn bad_files_fail_alone_and_the_reports_say_why() {
             "removed_max",
             "new_max",
             "cloud_max",
-            "cloud_mean"
+            "cloud_mean",
+            "holes_filled"
         ]
     );
     assert_eq!(rows.len(), 5, "{rows:?}");
     // Not measured without --deviation.
     assert!(rows[1..]
         .iter()
-        .all(|r| r[14..18].iter().all(String::is_empty)));
+        .all(|r| r[14..19].iter().all(String::is_empty)));
     // The cloud each trimmed file was paired with; none for a clean.
     let clouds: Vec<&str> = rows[1..].iter().map(|r| r[13].as_str()).collect();
     assert_eq!(
@@ -809,9 +810,16 @@ fn deviation_reports_how_far_each_output_lies_from_its_scan() {
     assert!(
         std::fs::read(d.join("held/j.stl")).unwrap() != std::fs::read(d.join("out/j.stl")).unwrap()
     );
-    // --fill-holes: the bytes `clean --fill-holes` writes.
+    // --fill-holes: the bytes `clean --fill-holes` writes, and the holes
+    // closed in the report and on the file's line.
     let filled = ["scans/j.stl", "--out-dir", "filled", "--fill-holes", "100"];
-    assert_ok(&batch(d, &filled));
+    let run = batch(d, &[&filled[..], &["--report", "f.json"]].concat());
+    assert_ok(&run);
+    assert_eq!(
+        json_report(&d.join("f.json"))["files"][0]["holes_filled"],
+        2
+    );
+    assert!(String::from_utf8_lossy(&run.stdout).contains("  holes filled=2  "));
     let single = d.join("filled.stl");
     let args = [
         "clean",

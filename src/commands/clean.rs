@@ -92,6 +92,8 @@ pub struct CleanOutcome {
     /// the output, and of the new ones from the input (the report's
     /// `input_to_output` and `output_to_input` maxima).
     pub deviation: Option<[f64; 2]>,
+    /// With `--fill-holes`: the holes closed.
+    pub holes_filled: Option<usize>,
 }
 
 /// Below this share of its area facing one direction, a mesh with a
@@ -330,6 +332,7 @@ pub fn clean_file(
             .input_to_output
             .zip(r.output_to_input)
             .map(|(removed, new)| [removed.max, new.max]),
+        holes_filled: r.holes_filled,
     })
 }
 

@@ -248,6 +248,7 @@ fn process(job: &Job, settings: &FileSettings) -> Row {
         new_max: None,
         cloud_max: None,
         cloud_mean: None,
+        holes_filled: None,
         cloud: match &job.cloud {
             CloudMatch::One(cloud) => Some(cloud.display().to_string()),
             _ => None,
@@ -272,6 +273,7 @@ fn process(job: &Job, settings: &FileSettings) -> Row {
             row.repaired = o.repaired;
             [row.removed_max, row.new_max] = o.deviation.map_or([None; 2], |d| d.map(Some));
             [row.cloud_max, row.cloud_mean] = o.cloud_deviation.map_or([None; 2], |d| d.map(Some));
+            row.holes_filled = o.holes_filled;
             row.note = o.note;
         }
         Err(e) => {
@@ -329,6 +331,7 @@ fn work(job: &Job, settings: &FileSettings) -> Result<Outcome> {
                 repaired: Some(o.repaired),
                 deviation: o.deviation,
                 cloud_deviation: None,
+                holes_filled: o.holes_filled,
                 note: if o.loops_in == 0 {
                     Some(CLOSED)
                 } else {
@@ -355,6 +358,7 @@ fn work(job: &Job, settings: &FileSettings) -> Result<Outcome> {
                 repaired: None,
                 deviation: None,
                 cloud_deviation: r.cloud_to_output.map(|d| [d.max, d.mean]),
+                holes_filled: None,
                 note: None,
             })
         }

@@ -76,6 +76,8 @@ pub struct Outcome {
     /// With `--deviation`, for a trimmed file: the largest and the mean
     /// distance of its cloud's points from the output.
     pub cloud_deviation: Option<[f64; 2]>,
+    /// With `--fill-holes`, for a cleaned file: the holes closed.
+    pub holes_filled: Option<usize>,
     /// What the user should know about the file (a closed mesh cleaned).
     pub note: Option<&'static str>,
 }
@@ -127,6 +129,9 @@ pub struct Row {
     /// cloud's points from the output.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub cloud_mean: Option<f64>,
+    /// With `--fill-holes`, for a cleaned file: the holes closed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub holes_filled: Option<usize>,
     /// The cloud a trimmed file was paired with (none for a clean, or
     /// when several clouds matched: the error names them).
     pub cloud: Option<String>,
@@ -145,6 +150,10 @@ impl Row {
             Some(n) if n > 0 => format!("  repaired={n}"),
             _ => String::new(),
         };
+        let filled = self
+            .holes_filled
+            .map(|n| format!("  holes filled={n}"))
+            .unwrap_or_default();
         let moved = match (
             self.removed_max,
             self.new_max,
@@ -165,7 +174,7 @@ impl Row {
         };
         match self.status {
             Status::Ok => format!(
-                "ok      {mode:<5}  {}  loops={}  faces {}→{}{repaired}{moved}  {secs:.2} s{note}",
+                "ok      {mode:<5}  {}  loops={}  faces {}→{}{filled}{repaired}{moved}  {secs:.2} s{note}",
                 self.input,
                 self.loops.unwrap_or(0),
                 self.faces_in.unwrap_or(0),
@@ -181,7 +190,7 @@ impl Row {
     }
 
     /// The row's CSV fields, in [`CSV_HEADER`] order.
-    fn csv_fields(&self) -> [String; 18] {
+    fn csv_fields(&self) -> [String; 19] {
         let opt = |v: Option<String>| v.unwrap_or_default();
         [
             self.input.clone(),
@@ -202,13 +211,14 @@ impl Row {
             opt(self.new_max.map(|v| v.to_string())),
             opt(self.cloud_max.map(|v| v.to_string())),
             opt(self.cloud_mean.map(|v| v.to_string())),
+            opt(self.holes_filled.map(|v| v.to_string())),
         ]
     }
 }
 
 /// The CSV columns (new ones go last, so that columns read by position
 /// keep theirs).
-pub const CSV_HEADER: [&str; 18] = [
+pub const CSV_HEADER: [&str; 19] = [
     "input",
     "output",
     "mode",
@@ -227,6 +237,7 @@ pub const CSV_HEADER: [&str; 18] = [
     "new_max",
     "cloud_max",
     "cloud_mean",
+    "holes_filled",
 ];
 
 /// The report formats, by the file's extension.
