@@ -212,9 +212,7 @@ pub unsafe extern "C" fn meshtrim_edges(
     run(error, || unsafe {
         set_string(report_json, None);
         let options = MeshtrimOptions::read(options);
-        let path = text(path, "path")?.ok_or_else(|| anyhow!("path: NULL"))?;
-        let path = Path::new(path);
-        let file_options = edge_file_options(path, text(units, "units")?, dxf_splines != 0)?;
+        let (path, file_options) = edges_file(path, units, dxf_splines)?;
         let stages = options.stages()?;
         let points = read_rows(points, point_count, "points")?;
         let (detection, edges, summary) =
@@ -253,9 +251,7 @@ pub unsafe extern "C" fn meshtrim_border_edges(
     // SAFETY (whole body): the caller's pointers, as documented above.
     run(error, || unsafe {
         let options = MeshtrimOptions::read(options);
-        let path = text(path, "path")?.ok_or_else(|| anyhow!("path: NULL"))?;
-        let path = Path::new(path);
-        let file_options = edge_file_options(path, text(units, "units")?, dxf_splines != 0)?;
+        let (path, file_options) = edges_file(path, units, dxf_splines)?;
         let stages = options.stages()?;
         let mesh = read_mesh(vertices, vertex_count, faces, face_count)?;
         mesh.validate()
@@ -263,6 +259,22 @@ pub unsafe extern "C" fn meshtrim_border_edges(
         let border = commands::clean::border_curves(&mesh, &stages, "vertices")?;
         commands::clean::write_border(path, &mesh, &border, file_options)
     })
+}
+
+/// The caller's edges file and how it is written, checked before any
+/// work.
+///
+/// # Safety
+/// `path` and `units` are NULL or NUL-terminated.
+unsafe fn edges_file<'a>(
+    path: *const c_char,
+    units: *const c_char,
+    dxf_splines: c_int,
+) -> Result<(&'a Path, EdgeFileOptions)> {
+    // SAFETY: as documented above.
+    let (path, units) = unsafe { (text(path, "path")?, text(units, "units")?) };
+    let path = Path::new(path.ok_or_else(|| anyhow!("path: NULL"))?);
+    Ok((path, edge_file_options(path, units, dxf_splines != 0)?))
 }
 
 /// How an edges file at `path` is written; its format and the options

@@ -243,21 +243,16 @@ fn triangulate(
     if n < 3 || distinct.len() != n {
         return None;
     }
-    // The face a triangle (i, m, j), i < m < j along the hole, becomes.
-    let face = |i: usize, m: usize, j: usize| [hole[j], hole[m], hole[i]];
-    let p = |i: usize| points[hole[i] as usize];
-    // The normal of the mesh's face along the hole's edge i → i + 1 (or
-    // n − 1 → 0).
-    let outside = |i: usize, j: usize| -> Point3 {
-        let (a, b) = if j == i + 1 { (i, j) } else { (j, i) };
-        edges
-            .face_normal
-            .get(&(hole[a], hole[b]))
-            .copied()
-            .unwrap_or([0.0; 3])
+    let polygon = Polygon {
+        points,
+        hole,
+        edges,
+        min_area2,
     };
-    let mut best: Vec<Option<Best>> = vec![None; n * n];
-    let at = |i: usize, j: usize| i * n + j;
+    let mut best = Table {
+        n,
+        cells: vec![None; n * n],
+    };
     for span in 2..n {
         for i in 0..n - span {
             let j = i + span;
@@ -268,77 +263,111 @@ fn triangulate(
             }
             let mut chosen: Option<Best> = None;
             for m in i + 1..j {
-                let Some(mut candidate) =
-                    triangle_best(i, m, j, &best, at, &face, &p, &outside, points, min_area2)
-                else {
+                let Some(mut candidate) = polygon.triangle_best(i, m, j, &best) else {
                     continue;
                 };
                 if span == n - 1 {
                     // The last triangle's base is the hole's closing edge.
-                    let normal = face_normal(points, face(i, m, j));
-                    candidate.angle = candidate.angle.max(1.0 - dot(normal, outside(i, j)));
+                    let normal = polygon.normal(i, m, j);
+                    candidate.angle = candidate
+                        .angle
+                        .max(1.0 - dot(normal, polygon.outside(i, j)));
                 }
                 if chosen.is_none_or(|c| candidate.better_than(&c)) {
                     chosen = Some(candidate);
                 }
             }
-            best[at(i, j)] = chosen;
+            *best.cell(i, j) = chosen;
         }
     }
-    best[at(0, n - 1)]?;
     let mut faces = Vec::with_capacity(n - 2);
     let mut todo = vec![(0, n - 1)];
     while let Some((i, j)) = todo.pop() {
         if j - i < 2 {
             continue;
         }
-        let m = best[at(i, j)]?.apex;
-        faces.push(face(i, m, j));
+        let m = best.get(i, j)?.apex;
+        faces.push(polygon.face(i, m, j));
         todo.push((i, m));
         todo.push((m, j));
     }
     Some(faces)
 }
 
-/// The best triangulation of sub-polygon (i, j) with apex m over its
-/// base, from the best of (i, m) and (m, j); None when a side has none or
-/// the triangle has no area.
-#[allow(clippy::too_many_arguments)]
-fn triangle_best(
-    i: usize,
-    m: usize,
-    j: usize,
-    best: &[Option<Best>],
-    at: impl Fn(usize, usize) -> usize,
-    face: &impl Fn(usize, usize, usize) -> [u32; 3],
-    p: &impl Fn(usize) -> Point3,
-    outside: &impl Fn(usize, usize) -> Point3,
-    points: &[Point3],
+/// A hole as the triangulation sees it: positions along it by index.
+struct Polygon<'a> {
+    points: &'a [Point3],
+    hole: &'a [u32],
+    edges: &'a MeshEdges,
     min_area2: f64,
-) -> Option<Best> {
-    let twice_area = cross(sub(p(m), p(i)), sub(p(j), p(i)));
-    if norm2(twice_area) <= 4.0 * min_area2 {
-        return None;
+}
+
+impl Polygon<'_> {
+    /// The face a triangle (i, m, j), i < m < j along the hole, becomes.
+    fn face(&self, i: usize, m: usize, j: usize) -> [u32; 3] {
+        [self.hole[j], self.hole[m], self.hole[i]]
     }
-    let normal = face_normal(points, face(i, m, j));
-    let mut angle: f64 = 0.0;
-    let mut area = norm2(twice_area).sqrt() / 2.0;
-    for (a, b) in [(i, m), (m, j)] {
-        let beside = if b == a + 1 {
-            outside(a, b)
-        } else {
-            let side = best[at(a, b)]?;
-            angle = angle.max(side.angle);
-            area += side.area;
-            face_normal(points, face(a, side.apex, b))
-        };
-        angle = angle.max(1.0 - dot(normal, beside));
+
+    fn normal(&self, i: usize, m: usize, j: usize) -> Point3 {
+        face_normal(self.points, self.face(i, m, j))
     }
-    Some(Best {
-        angle,
-        area,
-        apex: m,
-    })
+
+    /// The normal of the mesh's face along the hole's edge i → i + 1 (or
+    /// n − 1 → 0).
+    fn outside(&self, i: usize, j: usize) -> Point3 {
+        let (a, b) = if j == i + 1 { (i, j) } else { (j, i) };
+        self.edges
+            .face_normal
+            .get(&(self.hole[a], self.hole[b]))
+            .copied()
+            .unwrap_or([0.0; 3])
+    }
+
+    /// The best triangulation of sub-polygon (i, j) with apex m over its
+    /// base, from the best of (i, m) and (m, j); None when a side has none
+    /// or the triangle has no area.
+    fn triangle_best(&self, i: usize, m: usize, j: usize, best: &Table) -> Option<Best> {
+        let p = |k: usize| self.points[self.hole[k] as usize];
+        let twice_area = cross(sub(p(m), p(i)), sub(p(j), p(i)));
+        if norm2(twice_area) <= 4.0 * self.min_area2 {
+            return None;
+        }
+        let normal = self.normal(i, m, j);
+        let mut angle: f64 = 0.0;
+        let mut area = norm2(twice_area).sqrt() / 2.0;
+        for (a, b) in [(i, m), (m, j)] {
+            let beside = if b == a + 1 {
+                self.outside(a, b)
+            } else {
+                let side = best.get(a, b)?;
+                angle = angle.max(side.angle);
+                area += side.area;
+                self.normal(a, side.apex, b)
+            };
+            angle = angle.max(1.0 - dot(normal, beside));
+        }
+        Some(Best {
+            angle,
+            area,
+            apex: m,
+        })
+    }
+}
+
+/// The best triangulation of each sub-polygon (i, j), i < j.
+struct Table {
+    n: usize,
+    cells: Vec<Option<Best>>,
+}
+
+impl Table {
+    fn get(&self, i: usize, j: usize) -> Option<Best> {
+        self.cells[i * self.n + j]
+    }
+
+    fn cell(&mut self, i: usize, j: usize) -> &mut Option<Best> {
+        &mut self.cells[i * self.n + j]
+    }
 }
 
 #[cfg(test)]
